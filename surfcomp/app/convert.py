@@ -1,0 +1,62 @@
+"""Conversion between ``Part.BSplineSurface`` and :class:`surfcomp.core.bspline.Surface`."""
+
+import numpy as np
+
+from ..core.bspline import Surface
+
+
+def _flat_knots(knots, mults):
+    return np.repeat(np.asarray(knots, dtype=float), np.asarray(mults, dtype=int))
+
+
+def surface_from_part(bs, u_range=None, v_range=None):
+    """Return the core :class:`Surface` of a ``Part.BSplineSurface``.
+
+    Periodic surfaces are converted to non-periodic ones of the same geometry
+    (on a copy: the argument is never modified).
+
+    Parameters
+    ----------
+    bs : Part.BSplineSurface
+    u_range, v_range : (float, float), optional
+        The face's parameter bounds; default: the surface's own bounds.
+    """
+    if bs.isUPeriodic() or bs.isVPeriodic():
+        bs = bs.copy()
+        if bs.isUPeriodic():
+            bs.setUNotPeriodic()
+        if bs.isVPeriodic():
+            bs.setVNotPeriodic()
+    poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float)
+    weights = np.array(bs.getWeights(), dtype=float) if bs.isURational() or bs.isVRational() else None
+    ku = _flat_knots(bs.getUKnots(), bs.getUMultiplicities())
+    kv = _flat_knots(bs.getVKnots(), bs.getVMultiplicities())
+    return Surface(poles, ku, kv, bs.UDegree, bs.VDegree, weights, u_range, v_range)
+
+
+def _compress(flat):
+    knots, mults = [], []
+    for k in flat:
+        if knots and abs(k - knots[-1]) <= 1e-15 * max(1.0, abs(k)):
+            mults[-1] += 1
+        else:
+            knots.append(float(k))
+            mults.append(1)
+    return knots, mults
+
+
+def surface_to_part(surf):
+    """Return a new ``Part.BSplineSurface`` with the geometry of ``surf``."""
+    import FreeCAD
+    import Part
+
+    ku, mu = _compress(surf.knots_u)
+    kv, mv = _compress(surf.knots_v)
+    poles = [[FreeCAD.Vector(*p) for p in row] for row in surf.poles.tolist()]
+    out = Part.BSplineSurface()
+    kwargs = dict(poles=poles, umults=mu, vmults=mv, uknots=ku, vknots=kv, uperiodic=False,
+                  vperiodic=False, udegree=surf.degree_u, vdegree=surf.degree_v)
+    if surf.weights is not None:
+        kwargs["weights"] = surf.weights.tolist()
+    out.buildFromPolesMultsKnots(**kwargs)
+    return out

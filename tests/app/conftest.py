@@ -1,0 +1,8 @@
+"""App tests need FreeCAD headless; import it once for the whole folder.
+
+No skipping: when FreeCAD is missing these tests fail, because CI must run them.
+"""
+
+from surfcomp.app import fcenv
+
+fcenv.import_freecad()
