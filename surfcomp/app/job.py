@@ -1,0 +1,180 @@
+"""One batch job: nominal face + measurement file -> corrected face (STEP), report (JSON).
+
+Shared by ``python3 -m surfcomp compensate|inspect`` and the ``freecadcmd`` job macro.
+All outputs of a job are written together or not at all.
+"""
+
+import json
+import os
+from dataclasses import dataclass, field, fields
+
+from ..core.pipeline import Options, compensate, prepare
+from ..core.progress import sub
+from ..errors import InputError
+from ..io import report as report_io
+from ..io.atomic import Transaction
+from ..io.hashing import sha256_file
+from . import fcenv
+
+
+@dataclass
+class Job:
+    """A compensation job (paths and options). ``output``/``report``/``points``/``curves``
+    are optional outputs: corrected face (STEP/IGES/BREP by extension), JSON report,
+    corrected points (CSV) and the papers' curve net through them (STEP)."""
+
+    nominal: str
+    measurements: str
+    command: str = "compensate"
+    output: str = None
+    report: str = None
+    points: str = None
+    curves: str = None
+    face: str = None
+    object: str = None
+    units: str = "mm"
+    options: Options = field(default_factory=Options)
+
+    @classmethod
+    def from_dict(cls, data, base_dir="."):
+        """A job from a JSON job file's dict; relative paths are relative to ``base_dir``."""
+        known = {f.name for f in fields(cls)} - {"options"}
+        opt_names = {f.name for f in fields(Options)}
+        unknown = set(data) - known - opt_names
+        if unknown:
+            raise InputError("unknown job file keys: %s (expected some of %s)"
+                             % (", ".join(sorted(unknown)), ", ".join(sorted(known | opt_names))))
+        for key in ("nominal", "measurements"):
+            if key not in data:
+                raise InputError("the job file needs %r" % key)
+        kw = {k: data[k] for k in known if k in data}
+        for k in ("nominal", "measurements", "output", "report", "points", "curves"):
+            if kw.get(k):
+                kw[k] = os.path.join(base_dir, kw[k])
+        kw["options"] = Options(**{k: data[k] for k in opt_names if k in data})
+        return cls(**kw)
+
+
+def read_measurement_file(path, units="mm"):
+    """Read any supported measurement file (CSV dialects; point-only formats when available)."""
+    from ..io.measurements import read_measurements
+
+    try:
+        from ..io.pointfiles import detect_format, read_point_file
+    except ImportError:
+        return read_measurements(path, units=units)
+    fmt = detect_format(path)
+    if fmt in ("csv", "table"):
+        return read_measurements(path, units=units)
+    return read_point_file(path, fmt=fmt, units=units)
+
+
+def run_job(job, progress=None):
+    """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs."""
+    fcenv.import_freecad()
+    from .nominal import load_nominal
+
+    for out in (job.output, job.report, job.points, job.curves):
+        if out and os.path.abspath(out) in (os.path.abspath(job.nominal),
+                                            os.path.abspath(job.measurements)):
+            raise InputError("an output would overwrite an input file", file=out)
+    nominal = load_nominal(job.nominal, job.face, job.object)
+    ms = read_measurement_file(job.measurements, job.units)
+    prepared = prepare(nominal.surface, nominal.outward, ms, job.options, progress=sub(progress, 0, 0.3))
+    build = job.command == "compensate"
+    comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
+                      progress=sub(progress, 0.3, 0.95))
+    inputs = {
+        "nominal": {"path": os.path.abspath(job.nominal), "sha256": sha256_file(job.nominal),
+                    "face": nominal.face_name, "object": nominal.object_name,
+                    "surface": nominal.converted or "BSplineSurface",
+                    "poles": list(nominal.surface.shape),
+                    "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
+                    "rational": nominal.surface.weights is not None,
+                    "u_range": list(nominal.surface.u_range), "v_range": list(nominal.surface.v_range)},
+        "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
+                         "units": ms.units, "kind": ms.kind(), "points": len(ms),
+                         "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
+    }
+    outputs = {k: os.path.abspath(getattr(job, k)) for k in ("output", "report", "points", "curves")
+               if getattr(job, k)}
+    rep = report_io.build_report(job.command, inputs, comp, prepared.warnings, outputs)
+    with Transaction() as tx:
+        if build and job.output:
+            write_face(tx.stage(job.output), corrected_face(comp, nominal))
+        if job.points:
+            tx.stage_text(job.points, corrected_points_csv(comp))
+        if build and job.curves:
+            write_face(tx.stage(job.curves), curve_net(comp))
+        if job.report:
+            tx.stage_text(job.report, report_io.dumps(rep))
+        tx.commit()
+    return comp, rep
+
+
+def corrected_face(comp, nominal):
+    """The corrected ``Part.Face`` with the nominal face's orientation."""
+    import Part
+
+    from .convert import surface_to_part
+
+    face = Part.Face(surface_to_part(comp.corrected))
+    if nominal.outward < 0:
+        face.reverse()
+    return face
+
+
+def curve_net(comp):
+    """The papers' construction aid: B-spline curves through the corrected points along
+    both grid directions (Werner Fig. 3b), as a compound of edges."""
+    import FreeCAD
+    import Part
+
+    pts = comp.prepared.grid.take(comp.corrected_points())
+    edges = []
+    for line in list(pts) + list(pts.transpose(1, 0, 2)):
+        c = Part.BSplineCurve()
+        c.interpolate([FreeCAD.Vector(*p) for p in line.tolist()])
+        edges.append(c.toShape())
+    return Part.Compound(edges)
+
+
+def write_face(path, shape):
+    """Write a shape as STEP, IGES or BREP, chosen by the file extension of ``path``."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext in (".step", ".stp"):
+        shape.exportStep(path)
+    elif ext in (".iges", ".igs"):
+        shape.exportIges(path)
+    elif ext in (".brep", ".brp"):
+        shape.exportBrep(path)
+    else:
+        raise InputError("unsupported output type %r (expected .step, .iges or .brep)" % ext, file=path)
+
+
+def corrected_points_csv(comp):
+    """Corrected points (Werner eq. 2/3) as CSV in file order, with grid indices."""
+    p = comp.prepared
+    row, col = p.row_col()
+    cor = comp.corrected_points()
+    delta = comp.per_point("delta")
+    rows = ["row,col,x_nom,y_nom,z_nom,i,j,k,correction,x_cor,y_cor,z_cor"]
+    for k in range(p.u.size):
+        rows.append("%d,%d,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f,%.6f"
+                    % ((row[k], col[k]) + tuple(p.nominal[k]) + tuple(p.normal[k]) + (delta[k],) + tuple(cor[k])))
+    return "\n".join(rows) + "\n"
+
+
+def load_job_file(path):
+    """Read a JSON job file (see README, 'freecadcmd')."""
+    try:
+        with open(path, encoding="utf-8") as fh:
+            data = json.load(fh)
+    except OSError as exc:
+        raise InputError("cannot read the job file: %s" % exc, file=path) from exc
+    except json.JSONDecodeError as exc:
+        raise InputError("not valid JSON: %s (expected a JSON object)" % exc.msg,
+                         file=path, line=exc.lineno, column=exc.colno) from exc
+    if not isinstance(data, dict):
+        raise InputError("the job file must hold a JSON object", file=path)
+    return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))

@@ -1,0 +1,190 @@
+"""Load the nominal face from STEP/IGES/BREP or an FCStd document (app layer, headless).
+
+The nominal is never modified: everything here works on copies.
+"""
+
+import os
+from dataclasses import dataclass
+
+from ..errors import GeometryError
+from . import fcenv
+from .convert import surface_from_part
+
+CAD_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
+
+
+@dataclass
+class Nominal:
+    """The chosen nominal face and its B-spline form.
+
+    Attributes
+    ----------
+    face : Part.Face
+        A copy of the original face (as found in the file/document).
+    bspline_face : Part.Face
+        The same geometry as a B-spline face restricted to the face's UV bounds.
+    surface : surfcomp.core.bspline.Surface
+        Core arrays of ``bspline_face.Surface``; ``u_range``/``v_range`` = the face's UV bounds.
+    outward : int
+        +1 when the face's outward normal is Su x Sv, -1 when the face is reversed.
+    source, face_name, object_name : str
+    converted : str or None
+        What the original surface was when it had to be converted (e.g. 'Cylinder').
+    """
+
+    face: object
+    bspline_face: object
+    surface: object
+    outward: int
+    source: str
+    face_name: str
+    object_name: str = None
+    converted: str = None
+    shape: object = None
+
+
+def read_shape(path, object_name=None):
+    """Return ``(shape, object_name)`` from a CAD file or an FCStd document.
+
+    For an FCStd the document is opened hidden and closed again; ``object_name``
+    picks the object (by Name or Label); without it the only object with a shape
+    that has B-spline faces is taken.
+    """
+    fcenv.import_freecad()
+    import FreeCAD
+    import Part
+
+    if not os.path.isfile(path):
+        raise GeometryError("nominal file not found (expected a STEP, IGES, BREP or FCStd file)",
+                            file=path)
+    ext = os.path.splitext(path)[1].lower()
+    if ext == ".fcstd":
+        return _shape_from_document(path, object_name)
+    if ext not in CAD_EXTENSIONS:
+        raise GeometryError("unsupported nominal file type %r (expected .step/.stp, .iges/.igs, "
+                            ".brep/.brp or .FCStd)" % ext, file=path)
+    if object_name:
+        raise GeometryError("--object applies to FCStd documents only", file=path)
+    try:
+        shape = Part.read(path)
+    except (Part.OCCError, RuntimeError, ValueError) as exc:
+        raise GeometryError("cannot read the CAD file: %s" % exc, file=path) from exc
+    if shape.isNull() or not shape.Faces:
+        raise GeometryError("the file contains no faces", file=path)
+    del FreeCAD
+    return shape, None
+
+
+def _shape_from_document(path, object_name):
+    import FreeCAD
+
+    before = set(FreeCAD.listDocuments())
+    try:
+        doc = FreeCAD.openDocument(path, True)
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise GeometryError("cannot open the FreeCAD document: %s" % exc, file=path) from exc
+    try:
+        if object_name:
+            obj = doc.getObject(object_name) or next(
+                (o for o in doc.Objects if o.Label == object_name), None)
+            if obj is None:
+                names = ", ".join(o.Name for o in doc.Objects if hasattr(o, "Shape"))
+                raise GeometryError("no object %r in the document (objects with shapes: %s)"
+                                    % (object_name, names or "none"), file=path)
+            if not hasattr(obj, "Shape") or obj.Shape.isNull():
+                raise GeometryError("object %r has no shape" % object_name, file=path)
+            return obj.Shape.copy(), obj.Name
+        cands = [o for o in doc.Objects if hasattr(o, "Shape") and not o.Shape.isNull()
+                 and any(f.Surface.TypeId == "Part::GeomBSplineSurface" for f in o.Shape.Faces)
+                 and not o.InList]
+        if len(cands) != 1:
+            raise GeometryError("%s objects with B-spline faces at the top of the document (%s): "
+                                "choose one with --object NAME"
+                                % ("no" if not cands else len(cands),
+                                   ", ".join(o.Name for o in cands) or "none"), file=path)
+        return cands[0].Shape.copy(), cands[0].Name
+    finally:
+        if doc.Name not in before:
+            FreeCAD.closeDocument(doc.Name)
+
+
+def pick_face(shape, face_name=None, source=None):
+    """Return ``(face, 'FaceN')``: the named face, or the only B-spline face of ``shape``."""
+    faces = shape.Faces
+    if face_name:
+        name = face_name.strip()
+        if not (name.startswith("Face") and name[4:].isdigit()):
+            raise GeometryError("invalid face name %r (expected Face1 .. Face%d)"
+                                % (face_name, len(faces)), file=source)
+        k = int(name[4:])
+        if not 1 <= k <= len(faces):
+            raise GeometryError("the shape has no %s (it has %d faces: Face1 .. Face%d)"
+                                % (name, len(faces), len(faces)), file=source)
+        return faces[k - 1], name
+    bs = [(k, f) for k, f in enumerate(faces, 1) if f.Surface.TypeId == "Part::GeomBSplineSurface"]
+    if len(faces) == 1:
+        return faces[0], "Face1"
+    if len(bs) == 1:
+        return bs[0][1], "Face%d" % bs[0][0]
+    kinds = {}
+    for f in faces:
+        kinds[f.Surface.TypeId.split("::Geom")[-1]] = kinds.get(f.Surface.TypeId.split("::Geom")[-1], 0) + 1
+    raise GeometryError("%s B-spline faces among %d faces (%s): choose one with --face FaceN"
+                        % ("no" if not bs else "%d" % len(bs), len(faces),
+                           ", ".join("%d %s" % (c, k) for k, c in sorted(kinds.items())))
+                        + ("; B-spline faces: " + ", ".join("Face%d" % k for k, _ in bs[:20])
+                           if bs else ""), file=source)
+
+
+def to_bspline_face(face):
+    """Return ``(bspline_face, converted)``: the face's geometry as a B-spline face.
+
+    B-spline faces are kept (segmented to their UV bounds); Bezier, analytic,
+    revolution, extrusion and offset surfaces are converted with OCCT
+    (``Face.toNurbs``), which keeps the geometry.
+    """
+    import Part
+
+    surf = face.Surface
+    converted = None
+    if surf.TypeId == "Part::GeomBSplineSurface":
+        bface = face
+    else:
+        converted = surf.TypeId.split("::Geom")[-1]
+        try:
+            bface = face.toNurbs().Faces[0]
+        except (Part.OCCError, RuntimeError, IndexError) as exc:
+            raise GeometryError("cannot convert the %s face to a B-spline surface: %s"
+                                % (converted, exc)) from exc
+    u0, u1, v0, v1 = bface.ParameterRange
+    bs = bface.Surface.copy()
+    if bs.isUPeriodic():
+        bs.setUNotPeriodic()
+    if bs.isVPeriodic():
+        bs.setVNotPeriodic()
+    bu0, bu1, bv0, bv1 = bs.bounds()
+    tol = 1e-12
+    if u0 > bu0 + tol or u1 < bu1 - tol or v0 > bv0 + tol or v1 < bv1 - tol:
+        bs.segment(max(u0, bu0), min(u1, bu1), max(v0, bv0), min(v1, bv1))
+    out = Part.Face(bs)
+    if bface.Orientation == "Reversed":
+        out.reverse()
+    return out, converted
+
+
+def load_nominal(path, face_name=None, object_name=None):
+    """Load the nominal face (see module docstring) as a :class:`Nominal`."""
+    shape, obj = read_shape(path, object_name)
+    face, name = pick_face(shape, face_name, source=path)
+    return nominal_from_face(face, source=path, face_name=name, object_name=obj, shape=shape)
+
+
+def nominal_from_face(face, source="<document>", face_name="Face1", object_name=None, shape=None):
+    """Build a :class:`Nominal` from a ``Part.Face`` (a copy is kept)."""
+    face = face.copy()
+    bface, converted = to_bspline_face(face)
+    u0, u1, v0, v1 = bface.ParameterRange
+    surface = surface_from_part(bface.Surface, (u0, u1), (v0, v1))
+    outward = -1 if bface.Orientation == "Reversed" else 1
+    return Nominal(face=face, bspline_face=bface, surface=surface, outward=outward, source=source,
+                   face_name=face_name, object_name=object_name, converted=converted, shape=shape)

@@ -1,0 +1,120 @@
+"""Options and printing shared by the CLI subcommands."""
+
+import sys
+import time
+
+from ..core.deviations import format_table
+from ..core.pipeline import Options
+from ..core.filters import EDGE_MODES
+from ..core.methods import METHODS
+
+
+def add_input_options(p):
+    """NOMINAL MEASUREMENTS, face choice, units, and the measurement checks."""
+    p.add_argument("nominal", metavar="NOMINAL",
+                   help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)")
+    p.add_argument("measurements", metavar="MEASUREMENTS",
+                   help="measurement file (CSV/text; see README 'Measurement files')")
+    p.add_argument("--face", metavar="FaceN",
+                   help="the nominal face (default: the only B-spline face)")
+    p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
+    p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
+                   help="units of columns without a unit suffix (default mm)")
+    p.add_argument("--max-offset", type=float, default=1.0, metavar="MM",
+                   help="largest accepted distance of a point from the face (default 1 mm)")
+    p.add_argument("--flip-normals", action="store_true",
+                   help="the file's normals point into the material: flip them (and the sign "
+                        "of its deviations)")
+    p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
+    p.add_argument("--quiet", action="store_true", help="print no progress lines")
+
+
+def add_method_options(p):
+    p.add_argument("--method", choices=METHODS, default="filtered",
+                   help="raw (Werner eq. 2), filtered (eq. 3-5, default), mirror (needs --stock), "
+                        "offset (uniform tool-radius baseline)")
+    p.add_argument("--mask", type=int, default=5, metavar="N",
+                   help="odd mask size of the filter (default 5, as in Werner 2022)")
+    p.add_argument("--weights", metavar="W",
+                   help="custom mask weights, rows separated by ';', e.g. \"1 2 1; 2 4 2; 1 2 1\"")
+    p.add_argument("--mask-kind", choices=("box", "gaussian"), default="box",
+                   help="mask shape when no --weights are given (default box)")
+    p.add_argument("--sigma", type=float, metavar="STEPS",
+                   help="Gaussian sigma in grid steps (default mask size / 4)")
+    p.add_argument("--edge", choices=EDGE_MODES, default="renormalize",
+                   help="filter edge handling (default renormalize: divide by the weights on "
+                        "measured points)")
+    p.add_argument("--stock", type=float, metavar="MM",
+                   help="semi-finishing allowance for --method mirror (DH = stock / 2)")
+    p.add_argument("--refine", type=int, default=4, metavar="K",
+                   help="knot spans of the corrected surface per measurement grid step (default 4)")
+
+
+def options_from_args(args):
+    return Options(method=getattr(args, "method", "filtered"), mask_size=getattr(args, "mask", 5),
+                   weights=getattr(args, "weights", None),
+                   mask_kind=getattr(args, "mask_kind", "box"), sigma=getattr(args, "sigma", None),
+                   edge=getattr(args, "edge", "renormalize"), stock=getattr(args, "stock", None),
+                   max_offset=args.max_offset, flip_normals=args.flip_normals,
+                   refine=getattr(args, "refine", 4))
+
+
+class ProgressLine:
+    """Prints ``[ 42%] message`` lines to stderr, at most every half second."""
+
+    def __init__(self, quiet=False, stream=None):
+        self.quiet = quiet
+        self.stream = stream or sys.stderr
+        self._last = 0.0
+
+    def __call__(self, fraction, message=""):
+        now = time.monotonic()
+        if self.quiet or (now - self._last < 0.5 and fraction < 1.0):
+            return
+        self._last = now
+        print("[%3d%%] %s" % (round(100 * fraction), message), file=self.stream, flush=True)
+
+
+def print_summary(comp, rep, out=sys.stdout):
+    """The papers' table form, the correction applied and the corrected face's checks."""
+    p = comp.prepared
+    st = comp.statistics
+    inputs = rep["inputs"]
+    print("Nominal:      %s (%s, %s, %d x %d poles, degree %d x %d)"
+          % (inputs["nominal"]["path"], inputs["nominal"]["face"], inputs["nominal"]["surface"],
+             *inputs["nominal"]["poles"], *inputs["nominal"]["degree"]), file=out)
+    print("Measurements: %s (%d points, %s, read in %s)"
+          % (inputs["measurements"]["path"], inputs["measurements"]["points"],
+             inputs["measurements"]["kind"], inputs["measurements"]["units"]), file=out)
+    print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
+    for w in p.warnings:
+        print("warning: " + w, file=sys.stderr)
+    o = comp.options
+    c = comp.correction
+    print("", file=out)
+    print(format_table([("Raw deviations", st["deviation"]),
+                        ("Determined", st["determined"]),
+                        ("Random", st["random"])], unit="um",
+                       title="Deviations along the outward normal (Werner 2022 Tab. 1 and 3; "
+                             "determined = %dx%d %s filter, eq. 4-5)"
+                             % (c.mask.shape[0], c.mask.shape[0], rep["method"]["mask_kind"])),
+          file=out)
+    if comp.corrected is None:
+        return
+    extra = ""
+    if o.method == "mirror":
+        extra = ", stock %g mm (DH = %g mm)" % (o.stock, o.stock / 2)
+    print("", file=out)
+    print("Correction:   method %s%s; applied along the normal: %.2f .. %.2f um (mean %.2f um)"
+          % (o.method, extra, st["correction"].max_negative * 1e3,
+             st["correction"].max_positive * 1e3, st["correction"].mean * 1e3), file=out)
+    ch = comp.checks
+    print("Corrected face: %d x %d poles, degree %d x %d%s"
+          % (ch.poles_shape + (comp.corrected.degree_u, comp.corrected.degree_v,
+                               ", rational" if comp.corrected.weights is not None else "")), file=out)
+    print("  realised - intended correction at the %d measured points: max %.4f um"
+          % (p.u.size, ch.max_error_at_points * 1e3), file=out)
+    print("  zero correction reproduces the nominal within %.4f um (on a %d x %d check grid)"
+          % ((ch.max_zero_deviation * 1e3,) + tuple(ch.dense_shape)), file=out)
+    print("  largest correction anywhere on the face %.3f um (largest intended %.3f um)"
+          % (ch.max_realised * 1e3, ch.max_intended * 1e3), file=out)

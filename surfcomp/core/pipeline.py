@@ -1,0 +1,246 @@
+"""The compensation pipeline on core arrays (no FreeCAD): measurement set + nominal surface
+-> deviations, statistics, filtered components, intended corrections, corrected surface.
+
+The app layer loads faces and writes files around it; the CLI, the document objects
+and the GUI all call :func:`prepare` and :func:`compensate`.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, MeasurementFileError
+from .corrected import (DEFAULT_REFINE, build_corrected_surface, build_matching_surface,
+                        check_figures)
+from .deviations import deviation_components, statistics
+from .filters import make_mask
+from .grid import grid_from_indices, grid_from_uv
+from .methods import compute_correction
+from .progress import report, sub
+from .projection import project
+
+#: a given normal more than this many degrees off the face normal is reported
+NORMAL_WARNING_DEG = 5.0
+
+
+@dataclass
+class Options:
+    """User choices of a compensation (defaults as in Werner 2022 where it applies).
+
+    Lengths in mm. ``mask_size``/``weights``/``mask_kind``/``sigma``/``edge`` define the
+    filter (:mod:`surfcomp.core.filters`); ``stock`` is the mirror method's semi-finishing
+    allowance; ``max_offset`` the largest accepted distance of a point from the face;
+    ``refine`` the knot spans per measurement grid step of the corrected surface.
+    """
+
+    method: str = "filtered"
+    mask_size: int = 5
+    weights: object = None
+    mask_kind: str = "box"
+    sigma: float = None
+    edge: str = "renormalize"
+    stock: float = None
+    max_offset: float = 1.0
+    flip_normals: bool = False
+    refine: int = DEFAULT_REFINE
+
+    def mask(self):
+        return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
+
+
+@dataclass
+class Prepared:
+    """Measured points located on the face, with deviations, arranged on their grid.
+
+    Per-point arrays have shape (N,) or (N, 3) in file order; ``grid.index`` maps
+    grid nodes to point numbers.
+    """
+
+    u: np.ndarray
+    v: np.ndarray
+    nominal: np.ndarray
+    normal: np.ndarray
+    deviation: np.ndarray
+    grid: object
+    lines: np.ndarray
+    source: str
+    warnings: list = field(default_factory=list)
+
+    def row_col(self):
+        """Grid row and column of every point, in file order: two int arrays (N,)."""
+        g = self.grid
+        row = np.empty(self.u.size, dtype=int)
+        col = np.empty(self.u.size, dtype=int)
+        ii, jj = np.indices(g.shape)
+        row[g.index.ravel()] = ii.ravel()
+        col[g.index.ravel()] = jj.ravel()
+        return row, col
+
+
+def _err(ms, k, message):
+    return MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]))
+
+
+def prepare(surface, outward, ms, options=None, progress=None):
+    """Locate the measured points on the nominal face and compute their deviations.
+
+    Parameters
+    ----------
+    surface : Surface
+        Nominal (work area = ``u_range`` x ``v_range``).
+    outward : {1, -1}
+        Sign that turns ``Su x Sv`` into the face's outward normal.
+    ms : surfcomp.io.measurements.MeasurementSet
+    options : Options
+
+    Returns
+    -------
+    Prepared
+
+    Raises
+    ------
+    MeasurementFileError
+        A point farther than ``max_offset`` from the face, beyond its border, or a
+        given normal on the other side of the face (unless ``flip_normals``).
+    GridError
+        The points do not form a complete grid.
+    """
+    options = options or Options()
+    warnings = list(getattr(ms, "warnings", []) or [])
+    base = ms.nominal if ms.nominal is not None else ms.measured
+    if base is None:
+        raise InputError("the measurement set has neither nominal nor measured points", file=ms.source)
+    report(progress, 0.0, "locating %d points on the face" % len(base))
+    proj = project(surface, base, progress=sub(progress, 0.0, 0.8))
+    dist = proj.distance * outward
+    far = np.nonzero(np.abs(dist) > options.max_offset)[0]
+    if far.size:
+        k = far[np.argmax(np.abs(dist[far]))]
+        what = "nominal point" if ms.nominal is not None else "measured point"
+        raise _err(ms, k, "%s (%.4f, %.4f, %.4f) is %.4f mm from the face (expected at most "
+                   "--max-offset %g mm; %d point(s) are farther: wrong face, units or alignment?)"
+                   % ((what,) + tuple(base[k]) + (abs(dist[k]), options.max_offset, far.size)))
+    outside = np.nonzero(proj.outside)[0]
+    if outside.size:
+        k = outside[0]
+        raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
+                   "(%d point(s) do; expected points on the face)" % (tuple(base[k]) + (outside.size,)))
+    n_face = proj.normal * outward
+    if ms.normal is not None:
+        given = np.asarray(ms.normal, dtype=float)
+        if options.flip_normals:
+            given = -given
+        cosang = np.einsum("ij,ij->i", given, n_face)
+        opposite = np.nonzero(cosang < 0)[0]
+        if opposite.size:
+            k = opposite[0]
+            raise _err(ms, k, "the given normal points to the other side of the face than the "
+                       "face's outward normal (%d point(s)); use --flip-normals if the file's "
+                       "normals point into the material" % opposite.size)
+        ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
+        off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
+        for k in off[:10]:
+            warnings.append("%s:%d: the given normal is %.1f degrees off the face normal (more "
+                            "than %g)" % (ms.source, ms.lines[k], ang[k], NORMAL_WARNING_DEG))
+        if off.size > 10:
+            warnings.append("%s: %d more normals are more than %g degrees off the face normal"
+                            % (ms.source, off.size - 10, NORMAL_WARNING_DEG))
+        normal = given
+    else:
+        normal = n_face
+    if ms.deviation is not None:
+        d = np.asarray(ms.deviation, dtype=float) * (-1.0 if options.flip_normals else 1.0)
+    elif ms.nominal is not None and ms.measured is not None:
+        d = np.einsum("ij,ij->i", ms.measured - ms.nominal, normal)
+    else:
+        d = dist
+    nominal = ms.nominal if ms.nominal is not None else proj.foot
+    report(progress, 0.85, "arranging the points on their grid")
+    if ms.row is not None and ms.col is not None:
+        grid = grid_from_indices(ms.row, ms.col, proj.u, proj.v, ms.lines, ms.source)
+    else:
+        grid = grid_from_uv(proj.u, proj.v, ms.lines, ms.source)
+    report(progress, 1.0, "%d x %d grid" % grid.shape)
+    return Prepared(u=proj.u, v=proj.v, nominal=np.asarray(nominal, dtype=float), normal=normal,
+                    deviation=d, grid=grid, lines=ms.lines, source=ms.source, warnings=warnings)
+
+
+@dataclass
+class Compensation:
+    """Everything a compensation produced (grids (n, m) in mm; surfaces as core arrays)."""
+
+    prepared: Prepared
+    options: Options
+    correction: object          # methods.CorrectionResult on the grid
+    statistics: dict            # name -> deviations.Statistics
+    corrected: object = None    # Surface
+    zero: object = None         # Surface built with a zero field (construction check)
+    checks: object = None       # corrected.CheckFigures
+    spacing: tuple = None
+    field: object = None        # field.GridField of the intended correction
+    iterations: int = 0         # residual iterations of the construction
+
+    def per_point(self, name):
+        """A grid quantity back in file order (N,)."""
+        out = np.empty(self.prepared.u.size)
+        out[self.prepared.grid.index.ravel()] = getattr(self.correction, name).ravel()
+        return out
+
+    def corrected_points(self):
+        """Corrected points at the measured points (Werner eq. 2/3), (N, 3)."""
+        p = self.prepared
+        return p.nominal - deviation_components(self.per_point("delta"), p.normal)
+
+
+def grid_spacing(prepared):
+    """Median parameter step of the measurement grid along its two directions."""
+    g = prepared.grid
+    U, V = g.take(prepared.u), g.take(prepared.v)
+    step_s = np.hypot(np.diff(U, axis=0), np.diff(V, axis=0))
+    step_t = np.hypot(np.diff(U, axis=1), np.diff(V, axis=1))
+    # a parameter spacing in u and in v: the smallest grid steps projected on each axis
+    du = np.median(np.abs(np.diff(U, axis=0))) if U.shape[0] > 1 else np.median(step_s)
+    dv = np.median(np.abs(np.diff(V, axis=1))) if V.shape[1] > 1 else np.median(step_t)
+    return float(du or np.median(step_s)), float(dv or np.median(step_t))
+
+
+def compensate(surface, outward, prepared, options=None, build=True, progress=None):
+    """Filter, choose the correction and (optionally) build the corrected surface.
+
+    Parameters
+    ----------
+    surface : Surface
+    outward : {1, -1}
+    prepared : Prepared
+    options : Options
+    build : bool
+        False for inspection only (deviations, statistics, filtered components).
+
+    Returns
+    -------
+    Compensation
+    """
+    options = options or Options()
+    g = prepared.grid
+    d = g.take(prepared.deviation)
+    corr = compute_correction(d, options.method, options.mask(), options.edge, options.stock)
+    stats = {"deviation": statistics(corr.deviation),
+             "determined": statistics(corr.determined),
+             "random": statistics(corr.random),
+             "correction": statistics(corr.delta)}
+    result = Compensation(prepared=prepared, options=options, correction=corr, statistics=stats)
+    if not build:
+        return result
+    U, V = g.take(prepared.u), g.take(prepared.v)
+    du, dv = grid_spacing(prepared)
+    result.spacing = (du, dv)
+    report(progress, 0.05, "building the corrected surface")
+    result.corrected, result.field, result.iterations = build_matching_surface(
+        surface, U, V, corr.delta, outward, du, dv, options.refine, progress=sub(progress, 0.05, 0.7))
+    result.zero = build_corrected_surface(surface, lambda u, v: np.zeros(np.shape(u)), outward,
+                                          du, dv, options.refine)
+    report(progress, 0.75, "checking the corrected surface")
+    result.checks = check_figures(surface, result.corrected, result.zero, U.ravel(), V.ravel(),
+                                  corr.delta.ravel(), outward, g.shape)
+    report(progress, 1.0, "done")
+    return result

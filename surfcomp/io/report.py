@@ -1,0 +1,84 @@
+"""The JSON report of a compensation or inspection (schema in README.md, "JSON report").
+
+Pure: takes core results and plain input descriptions, returns JSON-able dicts.
+"""
+
+import datetime
+import json
+
+import numpy as np
+
+from .. import __version__
+
+SCHEMA = "surfcomp-report/1"
+
+
+def _list(a, digits=9):
+    a = np.asarray(a, dtype=float)
+    return np.round(a, digits).tolist()
+
+
+def build_report(command, inputs, comp, warnings=(), outputs=None):
+    """Assemble the report dict.
+
+    Parameters
+    ----------
+    command : {'compensate', 'inspect'}
+    inputs : dict
+        ``{'nominal': {...}, 'measurements': {...}}`` with paths and SHA-256.
+    comp : surfcomp.core.pipeline.Compensation
+    warnings : list of str
+    outputs : dict, optional
+        Paths of the files written.
+    """
+    p, c, o = comp.prepared, comp.correction, comp.options
+    g = p.grid
+    row, col = p.row_col()
+    out = {
+        "schema": SCHEMA,
+        "surfcomp_version": __version__,
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "command": command,
+        "units": "mm",
+        "inputs": inputs,
+        "method": {
+            "name": o.method,
+            "mask": _list(c.mask, 12),
+            "mask_size": int(c.mask.shape[0]),
+            "mask_kind": "custom" if o.weights is not None else o.mask_kind,
+            "edge": o.edge,
+            "stock_mm": o.stock,
+            "refine": o.refine,
+        },
+        "grid": {"shape": list(g.shape), "found_from": g.rows_from,
+                 "axes": "row = first grid index (along u), col = second (along v)"},
+        "statistics": {k: v.as_dict() for k, v in comp.statistics.items()},
+        "statistics_ddof": 1,
+        "points": {
+            "line": [int(x) for x in p.lines],
+            "row": row.tolist(),
+            "col": col.tolist(),
+            "u": _list(p.u, 12),
+            "v": _list(p.v, 12),
+            "nominal": _list(p.nominal),
+            "normal": _list(p.normal, 12),
+            "deviation": _list(p.deviation),
+            "determined": _list(comp.per_point("determined")),
+            "random": _list(comp.per_point("random")),
+            "correction": _list(comp.per_point("delta")),
+            "corrected": _list(comp.corrected_points()),
+        },
+        "warnings": list(warnings),
+    }
+    if comp.checks is not None:
+        out["corrected_face"] = comp.checks.as_dict()
+        out["corrected_face"]["degree"] = [comp.corrected.degree_u, comp.corrected.degree_v]
+        out["corrected_face"]["rational"] = comp.corrected.weights is not None
+    if outputs:
+        out["outputs"] = outputs
+    return out
+
+
+def dumps(report):
+    """The report as indented JSON text."""
+    return json.dumps(report, indent=1, sort_keys=False) + "\n"

@@ -1,0 +1,98 @@
+"""Grid detection from (u, v) and the C1 correction field."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from surfcomp.core.field import GridField
+from surfcomp.core.grid import grid_from_indices, grid_from_uv
+from surfcomp.errors import GridError
+
+
+def _uv_grid(n=7, m=10, skew=0.01):
+    s, t = np.meshgrid(np.linspace(0.05, 0.95, n), np.linspace(0.02, 0.98, m), indexing="ij")
+    return s + skew * np.sin(3 * t), t + skew * s ** 2
+
+
+def test_grid_from_uv_serpentine_shuffled_rows():
+    U, V = _uv_grid()
+    rng = np.random.default_rng(0)
+    # serpentine: every other row reversed, then rows shuffled
+    rows = [np.stack([U[:, j], V[:, j]], 1)[:: (1 if j % 2 else -1)] for j in range(U.shape[1])]
+    rows = [rows[k] for k in rng.permutation(len(rows))]
+    pts = np.concatenate(rows)
+    g = grid_from_uv(pts[:, 0], pts[:, 1])
+    assert g.shape == (7, 10)
+    assert_allclose(g.take(pts[:, 0]), U, atol=0)
+    assert_allclose(g.take(pts[:, 1]), V, atol=0)
+
+
+def test_grid_rows_of_constant_u_and_orientation():
+    U, V = _uv_grid(6, 4)
+    pts = np.stack([U.ravel(), V.ravel()], 1)[::-1]
+    g = grid_from_uv(pts[:, 0], pts[:, 1])
+    assert g.shape == (6, 4)
+    assert np.all(np.diff(g.take(pts[:, 0]), axis=0) > 0)
+    assert np.all(np.diff(g.take(pts[:, 1]), axis=1) > 0)
+
+
+def test_incomplete_grid_names_the_short_row():
+    U, V = _uv_grid(7, 10, skew=0.0)
+    u, v = np.delete(U.T.ravel(), 23), np.delete(V.T.ravel(), 23)  # row 3 (v = 0.34) loses u = 0.35
+    with pytest.raises(GridError) as exc:
+        grid_from_uv(u, v, lines=np.arange(u.size) + 2, source="scan.csv")
+    msg = str(exc.value)
+    assert msg.startswith("scan.csv: the 69 measured points do not form a complete n x m grid")
+    assert "the row at v=0.34 has 6 points (missing near u=0.35)" in msg
+
+
+def test_grid_from_indices_complete_duplicate_missing():
+    U, V = _uv_grid(3, 4)
+    r, c = np.indices((3, 4))
+    g = grid_from_indices(r.ravel() + 1, c.ravel() + 1, U.ravel(), V.ravel())
+    assert_allclose(g.take(U.ravel()), U, atol=0)
+    lines = np.arange(12) + 5
+    with pytest.raises(GridError, match=r"given twice \(also on line 5\)") as exc:
+        rr = r.ravel().copy()
+        rr[1] = 0
+        cc = c.ravel().copy()
+        cc[1] = 0
+        grid_from_indices(rr, cc, U.ravel(), V.ravel(), lines, "m.csv")
+    assert exc.value.line == 6
+    with pytest.raises(GridError, match=r"missing \(row 2, col 3\)"):
+        grid_from_indices(r.ravel()[:-1], c.ravel()[:-1], U.ravel()[:-1], V.ravel()[:-1])
+
+
+def test_field_interpolates_nodes_and_never_overshoots():
+    U, V = _uv_grid(7, 10, skew=0.02)
+    rng = np.random.default_rng(11)
+    D = rng.normal(0.0, 0.02, U.shape)  # noisy 'raw' data
+    f = GridField(U, V, D)
+    assert_allclose(f(U.ravel(), V.ravel()), D.ravel(), atol=1e-15)
+    uu, vv = np.meshgrid(np.linspace(0, 1, 201), np.linspace(0, 1, 201), indexing="ij")
+    val = f(uu, vv)
+    assert val.shape == uu.shape
+    assert val.max() <= D.max() + 1e-15 and val.min() >= D.min() - 1e-15
+
+
+def test_field_reproduces_constant_and_linear_data():
+    s, t = np.meshgrid(np.linspace(0, 1, 8), np.linspace(0, 1, 9), indexing="ij")
+    lin = 0.01 + 0.02 * s - 0.03 * t
+    f = GridField(s, t, lin)
+    uu, vv = np.meshgrid(np.linspace(0, 1, 57), np.linspace(0, 1, 61), indexing="ij")
+    assert_allclose(f(uu, vv), 0.01 + 0.02 * uu - 0.03 * vv, atol=1e-15)
+    c = GridField(s, t, np.full(s.shape, -0.004))
+    assert_allclose(c(uu, vv), -0.004, atol=1e-17)
+
+
+def test_field_is_continuous_and_bounded_outside():
+    s, t = np.meshgrid(np.linspace(0.1, 0.9, 6), np.linspace(0.1, 0.9, 6), indexing="ij")
+    D = 0.02 * s
+    f = GridField(s, t, D)
+    u = np.linspace(0.0, 1.0, 2001)
+    val = f(u, np.full(u.size, 0.5))
+    assert np.max(np.abs(np.diff(val))) < 1e-4  # no jump at the border (step 0.0005 in u)
+    assert val.min() >= D.min() - 1e-15 and val.max() <= D.max() + 1e-15
+    # inside the measured region the linear field is exact
+    inside = (u >= 0.1) & (u <= 0.9)
+    assert_allclose(val[inside], 0.02 * u[inside], atol=1e-15)
