@@ -51,11 +51,12 @@ def run_case(nominal, meas, out_dir):
     from surfcomp.app import job as jobmod
     from surfcomp.app.nominal import load_nominal
     from surfcomp.core.pipeline import Options, compensate, prepare
+    from surfcomp.io.readers import read_any
 
     times = {}
     t0 = time.perf_counter()
     nom = load_nominal(nominal)
-    ms = jobmod.read_measurement_file(meas)
+    ms = read_any(meas)
     times["read"] = time.perf_counter() - t0
     t = time.perf_counter()
     prep = prepare(nom.surface, nom.outward, ms, Options())

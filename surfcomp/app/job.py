@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..io import report as report_io
 from ..io.atomic import Transaction
 from ..io.hashing import sha256_file
+from ..io.readers import read_any
 from . import fcenv
 
 
@@ -55,20 +56,6 @@ class Job:
         return cls(**kw)
 
 
-def read_measurement_file(path, units="mm"):
-    """Read any supported measurement file (CSV dialects; point-only formats when available)."""
-    from ..io.measurements import read_measurements
-
-    try:
-        from ..io.pointfiles import detect_format, read_point_file
-    except ImportError:
-        return read_measurements(path, units=units)
-    fmt = detect_format(path)
-    if fmt in ("csv", "table"):
-        return read_measurements(path, units=units)
-    return read_point_file(path, fmt=fmt, units=units)
-
-
 def run_job(job, progress=None):
     """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs."""
     fcenv.import_freecad()
@@ -79,7 +66,7 @@ def run_job(job, progress=None):
                                             os.path.abspath(job.measurements)):
             raise InputError("an output would overwrite an input file", file=out)
     nominal = load_nominal(job.nominal, job.face, job.object)
-    ms = read_measurement_file(job.measurements, job.units)
+    ms = read_any(job.measurements, job.units)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options, progress=sub(progress, 0, 0.3))
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,

@@ -25,6 +25,8 @@ DEFAULT_REFINE = 4
 #: target of the residual iteration at the measured points (mm)
 MATCH_TOL = 2e-5
 MATCH_ITERATIONS = 8
+#: knot spans per direction at least (coarse grids), see _span
+MIN_SPANS = 120
 
 
 def refinement_knots(knots, degree, lo, hi, spacing):
@@ -40,6 +42,13 @@ def refinement_knots(knots, degree, lo, hi, spacing):
         parts = int(np.ceil((b - a) / spacing - 1e-9))
         new.extend(a + (b - a) * np.arange(1, parts) / parts)
     return np.asarray(new, dtype=float)
+
+
+def _span(width, spacing, refine):
+    """Largest knot span: ``spacing / refine``, and on coarse grids at most
+    ``width / MIN_SPANS`` (more spans damp the ringing of the fit between nodes;
+    coarse grids have few poles, so this is cheap)."""
+    return min(spacing / refine, width / MIN_SPANS)
 
 
 def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v=None,
@@ -68,9 +77,9 @@ def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v
     surf = nominal
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
     new_u = refinement_knots(surf.knots_u, surf.degree_u, u0, u1,
-                             spacing_u / refine) if spacing_u else ()
+                             _span(u1 - u0, spacing_u, refine)) if spacing_u else ()
     new_v = refinement_knots(surf.knots_v, surf.degree_v, v0, v1,
-                             spacing_v / refine) if spacing_v else ()
+                             _span(v1 - v0, spacing_v, refine)) if spacing_v else ()
     report(progress, 0.05, "refining the nominal's knots")
     fine = bspline.insert_knots(surf, new_u, new_v)
     us = bspline.greville(fine.knots_u, fine.degree_u)

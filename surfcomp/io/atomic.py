@@ -8,6 +8,17 @@ import os
 import tempfile
 
 
+def _mkstemp(path, suffix):
+    """A temporary file next to ``path`` with the permissions a plain ``open`` would give."""
+    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=suffix,
+                               dir=os.path.dirname(path))
+    os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    return tmp
+
+
 @contextlib.contextmanager
 def atomic_path(path, suffix=None):
     """Yield a temporary path next to ``path``; on success rename it to ``path``.
@@ -16,11 +27,9 @@ def atomic_path(path, suffix=None):
     the format from the extension (OCCT's STEP/IGES/BREP writers).
     """
     path = os.path.abspath(path)
-    folder = os.path.dirname(path)
-    os.makedirs(folder, exist_ok=True)
+    os.makedirs(os.path.dirname(path), exist_ok=True)
     suffix = os.path.splitext(path)[1] if suffix is None else suffix
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=suffix, dir=folder)
-    os.close(fd)
+    tmp = _mkstemp(path, suffix)
     try:
         yield tmp
         os.replace(tmp, path)
@@ -54,9 +63,7 @@ class Transaction:
         path = os.path.abspath(path)
         os.makedirs(os.path.dirname(path), exist_ok=True)
         suffix = os.path.splitext(path)[1] if suffix is None else suffix
-        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=suffix,
-                                   dir=os.path.dirname(path))
-        os.close(fd)
+        tmp = _mkstemp(path, suffix)
         self._staged.append((tmp, path))
         return tmp
 

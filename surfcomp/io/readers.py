@@ -1,0 +1,49 @@
+"""One entry point for every measurement file format (no FreeCAD).
+
+QIF, PC-DMIS XYZIJK and LinuxCNC probe logs are recognised by their content
+(:func:`surfcomp.io.pointfiles.detect_format`); everything else is read as a
+table with a header (:mod:`surfcomp.io.measurements`), and, when its header names
+none of the table's columns, as plain measured XYZ points.
+"""
+
+from ..errors import MeasurementFileError
+from .measurements import read_measurements
+from .pointfiles import detect_format, read_point_file
+
+FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")
+
+
+def read_any(path, units="mm", fmt="auto", sample=None):
+    """Read a measurement file of any supported format.
+
+    Parameters
+    ----------
+    path : str
+    units : {'mm', 'um', 'in'} or None
+        Units of values without a unit of their own (default mm).
+    fmt : str
+        One of :data:`FORMATS`; ``auto`` detects it.
+    sample : int or str, optional
+        Which measurement result of a QIF file holding several (default the first).
+
+    Returns
+    -------
+    surfcomp.io.measurements.MeasurementSet
+    """
+    if fmt not in FORMATS:
+        raise MeasurementFileError("unknown format %r (expected one of %s)"
+                                   % (fmt, ", ".join(FORMATS)), file=path)
+    if fmt == "table":
+        return read_measurements(path, units=units)
+    if fmt != "auto":
+        return read_point_file(path, fmt=fmt, units=units, sample=sample)
+    detected = detect_format(path)
+    if detected != "xyz":
+        return read_point_file(path, fmt=detected, units=units, sample=sample)
+    try:
+        return read_measurements(path, units=units)
+    except MeasurementFileError as table_error:
+        try:
+            return read_point_file(path, fmt="xyz", units=units)
+        except MeasurementFileError:
+            raise table_error from None

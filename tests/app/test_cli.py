@@ -1,0 +1,140 @@
+"""The batch CLI: exit codes, messages, atomic outputs (subprocesses of /usr/bin/python3 -m surfcomp)."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from surfcomp.app.nominal import load_nominal
+from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
+from tests.conftest import REALDATA
+
+
+def run_cli(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "surfcomp", *map(str, args)], cwd=cwd or ROOT,
+                          capture_output=True, text=True, timeout=300)
+
+
+def test_compensate_example_writes_step_and_report(tmp_path):
+    out = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "-o", tmp_path / "c.step",
+                  "--report", tmp_path / "r.json", "--points", tmp_path / "p.csv",
+                  "--curves", tmp_path / "net.step", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "Max. positive" in out.stdout and "47.13" in out.stdout
+    assert "realised - intended correction at the 2025 measured points" in out.stdout
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["inputs"]["measurements"]["sha256"] == __import__("hashlib").sha256(
+        open(EXAMPLE_CSV, "rb").read()).hexdigest()
+    assert rep["method"]["name"] == "filtered" and rep["method"]["mask_size"] == 5
+    assert len(rep["points"]["deviation"]) == 2025
+    assert (tmp_path / "p.csv").read_text().count("\n") == 2026
+    import Part
+
+    net = Part.read(str(tmp_path / "net.step"))
+    assert len(net.Edges) == 90  # 45 curves along each grid direction (Werner Fig. 3b)
+    assert oct(os.stat(tmp_path / "c.step").st_mode & 0o777) != "0o600"
+
+
+def test_inspect_prints_statistics_only(tmp_path):
+    out = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--report", tmp_path / "r.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "Standard deviation (ddof=1)" in out.stdout
+    assert "Corrected face" not in out.stdout
+    assert "corrected_face" not in json.loads((tmp_path / "r.json").read_text())
+
+
+def _bad(tmp_path, *args):
+    out = run_cli(*args, "-o", tmp_path / "c.step", "--report", tmp_path / "r.json", "--quiet")
+    assert out.returncode == 2, (out.returncode, out.stderr)
+    assert "Traceback" not in out.stderr
+    left = [x for x in os.listdir(tmp_path) if x.startswith(".") or x in ("c.step", "r.json")]
+    assert left == []  # no outputs, no temporary files
+    return out.stderr
+
+
+def test_bad_measurement_file_names_file_and_line(tmp_path):
+    meas = tmp_path / "bad.csv"
+    meas.write_text("x_nom,y_nom,z_nom,i,j,k,dev\n1,2,3,0,0,1,0.01\n1,2,abc,0,0,1,0.02\n")
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
+    assert "bad.csv:3" in err and "abc" in err
+
+
+def test_point_too_far_from_the_face(tmp_path):
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, _, _ = grid_on_face(nom, 5, 5)
+    P[2, 3] += 2.5 * N[2, 3]
+    meas = tmp_path / "far.csv"
+    write_cmm_csv(meas, P, N, np.zeros((5, 5)))
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
+    # serpentine order: column 3 is written reversed, so row 2 is the 3rd point of that row
+    assert "far.csv:" in err and "is 2.5000 mm from the face" in err and "--max-offset 1" in err
+
+
+def test_normals_on_the_other_side(tmp_path):
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, _, _ = grid_on_face(nom, 5, 5)
+    meas = tmp_path / "flip.csv"
+    write_cmm_csv(meas, P, -N, np.full((5, 5), 0.01))
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
+    assert "flip.csv:2:" in err and "--flip-normals" in err
+    ok = run_cli("compensate", EXAMPLE_STEP, meas, "--flip-normals", "--method", "raw",
+                 "--report", tmp_path / "ok.json", "--quiet")
+    assert ok.returncode == 0, ok.stderr
+    rep = json.loads((tmp_path / "ok.json").read_text())
+    np.testing.assert_allclose(rep["points"]["deviation"], -0.01, atol=1e-12)
+
+
+def test_incomplete_grid_is_refused_with_what_is_missing(tmp_path):
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, _, _ = grid_on_face(nom, 6, 5)
+    meas = tmp_path / "holes.csv"
+    write_cmm_csv(meas, P, N, np.zeros((6, 5)))
+    lines = meas.read_text().splitlines()
+    meas.write_text("\n".join(lines[:8] + lines[9:]) + "\n")
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
+    assert "do not form a complete n x m grid" in err and "has 5 points (missing near u=" in err
+
+
+@pytest.mark.parametrize("args,words", [
+    (("--face", "Face7"), "has no Face7"),
+    (("--method", "mirror"), "needs --stock"),
+    (("--weights", "1 1; 1 1"), "odd"),
+    (("--mask", "4"), "odd"),
+    (("--object", "Box"), "--object applies to FCStd"),
+])
+def test_bad_options(tmp_path, args, words):
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, EXAMPLE_CSV, *args)
+    assert words in err
+
+
+def test_ambiguous_face_lists_the_choices(tmp_path):
+    err = _bad(tmp_path, "compensate", os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step"),
+               EXAMPLE_CSV)
+    assert "42 B-spline faces among 192 faces" in err and "--face FaceN" in err
+
+
+def test_missing_nominal(tmp_path):
+    err = _bad(tmp_path, "compensate", tmp_path / "nope.step", EXAMPLE_CSV)
+    assert "nope.step: nominal file not found" in err
+
+
+def test_freecadcmd_job_route(tmp_path):
+    job = tmp_path / "job.json"
+    job.write_text(json.dumps({"command": "compensate", "nominal": EXAMPLE_STEP,
+                               "measurements": EXAMPLE_CSV, "output": "out/c.step",
+                               "report": "out/r.json", "method": "raw"}))
+    out = subprocess.run(["freecadcmd", os.path.join(ROOT, "macros", "surfcomp_job.py")],
+                         env=dict(os.environ, SURFCOMP_JOB=str(job)), capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 0, out.stdout + out.stderr
+    rep = json.loads((tmp_path / "out" / "r.json").read_text())
+    assert rep["method"]["name"] == "raw" and rep["corrected_face"]["max_error_at_points_mm"] < 1e-4
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"nominal": "x.step", "measurements": "y.csv", "colour": 3}')
+    out = subprocess.run(["freecadcmd", os.path.join(ROOT, "macros", "surfcomp_job.py")],
+                         env=dict(os.environ, SURFCOMP_JOB=str(bad)), capture_output=True,
+                         text=True, timeout=300)
+    assert out.returncode == 2 and "unknown job file keys: colour" in out.stderr
