@@ -22,7 +22,7 @@ UNIT_FACTORS = {
     "m": 1000.0,
 }
 
-_SUFFIX_BRACKET = re.compile(r"^(?P<base>.*?)\s*[\[(]\s*(?P<unit>[^\])]+?)\s*[\])]\s*$")
+SUFFIX_BRACKET = re.compile(r"^(?P<base>.*?)\s*[\[(]\s*(?P<unit>[^\])]+?)\s*[\])]\s*$")
 _SUFFIX_UNDERSCORE = re.compile(r"^(?P<base>.+?)_(?P<unit>mm|um|µm|μm|in|inch|cm|micron|microns)$",
                                 re.IGNORECASE)
 
@@ -54,7 +54,7 @@ def split_unit_suffix(name):
     ``"x"`` -> ``("x", None)``. The base is stripped but keeps its case.
     """
     text = name.strip()
-    m = _SUFFIX_BRACKET.match(text)
+    m = SUFFIX_BRACKET.match(text)
     if m and m.group("unit").strip().lower() in UNIT_FACTORS:
         return m.group("base").strip(), m.group("unit").strip().lower()
     m = _SUFFIX_UNDERSCORE.match(text)

@@ -1,0 +1,690 @@
+"""Measurement files: nominal points, measured points, normals and deviations (no FreeCAD).
+
+A measurement file is a text table with one row per measured point, as CMM software
+exports it (Werner 2022, section 2: "coordinates of nominal and observed points,
+deviations observed and directional cosines").
+
+File format
+-----------
+- Text in UTF-8, with or without a byte order mark; LF, CRLF (or CR-only) line ends.
+- Lines whose first non-blank characters are ``#`` or ``//`` are comments; blank lines
+  are skipped. With a ``,``, ``;`` or tab separator a line of separators only (``;;;``,
+  as spreadsheets write empty rows) counts as blank. There are no trailing comments.
+- The first line that is neither blank nor a comment is the header; it names the
+  columns. Every later line is one point.
+- Separator, detected on the header: tab if it has a tab, else ``;`` if it has one, else
+  ``,`` if it has one, else runs of blanks (spaces and tabs). ``MeasurementSet.separator``
+  is ``"\\t"``, ``";"``, ``","`` or ``" "`` (runs of blanks).
+- Decimal comma: accepted with every separator but ``,``. A file is read with a
+  decimal comma when any number in it has a comma; then no number may have a decimal
+  point (``1.5`` next to ``2,5`` is an error: thousands separators are not accepted).
+- Header names and id/name fields may be enclosed in double quotes (removed);
+  numbers must not be, and no field may contain the separator.
+- Numbers: ``[+-]digits[.digits][e[+-]digits]``. Empty fields, text, NaN and inf are
+  errors.
+
+Column names
+------------
+Matched case-insensitively after every run of characters other than ``a-z`` and
+``0-9`` became one ``_`` (``X Nom``, ``x-nom``, ``X.NOM`` all read as ``x_nom``).
+The y and z rows follow the x rows with ``b``/``beta``/``j`` and ``c``/``gamma``/``k``
+for ``a``/``alpha``/``i``.
+
+Alias table
+~~~~~~~~~~~
+- ``x_nom``: x_nom, nom_x, x_nominal, nominal_x, xnom, nomx, xn
+- ``y_nom``: y_nom, nom_y, y_nominal, nominal_y, ynom, nomy, yn
+- ``z_nom``: z_nom, nom_z, z_nominal, nominal_z, znom, nomz, zn
+- ``x_meas``: x_meas, meas_x, x_measured, measured_x, x_mes, mes_x, x_act, act_x,
+  x_actual, actual_x, xmeas, measx, xact, actx, xm
+- ``y_meas``: y_meas, meas_y, y_measured, measured_y, y_mes, mes_y, y_act, act_y,
+  y_actual, actual_y, ymeas, measy, yact, acty, ym
+- ``z_meas``: z_meas, meas_z, z_measured, measured_z, z_mes, mes_z, z_act, act_z,
+  z_actual, actual_z, zmeas, measz, zact, actz, zm
+- ``i``: i, nx, n_x, normal_x, cosx, cos_x, cosa, cos_a, cosalpha, cos_alpha
+- ``j``: j, ny, n_y, normal_y, cosy, cos_y, cosb, cos_b, cosbeta, cos_beta
+- ``k``: k, nz, n_z, normal_z, cosz, cos_z, cosc, cos_c, cosgamma, cos_gamma
+- ``dev``: dev, deviation, d, t, error, err
+- ``row``: row, row_index, row_idx
+- ``col``: col, column, col_index, col_idx, column_index
+- ``id``: id, name, point, point_id, point_name, pt, label
+
+``x``, ``y``, ``z`` alone are not accepted (nominal or measured?), nor are deviation
+components ``dx``, ``dy``, ``dz``; the error messages say so. Any other column is
+ignored and reported in ``MeasurementSet.warnings``.
+
+Units
+-----
+A length column (nominal, measured, deviation) may carry a unit suffix: ``dev[um]``,
+``dev(um)``, ``dev_um``, ``x_nom[mm]``, ``x_nom_in`` (units: ``mm``, ``um``/``µm``/
+``micron``, ``in``/``inch``, ``cm``, ``m``; see :mod:`surfcomp.io.units`). Columns without
+a suffix are in the ``units`` argument (the CLI's ``--units``, default ``mm``). Normals,
+row/col and id take no unit. Every array of the result is in mm.
+
+Accepted combinations (:meth:`MeasurementSet.kind`)
+---------------------------------------------------
+- ``nominal+normal+deviation``: nominal point, normal and deviation along it (CMM
+  reports as in Werner 2022, eq. 1).
+- ``nominal+measured``: the normal and deviation are left None (the pipeline takes the
+  face normal). A deviation column without a normal is then ignored (with a warning).
+- ``nominal+measured+normal``: ``deviation = (measured - nominal) . normal``.
+- ``all``: the file's deviation is kept and cross-checked against
+  ``(measured - nominal) . normal``; a difference over 1 um is a warning per point.
+Optional: ``row`` and ``col`` (both or neither) and ``id``.
+
+Errors
+------
+Every problem with the file raises :class:`surfcomp.errors.MeasurementFileError`
+(CLI exit code 2) with the file, 1-based line and, where it is about one field, the
+1-based column: ``file:line[:column]: what is wrong (expected ...)``.
+"""
+
+import codecs
+import hashlib
+import operator
+import os
+import re
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..errors import InputError, MeasurementFileError
+from .units import SUFFIX_BRACKET, UNIT_FACTORS, split_unit_suffix, unit_factor
+
+#: largest difference (mm) between a given deviation and (measured - nominal) . normal
+DEV_CHECK_TOL = 1e-3
+#: largest distance (mm) at which two nominal points are the same point
+DUPLICATE_TOL = 1e-9
+#: largest | |n| - 1 | of a given normal that passes without a warning
+NORMAL_LENGTH_TOL = 1e-3
+#: a given normal shorter than this has no direction (an error)
+NORMAL_ZERO = 1e-9
+#: per-point warnings of one kind listed before they are only counted
+MAX_POINT_WARNINGS = 10
+
+_AXES = (("x", "a", "alpha", "i"), ("y", "b", "beta", "j"), ("z", "c", "gamma", "k"))
+
+
+def _build_aliases():
+    nominal, measured, normal = {}, {}, {}
+    for x, a, greek, ijk in _AXES:
+        nominal[x + "_nom"] = [f % x for f in ("%s_nom", "nom_%s", "%s_nominal", "nominal_%s",
+                                                "%snom", "nom%s", "%sn")]
+        measured[x + "_meas"] = [f % x for f in (
+            "%s_meas", "meas_%s", "%s_measured", "measured_%s", "%s_mes", "mes_%s", "%s_act",
+            "act_%s", "%s_actual", "actual_%s", "%smeas", "meas%s", "%sact", "act%s", "%sm")]
+        normal[ijk] = [ijk, "n" + x, "n_" + x, "normal_" + x, "cos" + x, "cos_" + x,
+                       "cos" + a, "cos_" + a, "cos" + greek, "cos_" + greek]
+    return {**nominal, **measured, **normal,
+            "dev": ["dev", "deviation", "d", "t", "error", "err"],
+            "row": ["row", "row_index", "row_idx"],
+            "col": ["col", "column", "col_index", "col_idx", "column_index"],
+            "id": ["id", "name", "point", "point_id", "point_name", "pt", "label"]}
+
+
+#: role -> accepted (normalised) column names; the module docstring lists the same
+ALIASES = _build_aliases()
+_ROLE_OF = {name: role for role, names in ALIASES.items() for name in names}
+
+#: groups of roles that come together
+GROUPS = {
+    "nominal": ("x_nom", "y_nom", "z_nom"),
+    "measured": ("x_meas", "y_meas", "z_meas"),
+    "normal": ("i", "j", "k"),
+    "deviation": ("dev",),
+    "grid": ("row", "col"),
+}
+_GROUP_TEXT = {
+    "nominal": "nominal point (x_nom y_nom z_nom)",
+    "measured": "measured point (x_meas y_meas z_meas)",
+    "normal": "normal (i j k)",
+    "deviation": "deviation (dev)",
+}
+_LENGTH_ROLES = GROUPS["nominal"] + GROUPS["measured"] + GROUPS["deviation"]
+_EXPECTED_COMBOS = "expected nominal+normal+deviation or nominal+measured"
+
+_AMBIGUOUS = ("x, y, z alone are ambiguous (nominal or measured?): name the columns "
+              "x_nom y_nom z_nom or x_meas y_meas z_meas")
+_COMPONENTS = ("dx, dy, dz (deviation components) are not read: give the deviation along the "
+               "normal as dev with i j k, or the measured point x_meas y_meas z_meas")
+#: normalised names that are not accepted -> why
+_HINTS = {"x": _AMBIGUOUS, "y": _AMBIGUOUS, "z": _AMBIGUOUS,
+          "dx": _COMPONENTS, "dy": _COMPONENTS, "dz": _COMPONENTS}
+
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_NONFINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
+_SEP_NAMES = {",": "','", ";": "';'", "\t": "tabs", None: "blanks"}
+_UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
+
+
+@dataclass
+class MeasurementSet:
+    """Points read from a measurement file; all lengths in mm.
+
+    Attributes
+    ----------
+    nominal : ndarray, shape (N, 3) or None
+        Nominal points (mm).
+    measured : ndarray, shape (N, 3) or None
+        Measured (actual) points (mm).
+    normal : ndarray, shape (N, 3) or None
+        Unit normals (direction cosines, Werner 2022 eq. 1), renormalised.
+    deviation : ndarray, shape (N,) or None
+        Signed deviation along the normal (mm), positive when the measured point lies on
+        the side the normal points to: ``(measured - nominal) . normal``.
+    row, col : ndarray of int64, shape (N,) or None
+        Grid indices, when the file has them.
+    ids : list of str or None
+        Point names, when the file has them.
+    lines : ndarray of int64, shape (N,)
+        1-based line of each point in the source (for messages); ``1..N`` when None is
+        given.
+    source : str
+        File path or name used in messages.
+    sha256 : str
+        Hex SHA-256 of the raw file bytes.
+    units : str
+        Unit of the file's length columns (``'mm'``, ``'um'``, ``'in'``, ``'cm'``, ``'m'``),
+        or ``'mixed'`` when they differ.
+    columns : dict
+        Role (``'x_nom'``, ..., ``'i'``, ``'dev'``, ``'row'``, ``'col'``, ``'id'``) -> the
+        column name as written in the header.
+    ignored_columns : list of str
+        Header names of the columns not used.
+    warnings : list of str
+        ``'file:line: ...'`` texts (ignored columns, normal lengths, deviation check).
+    separator : str
+        ``','``, ``';'``, ``'\\t'`` or ``' '`` (runs of blanks).
+    decimal_comma : bool
+        The numbers were written with a decimal comma.
+    """
+
+    nominal: np.ndarray = None
+    measured: np.ndarray = None
+    normal: np.ndarray = None
+    deviation: np.ndarray = None
+    row: np.ndarray = None
+    col: np.ndarray = None
+    ids: list = None
+    lines: np.ndarray = None
+    source: str = "<data>"
+    sha256: str = ""
+    units: str = "mm"
+    columns: dict = field(default_factory=dict)
+    ignored_columns: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+    separator: str = ","
+    decimal_comma: bool = False
+
+    def __post_init__(self):
+        if self.lines is None:
+            n = next((len(a) for a in (self.nominal, self.measured, self.normal, self.deviation)
+                      if a is not None), 0)
+            self.lines = np.arange(1, n + 1, dtype=np.int64)
+
+    def kind(self):
+        """Which accepted combination of columns the set holds.
+
+        Returns
+        -------
+        str
+            ``'nominal+normal+deviation'``, ``'nominal+measured'``,
+            ``'nominal+measured+normal'`` or ``'all'`` (the deviation given as well);
+            for the measured-only sets of :mod:`surfcomp.io.pointfiles` (no nominal)
+            ``'measured'`` or ``'measured+normal'``.
+
+        Raises
+        ------
+        InputError
+            For a set built by hand that holds none of these.
+        """
+        if self.nominal is None:
+            if self.measured is not None and self.deviation is None:
+                return "measured" if self.normal is None else "measured+normal"
+        else:
+            if self.measured is None:
+                if self.normal is not None and self.deviation is not None:
+                    return "nominal+normal+deviation"
+            elif self.normal is None:
+                return "nominal+measured"
+            elif self.deviation is not None and "dev" in self.columns:
+                return "all"
+            else:
+                return "nominal+measured+normal"
+        raise InputError("the measurement set holds no accepted combination of nominal, "
+                         "measured, normal and deviation (%s)" % _EXPECTED_COMBOS, file=self.source)
+
+    def __len__(self):
+        return len(self.lines)
+
+
+def read_measurements(path, units="mm"):
+    """Read a measurement file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file (format: see the module docstring).
+    units : str or None
+        Unit of the length columns without a unit suffix (``mm``, ``um``, ``in``; None
+        means ``mm``).
+
+    Returns
+    -------
+    MeasurementSet
+        Every length in mm.
+
+    Raises
+    ------
+    MeasurementFileError
+        The file cannot be read or is not a valid measurement file (file, line, column
+        and what was expected in the message).
+    """
+    source = os.fspath(path)
+    try:
+        with open(source, "rb") as fh:
+            raw = fh.read()
+    except OSError as exc:
+        raise MeasurementFileError("cannot read the file: %s (expected a readable measurement "
+                                   "file)" % (exc.strerror or exc), file=source) from exc
+    return parse_measurements(raw, source=source, units=units)
+
+
+def parse_measurements(text_or_bytes, source="<text>", units="mm"):
+    """Parse the text of a measurement file.
+
+    Parameters
+    ----------
+    text_or_bytes : str or bytes
+        The file contents; bytes must be UTF-8 (a byte order mark is skipped). For a
+        ``str``, ``sha256`` is that of its UTF-8 encoding.
+    source : str
+        Name used in messages and stored as ``MeasurementSet.source``.
+    units : str or None
+        Unit of the length columns without a unit suffix (``mm``, ``um``, ``in``; None
+        means ``mm``).
+
+    Returns
+    -------
+    MeasurementSet
+        Every length in mm; see the module docstring for formats and checks.
+
+    Raises
+    ------
+    MeasurementFileError
+        On the first problem, with file, line and (for a field) column.
+    """
+    try:
+        default_factor = unit_factor("mm" if units is None else str(units))
+    except InputError as exc:
+        raise MeasurementFileError("--units %r is not a known unit (expected mm, um or in)"
+                                   % (units,), file=source) from exc
+    if isinstance(text_or_bytes, str):
+        text = text_or_bytes
+        raw = text.encode("utf-8", "surrogatepass")
+    else:
+        raw = bytes(text_or_bytes)
+        text = _decode(raw, source)
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
+
+
+def _decode(raw, source):
+    for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
+                      (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
+        if raw.startswith(bom):
+            raise MeasurementFileError("the file is %s text (expected UTF-8: save it as UTF-8)"
+                                       % name, file=source, line=1)
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise MeasurementFileError("byte 0x%02x at offset %d is not UTF-8 (expected UTF-8 text: "
+                                   "save the file as UTF-8)" % (raw[exc.start], exc.start),
+                                   file=source, line=line) from exc
+
+
+def _norm(name):
+    return re.sub(r"[^0-9a-z]+", "_", name.lower()).strip("_")
+
+
+def _role_of(name):
+    """(role or None, unit or None, bracket unit not understood or None) of a header name."""
+    base, unit = split_unit_suffix(name)
+    if unit is not None:
+        role = _ROLE_OF.get(_norm(base))
+        if role is not None:
+            return role, unit, None
+    role = _ROLE_OF.get(_norm(name))
+    if role is not None:
+        return role, None, None
+    m = SUFFIX_BRACKET.match(name)
+    if m and _ROLE_OF.get(_norm(m.group("base"))):
+        return _ROLE_OF[_norm(m.group("base"))], None, m.group("unit")
+    return None, None, None
+
+
+def _unquote(text):
+    text = text.strip()
+    if len(text) >= 2 and text[0] == text[-1] == '"':
+        text = text[1:-1].strip()
+    return text
+
+
+def _detect_separator(header):
+    for sep in ("\t", ";", ","):
+        if sep in header:
+            return sep
+    return None
+
+
+def _splitter(sep):
+    return str.split if sep is None else operator.methodcaller("split", sep)
+
+
+def _is_number(text):
+    """Whether ``text`` is a number with a decimal point or comma."""
+    return bool(_NUMBER.fullmatch(text.strip().replace(",", ".")))
+
+
+class _Parser:
+    """One parse of one file: keeps the source lines for messages."""
+
+    def __init__(self, text, source, default_factor):
+        self.source = source
+        self.default_factor = default_factor
+        if "\r" in text:
+            text = text.replace("\r\n", "\n")
+            if "\n" not in text:
+                text = text.replace("\r", "\n")
+        self.lines = text.split("\n")
+        self.warnings = []
+
+    def error(self, message, index=None, column=None):
+        """MeasurementFileError at the 0-based line ``index`` (1-based ``column``)."""
+        return MeasurementFileError(message, file=self.source,
+                                    line=None if index is None else index + 1, column=column)
+
+    # -- the parse and the header ------------------------------------------------------------
+
+    def run(self, sha256):
+        lines = self.lines
+        content = [k for k, ln in enumerate(lines)
+                   if (s := ln.lstrip()) and not s.startswith(("#", "//"))]
+        if not content:
+            if not any(ln.strip() for ln in lines):
+                raise self.error("the file is empty (expected a header row naming the columns, "
+                                 "then one row per point)")
+            last = max(k for k, ln in enumerate(lines) if ln.strip())
+            raise self.error("the file holds only comments and blank lines (expected a header "
+                             "row naming the columns, then one row per point)", last)
+        h = content[0]
+        self.sep = sep = _detect_separator(lines[h])
+        self.split = split = _splitter(sep)
+        names = [_unquote(f) for f in split(lines[h])]
+        if all(_is_number(f) for f in names):
+            raise self.error("this row holds only numbers but no header came before it "
+                             "(expected a header row naming the columns, e.g. "
+                             "x_nom,y_nom,z_nom,i,j,k,dev)%s" % self._commented_header_hint(h), h)
+        roles, factors, ignored = self._header(names, h)
+        numeric = [c for c, r in roles.items() if r != "id"]
+        data = content[1:]
+        if sep is not None:
+            blank = " \t" + sep
+            data = [k for k in data if lines[k].strip(blank)]
+        if not data:
+            raise self.error("the header is not followed by any data row (expected one row "
+                             "per point)", h)
+        rows = [lines[k] for k in data]
+        self._check_field_counts(rows, data, len(names), h)
+        decimal_comma = self._decimal_comma(rows, data, numeric, names)
+        values = self._numbers(rows, data, numeric, names, decimal_comma)
+        col_of = {r: c for c, r in roles.items()}
+        pos = {c: p for p, c in enumerate(numeric)}
+
+        def take(role_group):
+            return values[:, [pos[col_of[r]] for r in role_group]] * np.array(
+                [factors[col_of[r]] for r in role_group])
+
+        line_numbers = np.asarray(data, dtype=np.int64) + 1
+        ms = MeasurementSet(lines=line_numbers, source=self.source, sha256=sha256,
+                            separator=" " if sep is None else sep, decimal_comma=decimal_comma,
+                            columns={r: names[col_of[r]] for r in ALIASES if r in col_of},
+                            ignored_columns=[names[c] for c in ignored],
+                            warnings=self.warnings)
+        have = {g for g, rs in GROUPS.items() if rs[0] in col_of}
+        ms.nominal = take(GROUPS["nominal"])
+        self._check_duplicates(ms.nominal, data)
+        if "measured" in have:
+            ms.measured = take(GROUPS["measured"])
+        if "normal" in have:
+            ms.normal = self._unit_normals(values[:, [pos[col_of[r]] for r in "ijk"]], data,
+                                           [col_of[r] + 1 for r in "ijk"])
+        if "deviation" in have:
+            ms.deviation = take(("dev",))[:, 0]
+        if "grid" in have:
+            ms.row = self._integers(values[:, pos[col_of["row"]]], data, col_of["row"], names)
+            ms.col = self._integers(values[:, pos[col_of["col"]]], data, col_of["col"], names)
+        if "id" in col_of:
+            c = col_of["id"]
+            ms.ids = [_unquote(split(r)[c]) for r in rows]
+        if ms.measured is not None and ms.normal is not None:
+            computed = np.einsum("ij,ij->i", ms.measured - ms.nominal, ms.normal)
+            if ms.deviation is None:
+                ms.deviation = computed
+            else:
+                self._check_deviation(ms.deviation, computed, data)
+        used = [factors[col_of[r]] for r in _LENGTH_ROLES if r in col_of]
+        ms.units = _UNIT_NAMES.get(used[0], "mixed") if len(set(used)) == 1 else "mixed"
+        return ms
+
+    def _commented_header_hint(self, h):
+        """Hint when the last comment line before line ``h`` names known columns."""
+        for k in range(h - 1, -1, -1):
+            s = self.lines[k].strip()
+            if not s:
+                continue
+            body = s[2:] if s.startswith("//") else s.lstrip("#")
+            names = [_unquote(f) for f in _splitter(_detect_separator(body))(body)]
+            if any(_role_of(n)[0] for n in names):
+                return "; line %d looks like the header but is a comment" % (k + 1)
+            return ""
+        return ""
+
+    def _header(self, names, h):
+        roles, factors, ignored, first = {}, {}, [], {}
+        for c, name in enumerate(names):
+            role, unit, bad_unit = _role_of(name)
+            if role is None:
+                ignored.append(c)
+                continue
+            if bad_unit is not None:
+                raise self.error("column '%s' has the unit %r, which is not known (expected a "
+                                 "suffix [mm], [um] or [in], or none)" % (name, bad_unit), h, c + 1)
+            if unit is not None and role not in _LENGTH_ROLES:
+                raise self.error("column '%s' (%s) takes no unit (expected the name without "
+                                 "the [%s] suffix)" % (name, role, unit), h, c + 1)
+            if role in first:
+                raise self.error("column '%s' is %s again, already given by '%s' in column %d "
+                                 "(expected each column once)"
+                                 % (name, role, names[first[role]], first[role] + 1), h, c + 1)
+            first[role] = c
+            roles[c] = role
+            factors[c] = UNIT_FACTORS[unit] if unit is not None else self.default_factor
+        hints = sorted({_HINTS[_norm(names[c])] for c in ignored if _norm(names[c]) in _HINTS})
+        hint = "".join("; " + t for t in hints)
+        if not roles:
+            shown = ", ".join("'%s'" % n for n in names)
+            raise self.error("the header names no known column: %s (expected names such as "
+                             "x_nom y_nom z_nom, i j k, dev, x_meas y_meas z_meas; see the alias "
+                             "table)%s" % (shown, hint), h)
+        for group, rs in GROUPS.items():
+            present = [r for r in rs if r in first]
+            if present and len(present) < len(rs):
+                missing = [r for r in rs if r not in first]
+                raise self.error("the header has %s but no %s (expected all of %s, or none)"
+                                 % (" ".join(present), " ".join(missing), " ".join(rs)), h)
+        have = {g for g, rs in GROUPS.items() if rs[0] in first}
+        need = [g for g in ("nominal", "normal", "deviation", "measured")
+                if g not in have and not (g == "measured" and have >= {"normal", "deviation"})
+                and not (g in ("normal", "deviation") and "measured" in have)]
+        if need:
+            got = " and ".join(" ".join(GROUPS[g]) for g in ("nominal", "measured", "normal",
+                                                             "deviation") if g in have)
+            lost = ", ".join("'%s'" % names[c] for c in ignored)
+            raise self.error("the header has %sno %s (%s)%s%s"
+                             % (got + " but " if got else "",
+                                " and no ".join(_GROUP_TEXT[g] for g in need), _EXPECTED_COMBOS,
+                                "; ignored columns: " + lost if lost else "", hint), h)
+        for c in ignored:
+            name = names[c]
+            why = _HINTS.get(_norm(name), "not a known column name") if name else "it has no name"
+            self.warnings.append("%s:%d: column %d '%s' is ignored (%s)"
+                                 % (self.source, h + 1, c + 1, name, why))
+        if "deviation" in have and "measured" in have and "normal" not in have:
+            c = first["dev"]
+            del roles[c]
+            ignored = sorted(ignored + [c])
+            self.warnings.append("%s:%d: column %d '%s' is ignored (without a normal i j k the "
+                                 "deviation is computed from the face)"
+                                 % (self.source, h + 1, c + 1, names[c]))
+        return roles, factors, ignored
+
+    # -- data -------------------------------------------------------------------------------
+
+    def _check_field_counts(self, rows, data, expected, h):
+        sep = self.sep
+        if sep is None:
+            counts = np.fromiter(map(len, map(str.split, rows)), dtype=np.int64, count=len(rows))
+        else:
+            counts = np.fromiter(map(operator.methodcaller("count", sep), rows), dtype=np.int64,
+                                 count=len(rows)) + 1
+        bad = np.flatnonzero(counts != expected)
+        if bad.size:
+            k = int(bad[0])
+            ends = sep is not None and rows[k].rstrip().endswith(sep) and counts[k] > expected
+            raise self.error("the row has %d fields but the header on line %d has %d (expected %d "
+                             "fields separated by %s%s)"
+                             % (counts[k], h + 1, expected, expected, _SEP_NAMES[sep],
+                                "; the row ends with a separator" if ends else ""), data[k])
+
+    def _first_row_with(self, char, rows, numeric):
+        """(row index, column, field) of the first numeric field containing ``char``, or None."""
+        for k, row in enumerate(rows):
+            if char in row:
+                fields = self.split(row)
+                for c in numeric:
+                    if char in fields[c]:
+                        return k, c, fields[c].strip()
+        return None
+
+    def _decimal_comma(self, rows, data, numeric, names):
+        if self.sep == ",":
+            return False
+        comma = self._first_row_with(",", rows, numeric)
+        if comma is None:
+            return False
+        dot = self._first_row_with(".", rows, numeric)
+        if dot is not None:
+            k, c, text = dot
+            raise self.error("'%s' in column '%s' has a decimal point but line %d has a decimal "
+                             "comma ('%s') (expected one decimal mark in the whole file; "
+                             "thousands separators are not accepted)"
+                             % (text, names[c], data[comma[0]] + 1, comma[2]), data[k], c + 1)
+        return True
+
+    def _numbers(self, rows, data, numeric, names, decimal_comma):
+        """Float array (len(rows), len(numeric)); the first bad field raises."""
+        conv = [r.replace(",", ".") for r in rows] if decimal_comma else rows
+        try:
+            values = np.loadtxt(conv, dtype=float, delimiter=self.sep, usecols=numeric,
+                                comments=None, ndmin=2)
+        except ValueError as exc:
+            self._locate_bad_number(conv, rows, data, numeric, names)
+            raise self.error("the numbers cannot be read: %s (expected numbers)" % exc) from exc
+        finite = np.isfinite(values)
+        if not finite.all():
+            k, p = np.argwhere(~finite)[0]
+            self._locate_bad_number(conv[k:k + 1], rows[k:k + 1], data[k:k + 1],
+                                    numeric[p:p + 1], names)
+        return values
+
+    def _locate_bad_number(self, conv, rows, data, numeric, names):
+        """Raise for the first field of ``numeric`` columns that is not a finite number."""
+        split = self.split
+        for k, row in enumerate(conv):
+            fields = split(row)
+            for c in numeric:
+                text = fields[c].strip()
+                if _NUMBER.fullmatch(text):
+                    continue
+                shown = split(rows[k])[c].strip()
+                if not text:
+                    what = "column '%s' is empty (expected a number)" % names[c]
+                elif _NONFINITE.fullmatch(text):
+                    what = ("column '%s' holds '%s' (expected a finite number; leave the row out "
+                            "for a point not measured)" % (names[c], shown))
+                else:
+                    what = "column '%s' holds '%s' (expected a number)" % (names[c], shown)
+                raise self.error(what, data[k], c + 1)
+        for k, row in enumerate(conv):   # finite check: 1e999 parses as inf
+            fields = split(row)
+            for c in numeric:
+                if not np.isfinite(float(fields[c])):
+                    raise self.error("column '%s' holds '%s', which is not a finite number "
+                                     "(expected a finite number)"
+                                     % (names[c], split(rows[k])[c].strip()), data[k], c + 1)
+
+    def _integers(self, values, data, c, names):
+        whole = np.floor(values) == values
+        if not whole.all():
+            k = int(np.flatnonzero(~whole)[0])
+            raise self.error("column '%s' holds %r (expected a whole number: a grid index)"
+                             % (names[c], float(values[k])), data[k], c + 1)
+        return values.astype(np.int64)
+
+    def _check_duplicates(self, nominal, data):
+        pairs = cKDTree(nominal, balanced_tree=False).query_pairs(
+            DUPLICATE_TOL, output_type="ndarray")
+        if len(pairs):
+            first, again = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))[0]]
+            raise self.error("nominal point (%.9g, %.9g, %.9g) mm is given again; first on line %d "
+                             "(expected each nominal point once; %d duplicate pair(s) in all)"
+                             % (tuple(nominal[again]) + (data[first] + 1, len(pairs))), data[again])
+
+    def _unit_normals(self, n, data, columns):
+        length = np.linalg.norm(n, axis=1)
+        zero = np.flatnonzero(length < NORMAL_ZERO)
+        if zero.size:
+            k = int(zero[0])
+            raise self.error("the normal (%g, %g, %g) has zero length (expected a unit vector "
+                             "i j k; %d such row(s))" % (tuple(n[k]) + (zero.size,)), data[k],
+                             columns[0])
+        off = np.flatnonzero(np.abs(length - 1.0) > NORMAL_LENGTH_TOL)
+        self._point_warnings(off, data, lambda k: "the normal (%g, %g, %g) has length %.6g "
+                             "(expected a unit vector; used renormalised)" % (tuple(n[k]) + (length[k],)),
+                             "normals are not of unit length (renormalised)")
+        return n / length[:, None]
+
+    def _check_deviation(self, dev, computed, data):
+        diff = np.abs(dev - computed)
+        bad = np.flatnonzero(diff > DEV_CHECK_TOL)
+        self._point_warnings(bad, data, lambda k: "dev %.6f mm differs from (measured - nominal) . "
+                             "normal = %.6f mm by %.1f um (expected at most %g um)"
+                             % (dev[k], computed[k], diff[k] * 1e3, DEV_CHECK_TOL * 1e3),
+                             "deviations differ from (measured - nominal) . normal by more than "
+                             "%g um" % (DEV_CHECK_TOL * 1e3))
+        if bad.size and np.all(np.abs(dev[bad] + computed[bad]) <= DEV_CHECK_TOL):
+            self.warnings.append("%s: the %d differing deviation(s) have the opposite sign of "
+                                 "(measured - nominal) . normal: does the file measure along "
+                                 "the inward normal?" % (self.source, bad.size))
+
+    def _point_warnings(self, idx, data, text, summary):
+        for k in idx[:MAX_POINT_WARNINGS]:
+            self.warnings.append("%s:%d: %s" % (self.source, data[k] + 1, text(k)))
+        if idx.size > MAX_POINT_WARNINGS:
+            self.warnings.append("%s: %d more %s" % (self.source, idx.size - MAX_POINT_WARNINGS,
+                                                     summary))
+
