@@ -51,6 +51,33 @@ def _span(width, spacing, refine):
     return min(spacing / refine, width / MIN_SPANS)
 
 
+class _Sampling:
+    """The refined space of the nominal and its samples (computed once per construction)."""
+
+    def __init__(self, nominal, outward, spacing_u, spacing_v, refine):
+        (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
+        new_u = refinement_knots(nominal.knots_u, nominal.degree_u, u0, u1,
+                                 _span(u1 - u0, spacing_u, refine)) if spacing_u else ()
+        new_v = refinement_knots(nominal.knots_v, nominal.degree_v, v0, v1,
+                                 _span(v1 - v0, spacing_v, refine)) if spacing_v else ()
+        self.nominal = nominal
+        self.fine = bspline.insert_knots(nominal, new_u, new_v)
+        self.us = bspline.greville(self.fine.knots_u, self.fine.degree_u)
+        self.vs = bspline.greville(self.fine.knots_v, self.fine.degree_v)
+        self.S, Su, Sv = bspline.evaluate_grid(self.fine, self.us, self.vs, order=1)
+        n = np.cross(Su, Sv)
+        self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
+
+    def build(self, delta):
+        """The surface through ``S - delta n`` at the samples; ``delta`` shape (len(us), len(vs))."""
+        f = self.fine
+        target = self.S - np.asarray(delta, dtype=float)[..., None] * self.n
+        poles = bspline.interpolate_grid(self.us, self.vs, target, f.knots_u, f.knots_v,
+                                         f.degree_u, f.degree_v, f.weights)
+        return bspline.Surface(poles, f.knots_u, f.knots_v, f.degree_u, f.degree_v, f.weights,
+                               self.nominal.u_range, self.nominal.v_range)
+
+
 def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v=None,
                             refine=DEFAULT_REFINE, progress=None):
     """Build the corrected surface ``S(u, v) - delta(u, v) n(u, v)`` over the face's work area.
@@ -74,30 +101,13 @@ def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v
     Surface
         Same degrees, u/v directions, parametrisation and weights as the nominal.
     """
-    surf = nominal
-    (u0, u1), (v0, v1) = surf.u_range, surf.v_range
-    new_u = refinement_knots(surf.knots_u, surf.degree_u, u0, u1,
-                             _span(u1 - u0, spacing_u, refine)) if spacing_u else ()
-    new_v = refinement_knots(surf.knots_v, surf.degree_v, v0, v1,
-                             _span(v1 - v0, spacing_v, refine)) if spacing_v else ()
-    report(progress, 0.05, "refining the nominal's knots")
-    fine = bspline.insert_knots(surf, new_u, new_v)
-    us = bspline.greville(fine.knots_u, fine.degree_u)
-    vs = bspline.greville(fine.knots_v, fine.degree_v)
-    report(progress, 0.2, "sampling the nominal (%d x %d)" % (us.size, vs.size))
-    S, Su, Sv = bspline.evaluate_grid(fine, us, vs, order=1)
-    n = np.cross(Su, Sv)
-    n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
-    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    report(progress, 0.05, "sampling the nominal")
+    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+    uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")
     report(progress, 0.4, "evaluating the correction field")
     delta = np.asarray(field(uu.ravel(), vv.ravel()), dtype=float).reshape(uu.shape)
-    target = S - delta[..., None] * n
     report(progress, 0.7, "interpolating the corrected surface")
-    poles = bspline.interpolate_grid(us, vs, target, fine.knots_u, fine.knots_v,
-                                     fine.degree_u, fine.degree_v, fine.weights)
-    report(progress, 1.0, "corrected surface built")
-    return bspline.Surface(poles, fine.knots_u, fine.knots_v, fine.degree_u, fine.degree_v,
-                           fine.weights, surf.u_range, surf.v_range)
+    return smp.build(delta)
 
 
 def build_matching_surface(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
@@ -125,20 +135,24 @@ def build_matching_surface(nominal, U, V, delta, outward=1, spacing_u=None, spac
     iterations : int
     """
     delta = np.asarray(delta, dtype=float)
-    values = delta.copy()
     field = GridField(U, V, delta)
+    report(progress, 0.05, "sampling the nominal")
+    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+    uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")
+    s, t = field.locate(uu.ravel(), vv.ravel())  # the samples' place on the grid, once
+    values = delta.copy()
+    current = field
     k = 0
     while True:
-        current = field if k == 0 else GridField(U, V, values)
-        surf = build_corrected_surface(nominal, current, outward, spacing_u, spacing_v, refine,
-                                       progress=sub(progress, k / (iterations + 1),
-                                                    (k + 1) / (iterations + 1)))
+        report(progress, 0.1 + 0.9 * k / (iterations + 1), "building the corrected surface")
+        surf = smp.build(current.at_index(s, t).reshape(uu.shape))
         real = realised_correction(nominal, surf, U.ravel(), V.ravel(), outward,
                                    guess=values.ravel()).reshape(delta.shape)
         miss = delta - real
         if np.max(np.abs(miss)) <= tol or k >= iterations:
             return surf, field, k
         values = values + miss
+        current = field.with_values(values)
         k += 1
 
 
@@ -230,11 +244,16 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
     """
     real = realised_correction(nominal, corrected, u, v, outward, guess=delta)
     us, vs = dense_parameters(nominal, grid_shape, density)
-    uu, vv = np.meshgrid(us, vs, indexing="ij")
-    dense_real = realised_correction(nominal, corrected, uu.ravel(), vv.ravel(), outward)
-    dense_zero = realised_correction(nominal, zero, uu.ravel(), vv.ravel(), outward)
+    S, Su, Sv = bspline.evaluate_grid(nominal, us, vs, order=1)
+    n = np.cross(Su, Sv)
+    n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
+    # on the dense grid the normal line meets the corrected surface within the fit error
+    # of the same (u, v), so the normal component of S - S_c(u, v) is the realised
+    # correction to second order (exact Newton intersections are used at the points)
+    dense_real = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(corrected, us, vs), n)
+    dense_zero = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(zero, us, vs), n)
     return CheckFigures(max_error_at_points=float(np.max(np.abs(real - np.ravel(delta)))),
                         max_zero_deviation=float(np.max(np.abs(dense_zero))),
                         max_realised=float(np.max(np.abs(dense_real))),
                         max_intended=float(np.max(np.abs(delta))),
-                        dense_shape=uu.shape, poles_shape=tuple(corrected.shape))
+                        dense_shape=S.shape[:2], poles_shape=tuple(corrected.shape))

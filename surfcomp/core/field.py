@@ -94,6 +94,23 @@ class GridField:
         self._scale = np.array([np.ptp(U) or 1.0, np.ptp(V) or 1.0])
         self._tree = cKDTree(uv / self._scale)
 
+    def with_values(self, values):
+        """A field with the same grid positions and new node values (reuses the
+        located map and its KD-tree)."""
+        vals = np.asarray(values, dtype=float)
+        other = object.__new__(GridField)
+        other.__dict__.update(self.__dict__)
+        other._scalar = vals.ndim == 2
+        if other._scalar:
+            vals = vals[..., None]
+        F = np.concatenate([self._F[..., :2], vals], axis=2)
+        other._F = F
+        other._Fs = _pchip_slopes(F, 0)
+        other._Ft = _pchip_slopes(F, 1)
+        other._lo = vals.reshape(-1, vals.shape[2]).min(axis=0)
+        other._hi = vals.reshape(-1, vals.shape[2]).max(axis=0)
+        return other
+
     # -- Hermite patches in index space -------------------------------------------------
     def _eval(self, s, t, channels=slice(None), deriv=False):
         """Values (and d/ds, d/dt) at index coordinates inside [0, n-1] x [0, m-1]."""

@@ -42,7 +42,7 @@ import re
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .measurements import MeasurementSet
+from .measurements import NORMAL_LENGTH_TOL, NORMAL_ZERO, MeasurementSet
 from .units import split_unit_suffix, unit_factor
 
 #: formats :func:`read_point_file` reads
@@ -63,8 +63,8 @@ _ROLE_NAMES = {"x": "x_meas", "y": "y_meas", "z": "z_meas", "i": "i", "j": "j", 
 
 _PROBE_AXES = ("x", "y", "z", "a", "b", "c", "u", "v", "w")
 
-#: largest |length - 1| of a direction vector accepted without a warning
-_UNIT_TOL = 1e-3
+#: factor to mm -> unit name stored in ``MeasurementSet.units``
+_UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
 
 # --------------------------------------------------------------------------- text input
@@ -268,33 +268,30 @@ def _check_finite(path, arr, rows, sep, usecols, names):
 def _unit_directions(path, ijk, line_numbers, warnings):
     """Normalise probing directions (N, 3); zero vectors raise, others warn if not unit."""
     length = np.linalg.norm(ijk, axis=1)
-    zero = length < 1e-12
+    zero = length < NORMAL_ZERO
     if zero.any():
         k = int(np.argmax(zero))
         raise MeasurementFileError("the direction vector i j k is zero; expected a unit vector",
                                    file=str(path), line=int(line_numbers[k]))
     off = np.abs(length - 1.0)
-    if off.max() > _UNIT_TOL:
-        k = int(np.argmax(off > _UNIT_TOL))
+    if off.max() > NORMAL_LENGTH_TOL:
+        k = int(np.argmax(off > NORMAL_LENGTH_TOL))
         warnings.append((int(line_numbers[k]),
                          "%d direction vector(s) i j k are not of unit length (this line first; "
                          "largest |length - 1| = %.3g); used normalised"
-                         % (int((off > _UNIT_TOL).sum()), off.max())))
+                         % (int((off > NORMAL_LENGTH_TOL).sum()), off.max())))
     return ijk / length[:, None]
 
 
-def _resolve_units(path, units, file_units, what):
-    """Combine the ``units`` argument with units a file states.
+def _resolve_units(units, file_units):
+    """Unit name and factor to mm: the file's own units win, else ``units``, else mm.
 
-    Returns the unit name and its factor to mm; a contradiction raises InputError.
+    As for the unit suffixes of :mod:`surfcomp.io.measurements`, ``units`` is the unit
+    of values that carry none of their own.
     """
-    if file_units is None:
-        name = "mm" if units is None else units
-        return name, unit_factor(name)
-    if units is not None and unit_factor(units) != unit_factor(file_units):
-        raise InputError("units=%r contradicts the file, whose %s says %r"
-                         % (units, what, file_units), file=str(path))
-    return file_units, unit_factor(file_units)
+    name = file_units if file_units is not None else ("mm" if units is None else units)
+    factor = unit_factor(name)
+    return _UNIT_NAMES.get(factor, name.strip().lower()), factor
 
 
 # --------------------------------------------------------------------------- detection
@@ -375,10 +372,10 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     fmt : {"auto", "xyz", "xyzijk", "probe", "qif"}
         ``auto`` uses :func:`detect_format`.
     units : str, optional
-        Length unit of the numbers (``mm``, ``in``, ``um``...). Needed for probe logs
-        of G20 programs (default mm) and for plain XYZ files in other units; for
-        files that state their units (XYZIJK header, QIF FileUnits, units in the XYZ
-        header) it may be given only if it agrees.
+        Length unit of values that carry no unit of their own (``mm``, ``in``,
+        ``um``...; default mm): probe logs of G20 programs need ``in``. Units a file
+        states win: the XYZIJK header (METRIC or inch), QIF FileUnits, unit suffixes
+        in a plain XYZ header (``x[in]``).
     sample : int or str, optional
         QIF only: which MeasurementResults to read (0-based index, serial number or
         MeasurementResults id); default the first.
@@ -396,8 +393,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
         Empty file, malformed numbers, wrong field counts, NaN/inf, malformed
         XYZIJK header, bad QIF (file, line, column).
     InputError
-        Unknown ``fmt``/``units``, ``units`` contradicting the file, ``sample`` for a
-        format without samples.
+        Unknown ``fmt`` or ``units``, ``sample`` for a format without samples.
     """
     if fmt == "auto":
         fmt = detect_format(path)
@@ -512,7 +508,7 @@ def _read_xyz(path, lines, units, warnings):
     usecols = sorted(roles.values())
     arr = _parse_rows(path, rows, sep, decimal_comma, ncols, names, expected, usecols)
     pos = {r: usecols.index(k) for r, k in roles.items()}
-    unit_name, factor = _resolve_units(path, units, file_units, "header")
+    unit_name, factor = _resolve_units(units, file_units)
     measured = arr[:, [pos["x"], pos["y"], pos["z"]]] * factor
     normal = None
     if "i" in roles:
@@ -586,7 +582,7 @@ def _read_xyzijk(path, lines, units, warnings):
                                     for t, c in zip(rows.texts, counts.tolist())])
     ncols = 6 if with_dir[0] else 3
     arr = _parse_rows(path, rows, ",", False, ncols, names, allowed)
-    unit_name, factor = _resolve_units(path, units, file_units, "line 1")
+    unit_name, factor = _resolve_units(units, file_units)
     normal = None
     columns = {r: "column %d" % (k + 1) for k, r in enumerate("xyz")}
     if ncols == 6:
@@ -609,7 +605,7 @@ def _read_probe(path, lines, units, warnings):
     if units is None:
         warnings.append((None, "probe logs do not record their units; read as mm (G21), "
                                "give units='in' for G20 programs"))
-    unit_name, factor = _resolve_units(path, units, None, "")
+    unit_name, factor = _resolve_units(units, None)
     moved = [names[k] for k in range(3, 9) if np.any(arr[:, k] != 0.0)]
     if moved:
         warnings.append((None, "axes %s are not zero in the probe log; only X Y Z are used"

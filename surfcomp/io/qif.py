@@ -43,7 +43,8 @@ Lengths are in the ``FileUnits/PrimaryUnits/LinearUnit`` of the file, or in the 
 element's ``linearUnit`` attribute names (a LinearUnit of ``PrimaryUnits`` or
 ``OtherUnits``); a unit is identified by its ``UnitConversion/Factor`` (to metres) or,
 without one, by its name (mm, inch, ...). A file without ``FileUnits`` is in metres
-(the QIF default, Units.xsd) unless ``units`` is given. Everything returned is in mm.
+(the QIF default, Units.xsd) unless ``units`` is given (a warning says which unit was
+used); when the file has FileUnits, ``units`` is not used. Everything returned is in mm.
 
 Source lines
 ------------
@@ -61,7 +62,8 @@ from xml.parsers import expat
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .measurements import DEV_CHECK_TOL, MAX_POINT_WARNINGS, NORMAL_LENGTH_TOL, MeasurementSet
+from .measurements import (DEV_CHECK_TOL, MAX_POINT_WARNINGS, NORMAL_LENGTH_TOL, NORMAL_ZERO,
+                           MeasurementSet)
 from .units import unit_factor
 
 #: namespace URIs of QIF documents start with this (QIF 3: ``.../qif3``)
@@ -228,12 +230,13 @@ class _Units:
                 doc.warn("the file has no FileUnits/PrimaryUnits/LinearUnit: lengths are read "
                          "in metres (the QIF default); give units= if they are not")
             else:
-                self.primary, self.name = unit_factor(units), units
+                self.primary = unit_factor(units)
+                self.name = next((s for f, s in _SHORT.items() if f == self.primary), units)
+                doc.warn("the file has no FileUnits/PrimaryUnits/LinearUnit (the QIF default "
+                         "is metres): lengths are read in %s as units=%r says"
+                         % (self.name, units))
         else:
             self.primary, self.name = self._factor(lu)
-            if units is not None and unit_factor(units) != self.primary:
-                raise InputError("units=%r contradicts the file, whose FileUnits say %r"
-                                 % (units, self.name), file=doc.source, line=doc.line(lu))
         for el in doc.findall(doc.root, "q:FileUnits/q:OtherUnits/q:LinearUnit") + (
                 [lu] if lu is not None else []):
             name_el = doc.find(el, "q:UnitName")
@@ -371,8 +374,8 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
         Which ``MeasurementResults``: 0-based index, serial number or MeasurementResults
         id (see the module docstring). Default: the first (a warning lists the others).
     units : str, optional
-        Length unit for a file without ``FileUnits``; with ``FileUnits`` it may be given
-        only if it agrees.
+        Length unit for a file without ``FileUnits`` (default metres, the QIF default;
+        a warning says which unit was used). The file's ``FileUnits`` win.
     deviation_tol : float
         Largest accepted difference (mm) between the file's point-profile value and
         ``(actual - nominal) . normal`` before a warning (default
@@ -446,7 +449,7 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
         act.append(doc.numbers(aloc, 3, "actual x y z") * ufac.of(aloc))
         n = doc.numbers(normal_el, 3, "the unit normal i j k")
         length = float(np.linalg.norm(n))
-        if length < 1e-12:
+        if length < NORMAL_ZERO:
             raise doc.error("the <Normal> of <PointFeatureNominal id=%r> is zero; expected a "
                             "unit vector" % nominal_id, normal_el)
         if abs(length - 1.0) > NORMAL_LENGTH_TOL:

@@ -103,6 +103,7 @@ def test_plain_xyz_units_argument_scales():
     assert ms.units == "in"
     ms = read_point_file(sample("plain_header.xyz"), units="um")
     assert_allclose(ms.measured[3], [0.0115, 0.0205, -0.00075], rtol=0, atol=1e-15)
+    assert read_point_file(sample("plain_header.xyz"), units="INCH").units == "in"
 
 
 def test_plain_xyz_without_header_six_columns_probing_direction():
@@ -131,9 +132,11 @@ def test_plain_xyz_tab_with_inch_header_units():
     assert_allclose(ms.measured, np.array([[1, 2, 0.5], [-1, 0.25, 0.125]]) * 25.4,
                     rtol=0, atol=1e-12)
     assert ms.units == "in" and ms.separator == "\t"
-    assert read_point_file(sample("plain_tab_inch.txt"), units="in").units == "in"
-    with pytest.raises(InputError, match="contradicts"):
-        read_point_file(sample("plain_tab_inch.txt"), units="mm")
+    # the header's units win over the units argument (as unit suffixes do in tables)
+    for units in ("in", "mm", "um"):
+        again = read_point_file(sample("plain_tab_inch.txt"), units=units)
+        assert again.units == "in"
+        assert_allclose(again.measured, ms.measured, rtol=0, atol=0)
 
 
 def test_plain_xyz_large_file_matches_written_values(tmp_path):
@@ -242,10 +245,21 @@ def test_xyzijk_without_metric_is_inch():
     assert_allclose(ms.measured, [[25.4, 50.8, 12.7], [38.1, 50.8, 6.35], [-12.7, 3.175, 0.0]],
                     rtol=0, atol=1e-12)
     assert ms.units == "in" and ms.normal is None
-    with pytest.raises(InputError, match="contradicts the file, whose line 1 says 'in'"):
-        read_point_file(sample("pcdmis_inch.xyz"), units="mm")
-    assert_allclose(read_point_file(sample("pcdmis_inch.xyz"), units="in").measured,
-                    ms.measured, rtol=0, atol=0)
+    # the header decides: units= (e.g. the CLI's default mm) does not override it
+    for units in ("in", "mm"):
+        again = read_point_file(sample("pcdmis_inch.xyz"), units=units)
+        assert again.units == "in"
+        assert_allclose(again.measured, ms.measured, rtol=0, atol=0)
+    metric = read_point_file(sample("pcdmis_metric.xyz"), units="in")
+    assert metric.units == "mm" and metric.measured[0, 0] == 100.0
+
+
+def test_xyzijk_crlf_blanks_after_commas_and_bom(tmp_path):
+    path = write(tmp_path, b"\xef\xbb\xbfXYZIJK    METRIC  \r\n 1.5, -2 ,3e1\r\n\r\n4,5,6\r\n",
+                 mode="wb")
+    ms = read_point_file(path)
+    assert_allclose(ms.measured, [[1.5, -2.0, 30.0], [4.0, 5.0, 6.0]], rtol=0, atol=0)
+    assert_array_equal(ms.lines, [2, 4])
 
 
 @pytest.mark.parametrize("text, line, column, match", [
