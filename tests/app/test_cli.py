@@ -138,3 +138,32 @@ def test_freecadcmd_job_route(tmp_path):
                          env=dict(os.environ, SURFCOMP_JOB=str(bad)), capture_output=True,
                          text=True, timeout=300)
     assert out.returncode == 2 and "unknown job file keys: colour" in out.stderr
+
+
+def test_nominal_from_an_fcstd_document(tmp_path):
+    import FreeCAD
+    import Part
+
+    doc = FreeCAD.newDocument("SurfCompNominal")
+    try:
+        box = doc.addObject("Part::Box", "Box")
+        part = doc.addObject("Part::Feature", "Nominal")
+        part.Shape = Part.read(EXAMPLE_STEP)
+        doc.recompute()
+        path = tmp_path / "shop.FCStd"
+        doc.saveAs(str(path))
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    before = path.read_bytes()
+    out = run_cli("compensate", path, EXAMPLE_CSV, "--object", "Nominal", "--face", "Face1",
+                  "--report", tmp_path / "r.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["inputs"]["nominal"]["object"] == "Nominal"
+    assert rep["statistics"]["deviation"]["count"] == 2025
+    assert path.read_bytes() == before  # the document is never modified
+    bad_dir = tmp_path / "bad"
+    bad_dir.mkdir()
+    err = _bad(bad_dir, "compensate", path, EXAMPLE_CSV, "--object", "Nope")
+    assert "no object 'Nope' in the document" in err and "Nominal" in err
+    del box
