@@ -22,13 +22,16 @@ from scipy.spatial import cKDTree
 
 from . import bspline
 from .progress import report
-from ..errors import InputError
+from ..errors import GeometryError, InputError
 
 #: Newton stops when a full (second-order) step moves the foot point less than
 #: this (mm): the error left after applying it is O(step^2 / R) ~ 1e-13 mm
 STEP_TOL = 1e-6
 #: the same for Gauss-Newton steps and near curvature centres (linear convergence)
 STEP_TOL_SLOW = 1e-10
+#: after two consecutive full Newton steps d1, d2 the error left after d2 is
+#: about C d2^2 with C = d2 / d1^2; a step is also final when that is below this (mm)
+PREDICTED_TOL = 1e-10
 #: Newton iterations per point in the first, chunked pass (the rest is batched)
 FIRST_PASS_ITER = 8
 #: points per vectorised Newton chunk (keeps temporaries in cache)
@@ -110,9 +113,8 @@ class _SpanTable:
                 C[:, :, b, a, :] = (Bu @ Tv).reshape(Ku, Kv, dim) * fu * fv
         self.Kv = Kv
         self.row = (pv + 1) * (pu + 1) * dim
-        table = np.ascontiguousarray(C.reshape(Ku * Kv, self.row))
-        self._table = table
-        self._void = table.view(np.dtype((np.void, self.row * 8))).ravel()
+        # transposed: one column per span pair, gathered with table[:, keys]
+        self._table = np.ascontiguousarray(C.reshape(Ku * Kv, self.row).T)
 
     @staticmethod
     def _breaks(knots, p, n):
@@ -138,8 +140,7 @@ class _SpanTable:
         key, s, t, hu, hv = self.locate(u, v)
         n = u.size
         pu, pv, dim = self.pu, self.pv, self.dim
-        G = np.take(self._void, key).view(float).reshape(n, self.row)
-        G = np.ascontiguousarray(G.T).reshape(pv + 1, (pu + 1) * dim, n)
+        G = self._table[:, key].reshape(pv + 1, (pu + 1) * dim, n)
         W = _horner(G, t, order)  # W[l]: d^l/dt^l, (A*C, n)
         keys = bspline._ORDER_KEYS[order]
         A = {}
@@ -246,11 +247,12 @@ class _Newton:
         det = Huu * Hvv - Huv * Huv
         gn_det = a * c - b * b
         pd = (Huu > 0) & (Hvv > 0) & (det > 1e-10 * gn_det)
-        # Gauss-Newton fallback where the full Hessian is not positive definite
-        Huu = np.where(pd, Huu, a)
+        # (slightly damped) Gauss-Newton where the full Hessian is not positive definite
+        mu = 1e-9 * (a + c)
+        Huu = np.where(pd, Huu, a + mu)
         Huv = np.where(pd, Huv, b)
-        Hvv = np.where(pd, Hvv, c)
-        det = np.where(pd, det, gn_det)
+        Hvv = np.where(pd, Hvv, c + mu)
+        det = np.where(pd, det, (a + mu) * (c + mu) - b * b)
         fix_u = ((u <= self.u0) & (gu > 0)) | ((u >= self.u1) & (gu < 0))
         fix_v = ((v <= self.v0) & (gv > 0)) | ((v >= self.v1) & (gv < 0))
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
@@ -297,6 +299,7 @@ class _Newton:
         dul, dvl = np.zeros(n), np.zeros(n)
         halv = np.zeros(n)
         mvl = np.full(n, np.inf)
+        fastl = np.zeros(n, dtype=bool)
         best = None
         for it in range((maxiter or self.maxiter) + 1):
             if idx.size == 0:
@@ -322,8 +325,11 @@ class _Newton:
             du, dv, fast = self.step(uprev, vprev, r, *D[1:])
             mv = D[1] * du + D[2] * dv
             mvn = np.sqrt(_dot(mv, mv))
+            # quadratic convergence: predicted remaining error mvn^3 / mvl^2
+            quad = fast & fastl & (mvn <= 1e-3) & (mvn ** 3 <= PREDICTED_TOL * mvl ** 2)
+            done = acc & ((mvn <= np.where(fast, STEP_TOL, STEP_TOL_SLOW)) | quad)
             mvl = np.where(acc, mvn, mvl)
-            done = acc & (mvn <= np.where(fast, STEP_TOL, STEP_TOL_SLOW))
+            fastl = np.where(acc, fast, fastl)
             if anyworse:
                 # no decrease possible: the last accepted point is the answer; a
                 # minimum when the failed step was already at rounding level
@@ -358,6 +364,7 @@ class _Newton:
                 idx, Pa, ua, va = idx[keep], Pa[:, keep], ua[keep], va[keep]
                 uprev, vprev, fprev = uprev[keep], vprev[keep], fprev[keep]
                 dul, dvl, halv, mvl = dul[keep], dvl[keep], halv[keep], mvl[keep]
+                fastl = fastl[keep]
                 best = [b_[:, keep] for b_ in best]
         if idx.size:  # iteration limit: keep the last accepted point, not converged
             U[idx], V[idx] = uprev, vprev
@@ -399,7 +406,7 @@ class Projector:
     surf : bspline.Surface
         The face; projection stays inside ``surf.u_range x surf.v_range``.
     samples_per_span : int, optional
-        Seed samples per knot span and direction; default ``2 * (degree + 1)``,
+        Seed samples per knot span and direction; default ``3 * (degree + 1)``,
         reduced so that the grid has at most ``MAX_SAMPLES`` points.
     workers : int, optional
         Threads for the KD-tree queries (``cKDTree.query(workers=...)``);
@@ -419,8 +426,8 @@ class Projector:
         (u0, u1), (v0, v1) = surf.u_range, surf.v_range
         bu = np.unique(np.r_[u0, bu[(bu > u0) & (bu < u1)], u1])
         bv = np.unique(np.r_[v0, bv[(bv > v0) & (bv < v1)], v1])
-        mu = samples_per_span or 2 * (surf.degree_u + 1)
-        mv = samples_per_span or 2 * (surf.degree_v + 1)
+        mu = samples_per_span or 3 * (surf.degree_u + 1)
+        mv = samples_per_span or 3 * (surf.degree_v + 1)
         while (bu.size * mu) * (bv.size * mv) > MAX_SAMPLES and max(mu, mv) > 1:
             mu, mv = max(1, mu - 1), max(1, mv - 1)
         self.us = _sample_params(bu, mu, u0, u1)
@@ -439,10 +446,23 @@ class Projector:
         self.voxel = 0.5 * float(np.median(edges)) if edges.size else 1.0
         # points closer than this to the face have a unique closest point
         # (half the smallest radius of curvature seen at the samples)
-        kmax = _max_curvature(self.samples)
+        # degenerate samples (collapsed edges, poles) are no seeds: Newton cannot
+        # leave them (zero gradient) and all their parameters give one point
+        scale_u, scale_v = bspline._derivative_scales(surf)
+        Su, Sv = self.samples[1].T, self.samples[2].T
+        regular = ~bspline._degenerate(np.cross(Su, Sv), Su, Sv, scale_u, scale_v, rel=1e-6)
+        if not regular.any():
+            raise GeometryError("the face is degenerate everywhere (Su x Sv = 0)")
+        kmax = _max_curvature(self.samples)[regular]
         kmax = kmax[np.isfinite(kmax)]
         self.safe_distance = 0.5 / kmax.max() if kmax.size and kmax.max() > 0 else np.inf
-        self.tree = cKDTree(grid.reshape(-1, 3))
+        self.tree_ids = np.flatnonzero(regular)  # tree index -> sample index
+        # cumulative chord lengths along the grid lines: path lengths on the face
+        zero_u = np.zeros((1, grid.shape[1]))
+        zero_v = np.zeros((grid.shape[0], 1))
+        self.arc_u = np.r_[zero_u, np.cumsum(np.linalg.norm(np.diff(grid, axis=0), axis=2), 0)]
+        self.arc_v = np.c_[zero_v, np.cumsum(np.linalg.norm(np.diff(grid, axis=1), axis=2), 1)]
+        self.tree = cKDTree(grid.reshape(-1, 3)[self.tree_ids])
         self.newton = _Newton(self.ev, surf.u_range, surf.v_range)
 
     # ------------------------------------------------------------------ public
@@ -481,7 +501,8 @@ class Projector:
         if max_distance is not None:
             ub = float(max_distance) + self.eps + h
         dist, nb = self.tree.query(centres, k=1, distance_upper_bound=ub, workers=self.workers)
-        return nb[inv], np.isfinite(dist)[inv]
+        near = np.isfinite(dist)
+        return self.tree_ids[np.where(near, nb, 0)][inv], near[inv]
 
     def _project_block(self, P, idx, res, max_distance):
         seeds, near = self._seeds(P, max_distance)
@@ -506,7 +527,8 @@ class Projector:
         r = D[0] - P.T
         check = np.flatnonzero(~(_dot(r, r) < self.safe_distance ** 2))
         if check.size:
-            sus = check[self._suspicious(P[check], [d[:, check] for d in D])]
+            sus = check[self._suspicious(P[check], u[check], v[check],
+                                         [d[:, check] for d in D])]
             if sus.size:
                 self._reseed(P, sus, u, v, D, conv)
         self._finish(P, idx, u, v, D, conv, res, max_distance)
@@ -522,25 +544,31 @@ class Projector:
         iv = np.clip(np.searchsorted(self.vs, v), 0, self.vs.size - 1)
         return iu, iv
 
-    def _suspicious(self, P, D, k=6):
-        """Indices of points whose minimum may not be the global one."""
+    def _suspicious(self, P, u, v, D, k=12):
+        """Indices of points whose local minimum may not be the global one."""
         S, Su, Sv, Suu, Suv, Svv = D
         r = S - P.T
         a, b, c = _dot(Su, Su), _dot(Su, Sv), _dot(Sv, Sv)
         Huu, Huv, Hvv = a + _dot(r, Suu), b + _dot(r, Suv), c + _dot(r, Svv)
         # near a curvature centre the distance Hessian degenerates
         flat = (Huu * Hvv - Huv * Huv) < 0.5 * (a * c - b * b)
-        # a sample within reach that lies far from the foot on the face: on a flat
-        # face |X - F|^2 = |X - P|^2 - d^2; much more means strong concavity or
-        # another part of the face coming close (a second basin)
+        # a sample close enough to hold a better minimum (|X - P| < d + eps) that is
+        # far from the foot along the face (grid path > 3 |X - F| + 2 eps) although
+        # close in space: another part of the face comes close (a second basin)
         dist, nb = self.tree.query(P, k=min(k, self.tree.n), workers=self.workers)
-        nb = nb.reshape(P.shape[0], -1)
-        X = self.tree.data[nb]  # (n, k, 3)
-        xf = np.sum((X - S.T[:, None, :]) ** 2, axis=2)
-        xp = np.sum((X - P[:, None, :]) ** 2, axis=2)
-        d2 = _dot(r, r)[:, None]
-        spread = xf > 4.0 * np.maximum(xp - d2, 0.0) + (0.5 * self.eps) ** 2
-        return np.flatnonzero(flat | np.any(spread, axis=1))
+        nb = self.tree_ids[nb.reshape(P.shape[0], -1)]
+        dist = dist.reshape(P.shape[0], -1)
+        ki, kj = np.divmod(nb, self.vs.size)
+        i0, j0 = self._grid_index(u, v)
+        i0, j0 = i0[:, None], j0[:, None]
+        path = (np.abs(self.arc_u[ki, j0] - self.arc_u[i0, j0])
+                + np.abs(self.arc_v[ki, kj] - self.arc_v[ki, j0]))
+        X = self.samples[0][:, nb]  # (3, n, k)
+        xf = np.sqrt(np.sum((X - S[:, :, None]) ** 2, axis=0))
+        d = np.sqrt(_dot(r, r))[:, None]
+        reach = dist < d + self.eps
+        far = path > 3.0 * xf + 2.0 * self.eps
+        return np.flatnonzero(flat | np.any(reach & far, axis=1))
 
     def _reseed(self, P, sus, u, v, D, conv, max_seeds=12):
         """Newton from far-apart samples within reach of a better minimum; keep the best."""
@@ -555,7 +583,7 @@ class Projector:
                 continue
             cand = np.asarray(cand)
             dc = np.sum((self.tree.data[cand] - P[i]) ** 2, axis=1)
-            cand = cand[np.argsort(dc)][:4000]
+            cand = self.tree_ids[cand[np.argsort(dc)][:4000]]
             cu, cv = np.divmod(cand, nvs)
             cu_, cv_ = [int(iu_all[j])], [int(iv_all[j])]
             for c_, a_, b_ in zip(cand.tolist(), cu.tolist(), cv.tolist()):
@@ -587,13 +615,15 @@ class Projector:
         n = bspline._unit_normals(self.surf, u, v, Su, Sv)
         r = P - S
         d = np.einsum("ij,ij->i", r, n)
-        # outside: at a bound with the distance gradient pointing out of the work area
-        gu = np.einsum("ij,ij->i", -r, Su) / np.maximum(np.linalg.norm(Su, axis=1), 1e-300)
-        gv = np.einsum("ij,ij->i", -r, Sv) / np.maximum(np.linalg.norm(Sv, axis=1), 1e-300)
+        # outside: at a bound with a tangential residual (> 1e-8 mm) pointing out of
+        # the work area, i.e. the unconstrained foot lies beyond that bound
+        rt = r - d[:, None] * n
+        big = np.einsum("ij,ij->i", rt, rt) > 1e-16
+        tu = np.einsum("ij,ij->i", rt, Su)
+        tv = np.einsum("ij,ij->i", rt, Sv)
         (u0, u1), (v0, v1) = self.surf.u_range, self.surf.v_range
-        tol = 1e-8
-        out = (((u <= u0) & (gu > tol)) | ((u >= u1) & (gu < -tol)) |
-               ((v <= v0) & (gv > tol)) | ((v >= v1) & (gv < -tol)))
+        out = big & (((u <= u0) & (tu < 0)) | ((u >= u1) & (tu > 0)) |
+                     ((v <= v0) & (tv < 0)) | ((v >= v1) & (tv > 0)))
         d = np.where(out, np.copysign(np.linalg.norm(r, axis=1), d), d)
         keep = np.ones(u.size, dtype=bool)
         if max_distance is not None:
