@@ -1,0 +1,290 @@
+"""Path dressup: compensate the machine's axis errors on every move of a base operation.
+
+A thin proxy in the manner of Path's own dressups (``PathDressupPathBoundary``): the proxy
+turns properties into arrays, calls :func:`surfcomp.io.gcode.compensate_commands` (which
+uses :mod:`surfcomp.core.axis_errors`, Dobariya 2015 eq. 6-16), and writes ``Path`` and a
+few result properties back. No FreeCADGui, no PySide: it recomputes in ``freecadcmd``.
+
+Unlike Path's Z-correct dressup it keeps every parameter of a move (feed rates included,
+on every piece of a split move), keeps non-move commands (spindle, tool changes, comments,
+planes) in place and applies the compensation exactly once: each programmed point ``X``
+becomes the command ``X'`` with ``X' + E(X') = X``.
+
+The error measurements live in the document (float-list properties), not only as a path
+to a CSV file: the model is refitted from them on every recompute, so ``Model``,
+``Reference`` and ``WorkOffset`` can be changed without the file.
+"""
+
+from . import fcenv
+
+fcenv.setup_paths()
+
+import FreeCAD  # noqa: E402
+import Path  # noqa: E402
+
+try:  # FreeCAD 1.x
+    import Path.Dressup.Utils as PathDressup  # noqa: E402
+except ImportError:  # FreeCAD 0.20
+    import PathScripts.PathDressup as PathDressup  # noqa: E402
+try:  # FreeCAD 0.20 and 1.x both keep PathUtils here
+    import PathScripts.PathUtils as PathUtils  # noqa: E402
+except ImportError:  # pragma: no cover - a Path without PathScripts
+    PathUtils = None
+
+import os  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors  # noqa: E402
+from ..errors import InputError  # noqa: E402
+from ..io.axis_csv import AxisErrorTable, read_axis_errors  # noqa: E402
+from ..io.gcode import compensate_commands  # noqa: E402
+
+#: version of the document object's property set; onDocumentRestored upgrades older ones
+VERSION = 1
+
+_GROUP_DATA = "AxisErrors"
+_GROUP_COMP = "Compensation"
+_GROUP_RESULT = "Result"
+
+#: (type, name, group, tooltip, default, editor mode) of every property
+PROPERTIES = (
+    ("App::PropertyLink", "Base", "Base", "The base path to modify", None, 0),
+    ("App::PropertyStringList", "MeasuredAxis", _GROUP_DATA,
+     "Moving slide (X, Y or Z) of every measured row", None, 0),
+    ("App::PropertyFloatList", "MeasuredPosition", _GROUP_DATA,
+     "Position of the moving slide of every row (mm)", None, 0),
+    ("App::PropertyFloatList", "MeasuredErrorX", _GROUP_DATA,
+     "Tool-position error along X of every row (mm, actual - commanded)", None, 0),
+    ("App::PropertyFloatList", "MeasuredErrorY", _GROUP_DATA,
+     "Tool-position error along Y of every row (mm, actual - commanded)", None, 0),
+    ("App::PropertyFloatList", "MeasuredErrorZ", _GROUP_DATA,
+     "Tool-position error along Z of every row (mm, actual - commanded)", None, 0),
+    ("App::PropertyString", "SourceFile", _GROUP_DATA,
+     "File the measurements were read from (information only: the data is stored above)",
+     "", 1),
+    ("App::PropertyEnumeration", "Model", _GROUP_DATA,
+     "Degree of the error functions: auto (F-test per function), linear or quadratic",
+     ["auto"] + [m for m in MODEL_CHOICES if m != "auto"], 0),
+    ("App::PropertyVector", "Reference", _GROUP_DATA,
+     "Where the other slides stood while one slide was measured (measurement coordinates)",
+     None, 0),
+    ("App::PropertyVector", "WorkOffset", _GROUP_DATA,
+     "Measurement (machine) coordinates of the path's zero", None, 0),
+    ("App::PropertyLength", "SegmentLength", _GROUP_COMP,
+     "Longest piece of a split G1 move or of an arc turned into G1 segments", 2.0, 0),
+    ("App::PropertyLength", "Tolerance", _GROUP_COMP,
+     "Split a long G1 move only where the compensated path leaves its chord by more", 1e-4, 0),
+    ("App::PropertyLength", "ArcTolerance", _GROUP_COMP,
+     "Largest chord-to-arc deviation of arcs turned into G1 segments", 1e-3, 0),
+    ("App::PropertyStringList", "FitSummary", _GROUP_RESULT,
+     "Fitted error functions and the 12 components", None, 1),
+    ("App::PropertyLength", "ErrorBefore", _GROUP_RESULT,
+     "Largest predicted tool-position error of the base path's points", 0.0, 1),
+    ("App::PropertyLength", "ErrorAfter", _GROUP_RESULT,
+     "Largest predicted tool-position error after compensation", 0.0, 1),
+    ("App::PropertyLength", "MaxCorrection", _GROUP_RESULT,
+     "Largest correction applied to a point", 0.0, 1),
+    ("App::PropertyStringList", "Warnings", _GROUP_RESULT,
+     "What the compensation assumed (e.g. axes not yet programmed)", None, 1),
+    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     VERSION, 2),
+)
+
+
+def _add_properties(obj):
+    """Add every missing property (new objects and old documents alike)."""
+    added = []
+    for typ, name, group, tip, default, mode in PROPERTIES:
+        if name in obj.PropertiesList:
+            continue
+        obj.addProperty(typ, name, group, tip)
+        if typ == "App::PropertyEnumeration":
+            setattr(obj, name, default)
+            setattr(obj, name, default[0])
+        elif default is not None:
+            setattr(obj, name, default)
+        if mode:
+            obj.setEditorMode(name, mode)
+        added.append(name)
+    return added
+
+
+def set_measurements(obj, source):
+    """Store measurements in the object's properties.
+
+    Parameters
+    ----------
+    obj : the dressup document object
+    source : str, AxisErrorTable or mapping
+        A CSV file (read with :func:`surfcomp.io.axis_csv.read_axis_errors`), a table, or
+        ``{'x': (positions (n,), errors (n, 3))}`` in mm.
+    """
+    if isinstance(source, (str, os.PathLike)):
+        table = read_axis_errors(os.fspath(source))
+        obj.SourceFile = os.path.abspath(os.fspath(source))
+        data = table.data
+    elif isinstance(source, AxisErrorTable):
+        data = source.data
+        obj.SourceFile = source.path or ""
+    else:
+        data = {str(k).lower(): v for k, v in dict(source).items()}
+    axis, pos, ex, ey, ez = [], [], [], [], []
+    for ax in AXES:
+        if ax not in data:
+            continue
+        p, e = data[ax]
+        p = np.asarray(p, dtype=float).reshape(-1)
+        e = np.asarray(e, dtype=float).reshape(-1, 3)
+        if e.shape[0] != p.size:
+            raise InputError("axis %s: %d positions but %d error rows" % (ax.upper(), p.size,
+                                                                          e.shape[0]))
+        axis += [ax.upper()] * p.size
+        pos += p.tolist()
+        ex += e[:, 0].tolist()
+        ey += e[:, 1].tolist()
+        ez += e[:, 2].tolist()
+    obj.MeasuredAxis = axis
+    obj.MeasuredPosition = pos
+    obj.MeasuredErrorX = ex
+    obj.MeasuredErrorY = ey
+    obj.MeasuredErrorZ = ez
+
+
+def measurements(obj):
+    """The stored measurements as ``{'x': (positions, errors (n, 3))}`` (mm)."""
+    axis = [str(a).strip().lower() for a in obj.MeasuredAxis]
+    cols = [np.asarray(getattr(obj, n), dtype=float) for n in
+            ("MeasuredPosition", "MeasuredErrorX", "MeasuredErrorY", "MeasuredErrorZ")]
+    n = len(axis)
+    if any(c.size != n for c in cols):
+        raise InputError("%s: the measurement lists have different lengths (axis %d, "
+                         "position %d, errors %d/%d/%d)"
+                         % ((obj.Label, n) + tuple(c.size for c in cols)))
+    axis = np.array(axis)
+    out = {}
+    for ax in AXES:
+        sel = axis == ax
+        if sel.any():
+            out[ax] = (cols[0][sel], np.stack([c[sel] for c in cols[1:]], axis=1))
+    return out
+
+
+def _vec(v):
+    return np.array([v.x, v.y, v.z], dtype=float)
+
+
+def model_of(obj):
+    """Fit the error model from the object's properties (in the path's coordinates)."""
+    model = fit_axis_errors(measurements(obj), model=obj.Model, reference=_vec(obj.Reference),
+                            source=obj.Label)
+    return model, model.in_program_coordinates(_vec(obj.WorkOffset))
+
+
+def _base_commands(base):
+    if PathUtils is not None and hasattr(PathUtils, "getPathWithPlacement"):
+        return PathUtils.getPathWithPlacement(base).Commands
+    return base.Path.Commands
+
+
+def compensate_path(obj):
+    """Compute the dressup's Path from its base (what ``execute`` does), return the result."""
+    base = obj.Base
+    if base is None or not base.isDerivedFrom("Path::Feature"):
+        return Path.Path(), None
+    cmds = _base_commands(base)
+    model, prog_model = model_of(obj)
+    # messages name the dressup and the operation under it; "line" = base command number
+    source = "%s (on %s)" % (obj.Label, PathDressup.baseOp(base).Label)
+    res = compensate_commands([(c.Name, c.Parameters) for c in cmds], prog_model,
+                              segment_length=float(obj.SegmentLength.Value),
+                              tolerance=float(obj.Tolerance.Value),
+                              arc_tolerance=float(obj.ArcTolerance.Value), source=source)
+    out = [cmds[item] if isinstance(item, int) else Path.Command(item[0], item[1])
+           for item in res.commands]
+    return Path.Path(out), (model, prog_model, res)
+
+
+class DressupAxisErrors:
+    """Proxy of the axis-error compensation dressup (state lives in properties)."""
+
+    def __init__(self, obj, base):
+        _add_properties(obj)
+        obj.Base = base
+        obj.Proxy = self
+
+    # 1.x uses dumps/loads, 0.20 __getstate__/__setstate__: no state on the proxy
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def onDocumentRestored(self, obj):
+        _add_properties(obj)
+        if obj.Version < VERSION:
+            obj.Version = VERSION
+
+    def onDelete(self, obj, args):
+        if obj.Base:
+            job = PathUtils.findParentJob(obj) if PathUtils is not None else None
+            if job:
+                job.Proxy.addOperation(obj.Base, obj)
+            if obj.Base.ViewObject:
+                obj.Base.ViewObject.Visibility = True
+            obj.Base = None
+        return True
+
+    def execute(self, obj):
+        path, result = compensate_path(obj)
+        obj.Path = path
+        if result is None:
+            return
+        model, prog_model, res = result
+        pred = res.predicted(prog_model)
+        obj.FitSummary = model.summary_lines()
+        obj.ErrorBefore = pred["before"]["max_mm"]
+        obj.ErrorAfter = pred["after"]["max_mm"]
+        corr = np.abs(res.emitted - res.nominal)[res.known]
+        obj.MaxCorrection = float(np.linalg.norm(corr, axis=1).max()) if corr.size else 0.0
+        obj.Warnings = list(res.warnings)
+
+
+def Create(base, model_csv_or_data, name="DressupAxisErrors"):
+    """Create the axis-error compensation dressup on ``base``.
+
+    Parameters
+    ----------
+    base : Path::Feature
+        The operation (or another dressup) to compensate.
+    model_csv_or_data : str, AxisErrorTable or mapping
+        The per-axis measurements: a CSV file, a table, or ``{'x': (positions, errors)}``
+        (mm). They are copied into the document.
+    name : str
+        Object name; keep ``Dressup`` in it (Path finds the tool controller of dressups by
+        that part of the name).
+
+    Returns
+    -------
+    The new ``Path::FeaturePython`` object (placed in the base's Job in place of the base,
+    when there is one). Recompute the document to compute its Path.
+    """
+    if not base.isDerivedFrom("Path::Feature"):
+        raise InputError("%s is not a Path object (expected an operation or a dressup)"
+                         % base.Label)
+    doc = base.Document
+    obj = doc.addObject("Path::FeaturePython", name)
+    DressupAxisErrors(obj, base)
+    set_measurements(obj, model_csv_or_data)
+    job = PathUtils.findParentJob(base) if PathUtils is not None else None
+    if job is not None:
+        job.Proxy.addOperation(obj, base, True)
+    if FreeCAD.GuiUp and base.ViewObject:
+        base.ViewObject.Visibility = False
+    return obj

@@ -1,0 +1,226 @@
+"""``python3 -m surfcomp gcode``: compensate a G-code program for machine-axis errors.
+
+Dobariya et al. 2015: per-axis error measurements -> 1-D linear/quadratic error functions
+-> 12-component error model (eq. 6-16) -> compensated NC program. See docs/axis_errors.md.
+"""
+
+import datetime
+import json
+import os
+import sys
+
+import numpy as np
+
+from .. import __version__
+from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors, volumetric_map
+from ..errors import InputError
+from ..io.atomic import Transaction
+from ..io.axis_csv import read_axis_errors
+from ..io.gcode import compensate_gcode, read_gcode
+from ..io.hashing import sha256_file
+
+SCHEMA = "surfcomp-gcode-report/1"
+
+
+def add_parser(subparsers):
+    p = subparsers.add_parser(
+        "gcode", help="compensate a G-code program for the machine's axis errors",
+        description="Rewrite a 3-axis G-code program so that a machine with the measured "
+                    "geometric axis errors (Dobariya 2015: scale, straightness, flatness, "
+                    "squareness; linear or quadratic per axis) lands on the programmed "
+                    "points. Lines that need no change are kept byte for byte.")
+    p.add_argument("program", metavar="IN.ngc", help="G-code program (G0/G1/G2/G3, 3 axes)")
+    p.add_argument("--axis-errors", required=True, metavar="ERR.csv",
+                   help="per-axis error measurements: 'axis,position,ex,ey,ez' rows or "
+                        "'X EXX EYX EZX' tables (docs/axis_errors.md)")
+    p.add_argument("-o", "--output", required=True, metavar="OUT.ngc",
+                   help="compensated program (written atomically)")
+    p.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
+                   help="longest piece of a split G1 move or of an arc turned into G1 "
+                        "segments (default 2 mm)")
+    p.add_argument("--model", choices=MODEL_CHOICES, default="auto",
+                   help="degree of every error function, or auto: quadratic where the "
+                        "F-test of the quadratic term is significant at 5%% (default auto)")
+    p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
+    p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
+                   help="units of error-file columns without a unit suffix (default mm)")
+    p.add_argument("--reference", metavar="X,Y,Z", default="0,0,0",
+                   help="where the other slides stood while one slide was measured "
+                        "(error-file coordinates, mm; default 0,0,0)")
+    p.add_argument("--work-offset", metavar="X,Y,Z",
+                   help="error-file (machine) coordinates of the program zero, when they "
+                        "differ (mm; default: the same coordinates)")
+    p.add_argument("--start", metavar="X,Y,Z",
+                   help="machine position at the program start (program coordinates, mm); "
+                        "default unknown: an axis is not written before the program sets it")
+    p.add_argument("--tolerance", type=float, default=1e-4, metavar="MM",
+                   help="split a long G1 move only where the compensated path leaves its "
+                        "chord by more than this (default 0.0001 mm)")
+    p.add_argument("--arc-tolerance", type=float, default=1e-3, metavar="MM",
+                   help="largest chord-to-arc deviation of converted arcs (default 0.001 mm)")
+    p.add_argument("--decimals", type=int, metavar="N",
+                   help="least decimals of rewritten numbers (default 4 in mm, 5 in inch)")
+    p.set_defaults(run=run)
+    return p
+
+
+def _triple(text, option):
+    parts = [t for t in text.replace(";", ",").split(",")]
+    try:
+        vals = [float(t) for t in parts]
+    except ValueError:
+        vals = []
+    if len(vals) != 3 or not all(np.isfinite(vals)):
+        raise InputError("%s %r: expected three numbers X,Y,Z in mm" % (option, text))
+    return np.array(vals)
+
+
+def _positive(value, option):
+    if not (value > 0 and np.isfinite(value)):
+        raise InputError("%s %r: expected a positive length in mm" % (option, value))
+    return value
+
+
+def _um(v):
+    return v * 1e3
+
+
+def _outside_travel(model, points):
+    """Program points outside the measured travel: count and largest distance (mm)."""
+    if points.size == 0:
+        return 0, 0.0
+    lo, hi = model.travel[:, 0], model.travel[:, 1]
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    below = np.where(ok, lo - points, 0.0)
+    above = np.where(ok, points - hi, 0.0)
+    dist = np.maximum(np.maximum(below, above), 0.0).max(axis=1)
+    return int((dist > 1e-9).sum()), float(dist.max())
+
+
+def run(args):
+    seg = _positive(args.segment_length, "--segment-length")
+    tol = args.tolerance
+    if not (tol >= 0 and np.isfinite(tol)):
+        raise InputError("--tolerance %r: expected a length >= 0 in mm" % tol)
+    arc_tol = _positive(args.arc_tolerance, "--arc-tolerance")
+    if args.decimals is not None and not 0 <= args.decimals <= 9:
+        raise InputError("--decimals %d: expected 0 to 9" % args.decimals)
+    reference = _triple(args.reference, "--reference")
+    offset = None if args.work_offset is None else _triple(args.work_offset, "--work-offset")
+    start = None if args.start is None else _triple(args.start, "--start")
+
+    table = read_axis_errors(args.axis_errors, units=args.units)
+    model = fit_axis_errors(table.data, model=args.model, reference=reference,
+                            source=args.axis_errors)
+    prog_model = model if offset is None else model.in_program_coordinates(offset)
+    data = read_gcode(args.program)
+    res = compensate_gcode(data, prog_model, segment_length=seg, tolerance=tol,
+                           arc_tolerance=arc_tol, decimals=args.decimals, start=start,
+                           source=args.program)
+    pred = res.predicted(prog_model)
+    vmap = volumetric_map(model)
+    ends = res.program.end[res.program.known.all(axis=1)]
+    n_out, d_out = _outside_travel(prog_model, ends)
+    warnings = list(res.warnings)
+    if n_out:
+        warnings.append("%d program point(s) lie outside the measured travel (up to %.3f mm): "
+                        "the error functions are extrapolated there" % (n_out, d_out))
+    spread = model.offset_spread
+    rms_fit = max([f.rms for f in model.fits] or [0.0])
+    if spread.max() > max(1e-3, 3 * rms_fit):
+        warnings.append("the axes disagree about the error at the reference point by up to "
+                        "%.3f um: are the tables measured from the same reference (--reference)?"
+                        % _um(spread.max()))
+
+    outputs = {"program": os.path.abspath(args.output)}
+    with Transaction() as tr:
+        tmp = tr.stage(args.output)
+        with open(tmp, "wb") as fh:
+            fh.write(res.data)
+        if args.report:
+            outputs["report"] = os.path.abspath(args.report)
+            rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,
+                               outputs, seg, tol, arc_tol, reference, offset, start)
+            tr.stage_text(args.report, json.dumps(rep, indent=1, allow_nan=False) + "\n")
+        tr.commit()
+
+    print_summary(args, table, model, res, pred, vmap, warnings)
+    print("wrote %s" % args.output)
+    if args.report:
+        print("wrote %s" % args.report)
+    return 0
+
+
+def print_summary(args, table, model, res, pred, vmap, warnings, out=None):
+    """The fitted model, the predicted errors and what was rewritten (stdout)."""
+    out = sys.stdout if out is None else out
+    rows = table.rows()
+    print("Axis errors:  %s (%s layout; %s)"
+          % (args.axis_errors, table.layout,
+             ", ".join("%s %d rows" % (a.upper(), n) for a, n in rows.items())), file=out)
+    for line in model.summary_lines():
+        print(line, file=out)
+    env = vmap.as_dict()["envelope_mm"]
+    print("Predicted volumetric error over the measured envelope X %.1f..%.1f Y %.1f..%.1f "
+          "Z %.1f..%.1f mm: max %.3f um at (%.1f, %.1f, %.1f), RMS %.3f um"
+          % (tuple(v for r in env for v in r) + (_um(vmap.stats["max_mm"]),)
+             + tuple(vmap.stats["max_at_mm"]) + (_um(vmap.stats["rms_mm"]),)), file=out)
+    st = res.stats
+    print("", file=out)
+    print("Program:      %s (%d lines, %d moves)" % (args.program, st["lines_in"], st["moves"]),
+          file=out)
+    print("Output:       %d lines changed, %d added; %d G1 moves split, %d arcs turned into G1 "
+          "segments" % (st["lines_changed"], st["lines_added"], st["moves_split"],
+                        st["arcs_converted"]), file=out)
+    b, a = pred["before"], pred["after"]
+    print("Predicted positional error at the program's %d points (model, |E|):" % b["n"],
+          file=out)
+    print("  before compensation: max %.3f um, mean %.3f um, RMS %.3f um"
+          % (_um(b["max_mm"]), _um(b["mean_mm"]), _um(b["rms_mm"])), file=out)
+    print("  after compensation:  max %.4f um, mean %.4f um, RMS %.4f um (output rounding)"
+          % (_um(a["max_mm"]), _um(a["mean_mm"]), _um(a["rms_mm"])), file=out)
+    if model.fits:
+        worst = max(model.fits, key=lambda f: f.rms)
+        print("  the error functions fit the measurements within RMS %.3f um (worst: %s): "
+              "on the real machine the compensation is as good as that fit"
+              % (_um(worst.rms), worst.name), file=out)
+    if pred["points_unknown_axes"]:
+        print("  (%d point(s) with an axis the program had not set are not counted)"
+              % pred["points_unknown_axes"], file=out)
+    for w in warnings:
+        print("warning: " + w, file=sys.stderr)
+
+
+def build_report(args, table, model, prog_model, res, pred, vmap, warnings, outputs, seg, tol,
+                 arc_tol, reference, offset, start):
+    """The JSON report of ``gcode`` (schema ``surfcomp-gcode-report/1``)."""
+    return {
+        "schema": SCHEMA,
+        "surfcomp_version": __version__,
+        "created": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "command": "gcode",
+        "units": "mm",
+        "inputs": {
+            "program": {"path": os.path.abspath(args.program),
+                        "sha256": sha256_file(args.program), "lines": res.stats["lines_in"]},
+            "axis_errors": {"path": os.path.abspath(args.axis_errors),
+                            "sha256": sha256_file(args.axis_errors), "layout": table.layout,
+                            "rows": table.rows(), "units_without_suffix": args.units},
+        },
+        "options": {"model": args.model, "segment_length_mm": seg, "tolerance_mm": tol,
+                    "arc_tolerance_mm": arc_tol, "decimals": args.decimals,
+                    "reference_mm": reference.tolist(),
+                    "work_offset_mm": None if offset is None else offset.tolist(),
+                    "start_mm": None if start is None else start.tolist()},
+        "model": {**model.to_dict(), "components": model.components(),
+                  "fits": [dict(f.as_dict(), lines=table.lines[f.axis].tolist())
+                           for f in model.fits],
+                  "offset_spread_mm": model.offset_spread.tolist(),
+                  "sign": "error = actual - commanded; command X' solves X' + E(X') = X",
+                  "program_coordinates": prog_model.to_dict()},
+        "volumetric_map": vmap.as_dict(include_grid=True),
+        "program": res.stats,
+        "predicted": pred,
+        "warnings": list(warnings),
+        "outputs": outputs,
+    }

@@ -1,0 +1,731 @@
+"""Geometric error model of a 3-axis machine and its compensation (Dobariya et al. 2015).
+
+The model (Dobariya 2015, eq. 6-16)
+-----------------------------------
+Each slide ``a`` in ``x, y, z`` moves the tool by its travel ``t_a = X_a - r_a`` from a
+reference point ``r`` (default the program zero) and carries three 1-D error functions,
+``delta_i(a)`` = the tool-position error along ``i`` caused by slide ``a`` (``i`` in
+``x, y, z``): nine functions, each linear or quadratic in ``t_a`` and zero at ``t_a = 0``:
+
+- ``delta_a(a)`` positional error of slide ``a`` (eq. 6: ``delta_x(x) = delta_x1(x) +
+  delta_x2(x)``, scale error plus ball-screw positional error; the linear coefficient is
+  reported as the scale error, the quadratic one as the non-linear positional error);
+- ``delta_i(a) = delta'_i(a) + alpha_ai * t_a`` for ``i != a`` (eq. 7-8): straightness
+  ``delta'_y(x), delta'_x(y), delta'_x(z)`` and flatness ``delta'_z(x), delta'_z(y),
+  delta'_y(z)`` (the quadratic coefficients; a straightness error's linear part cannot be
+  told apart from an angle), and the slope ``alpha_ai`` of the cross-axis error.
+
+The three squareness errors are ``alpha_xy + alpha_yx``, ``alpha_xz + alpha_zx`` and
+``alpha_yz + alpha_zy`` (the angle between two slides minus 90 degrees); what is left of
+the six slopes is a rigid rotation of the measuring frame. The composition keeps all six
+slopes as measured, so a measured frame rotation is compensated too. Together: 3 positional
+(scale) + 3 straightness + 3 flatness + 3 squareness = the paper's 12 components.
+
+The tool-position error at a commanded point ``X`` is eq. 14,
+
+    E_i(X) = e0_i + delta_i(x) + delta_i(y) + delta_i(z),    i = x, y, z,
+
+with ``e0`` the error at the reference point (zero when the measurements are zeroed there).
+
+Sign convention: an error is **actual minus commanded** (the tool lands at ``X + E(X)``);
+Dobariya's eq. 1 defines ``E_p = P - P_a``, the opposite sign. Compensation (the issue's
+refinement of the paper's ``X' = X - E(X)``) solves ``X' + E(X') = X`` for the command
+``X'`` so that the tool lands on the programmed ``X``: Newton's method with the model's
+analytic Jacobian, vectorised over all points.
+
+Fitting
+-------
+Per axis, the measured rows (``position``, ``ex, ey, ez`` with the other slides at the
+reference) are fitted by least squares as polynomials in ``t`` of degree 1 or 2, one degree
+per component. ``model='linear'`` or ``'quadratic'`` fixes it; ``'auto'`` takes the
+quadratic only when the partial F-test of the quadratic term is significant at
+``alpha = 0.05`` (``F = (RSS_1 - RSS_2) / (RSS_2 / (n - 3))`` against ``F(1, n - 3)``), which
+needs ``n >= 4`` positions (with fewer, linear). A component fitted by a straight line
+within 1 nm RMS is linear. The value of each axis' fit at the reference is that axis'
+estimate of ``e0``; ``e0`` is their mean and the spread between axes is reported.
+
+Everything is in mm (angles and slopes in mm/mm = rad, quadratic terms in 1/mm).
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import stats
+
+from ..errors import ComputationError, InputError
+from .progress import report
+
+#: the three axes, in order
+AXES = ("x", "y", "z")
+#: fit choices of :func:`fit_axis_errors`
+MODEL_CHOICES = ("linear", "quadratic", "auto")
+#: significance level of the F-test of ``model='auto'``
+F_TEST_ALPHA = 0.05
+#: a component whose straight-line fit has an RMS residual below this (mm) stays linear
+EXACT_RMS = 1e-9
+#: Newton tolerance (mm) of :meth:`AxisErrorModel.compensate`
+COMPENSATE_TOL = 1e-10
+
+
+def _axis_index(name):
+    key = str(name).strip().lower()
+    if key not in AXES:
+        raise ValueError("axis must be one of x, y, z (got %r)" % (name,))
+    return AXES.index(key)
+
+
+def _points(points):
+    p = np.asarray(points, dtype=float)
+    if p.shape[-1:] != (3,):
+        raise ValueError("points must have shape (..., 3), got %s" % (p.shape,))
+    return p
+
+
+@dataclass
+class ComponentFit:
+    """The least-squares fit of one error function ``delta_i(a)``.
+
+    Attributes
+    ----------
+    axis, component : str
+        Moving slide ``a`` and error direction ``i`` (``'x'``, ``'y'``, ``'z'``).
+    degree : int
+        1 or 2.
+    coefficients : ndarray (3,)
+        ``b0, b1, b2`` of ``b0 + b1 t + b2 t**2`` with ``t = position - reference`` (mm,
+        mm/mm, 1/mm); ``b2 = 0`` for degree 1. ``b0`` is this axis' estimate of ``e0``.
+    positions, values, residuals : ndarray (n,)
+        Measured positions (mm), measured errors (mm), measured minus fitted (mm).
+    rss, rms, max_abs : float
+        Residual sum of squares (mm^2), RMS and largest absolute residual (mm).
+    r2_adjusted : float
+        Adjusted coefficient of determination; NaN when undefined (n <= degree + 1, or a
+        constant measured error).
+    rule : str
+        How the degree was chosen: ``'given'``, ``'F-test'``, ``'exact line'``, ``'n < 4'``.
+    f_statistic, p_value : float
+        Partial F-test of the quadratic term (``'auto'`` with n >= 4), else NaN.
+    """
+
+    axis: str
+    component: str
+    degree: int
+    coefficients: np.ndarray
+    positions: np.ndarray
+    values: np.ndarray
+    residuals: np.ndarray
+    rss: float
+    rms: float
+    max_abs: float
+    r2_adjusted: float
+    rule: str
+    f_statistic: float = float("nan")
+    p_value: float = float("nan")
+
+    @property
+    def name(self):
+        """Paper notation, e.g. ``delta_y(x)``."""
+        return "delta_%s(%s)" % (self.component, self.axis)
+
+    @property
+    def n(self):
+        return int(self.positions.size)
+
+    def as_dict(self):
+        def num(v):
+            return None if not np.isfinite(v) else float(v)
+        return {"function": self.name, "axis": self.axis, "component": self.component,
+                "degree": self.degree, "b0_mm": float(self.coefficients[0]),
+                "b1": float(self.coefficients[1]), "b2_per_mm": float(self.coefficients[2]),
+                "n": self.n, "rms_residual_mm": float(self.rms),
+                "max_residual_mm": float(self.max_abs), "r2_adjusted": num(self.r2_adjusted),
+                "rule": self.rule, "f_statistic": num(self.f_statistic),
+                "p_value": num(self.p_value),
+                "residuals_mm": [float(v) for v in self.residuals]}
+
+
+class AxisErrorModel:
+    """The 12-component error model of a 3-axis machine (Dobariya 2015, eq. 6-16).
+
+    Parameters
+    ----------
+    slope : array_like (3, 3)
+        ``slope[a, i]`` = linear coefficient of ``delta_i(a)`` (mm/mm): scale errors on the
+        diagonal, the squareness slopes ``alpha_ai`` off it.
+    curvature : array_like (3, 3)
+        ``curvature[a, i]`` = quadratic coefficient of ``delta_i(a)`` (1/mm): non-linear
+        positional error on the diagonal, straightness/flatness off it.
+    reference : array_like (3,)
+        Reference point ``r`` (mm) the travels ``t_a = X_a - r_a`` count from.
+    offset : array_like (3,)
+        ``e0``, the error at the reference point (mm).
+    travel : array_like (3, 2), optional
+        Measured range of each slide (mm); NaN rows for slides without data.
+    fits : list of ComponentFit, optional
+        The fits the model came from (for reports).
+    """
+
+    def __init__(self, slope=None, curvature=None, reference=(0.0, 0.0, 0.0),
+                 offset=(0.0, 0.0, 0.0), travel=None, fits=(), offset_spread=None):
+        self.slope = np.zeros((3, 3)) if slope is None else np.array(slope, dtype=float)
+        self.curvature = (np.zeros((3, 3)) if curvature is None
+                          else np.array(curvature, dtype=float))
+        self.reference = np.array(reference, dtype=float).reshape(3)
+        self.offset = np.array(offset, dtype=float).reshape(3)
+        self.travel = (np.full((3, 2), np.nan) if travel is None
+                       else np.array(travel, dtype=float).reshape(3, 2))
+        self.fits = list(fits)
+        self.offset_spread = (np.zeros(3) if offset_spread is None
+                              else np.array(offset_spread, dtype=float).reshape(3))
+        if self.slope.shape != (3, 3) or self.curvature.shape != (3, 3):
+            raise ValueError("slope and curvature must be 3 x 3")
+        for name, arr in (("slope", self.slope), ("curvature", self.curvature),
+                          ("reference", self.reference), ("offset", self.offset)):
+            if not np.all(np.isfinite(arr)):
+                raise ValueError("%s of the axis error model has non-finite values" % name)
+
+    # ----------------------------------------------------------------- construction
+    @classmethod
+    def zero(cls, reference=(0.0, 0.0, 0.0)):
+        """A model with no error at all (compensation returns its input exactly)."""
+        return cls(reference=reference)
+
+    @classmethod
+    def from_components(cls, scale=None, positional=None, straightness=None, squareness=None,
+                        reference=(0.0, 0.0, 0.0), offset=(0.0, 0.0, 0.0)):
+        """Build a model from the paper's named components (Dobariya 2015, eq. 6-8).
+
+        Parameters
+        ----------
+        scale : dict, optional
+            ``{'x': s}``: scale error ``delta_x1(x) = s * t_x`` (mm/mm), eq. 6.
+        positional : dict, optional
+            ``{'x': (c1, c2)}``: ball-screw positional error ``delta_x2(x) = c1 t + c2 t^2``,
+            eq. 6.
+        straightness : dict, optional
+            ``{'y(x)': (c1, c2)}``: straightness/flatness ``delta'_y(x) = c1 t_x + c2 t_x^2``
+            (error along ``y`` of slide ``x``), eq. 7-8. Keys ``'i(a)'`` with ``i != a``.
+        squareness : dict, optional
+            ``{'xy': alpha}``: ``alpha_xy`` (rad), entering ``delta_y(x)`` as
+            ``alpha_xy * t_x`` (eq. 7); key ``'ai'`` = moving slide ``a``, direction ``i``.
+        reference, offset : array_like (3,)
+            Reference point and error at it (mm).
+        """
+        slope = np.zeros((3, 3))
+        curv = np.zeros((3, 3))
+        for ax, s in (scale or {}).items():
+            a = _axis_index(ax)
+            slope[a, a] += float(s)
+        for ax, (c1, c2) in (positional or {}).items():
+            a = _axis_index(ax)
+            slope[a, a] += float(c1)
+            curv[a, a] += float(c2)
+        for key, (c1, c2) in (straightness or {}).items():
+            k = key.replace(" ", "").lower()
+            if len(k) != 4 or k[1] != "(" or k[3] != ")" or k[0] == k[2]:
+                raise ValueError("straightness keys are 'i(a)' with i != a, e.g. 'y(x)' "
+                                 "(got %r)" % key)
+            i, a = _axis_index(k[0]), _axis_index(k[2])
+            slope[a, i] += float(c1)
+            curv[a, i] += float(c2)
+        for key, alpha in (squareness or {}).items():
+            k = key.strip().lower()
+            if len(k) != 2 or k[0] == k[1]:
+                raise ValueError("squareness keys are two different axes, e.g. 'xy' (got %r)"
+                                 % key)
+            a, i = _axis_index(k[0]), _axis_index(k[1])
+            slope[a, i] += float(alpha)
+        return cls(slope, curv, reference=reference, offset=offset)
+
+    def to_dict(self):
+        """JSON-able dict; :meth:`from_dict` restores the model (without the fits)."""
+        return {"reference_mm": self.reference.tolist(), "offset_mm": self.offset.tolist(),
+                "slope": self.slope.tolist(), "curvature_per_mm": self.curvature.tolist(),
+                "travel_mm": [[None if not np.isfinite(v) else float(v) for v in row]
+                              for row in self.travel],
+                "layout": "slope[a][i], curvature[a][i]: slide a = x,y,z moving, "
+                          "error along i = x,y,z"}
+
+    @classmethod
+    def from_dict(cls, d):
+        travel = np.array([[np.nan if v is None else v for v in row]
+                           for row in d.get("travel_mm", [[None, None]] * 3)], dtype=float)
+        return cls(d["slope"], d["curvature_per_mm"], reference=d["reference_mm"],
+                   offset=d["offset_mm"], travel=travel)
+
+    def in_program_coordinates(self, work_offset):
+        """The same machine seen from a program whose zero sits at ``work_offset``.
+
+        Parameters
+        ----------
+        work_offset : array_like (3,)
+            Machine coordinates (mm) of the program zero (the G54 offset), when the error
+            measurements are in machine coordinates.
+
+        Returns
+        -------
+        AxisErrorModel
+            ``E_prog(P) = E(P + work_offset)``: reference and travel shifted by
+            ``-work_offset``.
+        """
+        o = np.array(work_offset, dtype=float).reshape(3)
+        return AxisErrorModel(self.slope, self.curvature, self.reference - o, self.offset,
+                              self.travel - o[:, None], self.fits, self.offset_spread)
+
+    # ------------------------------------------------------------------- evaluation
+    def is_zero(self):
+        return not (self.slope.any() or self.curvature.any() or self.offset.any())
+
+    def delta(self, component, axis, positions):
+        """One error function ``delta_i(a)`` (eq. 6-8) at slide positions (mm).
+
+        Parameters
+        ----------
+        component, axis : str
+            Error direction ``i`` and moving slide ``a``.
+        positions : array_like (n,)
+            Positions of slide ``a`` (mm, absolute, not travel).
+
+        Returns
+        -------
+        ndarray (n,)
+            ``slope[a, i] t + curvature[a, i] t^2`` with ``t = position - r_a`` (mm).
+        """
+        i, a = _axis_index(component), _axis_index(axis)
+        t = np.asarray(positions, dtype=float) - self.reference[a]
+        return self.slope[a, i] * t + self.curvature[a, i] * t * t
+
+    def error(self, points):
+        """Tool-position error ``E(X)`` (actual minus commanded), eq. 14.
+
+        Parameters
+        ----------
+        points : array_like (..., 3)
+            Commanded points (mm).
+
+        Returns
+        -------
+        ndarray (..., 3)
+            ``E_i = e0_i + sum_a (slope[a, i] t_a + curvature[a, i] t_a^2)`` (mm).
+        """
+        p = _points(points)
+        t = p - self.reference
+        return self.offset + t @ self.slope + (t * t) @ self.curvature
+
+    def jacobian(self, points):
+        """``dE_i/dX_a`` at the points: array (..., 3, 3) indexed ``[..., i, a]``."""
+        p = _points(points)
+        t = p - self.reference
+        d = self.slope[None, :, :] + 2.0 * t.reshape(-1, 3)[:, :, None] * self.curvature
+        return np.swapaxes(d, 1, 2).reshape(p.shape[:-1] + (3, 3))
+
+    def actual(self, points):
+        """Where the tool lands for commanded points: ``X + E(X)`` (mm)."""
+        p = _points(points)
+        return p + self.error(p)
+
+    def compensate(self, points, tol=COMPENSATE_TOL, max_iter=30):
+        """Commands ``X'`` with ``X' + E(X') = X``: the tool lands on the programmed ``X``.
+
+        Newton's method with the analytic Jacobian ``I + dE/dX``, started from the
+        paper's first-order ``X - E(X)``; vectorised over all points.
+
+        Parameters
+        ----------
+        points : array_like (..., 3)
+            Programmed points (mm).
+        tol : float
+            Largest accepted ``|X' + E(X') - X|`` per coordinate (mm).
+
+        Returns
+        -------
+        ndarray (..., 3)
+            Compensated commands (mm). A zero model returns the input values exactly.
+
+        Raises
+        ------
+        ComputationError
+            When Newton's method does not converge (an error model whose slopes reach
+            -1, i.e. a slide that does not move).
+        """
+        p = _points(points)
+        flat = p.reshape(-1, 3)
+        if self.is_zero() or flat.shape[0] == 0:
+            return p.copy()
+        xc = flat - self.error(flat)
+        for _ in range(max_iter):
+            r = xc + self.error(xc) - flat
+            bad = np.abs(r).max(axis=1) > tol
+            if not bad.any():
+                return xc.reshape(p.shape)
+            J = self.jacobian(xc[bad]) + np.eye(3)
+            try:
+                xc[bad] -= np.linalg.solve(J, r[bad][:, :, None])[:, :, 0]
+            except np.linalg.LinAlgError as exc:
+                raise ComputationError("axis error compensation: singular Jacobian (%s); the "
+                                       "error model's slopes make a slide stand still" % exc)
+        raise ComputationError("axis error compensation did not converge in %d Newton steps "
+                               "(largest residual %.3g mm)" % (max_iter, np.abs(r).max()))
+
+    # --------------------------------------------------------------------- reports
+    def components(self):
+        """The 12 components of Dobariya 2015 (plus the six measured slopes).
+
+        Returns
+        -------
+        dict
+            ``scale`` {axis: mm/mm}, ``positional_quadratic`` {axis: 1/mm} (eq. 6),
+            ``straightness`` {'y(x)', 'x(y)', 'x(z)': 1/mm}, ``flatness`` {'z(x)', 'z(y)',
+            'y(z)': 1/mm} (quadratic coefficients of ``delta'``, eq. 7-8),
+            ``squareness`` {'xy', 'xz', 'yz': rad} (``alpha_ab + alpha_ba``),
+            ``slopes`` {'xy', ...: rad} (the six ``alpha_ai``), ``offset_mm`` (e0).
+        """
+        s, c = self.slope, self.curvature
+        idx = {a: k for k, a in enumerate(AXES)}
+        return {
+            "scale": {a: float(s[k, k]) for k, a in enumerate(AXES)},
+            "positional_quadratic": {a: float(c[k, k]) for k, a in enumerate(AXES)},
+            "straightness": {key: float(c[idx[key[2]], idx[key[0]]])
+                             for key in ("y(x)", "x(y)", "x(z)")},
+            "flatness": {key: float(c[idx[key[2]], idx[key[0]]])
+                         for key in ("z(x)", "z(y)", "y(z)")},
+            "squareness": {ab: float(s[idx[ab[0]], idx[ab[1]]] + s[idx[ab[1]], idx[ab[0]]])
+                           for ab in ("xy", "xz", "yz")},
+            "slopes": {a + i: float(s[idx[a], idx[i]]) for a in AXES for i in AXES if a != i},
+            "offset_mm": self.offset.tolist(),
+        }
+
+    def summary_lines(self):
+        """Human-readable lines: per-function fit and the 12 components."""
+        out = []
+        if self.fits:
+            out.append("Fitted error functions (t = position - reference, mm; "
+                       "error = actual - commanded):")
+            out.append("  %-11s %3s %6s %12s %13s %13s %10s %10s  %s"
+                       % ("function", "n", "degree", "b0 [um]", "b1 [um/m]", "b2 [um/m^2]",
+                          "rms [um]", "max [um]", "rule"))
+            for f in self.fits:
+                out.append("  %-11s %3d %6d %12.3f %13.3f %13.3f %10.3f %10.3f  %s"
+                           % (f.name, f.n, f.degree, f.coefficients[0] * 1e3,
+                              f.coefficients[1] * 1e6, f.coefficients[2] * 1e9,
+                              f.rms * 1e3, f.max_abs * 1e3, f.rule
+                              + ("" if not np.isfinite(f.p_value) else " p=%.3g" % f.p_value)))
+            missing = [a.upper() for k, a in enumerate(AXES)
+                       if not np.isfinite(self.travel[k]).all()]
+            if missing:
+                out.append("  not measured (no error assumed): %s" % ", ".join(missing))
+        comp = self.components()
+        out.append("Components (Dobariya 2015, eq. 6-8): scale [um/m] X %.3f Y %.3f Z %.3f"
+                   % tuple(comp["scale"][a] * 1e6 for a in AXES))
+        out.append("  squareness [urad] XY %.3f XZ %.3f YZ %.3f; straightness [um/m^2] "
+                   "y(x) %.3f x(y) %.3f x(z) %.3f; flatness [um/m^2] z(x) %.3f z(y) %.3f "
+                   "y(z) %.3f"
+                   % (tuple(comp["squareness"][k] * 1e6 for k in ("xy", "xz", "yz"))
+                      + tuple(comp["straightness"][k] * 1e9 for k in ("y(x)", "x(y)", "x(z)"))
+                      + tuple(comp["flatness"][k] * 1e9 for k in ("z(x)", "z(y)", "y(z)"))))
+        out.append("  error at the reference (%.3f, %.3f, %.3f) mm: e0 = (%.3f, %.3f, %.3f) um"
+                   % (tuple(self.reference) + tuple(self.offset * 1e3))
+                   + ("" if not self.offset_spread.any() else
+                      " (spread between axes %.3f %.3f %.3f um)"
+                      % tuple(self.offset_spread * 1e3)))
+        return out
+
+    def fit_dicts(self):
+        return [f.as_dict() for f in self.fits]
+
+
+# ---------------------------------------------------------------------------- fitting
+def _polyfit(t, y, degree):
+    """Least squares ``y ~ sum b_k t^k``; returns (coefficients (3, m), residuals (n, m))."""
+    coef = np.polynomial.polynomial.polyfit(t, y, degree)
+    coef = np.atleast_2d(coef.T).T if y.ndim == 1 else coef
+    full = np.zeros((3,) + coef.shape[1:])
+    full[:degree + 1] = coef
+    fitted = np.polynomial.polynomial.polyval(t, coef)
+    fitted = fitted.T if y.ndim > 1 else fitted
+    return full, y - fitted
+
+
+def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_ALPHA,
+                    source=None):
+    """Fit the nine 1-D error functions from per-axis measurements (Dobariya 2015, sec. 4).
+
+    Parameters
+    ----------
+    data : mapping
+        ``{'x': (positions (n,), errors (n, 3)), ...}``: for each measured slide, its
+        positions (mm, absolute) and the tool-position errors along x, y, z (mm, actual
+        minus commanded) with the other slides at the reference. Missing slides get no
+        error (reported in the summary).
+    model : {'linear', 'quadratic', 'auto'}
+        Degree of every function, or ``'auto'``: per function, quadratic when the partial
+        F-test of the quadratic term is significant at ``alpha`` (needs n >= 4).
+    reference : array_like (3,)
+        Reference point (mm): where the other slides stood while one was measured.
+    source : str, optional
+        File name for error messages.
+
+    Returns
+    -------
+    AxisErrorModel
+        With ``fits`` (one :class:`ComponentFit` per measured function) and ``offset`` =
+        the mean of the per-axis estimates of the error at the reference.
+
+    Raises
+    ------
+    InputError
+        Unknown ``model``, no data at all, or too few distinct positions for the degree.
+    """
+    if model not in MODEL_CHOICES:
+        raise InputError("unknown axis error model %r (expected one of %s)"
+                         % (model, ", ".join(MODEL_CHOICES)), file=source)
+    ref = np.array(reference, dtype=float).reshape(3)
+    slope = np.zeros((3, 3))
+    curv = np.zeros((3, 3))
+    travel = np.full((3, 2), np.nan)
+    b0 = np.full((3, 3), np.nan)
+    fits = []
+    keys = {str(k).strip().lower(): v for k, v in dict(data).items()}
+    unknown = sorted(set(keys) - set(AXES))
+    if unknown:
+        raise InputError("unknown axis %r in the axis error data (expected x, y, z)"
+                         % unknown[0], file=source)
+    if not keys:
+        raise InputError("no axis error measurements (expected rows for X, Y and/or Z)",
+                         file=source)
+    for a, ax in enumerate(AXES):
+        if ax not in keys:
+            continue
+        pos, err = keys[ax]
+        pos = np.asarray(pos, dtype=float).reshape(-1)
+        err = np.asarray(err, dtype=float).reshape(-1, 3)
+        if err.shape[0] != pos.size:
+            raise ValueError("axis %s: %d positions but %d error rows" % (ax, pos.size,
+                                                                           err.shape[0]))
+        if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(err))):
+            raise InputError("axis %s: non-finite measured values" % ax.upper(), file=source)
+        n_distinct = np.unique(pos).size
+        need = 3 if model == "quadratic" else 2
+        if n_distinct < need:
+            raise InputError("axis %s: %d distinct position(s) measured; a %s fit needs at "
+                             "least %d" % (ax.upper(), n_distinct,
+                                           "quadratic" if need == 3 else "linear", need),
+                             file=source)
+        travel[a] = pos.min(), pos.max()
+        t = pos - ref[a]
+        n = pos.size
+        c1, r1 = _polyfit(t, err, 1)
+        c2, r2 = (_polyfit(t, err, 2) if n_distinct >= 3 else (None, None))
+        for i, comp in enumerate(AXES):
+            rss1 = float(np.sum(r1[:, i] ** 2))
+            f_stat = p_val = float("nan")
+            if model == "linear":
+                deg, rule = 1, "given"
+            elif model == "quadratic":
+                deg, rule = 2, "given"
+            elif c2 is None or n < 4:
+                deg, rule = 1, "n < 4"
+            elif rss1 <= n * EXACT_RMS ** 2:
+                deg, rule = 1, "exact line"
+            else:
+                rss2 = float(np.sum(r2[:, i] ** 2))
+                if rss2 <= n * EXACT_RMS ** 2:
+                    f_stat, p_val = float("inf"), 0.0
+                else:
+                    f_stat = (rss1 - rss2) / (rss2 / (n - 3))
+                    p_val = float(stats.f.sf(f_stat, 1, n - 3))
+                deg, rule = (2 if p_val < alpha else 1), "F-test"
+            coef = (c1 if deg == 1 else c2)[:, i].copy()
+            res = (r1 if deg == 1 else r2)[:, i].copy()
+            rss = float(np.sum(res ** 2))
+            tss = float(np.sum((err[:, i] - err[:, i].mean()) ** 2))
+            dof = n - deg - 1
+            r2a = (1.0 - (rss / dof) / (tss / (n - 1))) if (dof > 0 and tss > 0) else np.nan
+            fits.append(ComponentFit(ax, comp, deg, coef, pos.copy(), err[:, i].copy(), res,
+                                     rss, float(np.sqrt(rss / n)), float(np.abs(res).max()),
+                                     float(r2a), rule, float(f_stat), float(p_val)))
+            slope[a, i] = coef[1]
+            curv[a, i] = coef[2]
+            b0[a, i] = coef[0]
+    measured = np.isfinite(b0[:, 0])
+    offset = b0[measured].mean(axis=0)
+    spread = b0[measured].max(axis=0) - b0[measured].min(axis=0)
+    return AxisErrorModel(slope, curv, reference=ref, offset=offset, travel=travel, fits=fits,
+                          offset_spread=spread)
+
+
+# ------------------------------------------------------------------ volumetric error map
+@dataclass
+class VolumetricMap:
+    """Predicted error over a box (the work envelope).
+
+    Attributes
+    ----------
+    axes : tuple of 3 ndarrays
+        Grid coordinates along x, y, z (mm).
+    error : ndarray (nx, ny, nz, 3)
+        ``E(X)`` at the grid points (mm).
+    magnitude : ndarray (nx, ny, nz)
+        ``|E(X)|`` (mm).
+    """
+
+    axes: tuple
+    error: np.ndarray
+    magnitude: np.ndarray
+    stats: dict = field(default_factory=dict)
+
+    def as_dict(self, include_grid=False):
+        d = {"envelope_mm": [[float(a[0]), float(a[-1])] for a in self.axes],
+             "shape": list(self.magnitude.shape), **self.stats}
+        if include_grid:
+            d["axes_mm"] = [a.tolist() for a in self.axes]
+            d["error_mm"] = np.round(self.error, 9).tolist()
+        return d
+
+
+def volumetric_map(model, envelope=None, shape=(11, 11, 11)):
+    """Predicted volumetric error over the work envelope (Dobariya 2015, sec. 4.1).
+
+    Parameters
+    ----------
+    model : AxisErrorModel
+    envelope : array_like (3, 2), optional
+        ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]`` (mm); default the measured travel,
+        and the reference for unmeasured slides.
+    shape : tuple of 3 int
+        Grid points per axis (a slide with an empty range gets one).
+
+    Returns
+    -------
+    VolumetricMap
+        With ``stats``: ``max_mm``, ``mean_mm``, ``rms_mm`` of ``|E|``, ``max_at_mm`` (the
+        grid point of the largest error) and ``max_component_mm`` (largest ``|E_i|``).
+    """
+    if envelope is None:
+        env = model.travel.copy()
+        missing = ~np.isfinite(env).all(axis=1)
+        env[missing] = model.reference[missing, None]
+    else:
+        env = np.array(envelope, dtype=float).reshape(3, 2)
+    axes = tuple(np.linspace(env[k, 0], env[k, 1], 1 if env[k, 0] == env[k, 1] else int(n))
+                 for k, n in enumerate(shape))
+    grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1)
+    err = model.error(grid)
+    mag = np.linalg.norm(err, axis=-1)
+    k = np.unravel_index(np.argmax(mag), mag.shape)
+    st = {"max_mm": float(mag.max()), "mean_mm": float(mag.mean()),
+          "rms_mm": float(np.sqrt(np.mean(mag ** 2))), "max_at_mm": grid[k].tolist(),
+          "max_component_mm": np.abs(err).reshape(-1, 3).max(axis=0).tolist()}
+    return VolumetricMap(axes, err, mag, st)
+
+
+# ----------------------------------------------------------------- simulated machine
+class SimulatedMachine:
+    """A 3-axis machine with known geometric errors, for validation.
+
+    The tool lands at ``X + E_true(X)`` with ``E_true`` composed as in eq. 14 from a
+    polynomial :class:`AxisErrorModel` plus optional non-polynomial per-slide terms (e.g.
+    a periodic ball-screw error) that a linear/quadratic fit cannot represent.
+
+    Parameters
+    ----------
+    model : AxisErrorModel
+        The polynomial part (its reference is the machine's reference point).
+    extra : dict, optional
+        ``{'x': f}`` with ``f(t) -> (n, 3)``: additional error (mm) of slide ``x`` at travel
+        ``t = X_x - r_x``; should be 0 at ``t = 0`` so that the measurement at the
+        reference stays ``e0``.
+    """
+
+    def __init__(self, model, extra=None):
+        self.model = model
+        self.extra = {k.lower(): f for k, f in (extra or {}).items()}
+        for k in self.extra:
+            _axis_index(k)
+
+    def error(self, points):
+        """True tool-position error at commanded points (mm), shape (..., 3)."""
+        p = _points(points)
+        e = self.model.error(p)
+        for ax, f in self.extra.items():
+            a = _axis_index(ax)
+            t = (p[..., a] - self.model.reference[a]).reshape(-1)
+            e = e + np.asarray(f(t), dtype=float).reshape(p.shape)
+        return e
+
+    def actual(self, points):
+        """Where the tool lands for commanded points (mm)."""
+        p = _points(points)
+        return p + self.error(p)
+
+    def measure(self, positions, noise=0.0, seed=0):
+        """Simulate the per-axis measurement (one slide moves, the others at the reference).
+
+        Parameters
+        ----------
+        positions : mapping
+            ``{'x': positions (n,)}`` (mm).
+        noise : float
+            Standard deviation (mm) of Gaussian measurement noise per reading.
+        seed : int
+            Seed of ``numpy.random.default_rng``.
+
+        Returns
+        -------
+        dict
+            ``{'x': (positions (n,), errors (n, 3))}``, the input of :func:`fit_axis_errors`.
+        """
+        rng = np.random.default_rng(seed)
+        out = {}
+        for ax in AXES:
+            if ax not in positions and ax.upper() not in positions:
+                continue
+            p = np.asarray(positions.get(ax, positions.get(ax.upper())), dtype=float)
+            pts = np.repeat(self.model.reference[None, :], p.size, axis=0)
+            pts[:, _axis_index(ax)] = p
+            e = self.error(pts)
+            if noise:
+                e = e + rng.normal(0.0, noise, e.shape)
+            out[ax] = (p.copy(), e)
+        return out
+
+
+def error_stats(vectors):
+    """``max``, ``mean``, ``rms`` of ``|v|`` and largest ``|v_i|`` per axis (mm)."""
+    v = np.asarray(vectors, dtype=float).reshape(-1, 3)
+    if v.shape[0] == 0:
+        return {"n": 0, "max_mm": 0.0, "mean_mm": 0.0, "rms_mm": 0.0,
+                "max_component_mm": [0.0, 0.0, 0.0]}
+    m = np.linalg.norm(v, axis=1)
+    return {"n": int(v.shape[0]), "max_mm": float(m.max()), "mean_mm": float(m.mean()),
+            "rms_mm": float(np.sqrt(np.mean(m ** 2))),
+            "max_component_mm": np.abs(v).max(axis=0).tolist()}
+
+
+def validate(model, machine, points, progress=None):
+    """Positional error of programmed points before and after compensation.
+
+    Parameters
+    ----------
+    model : AxisErrorModel
+        The model used to compensate (e.g. fitted from ``machine.measure``).
+    machine : SimulatedMachine
+        The machine with the true errors.
+    points : array_like (n, 3)
+        Programmed points (mm).
+
+    Returns
+    -------
+    dict
+        ``before`` (tool error commanding ``X``) and ``after`` (commanding the compensated
+        ``X'``): :func:`error_stats` of ``actual - X``; ``reduction`` = 1 - after RMS /
+        before RMS.
+    """
+    p = _points(points).reshape(-1, 3)
+    report(progress, 0.0, "compensating %d points" % p.shape[0])
+    before = machine.actual(p) - p
+    after = machine.actual(model.compensate(p)) - p
+    report(progress, 1.0, "done")
+    b, a = error_stats(before), error_stats(after)
+    red = 1.0 - a["rms_mm"] / b["rms_mm"] if b["rms_mm"] > 0 else 0.0
+    return {"before": b, "after": a, "reduction": red}
