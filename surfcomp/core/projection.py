@@ -3,10 +3,13 @@
 Method: a dense sample grid of the face (:func:`bspline.evaluate_grid` with
 second derivatives) in a ``scipy.spatial.cKDTree`` gives seeds; safeguarded
 Newton iterations on ``(S - P) . Su = 0``, ``(S - P) . Sv = 0`` (second-order
-Hessian, Gauss-Newton fallback, step halving, bound constraints on the work
-area) refine them. Points near the curvature centre of concave regions, or
-whose nearest samples lie in different parts of the face, get several seeds
-and keep the best. Everything is vectorised over points and chunked.
+Hessian, shifted to positive definite where it is not, step halving, bound
+constraints on the work area) refine them. Points farther from the face than
+half its smallest radius of curvature are checked: samples within reach whose
+one-step prediction lands elsewhere, and (near curvature centres or where
+another part of the face comes close) all parts of the face within reach, seed
+further Newton runs; the best result wins. Everything is vectorised over points,
+chunked and run in threads.
 
 Evaluation inside the Newton loop uses a per-span power-basis table of the
 surface (Taylor coefficients of each polynomial piece, from the basis
@@ -14,7 +17,10 @@ functions' derivatives at the span starts) evaluated by Horner's scheme on
 structure-of-arrays data; it is tested against :func:`bspline.derivatives`.
 """
 
+import itertools
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,11 +33,8 @@ from ..errors import GeometryError, InputError
 #: Newton stops when a full (second-order) step moves the foot point less than
 #: this (mm): the error left after applying it is O(step^2 / R) ~ 1e-13 mm
 STEP_TOL = 1e-6
-#: the same for Gauss-Newton steps and near curvature centres (linear convergence)
+#: the same for other steps and near curvature centres (linear convergence)
 STEP_TOL_SLOW = 1e-10
-#: after two consecutive full Newton steps d1, d2 the error left after d2 is
-#: about C d2^2 with C = d2 / d1^2; a step is also final when that is below this (mm)
-PREDICTED_TOL = 1e-10
 #: Newton iterations per point in the first, chunked pass (the rest is batched)
 FIRST_PASS_ITER = 8
 #: points per vectorised Newton chunk (keeps temporaries in cache)
@@ -61,9 +64,11 @@ class Projection:
         The unconstrained foot point lies outside the work area: the closest
         point is on the face boundary (u or v at a bound).
     converged : ndarray of bool, shape (N,)
-        Newton converged (step below 1e-10 mm). False also for NaN input points
-        and points farther than ``max_distance``; their other fields are NaN
-        (``outside`` False).
+        Newton converged: the last full Newton step moved the foot less than
+        ``STEP_TOL`` (1e-6 mm, leaving an error ~1e-13 mm), another step less
+        than 1e-10 mm, or no further decrease was possible at the rounding
+        level. False also for NaN input points and points farther than
+        ``max_distance``; their other fields are NaN (``outside`` False).
     """
 
     u: np.ndarray
@@ -226,8 +231,9 @@ class _Newton:
     """Safeguarded, bound-constrained Newton iterations for many points at once.
 
     Minimises ``f(u, v) = |S(u, v) - P|^2 / 2`` over the work area: full
-    Newton steps where the Hessian of f is positive definite, Gauss-Newton
-    steps elsewhere, variables at a bound with the gradient pointing outwards
+    Newton steps where the Hessian of f is positive definite, shifted-Hessian
+    (or Gauss-Newton) steps elsewhere, variables at a bound with the gradient
+    pointing outwards
     held fixed (projected Newton), steps limited to half the work area, and
     halved back towards the last accepted point when f grew.
     """
@@ -247,17 +253,25 @@ class _Newton:
         det = Huu * Hvv - Huv * Huv
         gn_det = a * c - b * b
         pd = (Huu > 0) & (Hvv > 0) & (det > 1e-10 * gn_det)
-        # (slightly damped) Gauss-Newton where the full Hessian is not positive definite
-        mu = 1e-9 * (a + c)
-        Huu = np.where(pd, Huu, a + mu)
-        Huv = np.where(pd, Huv, b)
-        Hvv = np.where(pd, Hvv, c + mu)
-        det = np.where(pd, det, (a + mu) * (c + mu) - b * b)
         fix_u = ((u <= self.u0) & (gu > 0)) | ((u >= self.u1) & (gu < 0))
         fix_v = ((v <= self.v0) & (gv > 0)) | ((v >= self.v1) & (gv < 0))
+        # where the Hessian is not positive definite: the Hessian shifted by
+        # sigma I (sigma = 1.5 |lambda_min|, so its smallest eigenvalue becomes
+        # |lambda_min| / 2, plus a little Gauss-Newton scale); with one variable
+        # held at a bound only its own curvature matters (else Gauss-Newton)
+        mu = 1e-9 * (a + c)
+        h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
+        h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
+        if pd.all():
+            H_uu, H_uv, H_vv, det2 = Huu, Huv, Hvv, det
+        else:
+            lam_min = 0.5 * (Huu + Hvv) - np.sqrt(0.25 * (Huu - Hvv) ** 2 + Huv * Huv)
+            sigma = np.where(pd, 0.0, 1.5 * np.abs(np.minimum(lam_min, 0.0)) + 1e-3 * (a + c))
+            H_uu, H_uv, H_vv = Huu + sigma, Huv, Hvv + sigma
+            det2 = H_uu * H_vv - H_uv * H_uv
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            du = np.where(fix_v, -gu / Huu, (Huv * gv - Hvv * gu) / det)
-            dv = np.where(fix_u, -gv / Hvv, (Huv * gu - Huu * gv) / det)
+            du = np.where(fix_v, -gu / h_u, (H_uv * gv - H_vv * gu) / det2)
+            dv = np.where(fix_u, -gv / h_v, (H_uv * gu - H_uu * gv) / det2)
         du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
         dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
         # trust region: at most half the work area per step
@@ -266,7 +280,10 @@ class _Newton:
         scale = 1.0 / np.maximum(lim, 1.0)
         un = np.minimum(np.maximum(u + du * scale, self.u0), self.u1)
         vn = np.minimum(np.maximum(v + dv * scale, self.v0), self.v1)
-        fast = pd & (det > 0.5 * gn_det)
+        # fast = a true Newton step away from a curvature centre (quadratic convergence)
+        fast = np.where(fix_u | fix_v,
+                        np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a),
+                        pd & (det > 0.5 * gn_det))
         return un - u, vn - v, fast
 
     def run(self, P, u, v, seed_derivs=None, maxiter=None):
@@ -299,7 +316,6 @@ class _Newton:
         dul, dvl = np.zeros(n), np.zeros(n)
         halv = np.zeros(n)
         mvl = np.full(n, np.inf)
-        fastl = np.zeros(n, dtype=bool)
         best = None
         for it in range((maxiter or self.maxiter) + 1):
             if idx.size == 0:
@@ -325,11 +341,8 @@ class _Newton:
             du, dv, fast = self.step(uprev, vprev, r, *D[1:])
             mv = D[1] * du + D[2] * dv
             mvn = np.sqrt(_dot(mv, mv))
-            # quadratic convergence: predicted remaining error mvn^3 / mvl^2
-            quad = fast & fastl & (mvn <= 1e-3) & (mvn ** 3 <= PREDICTED_TOL * mvl ** 2)
-            done = acc & ((mvn <= np.where(fast, STEP_TOL, STEP_TOL_SLOW)) | quad)
+            done = acc & (mvn <= np.where(fast, STEP_TOL, STEP_TOL_SLOW))
             mvl = np.where(acc, mvn, mvl)
-            fastl = np.where(acc, fast, fastl)
             if anyworse:
                 # no decrease possible: the last accepted point is the answer; a
                 # minimum when the failed step was already at rounding level
@@ -364,7 +377,6 @@ class _Newton:
                 idx, Pa, ua, va = idx[keep], Pa[:, keep], ua[keep], va[keep]
                 uprev, vprev, fprev = uprev[keep], vprev[keep], fprev[keep]
                 dul, dvl, halv, mvl = dul[keep], dvl[keep], halv[keep], mvl[keep]
-                fastl = fastl[keep]
                 best = [b_[:, keep] for b_ in best]
         if idx.size:  # iteration limit: keep the last accepted point, not converged
             U[idx], V[idx] = uprev, vprev
@@ -406,16 +418,18 @@ class Projector:
     surf : bspline.Surface
         The face; projection stays inside ``surf.u_range x surf.v_range``.
     samples_per_span : int, optional
-        Seed samples per knot span and direction; default ``3 * (degree + 1)``,
-        reduced so that the grid has at most ``MAX_SAMPLES`` points.
+        Seed sample density: the grid spacing (mm, equal along u and v) is the
+        face length over ``spans * samples_per_span`` in the direction that gives
+        the finer spacing; default ``3 * (degree + 1)``; coarsened so that the
+        grid has at most ``MAX_SAMPLES`` points.
     workers : int, optional
-        Threads for the KD-tree queries (``cKDTree.query(workers=...)``);
-        default 1.
+        Threads for the Newton chunks and the KD-tree queries; default: the
+        number of CPUs.
     """
 
     def __init__(self, surf, samples_per_span=None, workers=None):
         self.surf = surf
-        self.workers = int(workers or 1)
+        self.workers = max(1, int(workers or os.cpu_count() or 1))
         if _SpanTable.size(surf) <= MAX_TABLE_VALUES:
             self.ev = _SpanTable(surf)
             bu, bv = self.ev.bu, self.ev.bv
@@ -428,10 +442,7 @@ class Projector:
         bv = np.unique(np.r_[v0, bv[(bv > v0) & (bv < v1)], v1])
         mu = samples_per_span or 3 * (surf.degree_u + 1)
         mv = samples_per_span or 3 * (surf.degree_v + 1)
-        while (bu.size * mu) * (bv.size * mv) > MAX_SAMPLES and max(mu, mv) > 1:
-            mu, mv = max(1, mu - 1), max(1, mv - 1)
-        self.us = _sample_params(bu, mu, u0, u1)
-        self.vs = _sample_params(bv, mv, v0, v1)
+        self.us, self.vs = self._sample_grid(bu, bv, mu, mv)
         D = bspline.evaluate_grid(surf, self.us, self.vs, order=2)
         self.samples = [d.reshape(-1, 3).T.copy() for d in D]  # SoA (3, M)
         grid = D[0]
@@ -444,8 +455,6 @@ class Projector:
                       np.linalg.norm(np.diff(grid, axis=1), axis=2).ravel()]
         edges = edges[edges > 0]
         self.voxel = 0.5 * float(np.median(edges)) if edges.size else 1.0
-        # points closer than this to the face have a unique closest point
-        # (half the smallest radius of curvature seen at the samples)
         # degenerate samples (collapsed edges, poles) are no seeds: Newton cannot
         # leave them (zero gradient) and all their parameters give one point
         scale_u, scale_v = bspline._derivative_scales(surf)
@@ -453,17 +462,44 @@ class Projector:
         regular = ~bspline._degenerate(np.cross(Su, Sv), Su, Sv, scale_u, scale_v, rel=1e-6)
         if not regular.any():
             raise GeometryError("the face is degenerate everywhere (Su x Sv = 0)")
+        # points closer than this to the face have a unique closest point
+        # (half the smallest radius of curvature seen at the samples)
         kmax = _max_curvature(self.samples)[regular]
         kmax = kmax[np.isfinite(kmax)]
         self.safe_distance = 0.5 / kmax.max() if kmax.size and kmax.max() > 0 else np.inf
         self.tree_ids = np.flatnonzero(regular)  # tree index -> sample index
-        # cumulative chord lengths along the grid lines: path lengths on the face
-        zero_u = np.zeros((1, grid.shape[1]))
-        zero_v = np.zeros((grid.shape[0], 1))
-        self.arc_u = np.r_[zero_u, np.cumsum(np.linalg.norm(np.diff(grid, axis=0), axis=2), 0)]
-        self.arc_v = np.c_[zero_v, np.cumsum(np.linalg.norm(np.diff(grid, axis=1), axis=2), 1)]
         self.tree = cKDTree(grid.reshape(-1, 3)[self.tree_ids])
         self.newton = _Newton(self.ev, surf.u_range, surf.v_range)
+
+    def _sample_grid(self, bu, bv, mu, mv):
+        """Sample parameters equally spaced in arc length (roughly square cells in mm).
+
+        The spacing is the finer of ``length / (spans * m)`` along u and v (the
+        per-span density), but no finer than what keeps the grid within
+        ``MAX_SAMPLES``.
+        """
+        surf = self.surf
+        (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+        fu = _sample_params(bu, 4, u0, u1)
+        fv = _sample_params(bv, 4, v0, v1)
+        lines = 7
+        Gu = bspline.evaluate_grid(surf, fu, np.linspace(v0, v1, lines))
+        Gv = bspline.evaluate_grid(surf, np.linspace(u0, u1, lines), fv)
+        # cumulative chord length along u / v, the longest of a few grid lines
+        Lu = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(Gu, axis=0), axis=2).max(axis=1))]
+        Lv = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(Gv, axis=1), axis=2).max(axis=0))]
+        lu, lv = Lu[-1], Lv[-1]
+        if lu <= 0 or lv <= 0:
+            raise GeometryError("the face has zero extent along u or v")
+        h = min(lu / max(1, (bu.size - 1) * mu), lv / max(1, (bv.size - 1) * mv))
+        h = max(h, np.sqrt(lu * lv / MAX_SAMPLES))
+        nu_s = int(min(np.ceil(lu / h), MAX_SAMPLES // 2)) + 1
+        nv_s = int(min(np.ceil(lv / h), MAX_SAMPLES // 2)) + 1
+        # equal arc-length steps (the inverse of the monotone length functions)
+        us = np.interp(np.linspace(0.0, lu, nu_s), Lu, fu)
+        vs = np.interp(np.linspace(0.0, lv, nv_s), Lv, fv)
+        us[[0, -1]], vs[[0, -1]] = (u0, u1), (v0, v1)
+        return np.unique(us), np.unique(vs)
 
     # ------------------------------------------------------------------ public
     def project(self, points, max_distance=None, progress=None):
@@ -476,11 +512,27 @@ class Projector:
                    normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
                    outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
         good = np.flatnonzero(np.all(np.isfinite(P), axis=1))
-        block = CHUNK * 32
-        for start in range(0, good.size, block):
-            idx = good[start:start + block]
-            self._project_block(P[idx], idx, res, max_distance)
-            report(progress, min(1.0, (start + block) / max(good.size, 1)), "projecting points")
+        # blocks are independent (disjoint result rows): one thread each
+        block = CHUNK * 8
+        blocks = [good[s_:s_ + block] for s_ in range(0, good.size, block)]
+        job = lambda idx: self._project_block(P[idx], idx, res, max_distance)  # noqa: E731
+        if self.workers == 1 or len(blocks) == 1:
+            for k, idx in enumerate(blocks):
+                job(idx)
+                report(progress, (k + 1) / len(blocks), "projecting points")
+        else:
+            with ThreadPoolExecutor(self.workers) as pool:
+                futures = [pool.submit(job, idx) for idx in blocks]
+                try:
+                    for k, fut in enumerate(futures):
+                        fut.result()
+                        report(progress, (k + 1) / len(blocks), "projecting points")
+                except BaseException:
+                    for fut in futures:
+                        fut.cancel()
+                    raise
+        if not blocks:
+            report(progress, 1.0, "projecting points")
         return Projection(**res)
 
     # ------------------------------------------------------------------ internals
@@ -500,7 +552,7 @@ class Projector:
         ub = np.inf
         if max_distance is not None:
             ub = float(max_distance) + self.eps + h
-        dist, nb = self.tree.query(centres, k=1, distance_upper_bound=ub, workers=self.workers)
+        dist, nb = self.tree.query(centres, k=1, distance_upper_bound=ub, workers=1)
         near = np.isfinite(dist)
         return self.tree_ids[np.where(near, nb, 0)][inv], near[inv]
 
@@ -527,10 +579,11 @@ class Projector:
         r = D[0] - P.T
         check = np.flatnonzero(~(_dot(r, r) < self.safe_distance ** 2))
         if check.size:
-            sus = check[self._suspicious(P[check], u[check], v[check],
-                                         [d[:, check] for d in D])]
+            sus, owner, seeds = self._suspicious(P[check], u[check], v[check],
+                                                 [d[:, check] for d in D])
+            self._best_of(P, check[owner], seeds, u, v, D, conv)
             if sus.size:
-                self._reseed(P, sus, u, v, D, conv)
+                self._reseed(P, check[sus], u, v, D, conv)
         self._finish(P, idx, u, v, D, conv, res, max_distance)
 
     def _newton_from_samples(self, P, seeds, maxiter=None):
@@ -540,9 +593,12 @@ class Projector:
         return self.newton.run(Pt, self.us[iu], self.vs[iv], sd, maxiter=maxiter)
 
     def _grid_index(self, u, v):
-        iu = np.clip(np.searchsorted(self.us, u), 0, self.us.size - 1)
-        iv = np.clip(np.searchsorted(self.vs, v), 0, self.vs.size - 1)
-        return iu, iv
+        """Indices of the nearest sample parameters."""
+        out = []
+        for t, ts in ((u, self.us), (v, self.vs)):
+            i = np.clip(np.searchsorted(ts, t), 1, ts.size - 1)
+            out.append(np.where(np.abs(t - ts[i - 1]) <= np.abs(ts[i] - t), i - 1, i))
+        return out[0], out[1]
 
     def _suspicious(self, P, u, v, D, k=12):
         """Indices of points whose local minimum may not be the global one."""
@@ -553,62 +609,115 @@ class Projector:
         # near a curvature centre the distance Hessian degenerates
         flat = (Huu * Hvv - Huv * Huv) < 0.5 * (a * c - b * b)
         # a sample close enough to hold a better minimum (|X - P| < d + eps) that is
-        # far from the foot along the face (grid path > 3 |X - F| + 2 eps) although
-        # close in space: another part of the face comes close (a second basin)
-        dist, nb = self.tree.query(P, k=min(k, self.tree.n), workers=self.workers)
+        # far from the foot along the face (length of the parameter offset in the
+        # foot's first fundamental form > 3 |X - F| + 2 eps) although close in
+        # space: another part of the face comes close (a second basin)
+        dist, nb = self.tree.query(P, k=min(k, self.tree.n), workers=1)
         nb = self.tree_ids[nb.reshape(P.shape[0], -1)]
         dist = dist.reshape(P.shape[0], -1)
         ki, kj = np.divmod(nb, self.vs.size)
         i0, j0 = self._grid_index(u, v)
         i0, j0 = i0[:, None], j0[:, None]
-        path = (np.abs(self.arc_u[ki, j0] - self.arc_u[i0, j0])
-                + np.abs(self.arc_v[ki, kj] - self.arc_v[ki, j0]))
+        du_, dv_ = self.us[ki] - u[:, None], self.vs[kj] - v[:, None]
+        path = np.sqrt(np.maximum(a[:, None] * du_ * du_ + 2.0 * b[:, None] * du_ * dv_
+                                  + c[:, None] * dv_ * dv_, 0.0))
         X = self.samples[0][:, nb]  # (3, n, k)
         xf = np.sqrt(np.sum((X - S[:, :, None]) ** 2, axis=0))
         d = np.sqrt(_dot(r, r))[:, None]
         reach = dist < d + self.eps
         far = path > 3.0 * xf + 2.0 * self.eps
-        return np.flatnonzero(flat | np.any(reach & far, axis=1))
+        sus = np.flatnonzero(flat | np.any(reach & far, axis=1))
+        # any sample within reach may sit in a neighbouring basin (near-ties, e.g.
+        # two minima a cell apart, or an interior minimum next to a boundary one)
+        owner, col = np.nonzero(reach)
+        seeds = nb[owner, col]
+        # one Newton step on the sample's stored derivatives predicts where that
+        # seed leads; only seeds predicted to reach another foot (more than half a
+        # grid cell away) at a distance not clearly worse get the full treatment
+        lu, lv, dp = self._predict(owner, seeds, P)
+        ii, jj = i0[owner, 0], j0[owner, 0]
+        cell_u = self.us[np.minimum(ii + 1, self.us.size - 1)] - self.us[np.maximum(ii - 1, 0)]
+        cell_v = self.vs[np.minimum(jj + 1, self.vs.size - 1)] - self.vs[np.maximum(jj - 1, 0)]
+        elsewhere = ((np.abs(lu - u[owner]) > 0.25 * cell_u)
+                     | (np.abs(lv - v[owner]) > 0.25 * cell_v))
+        promising = elsewhere & (dp < d[owner, 0] + 0.5 * self.eps)
+        owner, seeds = owner[promising], seeds[promising]
+        # at most three per point, the most promising first
+        order = np.lexsort((dp[promising], owner))
+        owner, seeds = owner[order], seeds[order]
+        rank = np.arange(owner.size) - np.searchsorted(owner, owner)
+        keep = rank < 3
+        return sus, owner[keep], seeds[keep]
 
-    def _reseed(self, P, sus, u, v, D, conv, max_seeds=12):
-        """Newton from far-apart samples within reach of a better minimum; keep the best."""
-        r = D[0][:, sus] - P[sus].T
-        d = np.sqrt(_dot(r, r))
-        balls = self.tree.query_ball_point(P[sus], d + self.eps, workers=self.workers)
-        owner, seeds = [], []
-        nvs = self.vs.size
-        iu_all, iv_all = self._grid_index(u[sus], v[sus])
-        for j, (i, cand) in enumerate(zip(sus, balls)):
-            if not cand:
-                continue
-            cand = np.asarray(cand)
-            dc = np.sum((self.tree.data[cand] - P[i]) ** 2, axis=1)
-            cand = self.tree_ids[cand[np.argsort(dc)][:4000]]
-            cu, cv = np.divmod(cand, nvs)
-            cu_, cv_ = [int(iu_all[j])], [int(iv_all[j])]
-            for c_, a_, b_ in zip(cand.tolist(), cu.tolist(), cv.tolist()):
-                if all(abs(a_ - x) > 2 or abs(b_ - y) > 2 for x, y in zip(cu_, cv_)):
-                    cu_.append(a_)
-                    cv_.append(b_)
-                    owner.append(i)
-                    seeds.append(c_)
-                    if len(cu_) > max_seeds:
-                        break
-        if not seeds:
+    def _best_of(self, P, owner, seeds, u, v, D, conv):
+        """Newton from extra seeds; a point keeps the best of its results."""
+        if owner.size == 0:
             return
-        owner, seeds = np.asarray(owner), np.asarray(seeds)
         u2, v2, D2, conv2 = self._newton_from_samples(P[owner], seeds)
         ro = D[0][:, owner] - P[owner].T
         rn = D2[0] - P[owner].T
         f_old, f_new = _dot(ro, ro), _dot(rn, rn)
         order = np.argsort(f_new, kind="stable")  # best candidate per point first
         first = order[np.unique(owner[order], return_index=True)[1]]
-        for s_ in first:
-            if f_new[s_] < f_old[s_] * (1 - 1e-12) - 1e-24:
-                i = owner[s_]
-                u[i], v[i], conv[i] = u2[s_], v2[s_], conv2[s_]
-                for a, b in zip(D, D2):
-                    a[:, i] = b[:, s_]
+        better = first[f_new[first] < f_old[first] * (1 - 1e-12) - 1e-24]
+        i = owner[better]
+        u[i], v[i], conv[i] = u2[better], v2[better], conv2[better]
+        for a, b in zip(D, D2):
+            a[:, i] = b[:, better]
+
+    def _predict(self, owner, seeds, P):
+        """One Newton step on the stored sample derivatives: landing (u, v) and distance."""
+        Pk = P[owner].T
+        sd = [s_[:, seeds] for s_ in self.samples]
+        ki, kj = np.divmod(seeds, self.vs.size)
+        su, sv = self.us[ki], self.vs[kj]
+        du, dv, _ = self.newton.step(su, sv, sd[0] - Pk, *sd[1:])
+        Sp = sd[0] + sd[1] * du + sd[2] * dv + 0.5 * (sd[3] * du * du + 2.0 * sd[4] * du * dv
+                                                       + sd[5] * dv * dv)
+        rp = Sp - Pk
+        return su + du, sv + dv, np.sqrt(_dot(rp, rp))
+
+    def _reseed(self, P, sus, u, v, D, conv, max_seeds=12, per_point=400, chunk=256):
+        """Newton from all parts of the face within reach of a better minimum; keep the best.
+
+        Candidates are the samples within ``d + eps`` of the point (thinned on the
+        grid to about ``per_point``); one Newton step on each sample's stored
+        derivatives predicts its landing point; landings away from the current
+        foot (other grid cells) that promise a distance below ``d + eps / 2`` are
+        deduplicated by cell and the ``max_seeds`` best run the full Newton.
+        """
+        for start in range(0, sus.size, chunk):
+            pts = sus[start:start + chunk]
+            r = D[0][:, pts] - P[pts].T
+            d = np.sqrt(_dot(r, r))
+            balls = self.tree.query_ball_point(P[pts], d + self.eps, workers=1)
+            lens = np.fromiter((len(b) for b in balls), dtype=np.intp, count=len(balls))
+            if lens.sum() == 0:
+                continue
+            cand = self.tree_ids[np.fromiter(itertools.chain.from_iterable(balls), dtype=np.intp,
+                                             count=int(lens.sum()))]
+            local = np.repeat(np.arange(pts.size), lens)
+            # thin crowded balls on the grid: keep every s-th row and column
+            stride = np.maximum(1, np.ceil(np.sqrt(lens / per_point))).astype(np.intp)[local]
+            ki, kj = np.divmod(cand, self.vs.size)
+            keep = (ki % stride == 0) & (kj % stride == 0)
+            local, cand = local[keep], cand[keep]
+            owner = pts[local]
+            lu, lv, dp = self._predict(owner, cand, P)
+            li, lj = self._grid_index(lu, lv)
+            fi, fj = self._grid_index(u[owner], v[owner])
+            ok = ((li != fi) | (lj != fj)) & (dp < d[local] + 0.5 * self.eps)
+            owner, cand, dp, li, lj = owner[ok], cand[ok], dp[ok], li[ok], lj[ok]
+            # best candidate per (point, landing cell), then the max_seeds best per point
+            order = np.lexsort((dp, lj, li, owner))
+            owner, cand, dp, li, lj = owner[order], cand[order], dp[order], li[order], lj[order]
+            first = np.r_[True, (np.diff(owner) != 0) | (np.diff(li) != 0) | (np.diff(lj) != 0)]
+            owner, cand, dp = owner[first], cand[first], dp[first]
+            order = np.lexsort((dp, owner))
+            owner, cand = owner[order], cand[order]
+            rank = np.arange(owner.size) - np.searchsorted(owner, owner)
+            sel = rank < max_seeds
+            self._best_of(P, owner[sel], cand[sel], u, v, D, conv)
 
     def _finish(self, P, idx, u, v, D, conv, res, max_distance):
         S, Su, Sv = D[0].T, D[1].T, D[2].T
@@ -651,7 +760,7 @@ def project(surf, points, max_distance=None, progress=None, workers=None):
     progress : callable, optional
         ``progress(fraction, message)``; may raise ``Cancelled``.
     workers : int, optional
-        Threads for the KD-tree queries; default 1.
+        Threads; default the number of CPUs.
 
     Returns
     -------

@@ -59,7 +59,8 @@ def _occt(part, u, v):
     vec = lambda x: tuple(x)  # noqa: E731
     rows = []
     for a, b in zip(u.tolist(), v.tolist()):
-        rows.append([vec(part.value(a, b)), vec(part.getDN(a, b, 1, 0)), vec(part.getDN(a, b, 0, 1)),
+        rows.append([vec(part.value(a, b)), vec(part.getDN(a, b, 1, 0)),
+                     vec(part.getDN(a, b, 0, 1)),
                      vec(part.getDN(a, b, 2, 0)), vec(part.getDN(a, b, 1, 1)),
                      vec(part.getDN(a, b, 0, 2)), vec(part.normal(a, b))])
     return np.array(rows)  # (n, 7, 3)
