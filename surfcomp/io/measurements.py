@@ -325,20 +325,22 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
         raw = text.encode("utf-8", "surrogatepass")
     else:
         raw = bytes(text_or_bytes)
-        text = _decode(raw, source)
+        text = decode_utf8(raw, source)
     if text.startswith("\ufeff"):
         text = text[1:]
     return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
 
 
-def _decode(raw, source):
+def decode_utf8(raw, source):
+    """Decode file bytes as UTF-8 (a byte order mark is skipped); UTF-16/32 and invalid
+    bytes raise MeasurementFileError naming the line."""
     for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
                       (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
         if raw.startswith(bom):
             raise MeasurementFileError("the file is %s text (expected UTF-8: save it as UTF-8)"
                                        % name, file=source, line=1)
     try:
-        return raw.decode("utf-8")
+        return raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         line = raw.count(b"\n", 0, exc.start) + 1
         raise MeasurementFileError("byte 0x%02x at offset %d is not UTF-8 (expected UTF-8 text: "

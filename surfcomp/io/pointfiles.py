@@ -33,7 +33,6 @@ Bad input raises :class:`surfcomp.errors.MeasurementFileError` with the file, th
 1-based line and the 1-based character column.
 """
 
-import codecs
 import hashlib
 import itertools
 import operator
@@ -42,7 +41,7 @@ import re
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .measurements import NORMAL_LENGTH_TOL, NORMAL_ZERO, MeasurementSet
+from .measurements import NORMAL_LENGTH_TOL, NORMAL_ZERO, MeasurementSet, decode_utf8
 from .units import split_unit_suffix, unit_factor
 
 #: formats :func:`read_point_file` reads
@@ -77,22 +76,6 @@ def _read_bytes(path):
     except OSError as exc:
         raise MeasurementFileError("cannot read the file: %s" % (exc.strerror or exc),
                                    file=str(path)) from exc
-
-
-def _decode(data, path):
-    """Decode file bytes as UTF-8 (a byte order mark is skipped); others raise."""
-    for bom, name in ((codecs.BOM_UTF32_LE, "UTF-32"), (codecs.BOM_UTF32_BE, "UTF-32"),
-                      (codecs.BOM_UTF16_LE, "UTF-16"), (codecs.BOM_UTF16_BE, "UTF-16")):
-        if data.startswith(bom):
-            raise MeasurementFileError("the file is %s text (expected UTF-8: save it as UTF-8)"
-                                       % name, file=str(path), line=1)
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
-        raise MeasurementFileError("byte 0x%02x at offset %d is not UTF-8 (expected UTF-8 text: "
-                                   "save the file as UTF-8)" % (data[exc.start], exc.start),
-                                   file=str(path), line=line) from exc
 
 
 def _split_lines(text):
@@ -410,7 +393,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
                          file=str(path))
     data = _read_bytes(path)
     warnings = []
-    text = _decode(data, path)
+    text = decode_utf8(data, str(path))
     if not text.strip():
         raise MeasurementFileError("the file is empty; expected measured points",
                                    file=str(path))
