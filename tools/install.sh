@@ -34,3 +34,20 @@ if ! /usr/bin/python3 -c "import opencamlib.ocl" 2>/dev/null; then
 else
   echo "surfcomp setup: OpenCamLib already installed"
 fi
+
+# Link this checkout into FreeCAD's user Mod folder, as the Addon Manager would clone it:
+# FreeCAD then puts it on sys.path at start-up (workbench, freecadcmd) and restores the
+# proxies of surfcomp objects in saved documents (it refuses proxies from other places).
+mod_dir="${XDG_DATA_HOME:-$HOME/.local/share}/FreeCAD/Mod"
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+mkdir -p "$mod_dir"
+if [ "$(readlink -f "$mod_dir/surfcomp" 2>/dev/null)" != "$repo" ]; then
+  if [ -e "$mod_dir/surfcomp" ] && [ ! -L "$mod_dir/surfcomp" ]; then
+    echo "surfcomp setup: $mod_dir/surfcomp exists and is not a link; leaving it alone" >&2
+  else
+    ln -sfn "$repo" "$mod_dir/surfcomp"
+    echo "surfcomp setup: linked $repo into $mod_dir"
+  fi
+else
+  echo "surfcomp setup: already linked into $mod_dir"
+fi
