@@ -27,6 +27,9 @@ MATCH_TOL = 2e-5
 MATCH_ITERATIONS = 8
 #: knot spans per direction at least (coarse grids), see _span
 MIN_SPANS = 120
+#: knot spans per direction beyond which dense grids get fewer spans per grid step
+#: (down to two), so the pole net grows like the number of points, not 16 times it
+MAX_SPANS = 1000
 
 
 def refinement_knots(knots, degree, lo, hi, spacing):
@@ -47,8 +50,12 @@ def refinement_knots(knots, degree, lo, hi, spacing):
 def _span(width, spacing, refine):
     """Largest knot span: ``spacing / refine``, and on coarse grids at most
     ``width / MIN_SPANS`` (more spans damp the ringing of the fit between nodes;
-    coarse grids have few poles, so this is cheap)."""
-    return min(spacing / refine, width / MIN_SPANS)
+    coarse grids have few poles, so this is cheap). Dense grids, whose ``refine``
+    spans per step would exceed ``MAX_SPANS``, get ``MAX_SPANS`` spans but never
+    fewer than one per grid step: their nodes are close enough that the cubic
+    space follows the field between them."""
+    span = min(spacing / refine, width / MIN_SPANS)
+    return max(span, min(spacing / 2, width / MAX_SPANS))
 
 
 class _Sampling:
@@ -110,9 +117,53 @@ def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v
     return smp.build(delta)
 
 
+@dataclass
+class Construction:
+    """A corrected surface with what was built alongside it (see :func:`construct`)."""
+
+    corrected: object     # Surface
+    zero: object          # Surface built the same way with a zero field
+    field: object         # the field through the intended values (maps, report)
+    iterations: int       # residual iterations at the nodes
+    checks: object        # CheckFigures
+
+
+def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
+              refine=DEFAULT_REFINE, field_factory=GridField, grid_shape=None, progress=None):
+    """Build the corrected surface for node corrections ``delta`` and check it.
+
+    The one entry point for the pipeline and the document objects: the refined
+    space is sampled once and serves the matching surface (:func:`build_matching_surface`),
+    the zero-field surface (the construction's self-check) and the check figures.
+
+    Parameters
+    ----------
+    U, V, delta : array_like, shape (n, m) (grids) or (N,) (scattered ``field_factory``)
+        Node parameters and intended corrections (mm).
+    grid_shape : tuple, optional
+        Shape of the measurement grid for the density of the dense check grid
+        (default ``U.shape``; give a shape for scattered nodes).
+
+    Returns
+    -------
+    Construction
+    """
+    U, V = np.asarray(U, dtype=float), np.asarray(V, dtype=float)
+    report(progress, 0.0, "sampling the nominal")
+    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+    surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
+                                  field_factory, sub(progress, 0.1, 0.75))
+    report(progress, 0.75, "checking the corrected surface")
+    zero = smp.build(np.zeros((smp.us.size, smp.vs.size)))
+    checks = check_figures(nominal, surf, zero, U.ravel(), V.ravel(), np.ravel(delta), outward,
+                           grid_shape or U.shape, realised=real.ravel())
+    report(progress, 1.0, "corrected surface checked")
+    return Construction(surf, zero, field, k, checks)
+
+
 def build_matching_surface(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
                            refine=DEFAULT_REFINE, tol=MATCH_TOL, iterations=MATCH_ITERATIONS,
-                           progress=None):
+                           field_factory=GridField, progress=None):
     """Corrected surface whose realised correction equals ``delta`` at the grid nodes.
 
     The field through the node values (:class:`GridField`) is C1 with curvature
@@ -125,35 +176,86 @@ def build_matching_surface(nominal, U, V, delta, outward=1, spacing_u=None, spac
     Parameters
     ----------
     U, V, delta : array_like, shape (n, m)
-        Grid node parameters and intended corrections (mm).
+        Grid node parameters and intended corrections (mm); for a scattered
+        ``field_factory`` shape (N,).
+    field_factory : callable
+        ``field_factory(U, V, delta)`` -> field with ``locate(u, v)`` (or
+        ``locate_grid(us, vs)``) returning a tuple ``loc``, ``at_index(*loc)`` and
+        ``with_values(values)``: :class:`GridField` for grids.
 
     Returns
     -------
     surface : Surface
-    field : GridField
+    field : GridField (or the ``field_factory``'s type)
         The field through the intended values (for maps and the report).
     iterations : int
     """
-    delta = np.asarray(delta, dtype=float)
-    field = GridField(U, V, delta)
     report(progress, 0.05, "sampling the nominal")
     smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+    surf, field, k, _ = _match(smp, np.asarray(U, dtype=float), np.asarray(V, dtype=float),
+                               delta, outward, tol, iterations, field_factory,
+                               sub(progress, 0.1, 1.0))
+    return surf, field, k
+
+
+def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
+    """The residual iteration of :func:`build_matching_surface` on a sampled space;
+    returns ``(surface, field, iterations, realised correction at the nodes)``."""
+    delta = np.asarray(delta, dtype=float)
+    field = field_factory(U, V, delta)
     uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")
-    s, t = field.locate(uu.ravel(), vv.ravel())  # the samples' place on the grid, once
+    # the samples' place in the field, once
+    if hasattr(field, "locate_grid"):
+        loc = field.locate_grid(smp.us, smp.vs)
+    else:
+        loc = field.locate(uu.ravel(), vv.ravel())
+    nodes = _NodeFrame(smp.nominal, U.ravel(), V.ravel(), outward)
     values = delta.copy()
     current = field
     k = 0
     while True:
-        report(progress, 0.1 + 0.9 * k / (iterations + 1), "building the corrected surface")
-        surf = smp.build(current.at_index(s, t).reshape(uu.shape))
-        real = realised_correction(nominal, surf, U.ravel(), V.ravel(), outward,
-                                   guess=values.ravel()).reshape(delta.shape)
+        report(progress, k / (iterations + 1), "building the corrected surface")
+        surf = smp.build(current.at_index(*loc).reshape(uu.shape))
+        real = nodes.realised(surf, guess=values.ravel()).reshape(delta.shape)
         miss = delta - real
         if np.max(np.abs(miss)) <= tol or k >= iterations:
-            return surf, field, k
+            return surf, field, k, real
         values = values + miss
         current = field.with_values(values)
         k += 1
+
+
+class _NodeFrame:
+    """Nominal points and outward normals at fixed (u, v), for repeated
+    :func:`realised_correction` calls against changing corrected surfaces."""
+
+    def __init__(self, nominal, u, v, outward):
+        self.u = np.ravel(u).astype(float)
+        self.v = np.ravel(v).astype(float)
+        self.P, Su, Sv = bspline.derivatives(nominal, self.u, self.v, order=1)
+        n = np.cross(Su, Sv)
+        self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
+
+    def realised(self, corrected, guess=None, iterations=20):
+        """See :func:`realised_correction`."""
+        u, v, P, n = self.u, self.v, self.P, self.n
+        t = np.zeros(u.size) if guess is None else np.ravel(guess).astype(float).copy()
+        a, b = u.copy(), v.copy()
+        (ua, ub), (va, vb) = corrected.u_range, corrected.v_range
+        act = np.arange(u.size)  # only the points whose intersection has not converged
+        for _ in range(iterations):
+            C, Cu, Cv = bspline.derivatives(corrected, a[act], b[act], order=1)
+            F = C + t[act, None] * n[act] - P[act]
+            keep = ~np.all(np.abs(F) < 1e-12, axis=1)
+            act, F, Cu, Cv = act[keep], F[keep], Cu[keep], Cv[keep]
+            if act.size == 0:
+                break
+            J = np.stack([Cu, Cv, n[act]], axis=2)
+            step = np.linalg.solve(J, -F[..., None])[..., 0]
+            a[act] = np.clip(a[act] + step[:, 0], ua, ub)
+            b[act] = np.clip(b[act] + step[:, 1], va, vb)
+            t[act] += step[:, 2]
+        return t
 
 
 def realised_correction(nominal, corrected, u, v, outward=1, guess=None, iterations=20):
@@ -176,25 +278,7 @@ def realised_correction(nominal, corrected, u, v, outward=1, guess=None, iterati
     ndarray, shape (N,)
         Realised correction in mm (positive: surface moved inwards).
     """
-    u = np.ravel(u).astype(float)
-    v = np.ravel(v).astype(float)
-    P, Su, Sv = bspline.derivatives(nominal, u, v, order=1)
-    n = np.cross(Su, Sv)
-    n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
-    t = np.zeros(u.size) if guess is None else np.ravel(guess).astype(float).copy()
-    a, b = u.copy(), v.copy()
-    (ua, ub), (va, vb) = corrected.u_range, corrected.v_range
-    for _ in range(iterations):
-        C, Cu, Cv = bspline.derivatives(corrected, a, b, order=1)
-        F = C + t[:, None] * n - P
-        J = np.stack([Cu, Cv, n], axis=2)
-        step = np.linalg.solve(J, -F[..., None])[..., 0]
-        a = np.clip(a + step[:, 0], ua, ub)
-        b = np.clip(b + step[:, 1], va, vb)
-        t = t + step[:, 2]
-        if np.all(np.abs(F) < 1e-12):
-            break
-    return t
+    return _NodeFrame(nominal, u, v, outward).realised(corrected, guess, iterations)
 
 
 @dataclass
@@ -224,14 +308,24 @@ class CheckFigures:
                 "poles": list(self.poles_shape)}
 
 
+#: the dense check grid is ``density`` times denser than the measurement grid, with the
+#: density lowered (to at least 2) for dense grids so that it stays near this many points
+DENSE_CHECK_POINTS = 4.5e6
+
+
 def dense_parameters(surf, shape, density=4):
-    """Parameters of a check grid ``density`` times denser than an n x m grid, over the work area."""
+    """Parameters of a check grid ``density`` times denser than an n x m grid, over the
+    work area (``density`` lowered towards 2 where the grid would exceed
+    ``DENSE_CHECK_POINTS``; the shape used is reported in the check figures)."""
+    n, m = max(shape[0] - 1, 1), max(shape[1] - 1, 1)
+    density = max(min(density, 2), min(density, int(np.sqrt(DENSE_CHECK_POINTS / (n * m)))))
     (u0, u1), (v0, v1) = surf.u_range, surf.v_range
     return (np.linspace(u0, u1, density * (shape[0] - 1) + 1),
             np.linspace(v0, v1, density * (shape[1] - 1) + 1))
 
 
-def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, density=4):
+def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, density=4,
+                  realised=None):
     """Compute :class:`CheckFigures` for a corrected surface.
 
     Parameters
@@ -241,19 +335,28 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
         The surface built the same way with a zero field.
     u, v, delta : array_like, shape (N,)
         Measured points' parameters and intended corrections.
+    realised : array_like, shape (N,), optional
+        The realised correction at the points when already known.
     """
-    real = realised_correction(nominal, corrected, u, v, outward, guess=delta)
+    if realised is None:
+        realised = realised_correction(nominal, corrected, u, v, outward, guess=delta)
     us, vs = dense_parameters(nominal, grid_shape, density)
-    S, Su, Sv = bspline.evaluate_grid(nominal, us, vs, order=1)
-    n = np.cross(Su, Sv)
-    n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
-    # on the dense grid the normal line meets the corrected surface within the fit error
-    # of the same (u, v), so the normal component of S - S_c(u, v) is the realised
-    # correction to second order (exact Newton intersections are used at the points)
-    dense_real = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(corrected, us, vs), n)
-    dense_zero = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(zero, us, vs), n)
-    return CheckFigures(max_error_at_points=float(np.max(np.abs(real - np.ravel(delta)))),
-                        max_zero_deviation=float(np.max(np.abs(dense_zero))),
-                        max_realised=float(np.max(np.abs(dense_real))),
+    max_real = max_zero = 0.0
+    # rows of the dense grid in blocks of about a million points (memory stays flat)
+    step = max(1, int(1e6 // vs.size))
+    for start in range(0, us.size, step):
+        ub = us[start:start + step]
+        S, Su, Sv = bspline.evaluate_grid(nominal, ub, vs, order=1)
+        n = np.cross(Su, Sv)
+        n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
+        # on the dense grid the normal line meets the corrected surface within the fit
+        # error of the same (u, v), so the normal component of S - S_c(u, v) is the
+        # realised correction to second order (exact Newton intersections at the points)
+        real = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(corrected, ub, vs), n)
+        zero_dev = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(zero, ub, vs), n)
+        max_real = max(max_real, float(np.max(np.abs(real))))
+        max_zero = max(max_zero, float(np.max(np.abs(zero_dev))))
+    return CheckFigures(max_error_at_points=float(np.max(np.abs(np.ravel(realised) - np.ravel(delta)))),
+                        max_zero_deviation=max_zero, max_realised=max_real,
                         max_intended=float(np.max(np.abs(delta))),
-                        dense_shape=S.shape[:2], poles_shape=tuple(corrected.shape))
+                        dense_shape=(us.size, vs.size), poles_shape=tuple(corrected.shape))

@@ -33,14 +33,19 @@ from ..errors import ComputationError
 _L = 0.5  # damping length of the outside continuation, in grid steps
 
 
-def _h(a):
-    a2, a3 = a * a, a * a * a
-    return (2 * a3 - 3 * a2 + 1, -2 * a3 + 3 * a2, a3 - 2 * a2 + a, a3 - a2)
+#: cubic Hermite basis h0..h3 (values at 0/1, slopes at 0/1) in powers 1, a, a^2, a^3
+_HERMITE = np.array([[1.0, 0.0, -3.0, 2.0],
+                     [0.0, 0.0, 3.0, -2.0],
+                     [0.0, 1.0, -2.0, 1.0],
+                     [0.0, 0.0, -1.0, 1.0]])
 
 
-def _dh(a):
-    a2 = a * a
-    return (6 * a2 - 6 * a, -6 * a2 + 6 * a, 3 * a2 - 4 * a + 1, 3 * a2 - 2 * a)
+def _powers(a):
+    return np.stack([np.ones_like(a), a, a * a, a * a * a], axis=1)
+
+
+def _dpowers(a):
+    return np.stack([np.zeros_like(a), np.ones_like(a), 2.0 * a, 3.0 * a * a], axis=1)
 
 
 def _pchip_slopes(F, axis):
@@ -86,7 +91,7 @@ class GridField:
         self._lo = vals.reshape(-1, vals.shape[2]).min(axis=0)
         self._hi = vals.reshape(-1, vals.shape[2]).max(axis=0)
         n, m = self.shape
-        k = max(1, min(4, int(4e6 // (n * m))))  # samples per cell for the seeds
+        k = max(1, min(4, int(np.sqrt(1e6 / (n * m)))))  # seeds per cell side (<= ~1M seeds)
         ss, tt = np.meshgrid(np.linspace(0, n - 1, k * (n - 1) + 1),
                              np.linspace(0, m - 1, k * (m - 1) + 1), indexing="ij")
         self._seed_st = np.stack([ss.ravel(), tt.ravel()], axis=1)
@@ -105,6 +110,7 @@ class GridField:
             vals = vals[..., None]
         F = np.concatenate([self._F[..., :2], vals], axis=2)
         other._F = F
+        other._coeffs = {k: v for k, v in self.__dict__.get("_coeffs", {}).items() if k == (0, 2)}
         other._Fs = _pchip_slopes(F, 0)
         other._Ft = _pchip_slopes(F, 1)
         other._lo = vals.reshape(-1, vals.shape[2]).min(axis=0)
@@ -112,38 +118,66 @@ class GridField:
         return other
 
     # -- Hermite patches in index space -------------------------------------------------
-    def _eval(self, s, t, channels=slice(None), deriv=False):
-        """Values (and d/ds, d/dt) at index coordinates inside [0, n-1] x [0, m-1]."""
+    def _coefficients(self, channels):
+        """Per-cell power-basis coefficients ((n-1)(m-1), 16, c) of the bicubic Hermite
+        patches of a channel group (``sum_ij C[ij] a^i b^j``), built once per group."""
+        key = (channels.start, channels.stop)
+        cache = self.__dict__.setdefault("_coeffs", {})
+        if key not in cache:
+            n, m = self.shape
+            F, Fs, Ft = self._F[..., channels], self._Fs[..., channels], self._Ft[..., channels]
+            c = F.shape[2]
+            M = np.zeros((n - 1, m - 1, c, 4, 4))  # M[..., k, l] multiplies h_k(a) h_l(b)
+            for p in (0, 1):
+                for q in (0, 1):
+                    M[..., p, q] = F[p:n - 1 + p, q:m - 1 + q]
+                    M[..., 2 + p, q] = Fs[p:n - 1 + p, q:m - 1 + q]
+                    M[..., p, 2 + q] = Ft[p:n - 1 + p, q:m - 1 + q]
+            C = _HERMITE.T @ M @ _HERMITE  # (.., c, i, j): power coefficients
+            cache[key] = np.ascontiguousarray(
+                np.moveaxis(C, 2, -1).reshape((n - 1) * (m - 1), 16, c))
+        return cache[key]
+
+    def _eval(self, s, t, channels=slice(None), deriv=False, block=32768):
+        """Values (and d/ds, d/dt) at index coordinates inside [0, n-1] x [0, m-1]
+        (in blocks that stay in cache: several times faster on millions of points)."""
+        C = self._coefficients(channels)
         n, m = self.shape
-        i = np.clip(np.floor(s).astype(np.int64), 0, n - 2)
-        j = np.clip(np.floor(t).astype(np.int64), 0, m - 2)
-        a = (s - i)[:, None]
-        b = (t - j)[:, None]
-        F, Fs, Ft = self._F[..., channels], self._Fs[..., channels], self._Ft[..., channels]
-        ha, hb = _h(a), _h(b)
-        val = 0.0
-        ds = dt = 0.0
-        if deriv:
-            dha, dhb = _dh(a), _dh(b)
-        for p in (0, 1):
-            for q in (0, 1):
-                f, fs, ft = F[i + p, j + q], Fs[i + p, j + q], Ft[i + p, j + q]
-                val = val + f * ha[p] * hb[q] + fs * ha[2 + p] * hb[q] + ft * ha[p] * hb[2 + q]
-                if deriv:
-                    ds = ds + f * dha[p] * hb[q] + fs * dha[2 + p] * hb[q] + ft * dha[p] * hb[2 + q]
-                    dt = dt + f * ha[p] * dhb[q] + fs * ha[2 + p] * dhb[q] + ft * ha[p] * dhb[2 + q]
+        N, c = s.size, C.shape[2]
+        val = np.empty((N, c))
+        ds = np.empty((N, c)) if deriv else 0.0
+        dt = np.empty((N, c)) if deriv else 0.0
+        for k in range(0, N, block):
+            sl = slice(k, k + block)
+            i = np.clip(np.floor(s[sl]).astype(np.int64), 0, n - 2)
+            j = np.clip(np.floor(t[sl]).astype(np.int64), 0, m - 2)
+            a, b = s[sl] - i, t[sl] - j
+            G = C[i * (m - 1) + j]
+            A, B = _powers(a), _powers(b)
+            val[sl] = np.einsum("nk,nkc->nc", (A[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
+            if deriv:
+                dA, dB = _dpowers(a), _dpowers(b)
+                ds[sl] = np.einsum("nk,nkc->nc", (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
+                dt[sl] = np.einsum("nk,nkc->nc", (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
         return val, ds, dt
 
     def _clamped(self, s, t):
         n, m = self.shape
         return np.clip(s, 0.0, n - 1.0), np.clip(t, 0.0, m - 1.0)
 
-    def _map(self, s, t):
-        """(u, v) and the Jacobian at any (s, t); linear continuation outside the grid."""
+    def _map(self, s, t, deriv=True):
+        """(u, v) and the Jacobian at any (s, t); linear continuation outside the grid.
+        Without ``deriv`` only the (u, v) (the Jacobian is None)."""
         sc, tc = self._clamped(s, t)
-        val, ds, dt = self._eval(sc, tc, slice(0, 2), deriv=True)
-        es, et = (s - sc)[:, None], (t - tc)[:, None]
-        return val + ds * es + dt * et, ds, dt
+        if deriv:
+            val, ds, dt = self._eval(sc, tc, slice(0, 2), deriv=True)
+            es, et = (s - sc)[:, None], (t - tc)[:, None]
+            return val + ds * es + dt * et, ds, dt
+        val = self._eval(sc, tc, slice(0, 2))[0]
+        out = np.nonzero((s != sc) | (t != tc))[0]
+        if out.size:
+            val[out] = self._map(s[out], t[out])[0]
+        return val, None, None
 
     # -- public ---------------------------------------------------------------------------
     def locate(self, u, v, iterations=30, tol=1e-13):
@@ -160,24 +194,72 @@ class GridField:
         """
         uv = np.stack([np.ravel(u), np.ravel(v)], axis=1).astype(float)
         _, k = self._tree.query(uv / self._scale)
-        s, t = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
+        return self._newton(uv, self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy(),
+                            iterations, tol)
+
+    def locate_grid(self, us, vs, stride=4):
+        """:meth:`locate` for the tensor grid ``us x vs`` (``meshgrid(..., indexing="ij")``
+        order, raveled): a grid whose node u depends on the row only and v on the column
+        only is inverted along one line each way; otherwise every ``stride``-th point is
+        located and the rest start Newton from the interpolated coarse solution.
+
+        Returns
+        -------
+        s, t : ndarray, shape (len(us) * len(vs),)
+        """
+        us = np.ravel(us).astype(float)
+        vs = np.ravel(vs).astype(float)
+        U, V = self._F[..., 0], self._F[..., 1]
+        if (np.max(np.ptp(U, axis=1)) <= 1e-12 * self._scale[0]
+                and np.max(np.ptp(V, axis=0)) <= 1e-12 * self._scale[1]):
+            # u(s, t) = u(s) and v(s, t) = v(t) exactly (Hermite weights sum to one)
+            s_line = self.locate(us, np.full(us.size, V[0, 0]))[0]
+            t_line = self.locate(np.full(vs.size, U[0, 0]), vs)[1]
+            ss, tt = np.meshgrid(s_line, t_line, indexing="ij")
+            return ss.ravel(), tt.ravel()
+        iu = np.unique(np.r_[np.arange(0, us.size, stride), us.size - 1])
+        iv = np.unique(np.r_[np.arange(0, vs.size, stride), vs.size - 1])
+        cu, cv = np.meshgrid(us[iu], vs[iv], indexing="ij")
+        cs, ct = (a.reshape(cu.shape) for a in self.locate(cu.ravel(), cv.ravel()))
+        seeds = []
+        for c in (cs, ct):
+            along_v = np.stack([np.interp(np.arange(vs.size), iv, row) for row in c])
+            seeds.append(np.stack([np.interp(np.arange(us.size), iu, col)
+                                   for col in along_v.T], axis=1).ravel())
+        uu, vv = np.meshgrid(us, vs, indexing="ij")
+        uv = np.stack([uu.ravel(), vv.ravel()], axis=1)
+        # a miss of 1e-7 grid cells moves a field value by less than 1e-7 of the value
+        # step between neighbouring nodes (1e-5 um for 100 um steps)
+        cells = max(self.shape) - 1
+        return self._newton(uv, seeds[0], seeds[1], tol=1e-7 / cells)
+
+    def _newton(self, uv, s, t, iterations=30, tol=1e-13):
+        """Solve map(s, t) = uv from the given starting points (Newton, steps limited to
+        one grid cell; only the points not yet converged are iterated)."""
+        act = np.arange(uv.shape[0])
         for _ in range(iterations):
-            val, ds, dt = self._map(s, t)
-            r = uv - val
+            # residuals first (values only), the Jacobian only where a step is needed
+            r = uv[act] - self._map(s[act], t[act], deriv=False)[0]
+            keep = ~np.all(np.abs(r) <= tol * self._scale, axis=1)
+            act, r = act[keep], r[keep]
+            if act.size == 0:
+                break
+            _, ds, dt = self._map(s[act], t[act])
             det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
             det = np.where(np.abs(det) < 1e-300, 1e-300, det)
             dS = (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
             dT = (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
             step = np.maximum(np.abs(dS), np.abs(dT))
             lim = np.where(step > 1.0, 1.0 / np.maximum(step, 1e-300), 1.0)
-            s, t = s + lim * dS, t + lim * dT
-            if np.all(np.abs(r) <= tol * self._scale):
-                break
-        val, _, _ = self._map(s, t)
-        if np.any(np.abs(uv - val) > 1e-9 * self._scale):
-            bad = int(np.argmax(np.abs(uv - val).max(axis=1)))
-            raise ComputationError("could not locate (u, v) = (%g, %g) on the measurement grid"
-                                   % tuple(uv[bad]))
+            s[act] += lim * dS
+            t[act] += lim * dT
+        if act.size:
+            val, _, _ = self._map(s[act], t[act])
+            miss = np.abs(uv[act] - val)
+            if np.any(miss > 1e-9 * self._scale):
+                bad = act[int(np.argmax(miss.max(axis=1)))]
+                raise ComputationError("could not locate (u, v) = (%g, %g) on the measurement grid"
+                                       % tuple(uv[bad]))
         return s, t
 
     def at_index(self, s, t):
@@ -185,9 +267,12 @@ class GridField:
         s = np.ravel(s).astype(float)
         t = np.ravel(t).astype(float)
         sc, tc = self._clamped(s, t)
-        val, ds, dt = self._eval(sc, tc, slice(2, None), deriv=True)
-        es, et = (s - sc)[:, None], (t - tc)[:, None]
-        val = val + ds * _L * np.tanh(es / _L) + dt * _L * np.tanh(et / _L)
+        val = self._eval(sc, tc, slice(2, None))[0]
+        out = np.nonzero((s != sc) | (t != tc))[0]  # continued beyond the border
+        if out.size:
+            _, ds, dt = self._eval(sc[out], tc[out], slice(2, None), deriv=True)
+            es, et = (s - sc)[out, None], (t - tc)[out, None]
+            val[out] += ds * _L * np.tanh(es / _L) + dt * _L * np.tanh(et / _L)
         val = np.clip(val, self._lo, self._hi)
         return val[:, 0] if self._scalar else val
 

@@ -10,8 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .corrected import (DEFAULT_REFINE, build_corrected_surface, build_matching_surface,
-                        check_figures)
+from .corrected import DEFAULT_REFINE, construct
 from .deviations import deviation_components, statistics
 from .filters import make_mask
 from .grid import grid_from_indices, grid_from_uv
@@ -234,13 +233,9 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     U, V = g.take(prepared.u), g.take(prepared.v)
     du, dv = grid_spacing(prepared)
     result.spacing = (du, dv)
-    report(progress, 0.05, "building the corrected surface")
-    result.corrected, result.field, result.iterations = build_matching_surface(
-        surface, U, V, corr.delta, outward, du, dv, options.refine, progress=sub(progress, 0.05, 0.7))
-    result.zero = build_corrected_surface(surface, lambda u, v: np.zeros(np.shape(u)), outward,
-                                          du, dv, options.refine)
-    report(progress, 0.75, "checking the corrected surface")
-    result.checks = check_figures(surface, result.corrected, result.zero, U.ravel(), V.ravel(),
-                                  corr.delta.ravel(), outward, g.shape)
+    built = construct(surface, U, V, corr.delta, outward, du, dv, options.refine,
+                      progress=sub(progress, 0.05, 1.0))
+    result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
+    result.iterations, result.checks = built.iterations, built.checks
     report(progress, 1.0, "done")
     return result

@@ -96,3 +96,42 @@ def test_field_is_continuous_and_bounded_outside():
     # inside the measured region the linear field is exact
     inside = (u >= 0.1) & (u <= 0.9)
     assert_allclose(val[inside], 0.02 * u[inside], atol=1e-15)
+
+
+@pytest.mark.parametrize("distorted", [False, True])
+def test_locate_grid_matches_pointwise_locate(distorted):
+    """The tensor-grid locator (separable shortcut, or coarse solve + interpolated
+    Newton seeds) finds the same index coordinates as the pointwise one, inside and
+    outside the measured region."""
+    t = np.linspace(0.05, 0.95, 40)
+    U, V = np.meshgrid(t, t ** 1.3, indexing="ij")
+    if distorted:
+        U = U + 0.01 * np.sin(4 * V)
+        V = V + 0.008 * np.cos(3 * U)
+    f = GridField(U, V, np.random.default_rng(3).normal(size=U.shape))
+    us, vs = np.linspace(0, 1, 157), np.linspace(0, 1, 131)
+    s, tt = f.locate_grid(us, vs)
+    uu, vv = np.meshgrid(us, vs, indexing="ij")
+    s_ref, t_ref = f.locate(uu.ravel(), vv.ravel())
+    assert_allclose(s, s_ref, atol=1e-6)
+    assert_allclose(tt, t_ref, atol=1e-6)
+    # the locator's stated accuracy, 1e-7 grid cells, times node steps of O(3) here
+    assert_allclose(f.at_index(s, tt), f.at_index(s_ref, t_ref), atol=3e-6)
+
+
+def test_pole_net_is_capped_for_dense_grids():
+    """Coarse grids: >= 120 spans; medium: 4 spans per grid step; dense: at most
+    MAX_SPANS spans, but never fewer than 2 per grid step."""
+    from surfcomp.core.corrected import MAX_SPANS, _span, dense_parameters
+
+    assert _span(1.0, 1 / 6, 4) == pytest.approx(1 / 120)
+    assert _span(1.0, 1 / 99, 4) == pytest.approx(1 / 396)
+    assert _span(1.0, 1 / 499, 4) == pytest.approx(1 / MAX_SPANS)
+    assert _span(1.0, 1 / 999, 4) == pytest.approx(1 / 1998)
+
+    class Box:
+        u_range = v_range = (0.0, 1.0)
+
+    assert [a.size for a in dense_parameters(Box, (45, 45))] == [177, 177]
+    assert [a.size for a in dense_parameters(Box, (500, 500))] == [1997, 1997]
+    assert [a.size for a in dense_parameters(Box, (1000, 1000))] == [1999, 1999]
