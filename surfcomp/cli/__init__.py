@@ -14,7 +14,7 @@ from .. import __version__
 from ..errors import SurfcompError
 
 #: subcommand modules, in the order ``--help`` lists them
-COMMANDS = ("compensate", "inspect", "gcode")
+COMMANDS = ("compensate", "inspect", "simulate", "gcode")
 
 
 def build_parser():

@@ -1,0 +1,333 @@
+"""One self-contained HTML inspection report per compensation (no FreeCAD).
+
+Input: the JSON report dict of :func:`surfcomp.io.report.build_report` (schema
+``surfcomp-report/1``) and optionally the virtual-machining result
+(:meth:`surfcomp.core.simulate.SimulationResult.as_dict`, schema
+``surfcomp-simulation/1``). Output: one HTML file, images embedded as base64 PNG
+(matplotlib's Agg canvas, no pyplot state, so it is safe inside a Qt application),
+no external resources. Sections carry stable ids for tools and tests:
+
+``inputs``      input files with SHA-256, the nominal face
+``method``      method, mask, edge handling, stock, grid
+``maps``        raw deviation, determined, random, correction, predicted residual (um)
+``histograms``  distributions of raw deviation, random component, predicted residual
+``statistics``  the papers' table (Werner 2022 Tab. 1 and 3) for every quantity
+``checks``      the corrected face's check figures (or why there are none)
+``simulation``  the before/after table over replicas (only with a simulation result)
+``warnings``    messages of the run
+
+The predicted residual is what is left if the machine repeats the measured error
+exactly: ``d - s - delta`` (``s`` the stock for the mirror method, else 0): zero for
+raw, the random component for filtered, ``d - mean(d)`` for offset.
+"""
+
+import base64
+import html
+import io
+
+import numpy as np
+
+from .atomic import write_text
+
+#: section ids in document order
+SECTIONS = ("inputs", "method", "maps", "histograms", "statistics", "checks", "simulation",
+            "warnings")
+
+_STAT_ROWS = (("count", "Points", None), ("max_negative", "Max. negative", 1e3),
+              ("max_positive", "Max. positive", 1e3), ("mean", "Average value", 1e3),
+              ("std", "Standard deviation (ddof=1)", 1e3), ("rms", "RMS", 1e3),
+              ("profile", "Profile error ISO 1101 (2 max|d|)", 1e3))
+
+_CSS = """
+body{font-family:DejaVu Sans,Arial,sans-serif;margin:24px;color:#222;max-width:1200px}
+h1{font-size:22px}h2{font-size:18px;border-bottom:1px solid #999;margin-top:28px}
+table{border-collapse:collapse;margin:8px 0}td,th{border:1px solid #bbb;padding:3px 8px}
+th{background:#eee}td.num{text-align:right;font-family:DejaVu Sans Mono,monospace}
+code{font-size:12px;word-break:break-all}.figs{display:flex;flex-wrap:wrap;gap:12px}
+figure{margin:0}figcaption{font-size:13px;text-align:center}
+"""
+
+
+def _e(x):
+    return html.escape(str(x), quote=True)
+
+
+def _png(fig):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=90)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def _img(fig, alt, caption):
+    return ('<figure><img alt="%s" src="data:image/png;base64,%s"><figcaption>%s</figcaption>'
+            "</figure>" % (_e(alt), _png(fig), _e(caption)))
+
+
+def _figure(size=(5.2, 4.2)):
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=size, layout="constrained")
+
+
+def _kv_table(rows):
+    out = ["<table>"]
+    for k, v in rows:
+        out.append("<tr><th>%s</th><td>%s</td></tr>" % (_e(k), v))
+    out.append("</table>")
+    return "".join(out)
+
+
+def grid_arrays(report):
+    """Per-point arrays of the report back on the measurement grid.
+
+    Returns
+    -------
+    dict
+        ``'x'``, ``'y'`` (n, m) nominal coordinates (mm) and ``'deviation'``,
+        ``'determined'``, ``'random'``, ``'correction'``, ``'residual'`` (n, m) in mm
+        (NaN where no point fell).
+    """
+    pts = report["points"]
+    n, m = report["grid"]["shape"]
+    row, col = np.asarray(pts["row"], dtype=int), np.asarray(pts["col"], dtype=int)
+    out = {}
+
+    def put(values):
+        a = np.full((n, m), np.nan)
+        a[row, col] = np.asarray(values, dtype=float)
+        return a
+
+    nominal = np.asarray(pts["nominal"], dtype=float)
+    out["x"], out["y"] = put(nominal[:, 0]), put(nominal[:, 1])
+    for key in ("deviation", "determined", "random", "correction"):
+        out[key] = put(pts[key])
+    out["residual"] = out["deviation"] - predicted_stock(report) - out["correction"]
+    return out
+
+
+def predicted_stock(report):
+    """The stock (mm) the mirror method's measured deviations include, else 0."""
+    meth = report.get("method", {})
+    return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
+
+
+def _map(x, y, values_um, title, symmetric=True):
+    fig = _figure()
+    ax = fig.add_subplot()
+    finite = values_um[np.isfinite(values_um)]
+    lim = float(np.max(np.abs(finite))) if finite.size else 1.0
+    lim = lim or 1.0
+    kw = dict(vmin=-lim, vmax=lim, cmap="RdBu_r") if symmetric else dict(cmap="viridis")
+    if np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and min(x.shape) > 1:
+        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values_um), shading="gouraud", **kw)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        ax.set_aspect("equal", adjustable="box")
+    else:
+        mesh = ax.imshow(values_um.T, origin="lower", **kw)
+        ax.set_xlabel("grid row")
+        ax.set_ylabel("grid column")
+    cb = fig.colorbar(mesh, ax=ax, shrink=0.85)
+    cb.set_label("µm (along the outward normal)")
+    ax.set_title(title, fontsize=11)
+    return fig
+
+
+def _hist(values_um, title, color):
+    fig = _figure((5.0, 3.4))
+    ax = fig.add_subplot()
+    v = values_um[np.isfinite(values_um)]
+    ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color=color, edgecolor="white")
+    ax.set_xlabel("µm")
+    ax.set_ylabel("points")
+    ax.set_title("%s (mean %.2f µm, std %.2f µm)" % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
+                 fontsize=10)
+    return fig
+
+
+def _stat_table(columns):
+    """``columns``: list of (header, statistics dict in mm)."""
+    out = ["<table><tr><th>Deviations (µm)</th>%s</tr>" % "".join("<th>%s</th>" % _e(h) for h, _ in columns)]
+    for key, label, f in _STAT_ROWS:
+        cells = []
+        for _, st in columns:
+            v = st.get(key)
+            cells.append('<td class="num">%s</td>' % ("" if v is None else
+                                                     ("%d" % v if f is None else "%.2f" % (v * f))))
+        out.append("<tr><th>%s</th>%s</tr>" % (_e(label), "".join(cells)))
+    out.append("</table>")
+    return "".join(out)
+
+
+def _section_inputs(report):
+    rows = []
+    for name, d in report.get("inputs", {}).items():
+        info = ["<b>%s</b>" % _e(d.get("path", ""))]
+        if d.get("sha256"):
+            info.append("SHA-256 <code>%s</code>" % _e(d["sha256"]))
+        extra = {k: v for k, v in d.items() if k not in ("path", "sha256") and v not in (None, [], {})}
+        if extra:
+            info.append(", ".join("%s: %s" % (_e(k), _e(v)) for k, v in extra.items()))
+        rows.append((name, "<br>".join(info)))
+    rows.append(("surfcomp", _e("%s, %s, created %s" % (report.get("surfcomp_version", "?"),
+                                                         report.get("command", "?"),
+                                                         report.get("created", "?")))))
+    return '<section id="inputs"><h2>Inputs</h2>%s</section>' % _kv_table(rows)
+
+
+def _section_method(report):
+    m = report.get("method", {})
+    mask = np.asarray(m.get("mask", [[1]]), dtype=float)
+    mask_html = "<table>%s</table>" % "".join(
+        "<tr>%s</tr>" % "".join('<td class="num">%g</td>' % w for w in row) for row in mask)
+    g = report.get("grid", {})
+    rows = [("Method", _e(m.get("name"))),
+            ("Mask", "%dx%d %s (Werner 2022 eq. 4-5)%s" % (mask.shape[0], mask.shape[1],
+                                                           _e(m.get("mask_kind")), mask_html)),
+            ("Edge handling", _e(m.get("edge"))),
+            ("Stock (mirror)", _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
+            ("Refinement", _e("%s knot spans per grid step" % m.get("refine"))),
+            ("Grid", _e("%s x %s (%s)" % (tuple(g.get("shape", ["?", "?"])) + (g.get("found_from", ""),))))]
+    return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
+
+
+def _section_maps(arrays):
+    figs = []
+    for key, title in (("deviation", "Raw deviation d"), ("determined", "Determined (filtered) d_f"),
+                       ("random", "Random d - d_f"), ("correction", "Correction applied delta"),
+                       ("residual", "Predicted residual")):
+        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]"),
+                         "map of " + key, title))
+    return ('<section id="maps"><h2>Maps</h2><p>Values along the outward normal in µm; '
+            'positive = material left. Predicted residual = d - stock - delta (what remains if '
+            'the machine repeats the measured error).</p><div class="figs">%s</div></section>'
+            % "".join(figs))
+
+
+def _section_histograms(arrays):
+    figs = [_img(_hist(arrays[k] * 1e3, t, c), "histogram of " + k, t)
+            for k, t, c in (("deviation", "Raw deviation", "#4477aa"),
+                            ("random", "Random component", "#cc6677"),
+                            ("residual", "Predicted residual", "#228833"))]
+    return '<section id="histograms"><h2>Histograms</h2><div class="figs">%s</div></section>' % "".join(figs)
+
+
+def _section_statistics(report, arrays):
+    st = report.get("statistics", {})
+    cols = [(h, st[k]) for k, h in (("deviation", "Raw deviations"), ("determined", "Determined"),
+                                    ("random", "Random"), ("correction", "Correction"))] if st else []
+    res = arrays["residual"][np.isfinite(arrays["residual"])]
+    if res.size:
+        std = float(np.std(res, ddof=1)) if res.size > 1 else 0.0
+        cols.append(("Predicted residual", {"count": res.size, "max_negative": res.min(),
+                                            "max_positive": res.max(), "mean": res.mean(),
+                                            "std": std, "rms": float(np.sqrt(np.mean(res ** 2))),
+                                            "profile": 2 * np.abs(res).max()}))
+    return ('<section id="statistics"><h2>Statistics</h2><p>Werner 2022 Tab. 1 and 3 form; '
+            'standard deviation with ddof=%s.</p>%s</section>'
+            % (_e(report.get("statistics_ddof", 1)), _stat_table(cols)))
+
+
+def _section_checks(report):
+    ch = report.get("corrected_face")
+    if not ch:
+        body = "<p>No corrected face was built (%s).</p>" % _e(report.get("command", "inspection"))
+    else:
+        labels = {"max_error_at_points_mm": ("Realised - intended correction at the measured points, max", 1e3, "µm"),
+                  "max_deviation_from_nominal_with_zero_correction_mm":
+                      ("Zero correction reproduces the nominal within", 1e3, "µm"),
+                  "max_abs_realised_correction_on_face_mm": ("Largest correction anywhere on the face", 1e3, "µm"),
+                  "max_abs_intended_correction_mm": ("Largest intended correction", 1e3, "µm")}
+        rows = []
+        for key, val in ch.items():
+            if key in labels:
+                text, f, unit = labels[key]
+                rows.append((text, '<span class="num">%.4f %s</span>' % (val * f, unit)))
+            else:
+                rows.append((key.replace("_", " "), _e(val)))
+        body = _kv_table(rows)
+    return '<section id="checks"><h2>Corrected face checks</h2>%s</section>' % body
+
+
+def _bar_chart(sim):
+    cols = [("Before", sim["before"])] + [(m["label"], m) for m in sim["methods"]]
+    fig = _figure((7.5, 3.6))
+    axes = fig.subplots(1, 2)
+    x = np.arange(len(cols))
+    for ax, key, title in zip(axes, ("std", "profile"), ("Standard deviation", "Profile error ISO 1101")):
+        vals = np.array([[r["all"][key] for r in c["replicas"]] for _, c in cols], dtype=object)
+        mean = np.array([np.mean(v) for v in vals]) * 1e3
+        lo = mean - np.array([np.min(v) for v in vals]) * 1e3
+        hi = np.array([np.max(v) for v in vals]) * 1e3 - mean
+        ax.bar(x, mean, yerr=[lo, hi], capsize=4, color="#88aacc")
+        ax.set_xticks(x, [h for h, _ in cols], rotation=30, ha="right", fontsize=8)
+        ax.set_ylabel("µm")
+        ax.set_title(title + " (bars: min..max over replicas)", fontsize=9)
+    return fig
+
+
+def _section_simulation(sim):
+    if not sim:
+        return ""
+    cols = [("Before", sim["before"])] + [(m["label"], m) for m in sim["methods"]]
+    head = "".join("<th>%s</th>" % _e(h) for h, _ in cols)
+    rows = []
+    for key, label, f in _STAT_ROWS[1:]:
+        if key == "rms":
+            continue
+        cells = []
+        for _, c in cols:
+            sp = c["spread"]["all"][key]
+            cells.append('<td class="num">%.2f (%.2f)</td>' % (sp["mean"] * f, sp["range"] * f))
+        rows.append("<tr><th>%s</th>%s</tr>" % (_e(label), "".join(cells)))
+    table = "<table><tr><th>Deviations (µm)</th>%s</tr>%s</table>" % (head, "".join(rows))
+    rep = ["<table><tr><th>Std per replica (µm)</th><th>values</th><th>range</th></tr>"]
+    for h, c in cols:
+        v = np.array([r["all"]["std"] for r in c["replicas"]]) * 1e3
+        rep.append('<tr><th>%s</th><td class="num">%s</td><td class="num">%.2f</td></tr>'
+                   % (_e(h), ", ".join("%.2f" % x for x in v), np.ptp(v)))
+    rep.append("</table>")
+    model = sim.get("model", {})
+    params = _kv_table([(k, _e(v)) for k, v in model.items() if k != "axis_errors"]
+                       + [("axis_errors", _e("yes" if model.get("axis_errors") else "none"))])
+    return ('<section id="simulation"><h2>Simulated machining: before / after</h2>'
+            '<p>%d replica(s), seed %s, measured on a %s grid and evaluated on %s points (grid nodes '
+            'and between). Cells: mean over replicas (range max - min), µm; mirror paper '
+            'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div><h3>Model parameters</h3>%s</section>'
+            % (sim.get("replicas", 0), _e(sim.get("seed")), _e("x".join(map(str, sim.get("grid", [])))),
+               _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
+               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"), params))
+
+
+def render_html(report, simulation=None):
+    """The report as one HTML document (str).
+
+    Parameters
+    ----------
+    report : dict
+        From :func:`surfcomp.io.report.build_report` (schema ``surfcomp-report/1``).
+    simulation : dict, optional
+        From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section).
+    """
+    arrays = grid_arrays(report)
+    warn = report.get("warnings") or []
+    warn_html = ("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(w) for w in warn)) if warn else "<p>None.</p>"
+    title = "surfcomp report: %s, method %s" % (report.get("command", ""), report.get("method", {}).get("name", ""))
+    parts = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
+             "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
+             "<h1>%s</h1>" % _e(title),
+             _section_inputs(report), _section_method(report), _section_maps(arrays),
+             _section_histograms(arrays), _section_statistics(report, arrays),
+             _section_checks(report), _section_simulation(simulation),
+             '<section id="warnings"><h2>Warnings</h2>%s</section>' % warn_html,
+             "</body></html>\n"]
+    return "\n".join(parts)
+
+
+def write_html_report(path, report, simulation=None):
+    """Write :func:`render_html` to ``path`` atomically (temporary file, then rename)."""
+    write_text(path, render_html(report, simulation))
+    return path

@@ -1,0 +1,132 @@
+"""The self-contained HTML report (surfcomp.io.html_report) rendered by headless Chromium:
+every section in the DOM, every image an embedded PNG that decodes, a non-blank screenshot
+showing the colour maps; predicted residuals by hand; atomic writing."""
+
+import base64
+import io
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from PIL import Image
+
+from surfcomp.core import bspline
+from surfcomp.core import simulate as sm
+from surfcomp.core.pipeline import Options, compensate, prepare
+from surfcomp.io import report as report_io
+from surfcomp.io.html_report import SECTIONS, grid_arrays, render_html, write_html_report
+
+
+def _surface():
+    x = np.linspace(0.0, 30.0, 5)
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    Z = 2.0 * np.sin(X / 12.0) * np.cos(Y / 15.0)
+    k = np.array([0, 0, 0, 0, 0.5, 1, 1, 1, 1.0])
+    return bspline.Surface(np.stack([X, Y, Z], axis=-1), k, k, 3, 3)
+
+
+def _report(method="filtered", stock=None, n=11, build=True, seed=1):
+    """A compensation report of a synthetic smooth field + noise on an n x n grid."""
+    surf = _surface()
+    us = np.linspace(0.02, 0.98, n)
+    S, Su, Sv = bspline.evaluate_grid(surf, us, us, order=1)
+    nrm = np.cross(Su, Sv)
+    nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
+    rng = np.random.default_rng(seed)
+    d = 0.02 * np.sin(S[..., 0] / 9.0) - 0.01 * (S[..., 1] / 30.0) ** 2 + rng.normal(0, 0.002, (n, n))
+    d = d + (stock or 0.0)
+    rows, cols = np.indices((n, n))
+    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3), deviation=d.ravel(),
+                             row=rows.ravel(), col=cols.ravel())
+    opt = Options(method=method, stock=stock)
+    comp = compensate(surf, 1, prepare(surf, 1, ms, opt), opt, build=build)
+    inputs = {"nominal": {"path": "/data/nominal.step", "sha256": "ab" * 32, "face": "Face1"},
+              "measurements": {"path": "/data/m<1>.csv", "sha256": "cd" * 32, "points": n * n}}
+    return report_io.build_report("compensate" if build else "inspect", inputs, comp, ["a <b> warning"])
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """A filtered compensation with a simulation, written and opened in headless Chromium."""
+    folder = tmp_path_factory.mktemp("html")
+    sim = sm.simulate(_surface(), 1, sm.MachiningModel(), grid=(9, 9), replicas=2, seed=3,
+                      specs=sm.method_specs(["none", "offset", "raw", "filtered"])).as_dict()
+    rep = _report()
+    path = str(folder / "report.html")
+    write_html_report(path, rep, sim)
+    base = ["chromium", "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+            "--user-data-dir=%s" % (folder / "profile")]
+    dom = subprocess.run(base + ["--dump-dom", "file://" + path], capture_output=True, text=True,
+                         timeout=120)
+    assert dom.returncode == 0, dom.stderr
+    shot = str(folder / "shot.png")
+    out = subprocess.run(base + ["--screenshot=%s" % shot, "--window-size=1200,2600", "file://" + path],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and os.path.isfile(shot), out.stderr
+    return {"path": path, "dom": dom.stdout, "shot": shot, "report": rep, "sim": sim, "folder": folder}
+
+
+def test_every_section_is_in_the_dom(rendered):
+    dom = rendered["dom"]
+    for sec in SECTIONS:
+        assert re.search(r'<section id="%s">' % sec, dom), sec
+    ids = re.findall(r'<section id="([a-z]+)">', dom)
+    assert ids == list(SECTIONS)  # document order
+    # the texts are escaped, the inputs carry their hashes
+    assert "m&lt;1&gt;.csv" in dom and "a &lt;b&gt; warning" in dom and "cd" * 32 in dom
+    sim_sec = dom.split('<section id="simulation">')[1].split("</section>")[0]
+    for label in ("Before", "none", "offset", "raw", "filtered"):
+        assert "<th>%s</th>" % label in sim_sec
+    assert "Profile error ISO 1101" in sim_sec
+
+
+def test_images_are_embedded_pngs_that_decode(rendered):
+    srcs = re.findall(r'<img alt="([^"]*)" src="([^"]*)"', rendered["dom"])
+    assert len(srcs) == 5 + 3 + 1  # maps, histograms, simulation bar chart
+    assert not re.search(r'src="(?!data:)', rendered["dom"])  # nothing loaded from outside
+    for alt, src in srcs:
+        assert src.startswith("data:image/png;base64,"), alt
+        img = Image.open(io.BytesIO(base64.b64decode(src.split(",", 1)[1])))
+        img.load()
+        assert img.format == "PNG" and img.size[0] > 300 and img.size[1] > 200, alt
+    maps = [a for a, _ in srcs if a.startswith("map of ")]
+    assert maps == ["map of deviation", "map of determined", "map of random", "map of correction",
+                    "map of residual"]
+
+
+def test_screenshot_shows_the_colour_maps(rendered):
+    a = np.asarray(Image.open(rendered["shot"]).convert("RGB")).astype(int)
+    assert a.shape[:2] == (2600, 1200)
+    nonwhite = np.mean(np.any(a < 245, axis=2))
+    assert nonwhite > 0.10, nonwhite
+    r, g, b = a[..., 0], a[..., 1], a[..., 2]
+    red = np.mean((r > 150) & (g < 90) & (b < 90))       # RdBu_r positive end
+    blue = np.mean((b > 120) & (r < 80) & (g < 130))      # RdBu_r negative end
+    assert red > 0.002 and blue > 0.002, (red, blue)
+    assert len(np.unique(a.reshape(-1, 3)[::37], axis=0)) > 200  # pictures, not only text
+
+
+def test_predicted_residual_by_method():
+    """d - s - delta: 0 for raw and mirror, the random component for filtered, d - mean for offset."""
+    for method, stock in (("raw", None), ("mirror", 0.25)):
+        arr = grid_arrays(_report(method, stock, n=7, build=False))
+        assert_allclose(arr["residual"], 0.0, atol=1e-9)
+    arr = grid_arrays(_report("filtered", n=7, build=False))
+    assert_allclose(arr["residual"], arr["random"], atol=1e-9)
+    arr = grid_arrays(_report("offset", n=7, build=False))
+    assert_allclose(arr["residual"], arr["deviation"] - np.mean(arr["deviation"]), atol=1e-8)
+
+
+def test_inspection_report_without_simulation_and_atomic_write(tmp_path):
+    rep = _report("filtered", n=7, build=False)
+    page = render_html(rep)
+    assert '<section id="simulation">' not in page
+    assert "No corrected face was built (inspect)" in page
+    path = tmp_path / "r.html"
+    path.write_text("old")
+    write_html_report(str(path), rep)
+    assert path.read_text() == page  # rendering is deterministic for one report dict
+    assert os.listdir(tmp_path) == ["r.html"]  # no temporary file left
