@@ -14,6 +14,7 @@ from ..errors import InputError
 from ..io import report as report_io
 from ..io.atomic import Transaction
 from ..io.hashing import sha256_file
+from ..io.html_report import render_html
 from ..io.readers import read_any
 from . import fcenv
 
@@ -31,9 +32,12 @@ class Job:
     report: str = None
     points: str = None
     curves: str = None
+    html: str = None
     face: str = None
     object: str = None
-    units: str = "mm"
+    units: str = None
+    fmt: str = "auto"
+    sample: str = None
     options: Options = field(default_factory=Options)
 
     @classmethod
@@ -49,7 +53,7 @@ class Job:
             if key not in data:
                 raise InputError("the job file needs %r" % key)
         kw = {k: data[k] for k in known if k in data}
-        for k in ("nominal", "measurements", "output", "report", "points", "curves"):
+        for k in ("nominal", "measurements", "output", "report", "points", "curves", "html"):
             if kw.get(k):
                 kw[k] = os.path.join(base_dir, kw[k])
         kw["options"] = Options(**{k: data[k] for k in opt_names if k in data})
@@ -61,12 +65,12 @@ def run_job(job, progress=None):
     fcenv.import_freecad()
     from .nominal import load_nominal
 
-    for out in (job.output, job.report, job.points, job.curves):
+    for out in (job.output, job.report, job.points, job.curves, job.html):
         if out and os.path.abspath(out) in (os.path.abspath(job.nominal),
                                             os.path.abspath(job.measurements)):
             raise InputError("an output would overwrite an input file", file=out)
     nominal = load_nominal(job.nominal, job.face, job.object)
-    ms = read_any(job.measurements, job.units)
+    ms = read_any(job.measurements, job.units, job.fmt, job.sample)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options, progress=sub(progress, 0, 0.3))
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
@@ -83,7 +87,8 @@ def run_job(job, progress=None):
                          "units": ms.units, "kind": ms.kind(), "points": len(ms),
                          "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
     }
-    outputs = {k: os.path.abspath(getattr(job, k)) for k in ("output", "report", "points", "curves")
+    outputs = {k: os.path.abspath(getattr(job, k)) for k in ("output", "report", "points", "curves",
+                                                               "html")
                if getattr(job, k)}
     rep = report_io.build_report(job.command, inputs, comp, prepared.warnings, outputs)
     with Transaction() as tx:
@@ -95,6 +100,8 @@ def run_job(job, progress=None):
             write_face(tx.stage(job.curves), curve_net(comp))
         if job.report:
             tx.stage_text(job.report, report_io.dumps(rep))
+        if job.html:
+            tx.stage_text(job.html, render_html(rep))
         tx.commit()
     return comp, rep
 

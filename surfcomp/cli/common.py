@@ -7,6 +7,7 @@ from ..core.deviations import format_table
 from ..core.pipeline import Options
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
+from ..io.readers import FORMATS
 
 
 def add_input_options(p):
@@ -18,8 +19,14 @@ def add_input_options(p):
     p.add_argument("--face", metavar="FaceN",
                    help="the nominal face (default: the only B-spline face)")
     p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
-    p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
-                   help="units of columns without a unit suffix (default mm)")
+    p.add_argument("--units", choices=("mm", "um", "in"), default=None,
+                   help="units of values that carry no unit of their own (column suffix, "
+                        "XYZIJK METRIC, QIF FileUnits); default mm")
+    p.add_argument("--format", dest="fmt", choices=FORMATS, default="auto",
+                   help="measurement file format (default auto: detected from the content)")
+    p.add_argument("--sample", metavar="N|ID",
+                   help="which measured part of a QIF file holding several: 0-based index, "
+                        "serial number or MeasurementResults id (default the first)")
     p.add_argument("--max-offset", type=float, default=1.0, metavar="MM",
                    help="largest accepted distance of a point from the face (default 1 mm)")
     p.add_argument("--flip-normals", action="store_true",
@@ -48,6 +55,29 @@ def add_method_options(p):
                    help="semi-finishing allowance for --method mirror (DH = stock / 2)")
     p.add_argument("--refine", type=int, default=4, metavar="K",
                    help="knot spans of the corrected surface per measurement grid step (default 4)")
+
+
+def job_from_args(args, command):
+    """The :class:`surfcomp.app.job.Job` of a ``compensate``/``inspect`` command line."""
+    from ..app.job import Job
+
+    outputs = {k: getattr(args, k, None) for k in ("output", "report", "points", "curves", "html")}
+    return Job(nominal=args.nominal, measurements=args.measurements, command=command,
+               face=args.face, object=args.object, units=args.units, fmt=args.fmt,
+               sample=args.sample, options=options_from_args(args), **outputs)
+
+
+def run_job_command(args, command):
+    """Run a job command line: progress on stderr, the summary, the files written."""
+    from ..app.job import run_job
+
+    job = job_from_args(args, command)
+    comp, rep = run_job(job, progress=ProgressLine(args.quiet))
+    print_summary(comp, rep)
+    for key in ("output", "points", "curves", "report", "html"):
+        if getattr(job, key):
+            print("wrote %s" % getattr(job, key))
+    return 0
 
 
 def options_from_args(args):

@@ -1,8 +1,8 @@
 """``python3 -m surfcomp compensate``: nominal + measurements -> corrected face."""
 
-from ..app.job import Job, run_job
+from ..errors import InputError
 from .common import (ProgressLine, add_input_options, add_method_options, options_from_args,
-                     print_summary)
+                     run_job_command)
 
 
 def add_parser(subparsers):
@@ -17,18 +17,59 @@ def add_parser(subparsers):
     p.add_argument("--points", metavar="OUT.csv", help="also write the corrected points (CSV)")
     p.add_argument("--curves", metavar="OUT.step",
                    help="also write the curve net through the corrected points (Werner Fig. 3b)")
+    p.add_argument("--html", metavar="OUT.html",
+                   help="also write the self-contained HTML inspection report")
+    doc = p.add_argument_group(
+        "shop document (NOMINAL is an .FCStd)",
+        "Add the compensation to the document, put it in the nominal's place so Path "
+        "regenerates the tool paths, save a copy and post the program. The input document "
+        "is never overwritten unless --overwrite-input is given.")
+    doc.add_argument("--replace", action="store_true",
+                     help="rebind every user of the nominal (Path Job models, operations, "
+                          "links) to the compensation and recompute")
+    doc.add_argument("--save", metavar="OUT.FCStd", help="save the updated document here")
+    doc.add_argument("--gcode", metavar="OUT.ngc",
+                     help="post the regenerated program of the Job using the compensation")
+    doc.add_argument("--post", default="linuxcnc", metavar="NAME",
+                     help="Path post-processor for --gcode (default linuxcnc)")
+    doc.add_argument("--post-args", default="--no-show-editor", metavar="ARGS",
+                     help="argument string for the post-processor (default --no-show-editor)")
+    doc.add_argument("--job", metavar="NAME", help="which Job to post when several use the face")
+    doc.add_argument("--overwrite-input", action="store_true",
+                     help="allow --save to overwrite the input document")
     p.set_defaults(run=run)
     return p
 
 
 def run(args):
-    job = Job(nominal=args.nominal, measurements=args.measurements, command="compensate",
-              output=args.output, report=args.report, points=args.points, curves=args.curves,
-              face=args.face, object=args.object, units=args.units,
-              options=options_from_args(args))
-    comp, rep = run_job(job, progress=ProgressLine(args.quiet))
-    print_summary(comp, rep)
-    for key in ("output", "points", "curves", "report"):
-        if getattr(args, key):
-            print("wrote %s" % getattr(args, key))
+    if args.replace or args.save or args.gcode:
+        return run_document(args)
+    return run_job_command(args, "compensate")
+
+
+def run_document(args):
+    """The shop-document route: compensate, replace, save, post (see the option group)."""
+    if not args.nominal.lower().endswith(".fcstd"):
+        raise InputError("--replace/--save/--gcode work on a FreeCAD document: NOMINAL must be "
+                         "an .FCStd file", file=args.nominal)
+    if not args.object:
+        raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
+                         "holding the nominal face)", file=args.nominal)
+    other = [o for o in ("output", "report", "points", "curves", "html") if getattr(args, o)]
+    if other:
+        raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
+                         "'compensate' without them for the files" % other[0])
+    if args.fmt != "auto" or args.sample is not None:
+        raise InputError("--format/--sample are not supported with --replace/--save/--gcode "
+                         "yet; convert the file to a table first")
+    from ..app.docjob import run_document_job, summary_lines
+
+    res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,
+                           save=args.save, replace=args.replace, gcode=args.gcode,
+                           post=args.post, post_args=args.post_args, job_name=args.job,
+                           units=args.units or "mm", options=options_from_args(args),
+                           overwrite_input=args.overwrite_input,
+                           progress=ProgressLine(args.quiet))
+    for line in summary_lines(res):
+        print(line)
     return 0

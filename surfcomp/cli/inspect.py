@@ -1,7 +1,6 @@
 """``python3 -m surfcomp inspect``: deviations and statistics only."""
 
-from ..app.job import Job, run_job
-from .common import ProgressLine, add_input_options, options_from_args, print_summary
+from .common import add_input_options, run_job_command
 
 
 def add_parser(subparsers):
@@ -18,11 +17,4 @@ def add_parser(subparsers):
 
 
 def run(args):
-    job = Job(nominal=args.nominal, measurements=args.measurements, command="inspect",
-              report=args.report, face=args.face, object=args.object, units=args.units,
-              options=options_from_args(args))
-    comp, rep = run_job(job, progress=ProgressLine(args.quiet))
-    print_summary(comp, rep)
-    if args.report:
-        print("wrote %s" % args.report)
-    return 0
+    return run_job_command(args, "inspect")

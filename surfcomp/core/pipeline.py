@@ -230,12 +230,23 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     result = Compensation(prepared=prepared, options=options, correction=corr, statistics=stats)
     if not build:
         return result
+    build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
+    report(progress, 1.0, "done")
+    return result
+
+
+def build_surface(result, surface, outward, delta, progress=None):
+    """Build and check the corrected surface of ``result`` for the grid corrections
+    ``delta`` (n, m) in mm (``result.correction.delta``, or an accumulated correction
+    of an iteration); fills ``corrected``, ``zero``, ``field``, ``iterations``,
+    ``checks`` and ``spacing`` and returns ``result``."""
+    prepared = result.prepared
+    g = prepared.grid
     U, V = g.take(prepared.u), g.take(prepared.v)
     du, dv = grid_spacing(prepared)
+    built = construct(surface, U, V, delta, outward, du, dv, result.options.refine,
+                      progress=progress)
     result.spacing = (du, dv)
-    built = construct(surface, U, V, corr.delta, outward, du, dv, options.refine,
-                      progress=sub(progress, 0.05, 1.0))
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
-    report(progress, 1.0, "done")
     return result

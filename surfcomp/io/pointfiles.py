@@ -266,12 +266,18 @@ def _unit_directions(path, ijk, line_numbers, warnings):
     return ijk / length[:, None]
 
 
-def _resolve_units(units, file_units):
+def _resolve_units(units, file_units, warnings=None, line=0):
     """Unit name and factor to mm: the file's own units win, else ``units``, else mm.
 
     As for the unit suffixes of :mod:`surfcomp.io.measurements`, ``units`` is the unit
-    of values that carry none of their own.
+    of values that carry none of their own; a different explicit ``units`` is reported
+    in ``warnings`` (a list of (line, message)) rather than silently dropped.
     """
+    if (warnings is not None and units is not None and file_units is not None
+            and unit_factor(units) != unit_factor(file_units)):
+        warnings.append((line, "the file states its units (%s); --units %s applies only to "
+                               "values without units of their own, so the file's units are used"
+                         % (file_units, units)))
     name = file_units if file_units is not None else ("mm" if units is None else units)
     factor = unit_factor(name)
     return _UNIT_NAMES.get(factor, name.strip().lower()), factor
@@ -491,7 +497,7 @@ def _read_xyz(path, lines, units, warnings):
     usecols = sorted(roles.values())
     arr = _parse_rows(path, rows, sep, decimal_comma, ncols, names, expected, usecols)
     pos = {r: usecols.index(k) for r, k in roles.items()}
-    unit_name, factor = _resolve_units(units, file_units)
+    unit_name, factor = _resolve_units(units, file_units, warnings, hline)
     measured = arr[:, [pos["x"], pos["y"], pos["z"]]] * factor
     normal = None
     if "i" in roles:
@@ -565,7 +571,7 @@ def _read_xyzijk(path, lines, units, warnings):
                                     for t, c in zip(rows.texts, counts.tolist())])
     ncols = 6 if with_dir[0] else 3
     arr = _parse_rows(path, rows, ",", False, ncols, names, allowed)
-    unit_name, factor = _resolve_units(units, file_units)
+    unit_name, factor = _resolve_units(units, file_units, warnings, 2)
     normal = None
     columns = {r: "column %d" % (k + 1) for k, r in enumerate("xyz")}
     if ncols == 6:

@@ -237,6 +237,9 @@ class _Units:
                          % (self.name, units))
         else:
             self.primary, self.name = self._factor(lu)
+            if units is not None and unit_factor(units) != self.primary:
+                doc.warn("the file states its units (%s); units=%r is not used"
+                         % (self.name, units))
         for el in doc.findall(doc.root, "q:FileUnits/q:OtherUnits/q:LinearUnit") + (
                 [lu] if lu is not None else []):
             name_el = doc.find(el, "q:UnitName")
@@ -341,7 +344,7 @@ def _choose(doc, blocks, samples, sample):
     if sample is None:
         if len(samples) > 1:
             doc.warn("the file holds %d measured parts (MeasurementResults): %s; the first is "
-                     "read, choose another with sample=" % (len(samples), listing))
+                     "read, choose another with sample= (CLI: --sample)" % (len(samples), listing))
         return 0
     if isinstance(sample, (bool, np.bool_)) or not isinstance(sample, (int, np.integer, str)):
         raise InputError("sample=%r: expected a 0-based index, a serial number or a "

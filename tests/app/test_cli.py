@@ -167,3 +167,58 @@ def test_nominal_from_an_fcstd_document(tmp_path):
     err = _bad(bad_dir, "compensate", path, EXAMPLE_CSV, "--object", "Nope")
     assert "no object 'Nope' in the document" in err and "Nominal" in err
     del box
+
+
+def _measured_points(n=15, m=12, seed=7):
+    """Measured points on the example face (nominal + d n) and their deviations d (mm)."""
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, U, V = grid_on_face(nom, n, m)
+    d = 0.02 * np.sin(U / U.max() * 3) * np.cos(V / V.max() * 2) + np.random.default_rng(
+        seed).normal(0, 0.002, U.shape)
+    return P + d[..., None] * N, N, d
+
+
+@pytest.mark.parametrize("kind", ["xyz_inch_header", "xyzijk_inch", "probe_log"])
+def test_point_only_files_through_the_pipeline(tmp_path, kind):
+    """Files with measured points only: deviations come from the projection engine and
+    equal the synthetic ones (units converted; file-stated units win with a warning)."""
+    M, N, d = _measured_points()
+    pts = M.reshape(-1, 3)
+    if kind == "xyz_inch_header":
+        path = tmp_path / "scan.xyz"
+        rows = ["x[in] y[in] z[in]"] + ["%.9f %.9f %.9f" % tuple(p / 25.4) for p in pts]
+        extra = ["--units", "mm"]  # overridden by the header's [in], with a warning
+    elif kind == "xyzijk_inch":
+        path = tmp_path / "scan.txt"
+        rows = ["XYZIJK"] + ["%.9f,%.9f,%.9f,%.9f,%.9f,%.9f" % (tuple(p / 25.4) + tuple(nv))
+                             for p, nv in zip(pts, N.reshape(-1, 3))]
+        extra = []
+    else:
+        path = tmp_path / "probe.txt"
+        rows = ["%.6f %.6f %.6f 0 0 0 0 0 0" % tuple(p) for p in pts]
+        extra = ["--format", "probe"]
+    path.write_text("\n".join(rows) + "\n")
+    out = run_cli("inspect", EXAMPLE_STEP, path, "--report", tmp_path / "r.json", "--quiet", *extra)
+    assert out.returncode == 0, out.stderr
+    rep = json.loads((tmp_path / "r.json").read_text())
+    got = np.array(rep["points"]["deviation"])
+    # file order = row-major over the 15 x 12 grid; values printed to 1e-9 in / 1e-6 mm
+    tol = 1e-6 if kind == "probe_log" else 5e-8
+    np.testing.assert_allclose(np.sort(got), np.sort(d.ravel()), atol=tol)
+    assert rep["grid"]["shape"] == [15, 12] or rep["grid"]["shape"] == [12, 15]
+    if kind == "xyz_inch_header":
+        assert "the file states its units (in); --units mm applies only" in out.stderr
+
+
+def test_html_report_written_with_the_other_outputs(tmp_path):
+    out = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "-o", tmp_path / "c.step",
+                  "--html", tmp_path / "r.html", "--quiet")
+    assert out.returncode == 0, out.stderr
+    html = (tmp_path / "r.html").read_text()
+    for section in ("inputs", "method", "maps", "histograms", "statistics", "checks"):
+        assert 'id="%s"' % section in html
+    assert html.count("data:image/png;base64,") >= 5
+    assert "wrote %s" % (tmp_path / "r.html") in out.stdout
+    # an input path among the outputs is refused before anything is written
+    bad = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "--html", EXAMPLE_CSV, "--quiet")
+    assert bad.returncode == 2 and "overwrite an input" in bad.stderr

@@ -33,15 +33,10 @@ def measured(model):
 
 
 @pytest.fixture
-def home(monkeypatch):
+def home():
     """Path finds its post-processors and tool-bit shapes under FreeCAD.getHomePath(),
-    which is the library folder when FreeCAD is imported from python3; point it at the
-    folder that has Mod/Path (as freecadcmd does)."""
-    for share in fcenv.SHARE_CANDIDATES:
-        if os.path.isdir(os.path.join(share, "Mod", "Path")):
-            monkeypatch.setattr(FreeCAD, "getHomePath", lambda s=share: s + "/")
-            return share
-    raise AssertionError("FreeCAD's Path workbench is not installed")
+    which is the library folder when FreeCAD is imported from python3 (fcenv fixes it)."""
+    return fcenv.setup_path_workbench(require_ocl=False)
 
 
 @pytest.fixture

@@ -1,0 +1,763 @@
+"""Document objects of the compensation: a measurement object and the compensation feature.
+
+Both are thin proxies (see /work/shared/STYLE.md, "Document objects"): every input and
+result lives in properties, ``execute`` turns properties into arrays, calls the core
+pipeline (:func:`surfcomp.core.pipeline.prepare` / :func:`~surfcomp.core.pipeline.compensate`)
+and writes the results back. No FreeCADGui, no PySide: everything recomputes in
+``freecadcmd``.
+
+``SurfComp_Measurement`` (``App::FeaturePython``)
+    The parsed measurement set kept inside the document (float/int list properties, mm),
+    with the source file's name, SHA-256, units and grid shape: the document still opens and
+    recomputes when the CSV file has moved or is gone.
+
+``SurfComp_Compensation`` (``Part::FeaturePython``)
+    Links the nominal (object + face name) and a measurement object; its ``Shape`` is the
+    corrected face, or the nominal's solid with that face replaced (``Output = solid``:
+    same number and order of faces, so ``FaceN`` links keep pointing at the right face).
+
+Iterations (Werner 2022: "deviations are always determined in relation to the initial,
+nominal model"): a compensation whose ``Base`` is the previous compensation takes a new
+measurement of the part machined from the previous corrected face. Its deviations are
+computed against the nominal, its own correction (``Increment``) is computed from them
+with the chosen method, and the corrections accumulate:
+``Correction = Base.Correction (at the new nodes) + Increment``. The corrected surface is
+``S(u, v) - Correction(u, v) n(u, v)`` of the nominal ``S``.
+
+The proxy module path ``surfcomp.app.features`` is permanent once documents exist.
+"""
+
+import json
+import os
+from dataclasses import replace as _dc_replace
+
+import numpy as np
+
+from . import fcenv
+
+fcenv.setup_paths()
+
+import FreeCAD  # noqa: E402
+
+from ..core.deviations import statistics  # noqa: E402
+from ..core.field import GridField  # noqa: E402
+from ..core.filters import EDGE_MODES  # noqa: E402
+from ..core.methods import METHODS  # noqa: E402
+from ..core.pipeline import Options, build_surface, compensate, prepare  # noqa: E402
+from ..errors import GeometryError, InputError  # noqa: E402
+from ..io.measurements import MeasurementSet  # noqa: E402
+from ..io.readers import FORMATS, read_any  # noqa: E402
+
+#: version of the property sets; onDocumentRestored upgrades older objects
+VERSION = 1
+
+MEASUREMENT_TYPE = "SurfComp_Measurement"
+COMPENSATION_TYPE = "SurfComp_Compensation"
+
+OUTPUTS = ("face", "solid")
+MASK_KINDS = ("box", "gaussian")
+#: quantities of :func:`deviation_field`
+QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
+
+#: a solid whose face was replaced gets its edges' tolerance raised to cover the shift of
+#: the face border inside the neighbouring faces (mm): refuse larger shifts
+MAX_EDGE_TOLERANCE = 1.0
+
+_RO = 1      # editor mode: read-only
+_HIDDEN = 2  # editor mode: hidden
+
+# (type, name, group, tooltip, default, editor mode)
+_MEAS = "Measurement"
+MEASUREMENT_PROPERTIES = (
+    ("App::PropertyString", "SourceName", _MEAS,
+     "File the measurements were read from (information only: the data is stored below)",
+     "", _RO),
+    ("App::PropertyString", "SourceSha256", _MEAS, "SHA-256 of the source file's bytes", "",
+     _RO),
+    ("App::PropertyString", "Units", _MEAS,
+     "Units of the source file's length columns (the stored values are in mm)", "mm", _RO),
+    ("App::PropertyString", "Kind", _MEAS,
+     "Columns the file had: nominal+normal+deviation, nominal+measured, ...", "", _RO),
+    ("App::PropertyInteger", "PointCount", _MEAS, "Number of measured points", 0, _RO),
+    ("App::PropertyIntegerList", "GridShape", _MEAS,
+     "Rows and columns of the grid when the file gives row/col indices (else empty)", None,
+     _RO),
+    ("App::PropertyFloatList", "NominalX", _MEAS, "Nominal points, x (mm)", None, _RO),
+    ("App::PropertyFloatList", "NominalY", _MEAS, "Nominal points, y (mm)", None, _RO),
+    ("App::PropertyFloatList", "NominalZ", _MEAS, "Nominal points, z (mm)", None, _RO),
+    ("App::PropertyFloatList", "MeasuredX", _MEAS, "Measured points, x (mm)", None, _RO),
+    ("App::PropertyFloatList", "MeasuredY", _MEAS, "Measured points, y (mm)", None, _RO),
+    ("App::PropertyFloatList", "MeasuredZ", _MEAS, "Measured points, z (mm)", None, _RO),
+    ("App::PropertyFloatList", "NormalI", _MEAS, "Normals, x component", None, _RO),
+    ("App::PropertyFloatList", "NormalJ", _MEAS, "Normals, y component", None, _RO),
+    ("App::PropertyFloatList", "NormalK", _MEAS, "Normals, z component", None, _RO),
+    ("App::PropertyFloatList", "Deviation", _MEAS,
+     "Deviation along the normal (mm, positive = material left)", None, _RO),
+    ("App::PropertyIntegerList", "Row", _MEAS, "Grid row of every point (when given)", None,
+     _RO),
+    ("App::PropertyIntegerList", "Col", _MEAS, "Grid column of every point (when given)",
+     None, _RO),
+    ("App::PropertyIntegerList", "Lines", _MEAS, "Line of every point in the source file",
+     None, _RO),
+    ("App::PropertyStringList", "Ids", _MEAS, "Point names (when given)", None, _RO),
+    ("App::PropertyString", "Columns", _MEAS,
+     "Role -> column name as written in the file (JSON)", "{}", _RO),
+    ("App::PropertyStringList", "ReadWarnings", _MEAS, "Warnings of the file reader", None,
+     _RO),
+    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     VERSION, _HIDDEN),
+)
+
+_IN, _RES = "Compensation", "Result"
+COMPENSATION_PROPERTIES = (
+    ("App::PropertyLink", "Nominal", _IN, "Object holding the nominal face", None, 0),
+    ("App::PropertyString", "FaceName", _IN, "The nominal face (FaceN of Nominal)", "Face1",
+     0),
+    ("App::PropertyLink", "Measurement", _IN, "Measurement object (SurfComp_Measurement)",
+     None, 0),
+    ("App::PropertyLink", "Base", _IN,
+     "Previous compensation (iterations): this measurement is of the part machined from its "
+     "corrected face; corrections accumulate", None, 0),
+    ("App::PropertyEnumeration", "Method", _IN,
+     "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs Stock), offset", list(METHODS), 0),
+    ("App::PropertyInteger", "MaskSize", _IN, "Odd size of the filter mask", 5, 0),
+    ("App::PropertyString", "Weights", _IN,
+     "Custom mask weights, rows separated by ';' (empty: MaskKind and MaskSize)", "", 0),
+    ("App::PropertyEnumeration", "MaskKind", _IN, "Mask shape without custom weights",
+     list(MASK_KINDS), 0),
+    ("App::PropertyFloat", "Sigma", _IN,
+     "Gaussian sigma in grid steps (0: MaskSize / 4)", 0.0, 0),
+    ("App::PropertyEnumeration", "Edge", _IN, "Edge handling of the filter", list(EDGE_MODES),
+     0),
+    ("App::PropertyLength", "Stock", _IN,
+     "Semi-finishing allowance of the mirror method (mm; DH = Stock / 2)", 0.0, 0),
+    ("App::PropertyLength", "MaxOffset", _IN,
+     "Largest accepted distance of a measured point from the face", 1.0, 0),
+    ("App::PropertyBool", "FlipNormals", _IN,
+     "The file's normals point into the material: flip them and the deviations' sign",
+     False, 0),
+    ("App::PropertyInteger", "Refine", _IN,
+     "Knot spans of the corrected surface per measurement grid step", 4, 0),
+    ("App::PropertyEnumeration", "Output", _IN,
+     "face: the corrected face; solid: the nominal's shape with the face replaced",
+     list(OUTPUTS), 0),
+    ("App::PropertyInteger", "GridRows", _RES, "Rows of the measurement grid", 0, _RO),
+    ("App::PropertyInteger", "GridCols", _RES, "Columns of the measurement grid", 0, _RO),
+    ("App::PropertyFloatList", "U", _RES, "Face parameter u of every grid node (row-major)",
+     None, _RO),
+    ("App::PropertyFloatList", "V", _RES, "Face parameter v of every grid node (row-major)",
+     None, _RO),
+    ("App::PropertyFloatList", "NominalPoints", _RES,
+     "Nominal point of every node, flat x y z (mm)", None, _RO),
+    ("App::PropertyFloatList", "Normals", _RES, "Outward normal of every node, flat", None,
+     _RO),
+    ("App::PropertyFloatList", "Deviation", _RES,
+     "Deviation from the nominal at every node (mm, NaN = not measured)", None, _RO),
+    ("App::PropertyFloatList", "Determined", _RES,
+     "Filtered (determined) component of the deviation (mm)", None, _RO),
+    ("App::PropertyFloatList", "Random", _RES, "Random component: deviation - determined (mm)",
+     None, _RO),
+    ("App::PropertyFloatList", "Increment", _RES,
+     "Correction of this round (mm); equals Correction without a Base", None, _RO),
+    ("App::PropertyFloatList", "Correction", _RES,
+     "Total correction realised by the corrected face (mm, accumulated over the Base chain)",
+     None, _RO),
+    ("App::PropertyString", "Statistics", _RES,
+     "name -> statistics (mm) as JSON", "{}", _RO),
+    ("App::PropertyString", "Checks", _RES, "Check figures of the corrected face (JSON)", "{}",
+     _RO),
+    ("App::PropertyStringList", "Warnings", _RES, "What the computation warned about", None,
+     _RO),
+    ("App::PropertyInteger", "Round", _RES, "Iteration round (1 without a Base)", 1, _RO),
+    ("App::PropertyLength", "EdgeTolerance", _RES,
+     "Largest edge tolerance of the output solid (covers the face border's shift)", 0.0,
+     _RO),
+    ("App::PropertyString", "ReplacedLinks", "Replace",
+     "Links rebound by surfcomp.app.replace.replace (JSON; restore() reverts them)", "",
+     _HIDDEN),
+    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     VERSION, _HIDDEN),
+)
+
+
+def _add_properties(obj, table):
+    """Add every missing property of ``table`` (new objects and old documents alike)."""
+    added = []
+    for typ, name, group, tip, default, mode in table:
+        if name in obj.PropertiesList:
+            continue
+        obj.addProperty(typ, name, group, tip)
+        if typ == "App::PropertyEnumeration":
+            setattr(obj, name, default)
+            setattr(obj, name, default[0])
+        elif default is not None:
+            setattr(obj, name, default)
+        if mode:
+            obj.setEditorMode(name, mode)
+        added.append(name)
+    return added
+
+
+class _Proxy:
+    """Common proxy behaviour: no state on the proxy, properties upgraded on restore."""
+
+    Type = None
+    PROPERTIES = ()
+
+    def __init__(self, obj):
+        _add_properties(obj, self.PROPERTIES)
+        obj.Proxy = self
+
+    # FreeCAD 1.x calls dumps/loads, 0.20 __getstate__/__setstate__: nothing to store
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    def __getstate__(self):
+        return None
+
+    def __setstate__(self, state):
+        return None
+
+    def onDocumentRestored(self, obj):
+        migrate(obj, self.PROPERTIES)
+
+
+def migrate(obj, table):
+    """Bring an object restored from an older document to the current property set.
+
+    Returns the names of the properties that were added.
+    """
+    added = _add_properties(obj, table)
+    if obj.Version < VERSION:
+        obj.Version = VERSION
+    return added
+
+
+# -- measurement object --------------------------------------------------------------------
+
+
+class MeasurementFeature(_Proxy):
+    """Proxy of ``SurfComp_Measurement``: a measurement set stored in the document."""
+
+    Type = MEASUREMENT_TYPE
+    PROPERTIES = MEASUREMENT_PROPERTIES
+
+    def execute(self, obj):
+        measurement_set(obj)  # checks that the stored lists fit together
+
+
+def _xyz(obj, names):
+    cols = [getattr(obj, n) for n in names]
+    if not any(len(c) for c in cols):
+        return None
+    return np.stack([np.asarray(c, dtype=float) for c in cols], axis=1)
+
+
+def set_measurement_data(obj, ms):
+    """Store a :class:`~surfcomp.io.measurements.MeasurementSet` in a measurement object.
+
+    Every array goes into a list property in mm (the file's units are recorded in
+    ``Units``); absent columns leave their lists empty.
+    """
+    n = next(len(a) for a in (ms.nominal, ms.measured, ms.normal, ms.deviation)
+             if a is not None)
+
+    def put(names, arr):
+        for k, name in enumerate(names):
+            setattr(obj, name, [] if arr is None else np.asarray(arr, float)[:, k].tolist())
+
+    put(("NominalX", "NominalY", "NominalZ"), ms.nominal)
+    put(("MeasuredX", "MeasuredY", "MeasuredZ"), ms.measured)
+    put(("NormalI", "NormalJ", "NormalK"), ms.normal)
+    obj.Deviation = [] if ms.deviation is None else np.asarray(ms.deviation, float).tolist()
+    obj.Row = [] if ms.row is None else [int(x) for x in ms.row]
+    obj.Col = [] if ms.col is None else [int(x) for x in ms.col]
+    obj.GridShape = ([] if ms.row is None or ms.col is None or n == 0 else
+                     [int(np.max(ms.row)) + 1, int(np.max(ms.col)) + 1])
+    obj.Lines = [int(x) for x in ms.lines]
+    obj.Ids = [] if ms.ids is None else [str(x) for x in ms.ids]
+    obj.SourceName = os.path.basename(str(ms.source))
+    obj.SourceSha256 = ms.sha256 or ""
+    obj.Units = ms.units or "mm"
+    try:
+        obj.Kind = ms.kind()
+    except InputError:
+        obj.Kind = ""
+    obj.Columns = json.dumps(dict(ms.columns or {}), sort_keys=True)
+    obj.ReadWarnings = [str(w) for w in (ms.warnings or [])]
+    obj.PointCount = n
+
+
+def measurement_set(obj):
+    """Rebuild the :class:`~surfcomp.io.measurements.MeasurementSet` from the properties.
+
+    No file access: this is what the compensation uses, so a document keeps working when
+    the source file has moved or is gone.
+
+    Raises
+    ------
+    InputError
+        The stored lists do not fit together (a damaged or hand-edited document).
+    """
+    nominal = _xyz(obj, ("NominalX", "NominalY", "NominalZ"))
+    measured = _xyz(obj, ("MeasuredX", "MeasuredY", "MeasuredZ"))
+    normal = _xyz(obj, ("NormalI", "NormalJ", "NormalK"))
+    dev = np.asarray(obj.Deviation, dtype=float) if len(obj.Deviation) else None
+    lists = {"NominalX/Y/Z": nominal, "MeasuredX/Y/Z": measured, "NormalI/J/K": normal,
+             "Deviation": dev}
+    lengths = {k: len(a) for k, a in lists.items() if a is not None}
+    for name in ("Row", "Col", "Lines", "Ids"):
+        if len(getattr(obj, name)):
+            lengths[name] = len(getattr(obj, name))
+    if not lengths:
+        raise InputError("%s holds no measured points" % obj.Label)
+    if len(set(lengths.values())) != 1 or obj.PointCount not in lengths.values():
+        raise InputError("%s: the stored measurement lists have different lengths (%s; "
+                         "PointCount %d): the document is damaged"
+                         % (obj.Label, ", ".join("%s %d" % kv for kv in sorted(lengths.items())),
+                            obj.PointCount))
+    ids = list(obj.Ids) if len(obj.Ids) else None
+    lines = np.asarray(obj.Lines, dtype=np.int64) if len(obj.Lines) else None
+    row = np.asarray(obj.Row, dtype=np.int64) if len(obj.Row) else None
+    col = np.asarray(obj.Col, dtype=np.int64) if len(obj.Col) else None
+    return MeasurementSet(nominal=nominal, measured=measured, normal=normal, deviation=dev,
+                          row=row, col=col, ids=ids, lines=lines,
+                          source=obj.SourceName or obj.Label, sha256=obj.SourceSha256,
+                          units=obj.Units, columns=json.loads(obj.Columns or "{}"),
+                          warnings=list(obj.ReadWarnings))
+
+
+def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample=None):
+    """Read a measurement file into a new ``SurfComp_Measurement`` object of ``doc``.
+
+    Parameters
+    ----------
+    doc : FreeCAD document
+    path : str
+        Any format :func:`surfcomp.io.readers.read_any` reads.
+    units : {'mm', 'um', 'in'}
+        Units of columns without a unit suffix.
+    fmt : str, optional
+        One of :data:`surfcomp.io.readers.FORMATS` (default: detected).
+    sample : int or str, optional
+        Which result of a QIF file holding several.
+
+    Returns
+    -------
+    The new ``App::FeaturePython`` object (its data is in the document from now on).
+    """
+    fmt = fmt or "auto"
+    if fmt not in FORMATS:
+        raise InputError("unknown format %r (expected one of %s)" % (fmt, ", ".join(FORMATS)))
+    ms = read_any(os.fspath(path), units=units, fmt=fmt, sample=sample)
+    obj = doc.addObject("App::FeaturePython", name)
+    MeasurementFeature(obj)
+    set_measurement_data(obj, ms)
+    return obj
+
+
+def make_measurement_from_set(doc, ms, name="Measurement"):
+    """A ``SurfComp_Measurement`` object holding an in-memory measurement set."""
+    obj = doc.addObject("App::FeaturePython", name)
+    MeasurementFeature(obj)
+    set_measurement_data(obj, ms)
+    return obj
+
+
+# -- compensation feature -----------------------------------------------------------------
+
+
+def is_type(obj, typ):
+    """True when ``obj`` is a surfcomp feature of ``typ`` (``MEASUREMENT_TYPE`` ...)."""
+    return getattr(getattr(obj, "Proxy", None), "Type", None) == typ
+
+
+def is_compensation(obj):
+    return is_type(obj, COMPENSATION_TYPE)
+
+
+def is_measurement(obj):
+    return is_type(obj, MEASUREMENT_TYPE)
+
+
+class CompensationFeature(_Proxy):
+    """Proxy of ``SurfComp_Compensation`` (see the module docstring)."""
+
+    Type = COMPENSATION_TYPE
+    PROPERTIES = COMPENSATION_PROPERTIES
+
+    def execute(self, obj):
+        result = _compute(obj)
+        _write_results(obj, result)
+        # during a recompute Part::Feature gives the Shape the Placement property's value:
+        # the feature sits where its nominal sits
+        obj.Placement = result.shape.Placement
+        obj.Shape = result.shape
+
+
+def options_of(obj):
+    """The core :class:`~surfcomp.core.pipeline.Options` of a compensation object."""
+    weights = obj.Weights.strip() or None
+    return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
+                   mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
+                   edge=obj.Edge, stock=float(obj.Stock.Value),
+                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.FlipNormals),
+                   refine=int(obj.Refine))
+
+
+def chain(obj):
+    """The compensation and its ``Base`` chain, newest first.
+
+    Raises
+    ------
+    InputError
+        A ``Base`` that is not a compensation, of another nominal face, or a cycle.
+    """
+    out = [obj]
+    seen = {obj.Name}
+    base = obj.Base
+    while base is not None:
+        if not is_compensation(base):
+            raise InputError("%s: Base %s is not a surfcomp compensation" % (obj.Label, base.Label))
+        if base.Name in seen:
+            raise InputError("%s: the Base chain has a cycle at %s" % (obj.Label, base.Label))
+        if base.Nominal != obj.Nominal or base.FaceName != obj.FaceName:
+            raise InputError("%s: Base %s compensates %s.%s, not %s.%s (iterations must "
+                             "compensate the same nominal face)"
+                             % (obj.Label, base.Label,
+                                getattr(base.Nominal, "Label", None), base.FaceName,
+                                getattr(obj.Nominal, "Label", None), obj.FaceName))
+        seen.add(base.Name)
+        out.append(base)
+        base = base.Base
+    return out
+
+
+class _Result:
+    """What ``_compute`` returns: the core compensation plus the app-side products."""
+
+    def __init__(self, comp, nominal, increment, shape, edge_tol, round_):
+        self.comp = comp
+        self.nominal = nominal
+        self.increment = increment
+        self.shape = shape
+        self.edge_tolerance = edge_tol
+        self.round = round_
+
+
+def nominal_of(obj):
+    """The :class:`~surfcomp.app.nominal.Nominal` of a compensation object, in the
+    nominal object's own coordinates (its Shape without its Placement), and that Placement."""
+    from .nominal import nominal_from_face, pick_face
+
+    nom_obj = obj.Nominal
+    if nom_obj is None:
+        raise InputError("%s has no Nominal (link the object holding the nominal face)"
+                         % obj.Label)
+    shape = getattr(nom_obj, "Shape", None)
+    if shape is None or shape.isNull() or not shape.Faces:
+        raise GeometryError("%s: the nominal %s has no faces" % (obj.Label, nom_obj.Label))
+    local = shape.copy()
+    placement = local.Placement
+    local.Placement = FreeCAD.Placement()
+    face, name = pick_face(local, obj.FaceName or None, source=nom_obj.Label)
+    nominal = nominal_from_face(face, source=nom_obj.Label, face_name=name,
+                                object_name=nom_obj.Name, shape=local)
+    return nominal, placement
+
+
+def _local_measurements(ms, placement):
+    """The measurement set in the nominal object's own coordinates."""
+    if placement.isIdentity():
+        return ms
+    m = np.array(placement.inverse().toMatrix().A, dtype=float).reshape(4, 4)
+    R, t = m[:3, :3], m[:3, 3]
+    kw = {}
+    for name in ("nominal", "measured"):
+        a = getattr(ms, name)
+        kw[name] = None if a is None else a @ R.T + t
+    kw["normal"] = None if ms.normal is None else ms.normal @ R.T
+    return _dc_replace(ms, **kw)
+
+
+def _compute(obj):
+    """Run the pipeline for a compensation object; return a :class:`_Result`."""
+    links = chain(obj)
+    if obj.Measurement is None or not is_measurement(obj.Measurement):
+        raise InputError("%s: Measurement must link a SurfComp_Measurement object" % obj.Label)
+    if obj.Output not in OUTPUTS:
+        raise InputError("%s: unknown Output %r (expected face or solid)" % (obj.Label, obj.Output))
+    nominal, placement = nominal_of(obj)
+    ms = _local_measurements(measurement_set(obj.Measurement), placement)
+    options = options_of(obj)
+    prepared = prepare(nominal.surface, nominal.outward, ms, options)
+    base = obj.Base
+    comp = compensate(nominal.surface, nominal.outward, prepared, options, build=base is None)
+    increment = comp.correction.delta
+    if base is not None:
+        U, V = prepared.grid.take(prepared.u), prepared.grid.take(prepared.v)
+        total = increment + deviation_field(base, "correction")(U, V)
+        comp = _build(nominal, prepared, comp, total)
+    shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
+    shape.Placement = placement
+    return _Result(comp, nominal, increment, shape, tol, len(links))
+
+
+def _build(nominal, prepared, comp, total):
+    """Build the corrected surface for an accumulated correction ``total`` (n, m) the
+    way :func:`surfcomp.core.pipeline.compensate` builds it for its own correction."""
+    corr = _dc_replace(comp.correction, delta=total)
+    comp = _dc_replace(comp, correction=corr)
+    comp.statistics = dict(comp.statistics)
+    comp.statistics["increment"] = comp.statistics["correction"]
+    comp.statistics["correction"] = statistics(total)
+    return build_surface(comp, nominal.surface, nominal.outward, total)
+
+
+def rebuild_face(face, bs):
+    """The face ``face`` with its surface replaced by ``bs`` (same parametrisation).
+
+    The boundary is rebuilt from the face's own 2D curves (pcurves) on the new surface,
+    so trimmed faces and holes keep their place in parameter space; edges come in the
+    order of ``face.Edges``.
+    """
+    import Part
+
+    outer = face.OuterWire
+    wires = [outer] + [w for w in face.Wires if not w.isSame(outer)]
+    new_wires = []
+    for w in wires:
+        edges = []
+        for e in w.Edges:
+            c2d, a, b = face.curveOnSurface(e)[:3]
+            edges.append(c2d.toShape(bs, a, b))
+        new_wires.append(Part.Wire(edges))
+    out = Part.Face(bs, new_wires[0])
+    if len(new_wires) > 1:
+        out = out.cutHoles(new_wires[1:]) or out
+    if face.Orientation == "Reversed":
+        out.reverse()
+    if not out.isValid():
+        out.fix(1e-7, 1e-7, 1e-4)
+    if not out.isValid() or len(out.Edges) != len(face.Edges):
+        raise GeometryError("cannot rebuild %s on the corrected surface (%d edges instead of "
+                            "%d)" % ("the face", len(out.Edges), len(face.Edges)))
+    return out
+
+
+def corrected_shape(nominal, corrected, output="face", label="compensation"):
+    """The output shape of a compensation: ``(shape, max_edge_tolerance)``.
+
+    Parameters
+    ----------
+    nominal : surfcomp.app.nominal.Nominal
+        ``nominal.face`` is the face in ``nominal.shape``.
+    corrected : surfcomp.core.bspline.Surface
+    output : {'face', 'solid'}
+        ``solid``: ``nominal.shape`` with the face (and its edges and vertices) replaced;
+        the neighbouring faces keep their surfaces, their shared edges get the tolerance
+        that covers the shift of the border (reported, at most
+        :data:`MAX_EDGE_TOLERANCE`). Same number and order of faces.
+    """
+    from .convert import surface_to_part
+
+    bs = surface_to_part(corrected)
+    old = nominal.face
+    new = rebuild_face(old, bs)
+    if output == "face":
+        return new, max(e.Tolerance for e in new.Edges)
+    shape = nominal.shape
+    idx = int(nominal.face_name[4:]) - 1
+    old = shape.Faces[idx]
+    new = rebuild_face(old, bs)
+    pairs = [(old, new)]
+    for a, b in zip(old.Edges, new.Edges):
+        pairs.append((a, b))
+    for a, b in zip(old.Vertexes, new.Vertexes):
+        pairs.append((a, b))
+    out = shape.replaceShape(pairs)
+    out.fix(1e-7, 1e-7, MAX_EDGE_TOLERANCE)
+    problems = []
+    if not out.isValid():
+        problems.append("not valid")
+    if len(out.Faces) != len(shape.Faces):
+        problems.append("%d faces instead of %d" % (len(out.Faces), len(shape.Faces)))
+    if len(out.Solids) != len(shape.Solids):
+        problems.append("%d solids instead of %d" % (len(out.Solids), len(shape.Solids)))
+    if not problems:
+        for k, (a, b) in enumerate(zip(shape.Faces, out.Faces)):
+            if k != idx and a.Surface.TypeId != b.Surface.TypeId:
+                problems.append("Face%d changed its type" % (k + 1))
+                break
+        if out.Faces[idx].Surface.TypeId != "Part::GeomBSplineSurface":
+            problems.append("%s is not the corrected surface" % nominal.face_name)
+    if problems:
+        raise GeometryError("%s: cannot replace %s in the nominal's shape (%s); use Output = "
+                            "face" % (label, nominal.face_name, ", ".join(problems)))
+    return out, max(e.Tolerance for e in out.Edges)
+
+
+def _flat(a):
+    return np.asarray(a, dtype=float).ravel().tolist()
+
+
+def _write_results(obj, r):
+    comp = r.comp
+    p = comp.prepared
+    g = p.grid
+    n, m = g.shape
+    obj.GridRows, obj.GridCols = n, m
+    obj.U = _flat(g.take(p.u))
+    obj.V = _flat(g.take(p.v))
+    obj.NominalPoints = _flat(g.take(p.nominal))
+    obj.Normals = _flat(g.take(p.normal))
+    c = comp.correction
+    obj.Deviation = _flat(c.deviation)
+    obj.Determined = _flat(c.determined)
+    obj.Random = _flat(c.random)
+    obj.Increment = _flat(r.increment)
+    obj.Correction = _flat(c.delta)
+    obj.Statistics = json.dumps({k: s.as_dict() for k, s in comp.statistics.items()},
+                                sort_keys=True)
+    obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
+    obj.Warnings = [str(w) for w in p.warnings]
+    obj.Round = r.round
+    obj.EdgeTolerance = float(r.edge_tolerance)
+
+
+def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
+                      weights="", edge="renormalize", stock=0.0, base=None,
+                      name="Compensation", output="face"):
+    """Create a ``SurfComp_Compensation`` feature (recompute the document to compute it).
+
+    Parameters
+    ----------
+    doc : FreeCAD document
+    nominal : document object with a Shape
+    face : str
+        ``FaceN`` of ``nominal`` (None: the only B-spline face).
+    measurement : ``SurfComp_Measurement`` object
+    method, mask_size, weights, edge, stock
+        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method).
+    base : ``SurfComp_Compensation``, optional
+        The previous round of an iteration.
+    output : {'face', 'solid'}
+
+    Returns
+    -------
+    The new ``Part::FeaturePython`` object.
+    """
+    if output not in OUTPUTS:
+        raise InputError("unknown output %r (expected face or solid)" % (output,))
+    if method not in METHODS:
+        raise InputError("unknown method %r (expected one of %s)" % (method, ", ".join(METHODS)))
+    if edge not in EDGE_MODES:
+        raise InputError("unknown edge handling %r (expected one of %s)"
+                         % (edge, ", ".join(EDGE_MODES)))
+    if not is_measurement(measurement):
+        raise InputError("%s is not a surfcomp measurement object" % measurement.Label)
+    if base is not None and not is_compensation(base):
+        raise InputError("%s is not a surfcomp compensation (expected the previous round)"
+                         % base.Label)
+    obj = doc.addObject("Part::FeaturePython", name)
+    CompensationFeature(obj)
+    obj.Nominal = nominal
+    obj.FaceName = face or ""
+    obj.Measurement = measurement
+    obj.Base = base
+    obj.Method = method
+    obj.MaskSize = int(mask_size)
+    obj.Weights = weights or ""
+    obj.Edge = edge
+    obj.Stock = float(stock or 0.0)
+    obj.Output = output
+    if not obj.FaceName:
+        from .nominal import pick_face
+        obj.FaceName = pick_face(nominal.Shape, None, source=nominal.Label)[1]
+    return obj
+
+
+def _grid(obj, name):
+    a = np.asarray(getattr(obj, name), dtype=float)
+    n, m = obj.GridRows, obj.GridCols
+    if n * m == 0 or a.size != n * m:
+        raise InputError("%s has no computed %s (recompute it first)" % (obj.Label, name))
+    return a.reshape(n, m)
+
+
+def _fill_gaps(values):
+    """Unmeasured nodes (NaN) take the value of the nearest measured node."""
+    bad = ~np.isfinite(values)
+    if not bad.any():
+        return values
+    if bad.all():
+        raise InputError("no measured node to build a field from")
+    from scipy import ndimage
+
+    idx = ndimage.distance_transform_edt(bad, return_distances=False, return_indices=True)
+    return values[tuple(idx)]
+
+
+def deviation_field(obj, quantity):
+    """A C1 field ``f(u, v)`` of a compensation's node values over the face's parameters.
+
+    Parameters
+    ----------
+    obj : ``SurfComp_Compensation`` (computed)
+    quantity : str
+        ``deviation``, ``determined``, ``random``, ``correction`` (total, accumulated),
+        ``increment`` (this round's correction) or ``residual``
+        (``deviation - increment``: what this round leaves uncorrected).
+
+    Returns
+    -------
+    surfcomp.core.field.GridField
+        Callable on arrays of u, v (face parameters); values in mm. Unmeasured nodes
+        take the value of their nearest measured node.
+    """
+    names = {"deviation": "Deviation", "determined": "Determined", "random": "Random",
+             "correction": "Correction", "increment": "Increment"}
+    if quantity == "residual":
+        values = _grid(obj, "Deviation") - _grid(obj, "Increment")
+    elif quantity in names:
+        values = _grid(obj, names[quantity])
+    else:
+        raise InputError("unknown quantity %r (expected one of %s)"
+                         % (quantity, ", ".join(QUANTITIES)))
+    return GridField(_grid(obj, "U"), _grid(obj, "V"), _fill_gaps(values))
+
+
+def compensation_result(obj):
+    """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
+    recomputed from its properties and links (nothing is cached on the proxy).
+
+    For an iteration, ``correction.delta`` is the accumulated correction and
+    ``statistics['increment']`` describes this round's own correction.
+    """
+    return _compute(obj).comp
+
+
+def corrected_surface(obj):
+    """The corrected surface of a computed compensation object as a core
+    :class:`~surfcomp.core.bspline.Surface` (from its Shape, in document coordinates:
+    the feature's Placement applied)."""
+    from .convert import surface_from_part
+
+    shape = obj.Shape
+    if obj.Output == "solid":
+        face = shape.Faces[int(obj.FaceName[4:]) - 1]
+    else:
+        face = shape.Faces[0]
+    u0, u1, v0, v1 = face.ParameterRange
+    return surface_from_part(face.Surface, (u0, u1), (v0, v1))
+
+
+__all__ = ["VERSION", "MEASUREMENT_TYPE", "COMPENSATION_TYPE", "MeasurementFeature",
+           "CompensationFeature", "make_measurement", "make_measurement_from_set",
+           "set_measurement_data", "measurement_set", "make_compensation",
+           "compensation_result", "deviation_field", "options_of", "chain", "migrate",
+           "is_compensation", "is_measurement", "corrected_shape", "rebuild_face",
+           "nominal_of", "corrected_surface"]

@@ -1,0 +1,298 @@
+"""Replace the nominal by the compensation in the document, and restore it.
+
+:func:`replace` rebinds every object that uses the nominal (a Path Job's model clone,
+operations' ``Base`` links, other features' links, sub-element links like
+``(obj, 'Face6')``) to the compensation feature, hides the nominal and keeps it
+unchanged. What it changed is recorded on the compensation (``ReplacedLinks``, saved with
+the document), so :func:`restore` puts back exactly the previous links, also after the
+document was saved and reopened.
+
+For an iteration (a compensation with a ``Base``) the users of the nominal *and* of the
+previous compensations in the chain move to the new one.
+
+Each call is one transaction (one undo step in the GUI); when anything fails the
+document is exactly as before: every link, visibility and record is put back and the
+objects that were not touched before are not touched after.
+"""
+
+import json
+
+from ..errors import GeometryError, InputError
+from . import features
+
+#: properties never rebound: group membership and the compensation's own inputs
+SKIP_PROPERTIES = ("Group", "ExpressionEngine", "InList", "OutList")
+
+
+def _kind(typeid):
+    """Link property kinds by their type id: 'link', 'list', 'sub', 'sublist' or None."""
+    if "Link" not in typeid or not typeid.startswith("App::Property"):
+        return None
+    t = typeid[len("App::Property"):]
+    if t.startswith("X"):
+        t = t[1:]
+    for suffix in ("Child", "Global", "Hidden"):
+        if t.endswith(suffix):
+            t = t[: -len(suffix)]
+    return {"Link": "link", "LinkList": "list", "LinkSub": "sub",
+            "LinkSubList": "sublist"}.get(t)
+
+
+def _encode(kind, value):
+    """A JSON-able form of a link property value (object names)."""
+    if kind == "link":
+        return value.Name if value is not None else None
+    if kind == "list":
+        return [o.Name for o in value]
+    if kind == "sub":
+        return None if not value else [value[0].Name, list(value[1])]
+    return [[o.Name, list(subs) if isinstance(subs, (list, tuple)) else [subs]]
+            for o, subs in value]
+
+
+def _decode(doc, kind, data):
+    def obj(name):
+        o = doc.getObject(name)
+        if o is None:
+            raise InputError("cannot restore a link to %s: the object is gone" % name)
+        return o
+
+    if kind == "link":
+        return obj(data) if data else None
+    if kind == "list":
+        return [obj(n) for n in data]
+    if kind == "sub":
+        return None if not data else (obj(data[0]), list(data[1]))
+    return [(obj(n), tuple(subs)) for n, subs in data]
+
+
+def _get(o, prop):
+    return getattr(o, prop)
+
+
+def _set(o, prop, value):
+    setattr(o, prop, value)
+
+
+def _map_subs(subs, mapping, where, label):
+    if mapping is None:
+        return list(subs)
+    out = []
+    for s in subs:
+        if s == "" or s in mapping:
+            out.append(mapping.get(s, s))
+        else:
+            raise GeometryError("%s links %s of the nominal, which the face output of %s "
+                                "does not have: set %s's Output to solid"
+                                % (where, s, label, label))
+    return out
+
+
+def _targets(comp):
+    """Objects whose users move to ``comp``: its nominal and the earlier rounds."""
+    return [comp.Nominal] + features.chain(comp)[1:]
+
+
+def _sub_mapping(comp):
+    """Sub-element names of a target -> names on the compensation's shape, or None when
+    every name stays (solid output, or a nominal that is the face itself: the rebuilt face
+    keeps the order of its edges and vertices)."""
+    if comp.Output == "solid" or len(comp.Nominal.Shape.Faces) == 1:
+        return None
+    return {comp.FaceName: "Face1"}
+
+
+def plan(doc, comp):
+    """What :func:`replace` would change: a list of ``(object, property, kind, old, new)``.
+
+    Raises
+    ------
+    GeometryError
+        A sub-element link to a face that the compensation's output does not have.
+    """
+    targets = _targets(comp)
+    names = {t.Name for t in targets}
+    mapping = _sub_mapping(comp)
+    clones = set()
+    changes = []
+    for o in doc.Objects:
+        if o is comp or features.is_compensation(o) or features.is_measurement(o):
+            continue
+        for prop in o.PropertiesList:
+            if prop in SKIP_PROPERTIES:
+                continue
+            kind = _kind(o.getTypeIdOfProperty(prop))
+            if kind is None:
+                continue
+            old = _get(o, prop)
+            where = "%s.%s" % (o.Label, prop)
+            if kind == "link":
+                if old is not None and old.Name in names:
+                    changes.append((o, prop, kind, old, comp))
+            elif kind == "list":
+                if any(x.Name in names for x in old):
+                    changes.append((o, prop, kind, old,
+                                    [comp if x.Name in names else x for x in old]))
+                    if o.isDerivedFrom("Part::Feature") and len(old) == 1:
+                        clones.add(o.Name)      # a clone of the nominal (Draft, Path model)
+            elif kind == "sub":
+                if old and old[0].Name in names:
+                    changes.append((o, prop, kind, old,
+                                    (comp, _map_subs(list(old[1]), mapping, where, comp.Label))))
+            else:
+                new = []
+                hit = False
+                for x, subs in old:
+                    subs = list(subs) if isinstance(subs, (list, tuple)) else [subs]
+                    if x.Name in names:
+                        hit = True
+                        new.append((comp, tuple(_map_subs(subs, mapping, where, comp.Label))))
+                    else:
+                        new.append((x, tuple(subs)))
+                if hit:
+                    changes.append((o, prop, kind, old, new))
+    if mapping is not None and clones:
+        # a clone of the nominal (Path's model, Draft) gets the face output's single face,
+        # so links to the clone's FaceN would point elsewhere
+        raise GeometryError("%s is cloned by %s: with the face output a clone would keep only "
+                            "the compensated face of the %d faces of %s, and links to its "
+                            "faces would move: set %s's Output to solid"
+                            % (comp.Nominal.Label, ", ".join(sorted(clones)),
+                               len(comp.Nominal.Shape.Faces), comp.Nominal.Label, comp.Label))
+    return changes
+
+
+def _snapshot(doc, objs):
+    return {o.Name: ("Touched" in o.State) for o in objs}
+
+
+class _Undo:
+    """Puts back what a failed replace/restore changed (with or without undo support)."""
+
+    def __init__(self, doc):
+        self.doc = doc
+        self.steps = []
+        self.touched = _snapshot(doc, doc.Objects)
+
+    def set(self, o, prop, value):
+        self.steps.append((o, prop, getattr(o, prop)))
+        setattr(o, prop, value)
+
+    def rollback(self):
+        for o, prop, value in reversed(self.steps):
+            setattr(o, prop, value)
+        for o in self.doc.Objects:
+            if o.Name in self.touched and not self.touched[o.Name] and "Touched" in o.State:
+                o.purgeTouched()
+
+
+def _run(doc, name, work):
+    undo = _Undo(doc)
+    doc.openTransaction(name)
+    try:
+        result = work(undo)
+    except BaseException:
+        undo.rollback()
+        doc.abortTransaction()
+        undo.rollback()     # the abort may have replayed older values: ours win
+        raise
+    doc.commitTransaction()
+    return result
+
+
+def _check_computed(comp):
+    if comp.Shape.isNull() or "Invalid" in comp.State or "Error" in comp.State:
+        raise InputError("%s is not computed (state %s): recompute it and fix its errors "
+                         "before replacing the nominal" % (comp.Label, ", ".join(comp.State)))
+
+
+def replace(doc, comp):
+    """Rebind the users of ``comp``'s nominal to ``comp``; hide the nominal.
+
+    Parameters
+    ----------
+    doc : FreeCAD document
+    comp : ``SurfComp_Compensation`` (computed; recompute the document first)
+
+    Returns
+    -------
+    list of (object name, property name)
+        The links that now point to ``comp``. Recompute the document afterwards so the
+        users (Path operations) regenerate.
+
+    Raises
+    ------
+    InputError
+        ``comp`` is not a computed compensation or is already replacing its nominal.
+    GeometryError
+        A user links a face the compensation's output does not have.
+    """
+    if not features.is_compensation(comp):
+        raise InputError("%s is not a surfcomp compensation" % comp.Label)
+    if comp.ReplacedLinks:
+        raise InputError("%s already replaces its nominal (restore it first)" % comp.Label)
+    _check_computed(comp)
+    nominal = comp.Nominal
+
+    def work(undo):
+        changes = plan(doc, comp)
+        record = {"links": [], "visibility": {}}
+        for o, prop, kind, old, new in changes:
+            record["links"].append({"object": o.Name, "property": prop, "kind": kind,
+                                    "old": _encode(kind, old)})
+            undo.set(o, prop, new)
+        for o, vis in ((nominal, False), (comp, True)):
+            if "Visibility" in o.PropertiesList:
+                record["visibility"][o.Name] = bool(o.Visibility)
+                undo.set(o, "Visibility", vis)
+        for earlier in features.chain(comp)[1:]:
+            if "Visibility" in earlier.PropertiesList and earlier.Visibility:
+                record["visibility"][earlier.Name] = True
+                undo.set(earlier, "Visibility", False)
+        undo.set(comp, "ReplacedLinks", json.dumps(record, sort_keys=True))
+        return [(o.Name, prop) for o, prop, _k, _o, _n in changes]
+
+    return _run(doc, "Replace %s by %s" % (nominal.Label, comp.Label), work)
+
+
+def restore(doc, comp):
+    """Undo :func:`replace`: put back the recorded links and visibilities.
+
+    Returns
+    -------
+    list of (object name, property name)
+        The links that were put back.
+    """
+    if not features.is_compensation(comp):
+        raise InputError("%s is not a surfcomp compensation" % comp.Label)
+    if not comp.ReplacedLinks:
+        raise InputError("%s does not replace its nominal (nothing to restore)" % comp.Label)
+    try:
+        record = json.loads(comp.ReplacedLinks)
+    except ValueError as exc:
+        raise InputError("%s: the replace record is damaged (%s)" % (comp.Label, exc)) from exc
+
+    def work(undo):
+        done = []
+        for item in record.get("links", []):
+            o = doc.getObject(item["object"])
+            if o is None:
+                continue    # the user deleted it meanwhile: nothing to put back
+            undo.set(o, item["property"], _decode(doc, item["kind"], item["old"]))
+            done.append((o.Name, item["property"]))
+        for name, vis in record.get("visibility", {}).items():
+            o = doc.getObject(name)
+            if o is not None and "Visibility" in o.PropertiesList:
+                undo.set(o, "Visibility", bool(vis))
+        undo.set(comp, "ReplacedLinks", "")
+        return done
+
+    return _run(doc, "Restore %s" % getattr(comp.Nominal, "Label", "nominal"), work)
+
+
+def is_replacing(comp):
+    """True when ``comp`` currently replaces its nominal."""
+    return bool(getattr(comp, "ReplacedLinks", ""))
+
+
+__all__ = ["replace", "restore", "plan", "is_replacing"]

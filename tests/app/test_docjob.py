@@ -1,0 +1,196 @@
+"""The batch route on a shop document: open, compensate, replace, regenerate, save, post."""
+
+import hashlib
+import os
+import sys
+
+import FreeCAD
+import numpy as np
+import pytest
+
+from surfcomp.app import docjob, features, fcenv, pathjob
+from surfcomp.app.nominal import nominal_from_face
+from surfcomp.core.pipeline import Options
+from surfcomp.errors import InputError, MeasurementFileError
+from tests.app.helpers import grid_on_face, write_cmm_csv
+from tests.app.test_features import add_part, block_solid, error_model
+from tests.app.test_path_regen import g1_points
+
+POST_ARGS = "--no-show-editor --no-header --precision=4"
+
+
+def sha(path):
+    return hashlib.sha256(open(path, "rb").read()).hexdigest()
+
+
+@pytest.fixture(scope="module")
+def shop(tmp_path_factory):
+    """shop.FCStd: a block under a Job with a 3D Surface op on Face2; meas.csv for Face2."""
+    tmp = tmp_path_factory.mktemp("shop")
+    fcenv.setup_path_workbench()
+    doc = FreeCAD.newDocument("shop")
+    solid = block_solid()
+    add_part(doc, solid, "Block")
+    job = pathjob.create_job(doc, [doc.getObject("Block")])
+    tc = pathjob.ball_end_tool_controller(job, 6.0)
+    op = pathjob.surface_operation(job, doc.getObject("Block"), ["Face2"], tc, step_over=100.0,
+                                   sample_interval=2.0, linear_deflection=0.005)
+    doc.recompute()
+    pathjob.model_clone(job, doc.getObject("Block")).touch()   # settle Path's stock box
+    doc.recompute()
+    cl = pathjob.cutter_locations(op)
+    gcode = pathjob.post_process(job, "linuxcnc", POST_ARGS)
+    path = str(tmp / "shop.FCStd")
+    doc.saveAs(path)
+    FreeCAD.closeDocument(doc.Name)
+    nominal = nominal_from_face(solid.Faces[1], face_name="Face2")
+    P, N, _, _ = grid_on_face(nominal, 15, 15, margin=0.0)
+    meas = str(tmp / "meas.csv")
+    write_cmm_csv(meas, P, N, error_model(P))
+    return {"doc": path, "meas": meas, "cl": cl, "gcode": gcode, "dir": tmp}
+
+
+def test_update_a_shop_document(shop, tmp_path):
+    digest = sha(shop["doc"])
+    out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+    res = docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2", save=out,
+                                  replace=True, gcode=ngc, post="linuxcnc", post_args=POST_ARGS,
+                                  options=Options(refine=1))
+    assert sha(shop["doc"]) == digest                       # the input is untouched
+    assert res.saved == out and res.gcode == ngc and res.jobs == ["Job"]
+    assert res.operations == ["Surface"] and res.replaced == [("Clone", "Objects")]
+    assert res.statistics["deviation"]["count"] == 225
+    assert res.checks["max_error_at_points_mm"] < 1e-4
+    assert sorted(os.listdir(tmp_path)) == ["out.FCStd", "out.ngc"]     # no temporary files
+    doc = FreeCAD.openDocument(out)
+    try:
+        assert docjob.restore_failures(doc, out) == []
+        comp = doc.getObject(res.compensation)
+        assert features.is_compensation(comp) and comp.Output == "solid"
+        assert comp.Measurement.SourceName == "meas.csv" and comp.Measurement.PointCount == 225
+        clone = doc.getObject("Clone")
+        assert clone.Objects == [comp] and doc.getObject("Block").Visibility is False
+        assert len(clone.Shape.Faces) == 6 and clone.Shape.isValid()
+        op = doc.getObject("Surface")
+        assert op.Base == [(clone, ("Face2",))]
+        cl = pathjob.cutter_locations(op)
+        # the regenerated path went down where the correction removes material (t > 0)
+        assert abs(len(cl) - len(shop["cl"])) <= 0.05 * len(cl)
+        corr = np.asarray(comp.Correction)
+        assert corr.max() > 0.02
+        from scipy.spatial import cKDTree
+        d, k = cKDTree(shop["cl"][:, :2]).query(cl[:, :2])
+        dz = (cl[:, 2] - shop["cl"][k, 2])[d < 0.05]
+        assert dz.size > 0.5 * len(cl)
+        assert -0.06 < dz.min() < -0.01 and dz.max() < 0.03
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    # the written program is the saved document's program (FreeCAD stores paths with
+    # fewer digits, so a last 4th decimal may differ by one)
+    text = open(ngc).read()
+    again = pathjob_gcode_of(out)
+    np.testing.assert_allclose(g1_points(text), g1_points(again), atol=1.01e-4)
+    assert [s for s in text.splitlines() if not s.startswith("G1 ")] == \
+        [s for s in again.splitlines() if not s.startswith("G1 ")]
+    assert text != shop["gcode"] and text.count("\nG1 ") > 50
+
+
+def pathjob_gcode_of(path):
+    doc = FreeCAD.openDocument(path)
+    try:
+        return pathjob.post_process(doc.getObject("Job"), "linuxcnc", POST_ARGS)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+
+
+def test_never_overwrites_the_input(shop, tmp_path):
+    digest = sha(shop["doc"])
+    with pytest.raises(InputError, match="refusing to overwrite the input document"):
+        docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                                save=shop["doc"])
+    with pytest.raises(InputError, match="need --save"):
+        docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2")
+    assert sha(shop["doc"]) == digest
+    assert FreeCAD.listDocuments() == {}
+
+
+def test_bad_measurements_write_nothing(shop, tmp_path):
+    bad = tmp_path / "bad.csv"
+    bad.write_text("x_nom,y_nom,z_nom,i,j,k,dev\n1,2,3,0,0,1,0.01\n1,2,abc,0,0,1,0.02\n")
+    with pytest.raises(MeasurementFileError, match=r"bad.csv:3"):
+        docjob.run_document_job(shop["doc"], str(bad), "Block", face="Face2",
+                                save=str(tmp_path / "o.FCStd"), gcode=str(tmp_path / "o.ngc"))
+    assert sorted(os.listdir(tmp_path)) == ["bad.csv"]
+    with pytest.raises(Exception, match="no object 'Nope'"):
+        docjob.run_document_job(shop["doc"], shop["meas"], "Nope", save=str(tmp_path / "o.FCStd"))
+    assert FreeCAD.listDocuments() == {}
+
+
+PROXY_MODULE = '''
+class Thing:
+    def __init__(self, obj):
+        obj.Proxy = self
+    def execute(self, obj):
+        pass
+    def __getstate__(self):
+        return None
+    def __setstate__(self, state):
+        return None
+'''
+
+
+def test_refuses_a_document_whose_objects_did_not_restore(shop, tmp_path, monkeypatch):
+    """An object whose proxy module is not importable at open time loses its proxy; saving
+    would make that loss permanent, so the route refuses and writes nothing."""
+    mod_dir = tmp_path / "mods"
+    mod_dir.mkdir()
+    (mod_dir / "surfcomp_test_gone.py").write_text(PROXY_MODULE)
+    monkeypatch.syspath_prepend(str(mod_dir))
+    import surfcomp_test_gone
+
+    doc = FreeCAD.openDocument(shop["doc"])
+    thing = doc.addObject("App::FeaturePython", "Thing")
+    surfcomp_test_gone.Thing(thing)
+    broken = str(tmp_path / "broken.FCStd")
+    doc.saveAs(broken)
+    FreeCAD.closeDocument(doc.Name)
+    del sys.modules["surfcomp_test_gone"]
+    monkeypatch.setattr(sys, "path", [p for p in sys.path if p != str(mod_dir)])
+    (mod_dir / "surfcomp_test_gone.py").unlink()
+    out = tmp_path / "out.FCStd"
+    with pytest.raises(InputError, match=r"1 object\(s\) did not restore.*Thing "
+                                         r"\(App::FeaturePython, label 'Thing'\): its Python "
+                                         r"proxy was not restored"):
+        docjob.run_document_job(broken, shop["meas"], "Block", face="Face2", save=str(out))
+    assert not out.exists()
+    assert FreeCAD.listDocuments() == {}
+
+
+def test_the_batch_command_line(shop, tmp_path):
+    """The issue's command: compensate DOC MEAS --object --face --replace --save --gcode --post."""
+    import subprocess
+
+    from tests.app.helpers import ROOT
+
+    digest = sha(shop["doc"])
+    out, ngc = tmp_path / "out.FCStd", tmp_path / "out.ngc"
+    cmd = [sys.executable, "-m", "surfcomp", "compensate", shop["doc"], shop["meas"],
+           "--object", "Block", "--face", "Face2", "--replace", "--save", str(out),
+           "--gcode", str(ngc), "--post", "linuxcnc", "--post-args", POST_ARGS, "--refine", "1",
+           "--quiet"]
+    run = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    assert "replaced the nominal in: Clone.Objects" in run.stdout
+    assert "regenerated: Surface" in run.stdout and "wrote %s" % out in run.stdout
+    assert sha(shop["doc"]) == digest
+    # the same program as the library route of test_update_a_shop_document
+    np.testing.assert_allclose(g1_points(ngc.read_text()), g1_points(pathjob_gcode_of(str(out))),
+                               atol=1.01e-4)
+    assert ngc.read_text() != shop["gcode"]
+    # files and the document route do not mix; the input is refused as output
+    bad = subprocess.run(cmd[:-1] + ["-o", str(tmp_path / "c.step")], cwd=ROOT,
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and "cannot be combined" in bad.stderr
+    bad = subprocess.run(cmd[:10] + ["--save", shop["doc"], "--quiet"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and sha(shop["doc"]) == digest
