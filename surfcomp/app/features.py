@@ -43,7 +43,8 @@ from ..core.deviations import statistics  # noqa: E402
 from ..core.field import GridField  # noqa: E402
 from ..core.filters import EDGE_MODES  # noqa: E402
 from ..core.methods import METHODS  # noqa: E402
-from ..core.pipeline import Options, build_surface, compensate, prepare  # noqa: E402
+from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare  # noqa: E402
+from ..core.scattered import ScatteredField  # noqa: E402
 from ..errors import GeometryError, InputError  # noqa: E402
 from ..io.measurements import MeasurementSet  # noqa: E402
 from ..io.readers import FORMATS, read_any  # noqa: E402
@@ -141,8 +142,23 @@ COMPENSATION_PROPERTIES = (
     ("App::PropertyEnumeration", "Output", _IN,
      "face: the corrected face; solid: the nominal's shape with the face replaced",
      list(OUTPUTS), 0),
-    ("App::PropertyInteger", "GridRows", _RES, "Rows of the measurement grid", 0, _RO),
-    ("App::PropertyInteger", "GridCols", _RES, "Columns of the measurement grid", 0, _RO),
+    ("App::PropertyEnumeration", "Layout", _IN,
+     "auto: a complete grid if the points form one, else scattered; grid: refuse others",
+     list(LAYOUTS), 0),
+    ("App::PropertyLength", "Smoothing", _IN,
+     "Scattered points: smoothing length of the fit that replaces the mask filter "
+     "(0: chosen by generalized cross-validation)", 0.0, 0),
+    ("App::PropertyLength", "TipRadius", _IN,
+     "Stylus ball radius when the measured points are tip centres (probe logs)", 0.0, 0),
+    ("App::PropertyInteger", "GridRows", _RES,
+     "Rows of the measurement grid (scattered layouts: the number of points)", 0, _RO),
+    ("App::PropertyInteger", "GridCols", _RES,
+     "Columns of the measurement grid (scattered layouts: 1)", 0, _RO),
+    ("App::PropertyBool", "Scattered", _RES,
+     "The points are a scattered layout (not a grid): fields are built over the points",
+     False, _RO),
+    ("App::PropertyFloatList", "FieldScale", _RES,
+     "Scattered layouts: mm per unit parameter along u and v used by the fits", None, _RO),
     ("App::PropertyFloatList", "U", _RES, "Face parameter u of every grid node (row-major)",
      None, _RO),
     ("App::PropertyFloatList", "V", _RES, "Face parameter v of every grid node (row-major)",
@@ -405,7 +421,9 @@ def options_of(obj):
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
                    max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.FlipNormals),
-                   refine=int(obj.Refine))
+                   refine=int(obj.Refine), layout=obj.Layout,
+                   smoothing=(float(obj.Smoothing.Value) or None),
+                   tip_radius=float(obj.TipRadius.Value))
 
 
 def chain(obj):
@@ -608,8 +626,10 @@ def _write_results(obj, r):
     comp = r.comp
     p = comp.prepared
     g = p.grid
-    n, m = g.shape
+    n, m = (g.shape[0], 1) if p.scattered else g.shape
     obj.GridRows, obj.GridCols = n, m
+    obj.Scattered = bool(p.scattered)
+    obj.FieldScale = list(comp.scale) if p.scattered else []
     obj.U = _flat(g.take(p.u))
     obj.V = _flat(g.take(p.v))
     obj.NominalPoints = _flat(g.take(p.nominal))
@@ -727,6 +747,10 @@ def deviation_field(obj, quantity):
     else:
         raise InputError("unknown quantity %r (expected one of %s)"
                          % (quantity, ", ".join(QUANTITIES)))
+    if obj.Scattered:
+        surf = nominal_of(obj)[0].surface
+        return ScatteredField(_grid(obj, "U").ravel(), _grid(obj, "V").ravel(), values.ravel(),
+                              scale=tuple(obj.FieldScale), box=(surf.u_range, surf.v_range))
     return GridField(_grid(obj, "U"), _grid(obj, "V"), _fill_gaps(values))
 
 

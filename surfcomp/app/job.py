@@ -8,6 +8,8 @@ import json
 import os
 from dataclasses import dataclass, field, fields
 
+import numpy as np
+
 from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import sub
 from ..errors import InputError
@@ -124,6 +126,9 @@ def curve_net(comp):
     import FreeCAD
     import Part
 
+    if comp.prepared.scattered:
+        raise InputError("--curves needs a measurement grid (the curve net runs along its rows "
+                         "and columns); these points are scattered")
     pts = comp.prepared.grid.take(comp.corrected_points())
     edges = []
     for line in list(pts) + list(pts.transpose(1, 0, 2)):
@@ -147,9 +152,12 @@ def write_face(path, shape):
 
 
 def corrected_points_csv(comp):
-    """Corrected points (Werner eq. 2/3) as CSV in file order, with grid indices."""
+    """Corrected points (Werner eq. 2/3) as CSV in file order, with grid indices (-1 for
+    scattered points)."""
     p = comp.prepared
     row, col = p.row_col()
+    if row is None:  # scattered: no grid indices
+        row = col = np.full(p.u.size, -1)
     cor = comp.corrected_points()
     delta = comp.per_point("delta")
     rows = ["row,col,x_nom,y_nom,z_nom,i,j,k,correction,x_cor,y_cor,z_cor"]

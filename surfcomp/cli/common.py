@@ -32,6 +32,14 @@ def add_input_options(p):
     p.add_argument("--flip-normals", action="store_true",
                    help="the file's normals point into the material: flip them (and the sign "
                         "of its deviations)")
+    p.add_argument("--layout", choices=("auto", "grid", "scattered"), default="auto",
+                   help="arrangement of the points: auto (a complete grid if they form one, "
+                        "else scattered, with a warning), grid (refuse anything else) or "
+                        "scattered")
+    p.add_argument("--tip-radius", type=float, default=0.0, metavar="MM",
+                   help="stylus ball radius when the measured points are tip centres (probe "
+                        "logs): each contact point is the centre moved by it against the "
+                        "outward normal (default 0)")
     p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
 
@@ -53,6 +61,10 @@ def add_method_options(p):
                         "measured points)")
     p.add_argument("--stock", type=float, metavar="MM",
                    help="semi-finishing allowance for --method mirror (DH = stock / 2)")
+    p.add_argument("--smoothing", type=float, metavar="MM",
+                   help="scattered layouts: smoothing length of the fit that takes the mask "
+                        "filter's place (the wavelength damped to half; default chosen by "
+                        "generalized cross-validation)")
     p.add_argument("--refine", type=int, default=4, metavar="K",
                    help="knot spans of the corrected surface per measurement grid step (default 4)")
 
@@ -86,6 +98,8 @@ def options_from_args(args):
                    mask_kind=getattr(args, "mask_kind", "box"), sigma=getattr(args, "sigma", None),
                    edge=getattr(args, "edge", "renormalize"), stock=getattr(args, "stock", None),
                    max_offset=args.max_offset, flip_normals=args.flip_normals,
+                   tip_radius=args.tip_radius, layout=args.layout,
+                   smoothing=getattr(args, "smoothing", None),
                    refine=getattr(args, "refine", 4))
 
 
@@ -116,19 +130,28 @@ def print_summary(comp, rep, out=sys.stdout):
     print("Measurements: %s (%d points, %s, read in %s)"
           % (inputs["measurements"]["path"], inputs["measurements"]["points"],
              inputs["measurements"]["kind"], inputs["measurements"]["units"]), file=out)
-    print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
+    if p.scattered:
+        print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
+    else:
+        print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
     for w in p.warnings:
         print("warning: " + w, file=sys.stderr)
     o = comp.options
     c = comp.correction
     print("", file=out)
+    if comp.fit is not None:
+        f = comp.fit
+        how = ("thin-plate smoothing fit, smoothing length %.3g mm (%s); fit residual RMS "
+               "%.2f um, leave-one-out RMS %.2f um" % (f.smoothing, f.chosen_by, f.fit_rms * 1e3,
+                                                      f.loo_rms * 1e3))
+    else:
+        how = "%dx%d %s filter, eq. 4-5" % (c.mask.shape[0], c.mask.shape[0],
+                                            rep["method"]["mask_kind"])
     print(format_table([("Raw deviations", st["deviation"]),
                         ("Determined", st["determined"]),
                         ("Random", st["random"])], unit="um",
                        title="Deviations along the outward normal (Werner 2022 Tab. 1 and 3; "
-                             "determined = %dx%d %s filter, eq. 4-5)"
-                             % (c.mask.shape[0], c.mask.shape[0], rep["method"]["mask_kind"])),
-          file=out)
+                             "determined = %s)" % how), file=out)
     if comp.corrected is None:
         return
     extra = ""

@@ -28,6 +28,26 @@ class Grid:
         return np.asarray(values)[self.index]
 
 
+@dataclass(frozen=True)
+class Scattered:
+    """A layout that is not a complete grid: the points in file order (``shape`` (N,)).
+
+    Same interface as :class:`Grid` (``index``, ``shape``, ``take``) so per-point and
+    per-node arrays convert alike; ``rows_from`` says why the points are scattered.
+    """
+
+    index: np.ndarray
+    rows_from: str
+
+    @property
+    def shape(self):
+        return self.index.shape
+
+    def take(self, values):
+        """Per-point ``values`` (N, ...) in node order (the file order)."""
+        return np.asarray(values)[self.index]
+
+
 def _where(source, lines, k):
     return dict(file=source, line=int(lines[k]) if lines is not None else None)
 

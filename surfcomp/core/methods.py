@@ -41,7 +41,8 @@ class CorrectionResult:
     stock: float = None
 
 
-def compute_correction(d, method="filtered", mask=None, edge="renormalize", stock=None):
+def compute_correction(d, method="filtered", mask=None, edge="renormalize", stock=None,
+                       determined=None):
     """Intended correction ``delta`` at every grid node for ``method``.
 
     Parameters
@@ -55,6 +56,10 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
         Edge handling of the filter (see :func:`surfcomp.core.filters.mask_filter`).
     stock : float, optional
         Semi-finishing allowance in mm; required for ``mirror`` (DH = stock / 2).
+    determined : array_like, shape of ``d``, optional
+        The determined (systematic) component when it comes from elsewhere (the
+        smoothing fit of scattered layouts); then no mask filter is applied and
+        ``mask`` is None in the result.
 
     Returns
     -------
@@ -63,8 +68,11 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
     if method not in METHODS:
         raise InputError("unknown method %r (expected one of %s)" % (method, ", ".join(METHODS)))
     d = np.asarray(d, dtype=float)
-    mask = make_mask(5) if mask is None else np.asarray(mask, dtype=float)
-    determined = mask_filter(d, mask, edge)
+    if determined is None:
+        mask = make_mask(5) if mask is None else np.asarray(mask, dtype=float)
+        determined = mask_filter(d, mask, edge)
+    else:
+        determined, mask = np.asarray(determined, dtype=float), None
     if method == "raw":
         delta = d.copy()
     elif method == "filtered":

@@ -5,21 +5,31 @@ The app layer loads faces and writes files around it; the CLI, the document obje
 and the GUI all call :func:`prepare` and :func:`compensate`.
 """
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from ..errors import InputError, MeasurementFileError
+from ..errors import GridError, InputError, MeasurementFileError
 from .corrected import DEFAULT_REFINE, construct
+from .field import GridField
 from .deviations import deviation_components, statistics
 from .filters import make_mask
-from .grid import grid_from_indices, grid_from_uv
+from . import bspline
+from .grid import Scattered, grid_from_indices, grid_from_uv
 from .methods import compute_correction
 from .progress import report, sub
 from .projection import project
+from .scattered import ScatteredField, smooth
 
 #: a given normal more than this many degrees off the face normal is reported
 NORMAL_WARNING_DEG = 5.0
+#: a corrected face that misses the intended correction at a point by more is reported
+MISS_WARNING = 1e-4
+#: how the points are arranged: found automatically (a complete grid, else scattered),
+#: or forced
+LAYOUTS = ("auto", "grid", "scattered")
 
 
 @dataclass
@@ -29,7 +39,12 @@ class Options:
     Lengths in mm. ``mask_size``/``weights``/``mask_kind``/``sigma``/``edge`` define the
     filter (:mod:`surfcomp.core.filters`); ``stock`` is the mirror method's semi-finishing
     allowance; ``max_offset`` the largest accepted distance of a point from the face;
-    ``refine`` the knot spans per measurement grid step of the corrected surface.
+    ``refine`` the knot spans per measurement grid step of the corrected surface;
+    ``tip_radius`` the stylus ball radius when the measured points are tip centres
+    (the contact point is the centre moved by it against the outward normal);
+    ``layout`` one of :data:`LAYOUTS`; ``smoothing`` the smoothing length (mm) of the
+    scattered layouts' fit (None: chosen by generalized cross-validation, see
+    :func:`surfcomp.core.scattered.smooth`), their counterpart of the mask filter.
     """
 
     method: str = "filtered"
@@ -42,6 +57,9 @@ class Options:
     max_offset: float = 1.0
     flip_normals: bool = False
     refine: int = DEFAULT_REFINE
+    tip_radius: float = 0.0
+    layout: str = "auto"
+    smoothing: float = None
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -65,9 +83,17 @@ class Prepared:
     source: str
     warnings: list = field(default_factory=list)
 
+    @property
+    def scattered(self):
+        """True when the points are not a grid (:class:`surfcomp.core.grid.Scattered`)."""
+        return isinstance(self.grid, Scattered)
+
     def row_col(self):
-        """Grid row and column of every point, in file order: two int arrays (N,)."""
+        """Grid row and column of every point, in file order: two int arrays (N,)
+        (None, None for a scattered layout)."""
         g = self.grid
+        if self.scattered:
+            return None, None
         row = np.empty(self.u.size, dtype=int)
         col = np.empty(self.u.size, dtype=int)
         ii, jj = np.indices(g.shape)
@@ -109,9 +135,22 @@ def prepare(surface, outward, ms, options=None, progress=None):
     base = ms.nominal if ms.nominal is not None else ms.measured
     if base is None:
         raise InputError("the measurement set has neither nominal nor measured points", file=ms.source)
+    tip = float(options.tip_radius or 0.0)
+    if tip < 0:
+        raise InputError("the tip radius must be >= 0 mm, got %g" % tip, file=ms.source)
+    if tip and ms.deviation is not None:
+        raise InputError("--tip-radius applies to measured points (tip centres); this file "
+                         "gives deviations, which the CMM has already compensated", file=ms.source)
+    if tip and ms.measured is None:
+        raise InputError("--tip-radius needs measured points (tip centres) in the file",
+                         file=ms.source)
+    if getattr(ms, "tip_centres", False) and not tip:
+        warnings.append("%s: the points are stylus tip centres (probe log); without "
+                        "--tip-radius every deviation is off by the tip radius" % ms.source)
     report(progress, 0.0, "locating %d points on the face" % len(base))
     proj = project(surface, base, progress=sub(progress, 0.0, 0.8))
-    dist = proj.distance * outward
+    # a tip centre lies one tip radius outside its contact point (along the normal)
+    dist = proj.distance * outward - (tip if ms.nominal is None else 0.0)
     far = np.nonzero(np.abs(dist) > options.max_offset)[0]
     if far.size:
         k = far[np.argmax(np.abs(dist[far]))]
@@ -150,16 +189,30 @@ def prepare(surface, outward, ms, options=None, progress=None):
     if ms.deviation is not None:
         d = np.asarray(ms.deviation, dtype=float) * (-1.0 if options.flip_normals else 1.0)
     elif ms.nominal is not None and ms.measured is not None:
-        d = np.einsum("ij,ij->i", ms.measured - ms.nominal, normal)
+        d = np.einsum("ij,ij->i", ms.measured - ms.nominal, normal) - tip
     else:
         d = dist
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
-    if ms.row is not None and ms.col is not None:
+    if options.layout not in LAYOUTS:
+        raise InputError("unknown layout %r (expected one of %s)"
+                         % (options.layout, ", ".join(LAYOUTS)))
+    if options.layout == "scattered":
+        grid = Scattered(np.arange(proj.u.size), "scattered (as asked)")
+    elif ms.row is not None and ms.col is not None:
         grid = grid_from_indices(ms.row, ms.col, proj.u, proj.v, ms.lines, ms.source)
     else:
-        grid = grid_from_uv(proj.u, proj.v, ms.lines, ms.source)
-    report(progress, 1.0, "%d x %d grid" % grid.shape)
+        try:
+            grid = grid_from_uv(proj.u, proj.v, ms.lines, ms.source)
+        except GridError as exc:
+            if options.layout == "grid":
+                raise
+            grid = Scattered(np.arange(proj.u.size), "scattered (not a complete grid)")
+            warnings.append("%s; the points are used as a scattered layout (the determined "
+                            "component comes from a smoothing fit instead of the mask "
+                            "filter; --layout grid refuses such files)" % exc)
+    report(progress, 1.0, "%s layout" % ("scattered" if isinstance(grid, Scattered)
+                                         else "%d x %d grid" % grid.shape))
     return Prepared(u=proj.u, v=proj.v, nominal=np.asarray(nominal, dtype=float), normal=normal,
                     deviation=d, grid=grid, lines=ms.lines, source=ms.source, warnings=warnings)
 
@@ -178,6 +231,8 @@ class Compensation:
     spacing: tuple = None
     field: object = None        # field.GridField of the intended correction
     iterations: int = 0         # residual iterations of the construction
+    fit: object = None          # scattered.SmoothFit (scattered layouts only)
+    scale: tuple = None         # mm per unit parameter along u and v at the points
 
     def per_point(self, name):
         """A grid quantity back in file order (N,)."""
@@ -222,12 +277,21 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     options = options or Options()
     g = prepared.grid
     d = g.take(prepared.deviation)
-    corr = compute_correction(d, options.method, options.mask(), options.edge, options.stock)
+    scale = parameter_scale(surface, prepared)
+    fit = None
+    if prepared.scattered:
+        report(progress, 0.0, "smoothing fit of %d scattered points" % d.size)
+        fit = smooth(prepared.u, prepared.v, d, options.smoothing, scale=scale)
+        corr = compute_correction(d, options.method, None, options.edge, options.stock,
+                                  determined=fit.determined)
+    else:
+        corr = compute_correction(d, options.method, options.mask(), options.edge, options.stock)
     stats = {"deviation": statistics(corr.deviation),
              "determined": statistics(corr.determined),
              "random": statistics(corr.random),
              "correction": statistics(corr.delta)}
-    result = Compensation(prepared=prepared, options=options, correction=corr, statistics=stats)
+    result = Compensation(prepared=prepared, options=options, correction=corr, statistics=stats,
+                          fit=fit, scale=scale)
     if not build:
         return result
     build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
@@ -236,17 +300,53 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
 
 
 def build_surface(result, surface, outward, delta, progress=None):
-    """Build and check the corrected surface of ``result`` for the grid corrections
-    ``delta`` (n, m) in mm (``result.correction.delta``, or an accumulated correction
-    of an iteration); fills ``corrected``, ``zero``, ``field``, ``iterations``,
-    ``checks`` and ``spacing`` and returns ``result``."""
+    """Build and check the corrected surface of ``result`` for the node corrections
+    ``delta`` in mm (``result.correction.delta``, or an accumulated correction of an
+    iteration; (n, m) on a grid, (N,) for scattered points); fills ``corrected``,
+    ``zero``, ``field``, ``iterations``, ``checks`` and ``spacing`` and returns ``result``."""
     prepared = result.prepared
     g = prepared.grid
     U, V = g.take(prepared.u), g.take(prepared.v)
-    du, dv = grid_spacing(prepared)
+    if prepared.scattered:
+        scale = result.scale or parameter_scale(surface, prepared)
+        du, dv = scattered_spacing(prepared, scale)
+        factory = functools.partial(ScatteredField, scale=scale,
+                                    box=(surface.u_range, surface.v_range))
+        (u0, u1), (v0, v1) = surface.u_range, surface.v_range
+        shape = (int(np.ceil((u1 - u0) / du)) + 1, int(np.ceil((v1 - v0) / dv)) + 1)
+    else:
+        du, dv = grid_spacing(prepared)
+        factory, shape = GridField, None
     built = construct(surface, U, V, delta, outward, du, dv, result.options.refine,
-                      progress=progress)
+                      field_factory=factory, grid_shape=shape, progress=progress)
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
+    if built.checks.max_error_at_points > MISS_WARNING:
+        prepared.warnings.append(
+            "%s: the corrected face misses the intended correction by up to %.3f um at the "
+            "measured points (more than %.1f um): neighbouring points closer than the knot "
+            "spacing with different corrections (raw data?); the filtered method or a larger "
+            "--refine helps" % (prepared.source, built.checks.max_error_at_points * 1e3,
+                                MISS_WARNING * 1e3))
     return result
+
+
+def parameter_scale(surface, prepared):
+    """Median length per unit parameter (mm) along u and along v at the measured points,
+    so that fits over (u, v) are isotropic on the face."""
+    _, Su, Sv = bspline.derivatives(surface, prepared.u, prepared.v, order=1)
+    return (float(np.median(np.linalg.norm(Su, axis=-1))) or 1.0,
+            float(np.median(np.linalg.norm(Sv, axis=-1))) or 1.0)
+
+
+def scattered_spacing(prepared, scale):
+    """Parameter spacing (du, dv) of a scattered layout: the median distance (mm) from
+    each point to its nearest neighbour, in parameter units along u and v."""
+    x = np.stack([prepared.u * scale[0], prepared.v * scale[1]], axis=1)
+    dist, _ = cKDTree(x).query(x, k=2)
+    h = float(np.median(dist[:, 1]))
+    if not h > 0:
+        raise InputError("the measured points coincide: no spacing between them",
+                         file=prepared.source)
+    return h / scale[0], h / scale[1]

@@ -88,17 +88,21 @@ def grid_arrays(report):
     dict
         ``'x'``, ``'y'`` (n, m) nominal coordinates (mm) and ``'deviation'``,
         ``'determined'``, ``'random'``, ``'correction'``, ``'residual'`` (n, m) in mm
-        (NaN where no point fell).
+        (NaN where no point fell); (N,) per point for a scattered layout.
     """
     pts = report["points"]
-    n, m = report["grid"]["shape"]
-    row, col = np.asarray(pts["row"], dtype=int), np.asarray(pts["col"], dtype=int)
     out = {}
+    if pts.get("row") is None:  # scattered layout: per-point arrays (N,)
+        def put(values):
+            return np.asarray(values, dtype=float)
+    else:
+        n, m = report["grid"]["shape"]
+        row, col = np.asarray(pts["row"], dtype=int), np.asarray(pts["col"], dtype=int)
 
-    def put(values):
-        a = np.full((n, m), np.nan)
-        a[row, col] = np.asarray(values, dtype=float)
-        return a
+        def put(values):
+            a = np.full((n, m), np.nan)
+            a[row, col] = np.asarray(values, dtype=float)
+            return a
 
     nominal = np.asarray(pts["nominal"], dtype=float)
     out["x"], out["y"] = put(nominal[:, 0]), put(nominal[:, 1])
@@ -121,7 +125,13 @@ def _map(x, y, values_um, title, symmetric=True):
     lim = float(np.max(np.abs(finite))) if finite.size else 1.0
     lim = lim or 1.0
     kw = dict(vmin=-lim, vmax=lim, cmap="RdBu_r") if symmetric else dict(cmap="viridis")
-    if np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and min(x.shape) > 1:
+    if x.ndim == 1:  # scattered points: Delaunay triangles of the nominal x, y
+        mesh = ax.tripcolor(x, y, values_um, shading="gouraud", **kw)
+        ax.plot(x, y, ".", color="k", markersize=1.5)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        ax.set_aspect("equal", adjustable="box")
+    elif np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and min(x.shape) > 1:
         mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values_um), shading="gouraud", **kw)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
@@ -180,17 +190,29 @@ def _section_inputs(report):
 
 def _section_method(report):
     m = report.get("method", {})
-    mask = np.asarray(m.get("mask", [[1]]), dtype=float)
-    mask_html = "<table>%s</table>" % "".join(
-        "<tr>%s</tr>" % "".join('<td class="num">%g</td>' % w for w in row) for row in mask)
     g = report.get("grid", {})
+    fit = report.get("scattered_fit")
+    if fit is not None:
+        filt = ("Smoothing fit (scattered points)",
+                _e("thin-plate smoothing length %.3g mm (%s); fit residual RMS %.2f µm, "
+                   "leave-one-out RMS %.2f µm, estimated field error RMS %.2f µm"
+                   % (fit["smoothing"], fit["chosen_by"], fit["fit_rms"] * 1e3,
+                      fit["loo_rms"] * 1e3, (fit.get("field_error_rms") or 0.0) * 1e3)))
+    else:
+        mask = np.asarray(m.get("mask") or [[1]], dtype=float)
+        mask_html = "<table>%s</table>" % "".join(
+            "<tr>%s</tr>" % "".join('<td class="num">%g</td>' % w for w in row) for row in mask)
+        filt = ("Mask", "%dx%d %s (Werner 2022 eq. 4-5)%s" % (mask.shape[0], mask.shape[1],
+                                                              _e(m.get("mask_kind")), mask_html))
+    layout = ("%d scattered points (%s)" % (g.get("shape", ["?"])[0], g.get("found_from", ""))
+              if g.get("layout") == "scattered" else
+              "%s x %s (%s)" % (tuple(g.get("shape", ["?", "?"])) + (g.get("found_from", ""),)))
     rows = [("Method", _e(m.get("name"))),
-            ("Mask", "%dx%d %s (Werner 2022 eq. 4-5)%s" % (mask.shape[0], mask.shape[1],
-                                                           _e(m.get("mask_kind")), mask_html)),
+            filt,
             ("Edge handling", _e(m.get("edge"))),
             ("Stock (mirror)", _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
             ("Refinement", _e("%s knot spans per grid step" % m.get("refine"))),
-            ("Grid", _e("%s x %s (%s)" % (tuple(g.get("shape", ["?", "?"])) + (g.get("found_from", ""),))))]
+            ("Layout", _e(layout))]
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
 
 

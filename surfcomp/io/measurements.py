@@ -198,6 +198,9 @@ class MeasurementSet:
         ``','``, ``';'``, ``'\\t'`` or ``' '`` (runs of blanks).
     decimal_comma : bool
         The numbers were written with a decimal comma.
+    tip_centres : bool
+        The measured points are stylus tip centres (LinuxCNC probe logs), not contact
+        points: they need the tip radius (``Options.tip_radius``).
     """
 
     nominal: np.ndarray = None
@@ -216,6 +219,7 @@ class MeasurementSet:
     warnings: list = field(default_factory=list)
     separator: str = ","
     decimal_comma: bool = False
+    tip_centres: bool = False
 
     def __post_init__(self):
         if self.lines is None:

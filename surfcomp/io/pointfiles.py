@@ -412,7 +412,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
              "%s: %s" % (source, text) for line, text in warnings]
     return MeasurementSet(nominal=None, deviation=None, row=None, col=None, ids=None,
                           source=source, sha256=hashlib.sha256(data).hexdigest(),
-                          warnings=texts, **fields)
+                          warnings=texts, tip_centres=is_tip_centre(fmt), **fields)
 
 
 def _read_xyz(path, lines, units, warnings):

@@ -43,21 +43,24 @@ def build_report(command, inputs, comp, warnings=(), outputs=None):
         "inputs": inputs,
         "method": {
             "name": o.method,
-            "mask": _list(c.mask, 12),
-            "mask_size": int(c.mask.shape[0]),
+            "mask": None if c.mask is None else _list(c.mask, 12),
+            "mask_size": None if c.mask is None else int(c.mask.shape[0]),
             "mask_kind": "custom" if o.weights is not None else o.mask_kind,
             "edge": o.edge,
             "stock_mm": o.stock,
             "refine": o.refine,
+            "tip_radius_mm": o.tip_radius,
         },
         "grid": {"shape": list(g.shape), "found_from": g.rows_from,
-                 "axes": "row = first grid index (along u), col = second (along v)"},
+                 "layout": "scattered" if p.scattered else "grid",
+                 "axes": ("points in file order" if p.scattered else
+                          "row = first grid index (along u), col = second (along v)")},
         "statistics": {k: v.as_dict() for k, v in comp.statistics.items()},
         "statistics_ddof": 1,
         "points": {
             "line": [int(x) for x in p.lines],
-            "row": row.tolist(),
-            "col": col.tolist(),
+            "row": None if row is None else row.tolist(),
+            "col": None if col is None else col.tolist(),
             "u": _list(p.u, 12),
             "v": _list(p.v, 12),
             "nominal": _list(p.nominal),
@@ -70,6 +73,8 @@ def build_report(command, inputs, comp, warnings=(), outputs=None):
         },
         "warnings": list(warnings),
     }
+    if comp.fit is not None:
+        out["scattered_fit"] = comp.fit.as_dict()
     if comp.checks is not None:
         out["corrected_face"] = comp.checks.as_dict()
         out["corrected_face"]["degree"] = [comp.corrected.degree_u, comp.corrected.degree_v]

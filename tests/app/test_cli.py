@@ -94,8 +94,13 @@ def test_incomplete_grid_is_refused_with_what_is_missing(tmp_path):
     write_cmm_csv(meas, P, N, np.zeros((6, 5)))
     lines = meas.read_text().splitlines()
     meas.write_text("\n".join(lines[:8] + lines[9:]) + "\n")
-    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
+    err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas, "--layout", "grid")
     assert "do not form a complete n x m grid" in err and "has 5 points (missing near u=" in err
+    # by default such a set is used as a scattered layout, with the same reason as a warning
+    out = run_cli("inspect", EXAMPLE_STEP, meas, "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "has 5 points (missing near u=" in out.stderr and "scattered layout" in out.stderr
+    assert "29 scattered points" in out.stdout
 
 
 @pytest.mark.parametrize("args,words", [
@@ -222,3 +227,76 @@ def test_html_report_written_with_the_other_outputs(tmp_path):
     # an input path among the outputs is refused before anything is written
     bad = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "--html", EXAMPLE_CSV, "--quiet")
     assert bad.returncode == 2 and "overwrite an input" in bad.stderr
+
+
+def test_probe_log_tip_radius_compensation(tmp_path):
+    """A LinuxCNC probe log holds tip centres R outside the contact points: with
+    --tip-radius R the deviations are the contact points' (within the 1e-6 mm print
+    precision); without it they are off by R and a warning says so."""
+    M, N, d = _measured_points(seed=11)
+    R = 1.5
+    centres = (M + R * N).reshape(-1, 3)   # ball of radius R touching at M
+    path = tmp_path / "probe.txt"
+    path.write_text("\n".join("%.6f %.6f %.6f 0 0 0 0 0 0" % tuple(c) for c in centres) + "\n")
+    # R is above the default --max-offset: the check applies to the contact points
+    out = run_cli("inspect", EXAMPLE_STEP, path, "--tip-radius", R, "--report",
+                  tmp_path / "r.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    got = np.array(json.loads((tmp_path / "r.json").read_text())["points"]["deviation"])
+    np.testing.assert_allclose(np.sort(got), np.sort(d.ravel()), atol=2e-6)
+    out = run_cli("inspect", EXAMPLE_STEP, path, "--max-offset", 2, "--quiet")
+    assert out.returncode == 0 and "tip centres (probe log); without --tip-radius" in out.stderr
+    assert "1541.5" in out.stdout or "Max. positive" in out.stdout
+    bad = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--tip-radius", 1, "--quiet")
+    assert bad.returncode == 2 and "already compensated" in bad.stderr
+
+
+def test_scattered_adaptive_layout_end_to_end(tmp_path):
+    """A 7 x 10 adaptive layout like the mirror paper's (points along 7 curves, unevenly
+    spaced, no grid): the smoothing fit replaces the mask filter, and the corrected face
+    meets the pipeline's requirements (realised = intended within 0.1 um at the points,
+    no overshoot, zero field gives the nominal) checked independently with OCCT."""
+    import Part
+
+    from tests.app.helpers import realised_by_occt
+
+    nom = load_nominal(EXAMPLE_STEP)
+    rng = np.random.default_rng(5)
+    (u0, u1), (v0, v1) = nom.surface.u_range, nom.surface.v_range
+    curves = np.linspace(0.06, 0.94, 7) + rng.uniform(-0.02, 0.02, 7)
+    U, V = [], []
+    for c in curves:
+        # unevenly spaced along the curve, but not closer than ~40 % of the mean step
+        t = np.linspace(0.04, 0.96, 10) + rng.uniform(-0.03, 0.03, 10)
+        U.append(u0 + (u1 - u0) * (c + 0.05 * np.sin(6 * t)))
+        V.append(v0 + (v1 - v0) * t)
+    U, V = np.concatenate(U), np.concatenate(V)
+    from surfcomp.core import bspline
+
+    P = bspline.evaluate(nom.surface, U, V)
+    N = bspline.normals(nom.surface, U, V) * nom.outward
+    d = 0.03 * np.sin(2 * U / u1) * np.cos(1.5 * V / v1) + 0.01 + rng.normal(0, 0.002, U.size)
+    meas = tmp_path / "adaptive.csv"
+    meas.write_text("x_nom,y_nom,z_nom,i,j,k,dev\n" + "".join(
+        "%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % (tuple(p) + tuple(n) + (x,))
+        for p, n, x in zip(P, N, d)))
+    for method in ("filtered", "raw"):
+        out = run_cli("compensate", EXAMPLE_STEP, meas, "--method", method, "-o",
+                      tmp_path / "c.step", "--report", tmp_path / "r.json", "--html",
+                      tmp_path / "r.html", "--quiet")
+        assert out.returncode == 0, out.stderr
+        assert "70 scattered points" in out.stdout and "do not form" in out.stderr
+        rep = json.loads((tmp_path / "r.json").read_text())
+        assert rep["grid"]["layout"] == "scattered" and rep["points"]["row"] is None
+        fit = rep["scattered_fit"]
+        assert fit["chosen_by"] == "gcv" and 0 < fit["loo_rms"] < 0.01
+        cf = rep["corrected_face"]
+        assert cf["max_error_at_points_mm"] < 1e-4
+        assert cf["max_deviation_from_nominal_with_zero_correction_mm"] < 1e-4
+        assert cf["max_abs_realised_correction_on_face_mm"] <= cf["max_abs_intended_correction_mm"] + 1e-3
+        face = Part.read(str(tmp_path / "c.step")).Faces[0]
+        want = np.array(rep["points"]["correction"])
+        if method == "filtered":   # the smoothed values, not the raw ones
+            assert np.abs(want - d).max() > 0.002
+        np.testing.assert_allclose(realised_by_occt(face, P, N), want, atol=1e-4)
+        assert 'id="maps"' in (tmp_path / "r.html").read_text()
