@@ -1,0 +1,1 @@
+"""FreeCAD GUI layer of surfcomp: commands, task panels, view providers, colour maps (imported lazily by InitGui.py)."""

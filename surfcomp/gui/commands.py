@@ -1,0 +1,402 @@
+"""The workbench's commands (ids ``SurfComp_<Verb><Noun>``).
+
+One base class, :class:`Command`, carries the boilerplate: resources (icon named after
+the command id in ``resources/icons``, translatable texts), ``IsActive`` from the
+selection, and ``Activated`` running the command's macro lines (``Gui.addModule`` +
+``Gui.doCommand`` calling the app factories) inside one transaction. A
+:class:`~surfcomp.errors.SurfcompError` aborts the transaction (the document is left as
+it was) and is shown with the CLI's message through :mod:`surfcomp.gui.dialogs`.
+"""
+
+import os
+
+import FreeCAD
+import FreeCADGui
+
+from PySide.QtCore import QT_TRANSLATE_NOOP
+
+from .. import paths
+from ..app import features
+from ..errors import ComputationError, InputError, SurfcompError
+from . import dialogs, prefs
+
+translate = FreeCAD.Qt.translate
+
+CAD_FILTER = "CAD files (*.step *.stp *.iges *.igs *.brep *.brp);;All files (*)"
+MEASUREMENT_FILTER = ("Measurements (*.csv *.txt *.xyz *.qif *.dat *.log);;All files (*)")
+
+
+# -- selection ------------------------------------------------------------------------------
+def selected_face():
+    """``(object, 'FaceN')`` of the one selected face, or None."""
+    faces = [(s.Object, n) for s in FreeCADGui.Selection.getSelectionEx()
+             for n in s.SubElementNames if n.startswith("Face")]
+    return faces[0] if len(faces) == 1 else None
+
+
+def selected(kind):
+    """Selected objects for which ``kind(obj)`` is true."""
+    return [o for o in FreeCADGui.Selection.getSelection() if kind(o)]
+
+
+def selected_compensation():
+    found = selected(features.is_compensation)
+    return found[0] if len(found) == 1 else None
+
+
+def measurement_for_selection(doc):
+    """The selected measurement object, else the only one of the document, else None."""
+    found = selected(features.is_measurement)
+    if len(found) == 1:
+        return found[0]
+    if found:
+        return None
+    every = [o for o in doc.Objects if features.is_measurement(o)] if doc else []
+    return every[0] if len(every) == 1 else None
+
+
+def _state_error(obj):
+    """The error of an object that failed to recompute, as a SurfcompError."""
+    status = obj.getStatusString() if hasattr(obj, "getStatusString") else ""
+    return ComputationError("%s could not be computed: %s" % (obj.Label, status or
+                                                              ", ".join(obj.State)))
+
+
+# -- the base command -----------------------------------------------------------------------
+class Command:
+    """Boilerplate of every SurfComp command; subclasses set the texts and ``run``."""
+
+    ID = ""
+    MENU = ""
+    TIP = ""
+
+    def GetResources(self):
+        return {"Pixmap": paths.icon(self.ID + ".svg"), "MenuText": self.MENU,
+                "ToolTip": self.TIP, "StatusTip": self.TIP}
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and bool(self.active())
+
+    def active(self):
+        return True
+
+    def Activated(self):
+        doc = FreeCAD.ActiveDocument
+        try:
+            self.run()
+        except SurfcompError as exc:
+            if doc is not None and doc.HasPendingTransaction:
+                doc.abortTransaction()
+            dialogs.show_error(translate("SurfComp", "SurfComp: %s") % self.MENU, str(exc))
+
+    def run(self):
+        raise NotImplementedError
+
+    # helpers for run()
+    @staticmethod
+    def macro(label, lines, modules=()):
+        """Run ``lines`` with ``Gui.doCommand`` (so they are recorded in macros) inside one
+        transaction of the active document; abort it on any error and re-raise."""
+        doc = FreeCAD.ActiveDocument
+        for mod in modules:
+            FreeCADGui.addModule(mod)
+        doc.openTransaction(label)
+        try:
+            for line in lines:
+                FreeCADGui.doCommand(line)
+        except BaseException:
+            doc.abortTransaction()
+            raise
+        doc.commitTransaction()
+
+    @staticmethod
+    def new_objects(before):
+        doc = FreeCAD.ActiveDocument
+        return [o for o in doc.Objects if o.Name not in before]
+
+
+def create_compensation(label, display="Map", quantity="deviation"):
+    """Macro: a compensation of the selected face and measurement with the preferences'
+    method, mask and edge handling; computed and shown. Returns the new object.
+
+    Raises SurfcompError (the document is then left unchanged) when the inputs are
+    missing or the computation fails.
+    """
+    doc = FreeCAD.ActiveDocument
+    sel = selected_face()
+    meas = measurement_for_selection(doc)
+    if sel is None or meas is None:
+        raise InputError("select the nominal face (one face) and a measurement object")
+    nom, face = sel
+    before = {o.Name for o in doc.Objects}
+    lines = ["_doc = App.ActiveDocument",
+             "_comp = surfcomp.app.features.make_compensation(_doc, _doc.getObject(%r), %r, "
+             "_doc.getObject(%r), method=%r, mask_size=%d, edge=%r)"
+             % (nom.Name, face, meas.Name, prefs.method(), prefs.mask_size(), prefs.edge()),
+             "surfcomp.gui.viewproviders.attach(_comp)",
+             "_comp.ViewObject.Map = %r" % quantity,
+             "_doc.recompute()",
+             # the map lies on the nominal face: hide what would cover it
+             "_doc.getObject(%r).ViewObject.Visibility = False" % nom.Name,
+             "_doc.getObject(%r).ViewObject.Visibility = False" % meas.Name]
+    doc.openTransaction(label)
+    try:
+        FreeCADGui.addModule("surfcomp.app.features")
+        FreeCADGui.addModule("surfcomp.gui.viewproviders")
+        for line in lines:
+            FreeCADGui.doCommand(line)
+        comp = next(o for o in Command.new_objects(before) if features.is_compensation(o))
+        if "Invalid" in comp.State or "Error" in comp.State or comp.Shape.isNull():
+            raise _state_error(comp)
+        comp.ViewObject.DisplayMode = display
+    except BaseException:
+        doc.abortTransaction()
+        doc.recompute()
+        raise
+    doc.commitTransaction()
+    return comp
+
+
+# -- the commands -----------------------------------------------------------------------------
+class LoadNominal(Command):
+    ID = "SurfComp_LoadNominal"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_LoadNominal", "Load nominal")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_LoadNominal",
+                            "Check the selected face as nominal, or read a STEP/IGES/BREP file "
+                            "into the document")
+
+    def IsActive(self):
+        return True
+
+    def run(self):
+        sel = selected_face()
+        if sel is not None:
+            from ..app.nominal import nominal_from_face
+
+            obj, name = sel
+            nom = nominal_from_face(getattr(obj.Shape, name), source=obj.Label, face_name=name)
+            FreeCAD.Console.PrintMessage(
+                "SurfComp nominal: %s.%s (%s, %d x %d poles)\n"
+                % (obj.Label, name, nom.converted or "BSplineSurface", *nom.surface.shape))
+            return
+        path = dialogs.ask_open_file(translate("SurfComp", "Nominal face"), CAD_FILTER)
+        if not path:
+            return
+        if FreeCAD.ActiveDocument is None:
+            FreeCADGui.doCommand("App.newDocument()")
+        label = os.path.splitext(os.path.basename(path))[0]
+        self.macro(translate("SurfComp", "Load nominal"), [
+            "_shape, _name = surfcomp.app.nominal.read_shape(%r)" % path,
+            "_nominal = App.ActiveDocument.addObject('Part::Feature', 'Nominal')",
+            "_nominal.Shape = _shape",
+            "_nominal.Label = %r" % label,
+            "App.ActiveDocument.recompute()"], modules=("surfcomp.app.nominal",))
+
+
+class ImportMeasurements(Command):
+    ID = "SurfComp_ImportMeasurements"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements", "Import measurements")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements",
+                            "Read a measurement file (CSV, XYZ, XYZIJK, probe log, QIF): "
+                            "preview of columns, units, points and problems first")
+
+    def run(self):
+        from ..io.readers import read_any
+        from .panels import PreviewDialog
+
+        path = dialogs.ask_open_file(translate("SurfComp", "Measurement file"),
+                                     MEASUREMENT_FILTER)
+        if not path:
+            return
+        units = prefs.file_units()
+        ms = read_any(path, units=units)
+        if not dialogs.run_dialog(PreviewDialog(ms)):
+            return
+        self.macro(translate("SurfComp", "Import measurements"), [
+            "_meas = surfcomp.app.features.make_measurement(App.ActiveDocument, %r, units=%r)"
+            % (path, units),
+            "surfcomp.gui.viewproviders.attach(_meas)",
+            "App.ActiveDocument.recompute()"],
+            modules=("surfcomp.app.features", "surfcomp.gui.viewproviders"))
+
+
+class _MapCommand(Command):
+    QUANTITY = "deviation"
+
+    def active(self):
+        if selected_compensation() is not None:
+            return True
+        return selected_face() is not None and \
+            measurement_for_selection(FreeCAD.ActiveDocument) is not None
+
+    def run(self):
+        comp = selected_compensation()
+        if comp is None:
+            create_compensation(self.MENU, "Map", self.QUANTITY)
+            return
+        self.show(comp, self.QUANTITY)
+
+    @staticmethod
+    def show(comp, quantity):
+        vobj = comp.ViewObject
+        if vobj is None or "Map" not in vobj.PropertiesList:
+            raise InputError("%s has no colour map view (open it with the SurfComp "
+                             "workbench loaded)" % comp.Label)
+        vobj.Map = quantity
+        vobj.DisplayMode = "Map"
+        vobj.Visibility = True
+        for other in (comp.Nominal, comp.Measurement):
+            if other is not None and other.ViewObject is not None:
+                other.ViewObject.Visibility = False
+
+
+class DeviationMap(_MapCommand):
+    ID = "SurfComp_DeviationMap"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_DeviationMap", "Deviation map")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_DeviationMap",
+                            "Colour map of the deviations on the nominal face (select the "
+                            "face and a measurement, or a compensation)")
+
+
+class Filter(Command):
+    ID = "SurfComp_Filter"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_Filter", "Filter")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_Filter",
+                            "Mask size, weights and edge handling of the filter, with live "
+                            "maps of the determined and random components")
+
+    def active(self):
+        return selected_compensation() is not None
+
+    def run(self):
+        comp = selected_compensation()
+        FreeCADGui.ActiveDocument.setEdit(comp.Name, 0)
+
+
+class Mirror(Command):
+    ID = "SurfComp_Mirror"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_Mirror", "Mirror (stock)")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_Mirror",
+                            "Mirror method with a semi-finishing allowance: the corrected face "
+                            "mirrors the determined error (stock in mm)")
+
+    def active(self):
+        return selected_compensation() is not None
+
+    def run(self):
+        comp = selected_compensation()
+        stock = dialogs.ask_float(self.MENU, translate("SurfComp", "Stock (mm)"),
+                                  float(comp.Stock.Value) or 0.1, 0.0, 100.0)
+        if stock is None:
+            return
+        doc = FreeCAD.ActiveDocument
+        self.macro(self.MENU, [
+            "_comp = App.ActiveDocument.getObject(%r)" % comp.Name,
+            "_comp.Method = 'mirror'",
+            "_comp.Stock = %r" % stock,
+            "_comp.ViewObject.Map = 'correction'",
+            "App.ActiveDocument.recompute()"])
+        if "Invalid" in comp.State or "Error" in comp.State:
+            err = _state_error(comp)
+            doc.undo()
+            doc.recompute()
+            raise err
+
+
+class BuildFace(Command):
+    ID = "SurfComp_BuildFace"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_BuildFace", "Build corrected face")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_BuildFace",
+                            "Add the corrected face of the selected compensation as a plain "
+                            "Part feature (for export); with a face and a measurement selected, "
+                            "compute the compensation first")
+
+    def active(self):
+        return _MapCommand.active(self)
+
+    def run(self):
+        comp = selected_compensation()
+        if comp is None:
+            comp = create_compensation(self.MENU, "Shaded")
+        self.macro(self.MENU, [
+            "_comp = App.ActiveDocument.getObject(%r)" % comp.Name,
+            "_face = App.ActiveDocument.addObject('Part::Feature', 'CorrectedFace')",
+            "_face.Shape = _comp.Shape.copy()",
+            "_face.Label = %r" % (comp.Label + " corrected face"),
+            "App.ActiveDocument.recompute()"])
+
+
+class ReplaceInDocument(Command):
+    ID = "SurfComp_ReplaceInDocument"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Replace in document")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument",
+                            "Let the users of the nominal (Path jobs, links) use the corrected "
+                            "face instead; Restore puts the nominal back")
+
+    def active(self):
+        from ..app import replace
+
+        comp = selected_compensation()
+        return comp is not None and not replace.is_replacing(comp)
+
+    def run(self):
+        # surfcomp.app.replace opens and commits its own transaction
+        comp = selected_compensation()
+        FreeCADGui.addModule("surfcomp.app.replace")
+        FreeCADGui.doCommand("surfcomp.app.replace.replace(App.ActiveDocument, "
+                             "App.ActiveDocument.getObject(%r))" % comp.Name)
+        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+
+
+class RestoreNominal(Command):
+    ID = "SurfComp_RestoreNominal"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Restore nominal")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal",
+                            "Undo Replace in document: the users of the nominal use it again")
+
+    def active(self):
+        from ..app import replace
+
+        comp = selected_compensation()
+        return comp is not None and replace.is_replacing(comp)
+
+    def run(self):
+        comp = selected_compensation()
+        FreeCADGui.addModule("surfcomp.app.replace")
+        FreeCADGui.doCommand("surfcomp.app.replace.restore(App.ActiveDocument, "
+                             "App.ActiveDocument.getObject(%r))" % comp.Name)
+        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+
+
+class Report(Command):
+    ID = "SurfComp_Report"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_Report", "Report")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_Report",
+                            "Statistics of deviations, determined and random components and "
+                            "correction (like the papers' tables), copyable")
+
+    def active(self):
+        comp = selected_compensation()
+        return comp is not None and comp.Statistics not in ("", "{}")
+
+    def run(self):
+        from .panels import ReportDialog
+
+        dialogs.run_dialog(ReportDialog(selected_compensation()))
+
+
+COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, Filter, Mirror, BuildFace,
+            ReplaceInDocument, RestoreNominal, Report)
+#: toolbar/menu order (None: separator)
+TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
+           "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
+           "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report")
+
+
+def register():
+    """Add every command to FreeCAD (idempotent)."""
+    known = set(FreeCADGui.listCommands())
+    for cls in COMMANDS:
+        if cls.ID not in known:
+            FreeCADGui.addCommand(cls.ID, cls())
+    return [c.ID for c in COMMANDS]

@@ -1,0 +1,45 @@
+"""The workbench's modal questions and messages, in one place.
+
+Commands never call Qt dialogs directly: they call these functions, so scripts and the
+GUI tests can replace them (e.g. ``dialogs.show_error = recorder``) and run every command
+without a blocking dialog.
+"""
+
+import FreeCAD
+import FreeCADGui
+
+from PySide import QtGui
+
+translate = FreeCAD.Qt.translate
+
+
+def _parent():
+    return FreeCADGui.getMainWindow()
+
+
+def show_error(title, message):
+    """Show an error the way the CLI words it (``file:line:column: what is wrong``)."""
+    FreeCAD.Console.PrintError("%s: %s\n" % (title, message))
+    QtGui.QMessageBox.critical(_parent(), title, message)
+
+
+def show_info(title, message):
+    QtGui.QMessageBox.information(_parent(), title, message)
+
+
+def ask_open_file(title, filters):
+    """A file to open, or None when the user cancels."""
+    path, _ = QtGui.QFileDialog.getOpenFileName(_parent(), title, "", filters)
+    return path or None
+
+
+def ask_float(title, label, value, minimum, maximum, decimals=4):
+    """A number, or None when the user cancels."""
+    val, ok = QtGui.QInputDialog.getDouble(_parent(), title, label, value, minimum, maximum,
+                                           decimals)
+    return float(val) if ok else None
+
+
+def run_dialog(dialog):
+    """Run a modal dialog; True when accepted."""
+    return dialog.exec_() == QtGui.QDialog.Accepted

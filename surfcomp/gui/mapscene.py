@@ -1,0 +1,292 @@
+"""Coin scene of a colour map: coloured face mesh, coloured point markers, labels at the
+extremes and a colour-bar legend drawn over the 3D view (FreeCAD GUI only).
+
+No numerics here: colours, ranges and legend levels come from
+:mod:`surfcomp.core.colormap`; the mesh and the values are given by the caller.
+
+Use::
+
+    scene = MapScene()
+    scene.set_data(points, triangles, values, marker_points, marker_values, title="Deviation")
+    scene.set_style(MapStyle(scheme="rainbow", unit="um"))
+    some_separator.addChild(scene.root)
+
+``set_style`` only recolours (no new geometry), so changing range, scheme or
+tolerance band redraws at once.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+from pivy import coin
+
+from ..core import colormap
+
+#: legend placement in normalised device coordinates (-1 .. 1 across the view)
+BAR_X = (0.74, 0.79)
+BAR_Y = (-0.70, 0.70)
+LABEL_X = 0.805
+TITLE_Y = 0.78
+
+
+@dataclass
+class MapStyle:
+    """Display choices of a map (all lengths in mm).
+
+    ``vmin``/``vmax`` None: symmetric range around zero from the values;
+    ``tolerance`` ``(lower, upper)`` switches to the tolerance-band colouring.
+    """
+
+    scheme: str = colormap.DEFAULT_SCHEME
+    vmin: float = None
+    vmax: float = None
+    tolerance: tuple = None
+    unit: str = "mm"
+    levels: int = 10
+    show_points: bool = True
+    show_labels: bool = True
+    show_legend: bool = True
+    point_size: int = 7
+
+    def range_for(self, values):
+        """The colour range for ``values``: the style's own or the symmetric default."""
+        if self.vmin is not None and self.vmax is not None and self.vmax > self.vmin:
+            return float(self.vmin), float(self.vmax)
+        return colormap.symmetric_range(values)
+
+
+def _colors(values, style, vmin, vmax):
+    if style.tolerance is not None:
+        return colormap.tolerance_colors(values, *style.tolerance)
+    return colormap.map_colors(values, vmin, vmax, style.scheme)
+
+
+def _text(position, text, color=(0.0, 0.0, 0.0), size=15, justification=None):
+    sep = coin.SoSeparator()
+    tr = coin.SoTranslation()
+    tr.translation.setValue(*map(float, position))
+    col = coin.SoBaseColor()
+    col.rgb.setValue(*color)
+    font = coin.SoFont()
+    font.size = size
+    txt = coin.SoText2()
+    txt.string.setValue(text)
+    if justification is not None:
+        txt.justification = justification
+    for node in (tr, col, font, txt):
+        sep.addChild(node)
+    return sep
+
+
+class MapScene:
+    """The scene nodes of one colour map (see module docstring). ``root`` is the node
+    to add to a view provider's display mode or to a scene graph."""
+
+    def __init__(self):
+        self.root = coin.SoSeparator()
+        self.root.setName("SurfCompMap")
+        self._style = MapStyle()
+        self._values = None
+        self._marker_values = None
+        self._marker_points = None
+        self._points = None
+        self._title = ""
+        self.range = None
+
+        # the face mesh: unlit per-vertex colours, pushed back so markers stay in front
+        self.surface = coin.SoSeparator()
+        hints = coin.SoShapeHints()
+        hints.vertexOrdering = coin.SoShapeHints.UNKNOWN_ORDERING
+        self.surface_coords = coin.SoCoordinate3()
+        self.surface_colors = coin.SoBaseColor()
+        binding = coin.SoMaterialBinding()
+        binding.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
+        offset = coin.SoPolygonOffset()
+        offset.factor = 1.0
+        offset.units = 1.0
+        self.faces = coin.SoIndexedFaceSet()
+        light = coin.SoLightModel()
+        light.model = coin.SoLightModel.BASE_COLOR
+        for node in (hints, light, offset, self.surface_coords, self.surface_colors, binding,
+                     self.faces):
+            self.surface.addChild(node)
+
+        # measured points as coloured markers
+        self.markers_switch = coin.SoSwitch()
+        markers = coin.SoSeparator()
+        self.marker_coords = coin.SoCoordinate3()
+        self.marker_colors = coin.SoBaseColor()
+        mbind = coin.SoMaterialBinding()
+        mbind.value = coin.SoMaterialBinding.PER_VERTEX
+        # GL points, not SoMarkerSet: bitmap markers cost seconds for 40 000 points
+        self.marker_style = coin.SoDrawStyle()
+        self.marker_style.pointSize = 7
+        self.marker_set = coin.SoPointSet()
+        for node in (light.copy(), self.marker_style, self.marker_coords, self.marker_colors,
+                     mbind, self.marker_set):
+            markers.addChild(node)
+        self.markers_switch.addChild(markers)
+
+        # labels at the largest positive and negative value
+        self.labels_switch = coin.SoSwitch()
+        self.labels = coin.SoAnnotation()      # drawn over the surface
+        self.labels_switch.addChild(self.labels)
+
+        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes
+        self.legend_switch = coin.SoSwitch()
+        self.legend = coin.SoAnnotation()
+        self.legend_switch.addChild(self.legend)
+        skip = coin.SoType.fromName(coin.SbName("SoSkipBoundingGroup")).createInstance()
+        skip.addChild(self.legend_switch)
+
+        for node in (self.surface, self.markers_switch, self.labels_switch, skip):
+            self.root.addChild(node)
+
+    # -- data --------------------------------------------------------------------------
+    def set_data(self, points, triangles, values, marker_points=None, marker_values=None,
+                 title=""):
+        """New geometry and values.
+
+        Parameters
+        ----------
+        points : ndarray, shape (N, 3)
+            Mesh vertices (mm).
+        triangles : ndarray of int, shape (M, 3)
+        values : ndarray, shape (N,)
+            Value at every vertex (mm).
+        marker_points : ndarray, shape (K, 3), optional
+            Measured points drawn as markers, coloured by ``marker_values`` (K,).
+        title : str
+            Legend title (e.g. ``'Deviation'``).
+        """
+        points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+        tri = np.asarray(triangles, dtype=np.int32).reshape(-1, 3)
+        self._values = np.asarray(values, dtype=float).ravel()
+        self._points = points.astype(float)
+        self.surface_coords.point.setNum(0)
+        self.surface_coords.point.setValues(0, len(points), points)
+        idx = np.concatenate([tri, -np.ones((len(tri), 1), dtype=np.int32)], axis=1).ravel()
+        self.faces.coordIndex.setNum(0)
+        self.faces.coordIndex.setValues(0, len(idx), idx.tolist())
+        self.faces.materialIndex.setNum(0)
+        self.faces.materialIndex.setValues(0, len(idx), idx.tolist())
+        if marker_points is not None and len(marker_points):
+            mp = np.ascontiguousarray(marker_points, dtype=np.float32).reshape(-1, 3)
+            self._marker_points = mp.astype(float)
+            self._marker_values = np.asarray(marker_values, dtype=float).ravel()
+            self.marker_coords.point.setNum(0)
+            self.marker_coords.point.setValues(0, len(mp), mp)
+        else:
+            self._marker_points = self._marker_values = None
+            self.marker_coords.point.setNum(0)
+        self._title = title
+        self.set_style(self._style)
+
+    def clear(self):
+        """Show nothing (no data)."""
+        self._values = self._marker_values = self._marker_points = None
+        for field in (self.surface_coords.point, self.faces.coordIndex,
+                      self.faces.materialIndex, self.marker_coords.point):
+            field.setNum(0)
+        self.labels.removeAllChildren()
+        self.legend.removeAllChildren()
+        self.range = None
+
+    # -- style ------------------------------------------------------------------------
+    def set_style(self, style):
+        """Recolour with ``style`` (:class:`MapStyle`); geometry is kept."""
+        self._style = style
+        if self._values is None:
+            return
+        ref = self._marker_values if self._marker_values is not None else self._values
+        vmin, vmax = style.range_for(np.concatenate([self._values, ref]))
+        self.range = (vmin, vmax)
+        cols = _colors(self._values, style, vmin, vmax).astype(np.float32)
+        self.surface_colors.rgb.setNum(0)
+        self.surface_colors.rgb.setValues(0, len(cols), cols)
+        self.markers_switch.whichChild = -1
+        if self._marker_values is not None and style.show_points:
+            mc = _colors(self._marker_values, style, vmin, vmax).astype(np.float32)
+            self.marker_colors.rgb.setNum(0)
+            self.marker_colors.rgb.setValues(0, len(mc), mc)
+            self.marker_style.pointSize = float(style.point_size)
+            self.markers_switch.whichChild = 0
+        self._draw_labels(style)
+        self._draw_legend(style, vmin, vmax)
+
+    def _draw_labels(self, style):
+        self.labels.removeAllChildren()
+        self.labels_switch.whichChild = 0 if style.show_labels else -1
+        if self._marker_values is not None:
+            pts, vals = self._marker_points, self._marker_values
+        else:
+            pts, vals = None, self._values
+        if pts is None:
+            pts = self._points
+        i_max, i_min = colormap.extremes(vals)
+        for idx, word in ((i_max, "max"), (i_min, "min")):
+            if idx is None:
+                continue
+            self.labels.addChild(_text(pts[idx], "  %s %s" % (word, colormap.format_value(
+                vals[idx], style.unit))))
+        self.extreme_indices = (i_max, i_min)
+
+    def _draw_legend(self, style, vmin, vmax):
+        leg = self.legend
+        leg.removeAllChildren()
+        self.legend_switch.whichChild = 0 if style.show_legend else -1
+        cam = coin.SoOrthographicCamera()
+        cam.viewportMapping = coin.SoCamera.LEAVE_ALONE
+        cam.position.setValue(0.0, 0.0, 1.0)
+        cam.height = 2.0
+        cam.nearDistance = 0.5
+        cam.farDistance = 1.5
+        light = coin.SoLightModel()
+        light.model = coin.SoLightModel.BASE_COLOR
+        leg.addChild(cam)
+        leg.addChild(light)
+        data = colormap.legend(vmin, vmax, style.scheme, style.unit, style.levels,
+                               style.tolerance)
+        stops = data["stops"]
+        y0, y1 = BAR_Y
+        x0, x1 = BAR_X
+        coords, colors, index = [], [], []
+        for (f0, c0), (f1, c1) in zip(stops[:-1], stops[1:]):
+            if f1 <= f0:
+                continue
+            ya, yb = y0 + f0 * (y1 - y0), y0 + f1 * (y1 - y0)
+            k = len(coords)
+            coords += [(x0, ya, 0.0), (x1, ya, 0.0), (x1, yb, 0.0), (x0, yb, 0.0)]
+            colors += [c0, c0, c1, c1]
+            index += [k, k + 1, k + 2, k + 3, -1]
+        bar = coin.SoSeparator()
+        c3 = coin.SoCoordinate3()
+        c3.point.setValues(0, len(coords), coords)
+        bc = coin.SoBaseColor()
+        bc.rgb.setValues(0, len(colors), colors)
+        mb = coin.SoMaterialBinding()
+        mb.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
+        fs = coin.SoIndexedFaceSet()
+        fs.coordIndex.setValues(0, len(index), index)
+        fs.materialIndex.setValues(0, len(index), index)
+        frame_c = coin.SoCoordinate3()
+        frame_c.point.setValues(0, 5, [(x0, y0, 0.01), (x1, y0, 0.01), (x1, y1, 0.01),
+                                       (x0, y1, 0.01), (x0, y0, 0.01)])
+        frame_col = coin.SoBaseColor()
+        frame_col.rgb.setValue(0.0, 0.0, 0.0)
+        frame = coin.SoLineSet()
+        frame.numVertices.setValue(5)
+        for node in (c3, bc, mb, fs):
+            bar.addChild(node)
+        fsep = coin.SoSeparator()
+        for node in (frame_c, frame_col, frame):
+            fsep.addChild(node)
+        leg.addChild(bar)
+        leg.addChild(fsep)
+        for f, text in data["labels"]:
+            leg.addChild(_text((LABEL_X, y0 + f * (y1 - y0) - 0.01, 0.0), text))
+        title = self._title + (" [%s]" % style.unit if self._title else "")
+        if style.tolerance is not None:
+            title += " - tolerance band"
+        leg.addChild(_text((x1, TITLE_Y, 0.0), title, size=17,
+                           justification=coin.SoText2.RIGHT))

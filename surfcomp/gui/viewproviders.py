@@ -1,0 +1,342 @@
+"""View providers of the surfcomp document objects (FreeCAD GUI only).
+
+``ViewProviderCompensation`` adds the display mode ``Map``: the chosen quantity
+(raw deviation, determined or random component, correction, predicted residual) drawn
+on the nominal face as a colour map with markers, labels and a legend. Range, scheme,
+tolerance band and unit are properties of the view object: changing them recolours
+without recomputing the document. State lives in properties; the proxy only caches
+the mesh and values (rebuilt whenever the object's Shape changes).
+
+The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
+"""
+
+import numpy as np
+
+import FreeCAD
+from PySide import QtCore
+
+from .. import paths
+from ..app import features
+from ..core import colormap
+from ..errors import SurfcompError
+from . import prefs
+from .mapscene import MapScene, MapStyle
+
+VERSION = 1
+
+QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
+TITLES = {"deviation": "Deviation", "determined": "Determined component",
+          "random": "Random component", "correction": "Correction",
+          "increment": "Correction of this round", "residual": "Predicted residual"}
+#: view properties whose change only recolours the map
+STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "ToleranceBand",
+                    "ToleranceLower", "ToleranceUpper", "LegendUnit", "ShowPoints",
+                    "ShowLabels", "ShowLegend")
+
+#: compensation properties whose change invalidates the drawn map
+RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "NominalPoints", "Deviation",
+                     "Determined", "Random", "Increment", "Correction", "Version")
+
+_G = "Colour map"
+# (type, name, tooltip, default)
+MAP_PROPERTIES = (
+    ("App::PropertyEnumeration", "Map", "Quantity drawn in the Map display mode",
+     list(QUANTITIES)),
+    ("App::PropertyEnumeration", "Scheme", "Colour scheme", list(colormap.SCHEMES)),
+    ("App::PropertyBool", "AutoRange",
+     "Symmetric range from the largest absolute value (off: RangeMin .. RangeMax)", True),
+    ("App::PropertyDistance", "RangeMin", "Lower end of the colour range (AutoRange off)",
+     -0.05),
+    ("App::PropertyDistance", "RangeMax", "Upper end of the colour range (AutoRange off)",
+     0.05),
+    ("App::PropertyBool", "ToleranceBand",
+     "Tolerance band mode: in tolerance one colour, below and above their own", False),
+    ("App::PropertyDistance", "ToleranceLower", "Lower limit of the tolerance band", -0.01),
+    ("App::PropertyDistance", "ToleranceUpper", "Upper limit of the tolerance band", 0.01),
+    ("App::PropertyEnumeration", "LegendUnit", "Unit of the legend and labels", ["mm", "um"]),
+    ("App::PropertyBool", "ShowPoints", "Draw the measured points as coloured markers", True),
+    ("App::PropertyBool", "ShowLabels", "Label the largest positive and negative value",
+     True),
+    ("App::PropertyBool", "ShowLegend", "Draw the colour bar legend", True),
+    ("App::PropertyInteger", "MapVersion", "Property set version of this view", VERSION),
+)
+
+
+def add_map_properties(vobj, from_preferences=True):
+    """Add the missing colour-map properties to ``vobj`` (new objects, old documents)."""
+    for typ, name, tip, default in MAP_PROPERTIES:
+        if name in vobj.PropertiesList:
+            continue
+        vobj.addProperty(typ, name, _G, tip)
+        setattr(vobj, name, default)
+        if typ == "App::PropertyEnumeration":
+            setattr(vobj, name, default[0])
+    vobj.setEditorMode("MapVersion", 2)
+    if from_preferences:
+        vobj.Scheme = prefs.scheme()
+        vobj.ToleranceBand = prefs.tolerance_band()
+        vobj.ToleranceLower, vobj.ToleranceUpper = prefs.tolerance()
+        vobj.LegendUnit = prefs.display_unit()
+
+
+def has_map_properties(vobj):
+    """True once every colour-map property exists (they are added, and restored from a
+    file, one at a time: ``onChanged`` fires in between)."""
+    names = set(vobj.PropertiesList)
+    return all(p[1] in names for p in MAP_PROPERTIES)
+
+
+def style_of(vobj):
+    """The :class:`MapStyle` the view properties describe."""
+    auto = vobj.AutoRange
+    tol = (float(vobj.ToleranceLower.Value), float(vobj.ToleranceUpper.Value)) \
+        if vobj.ToleranceBand else None
+    return MapStyle(scheme=vobj.Scheme,
+                    vmin=None if auto else float(vobj.RangeMin.Value),
+                    vmax=None if auto else float(vobj.RangeMax.Value),
+                    tolerance=tol, unit=vobj.LegendUnit, show_points=vobj.ShowPoints,
+                    show_labels=vobj.ShowLabels, show_legend=vobj.ShowLegend)
+
+
+def map_data(obj, quantity, samples=None):
+    """Mesh and values of a computed compensation's map (no drawing).
+
+    Returns
+    -------
+    dict
+        ``points`` (N, 3), ``triangles`` (M, 3), ``values`` (N,) on the mesh,
+        ``markers`` (K, 3) measured nodes and ``marker_values`` (K,), mm, in the
+        nominal object's own coordinates.
+    """
+    nominal, _placement = features.nominal_of(obj)
+    n, m = int(obj.GridRows), int(obj.GridCols)
+    samples = samples or colormap.mesh_resolution((n, m))
+    pts, tri, u, v = colormap.uv_grid_mesh(nominal.surface, samples)
+    field = features.deviation_field(obj, quantity)
+    values = field(u, v)
+    nodes = np.asarray(obj.NominalPoints, dtype=float).reshape(-1, 3)
+    dev = np.asarray(obj.Deviation, dtype=float)
+    if quantity == "residual":
+        node_values = dev - np.asarray(obj.Increment, dtype=float)
+    else:
+        node_values = np.asarray(getattr(obj, quantity.capitalize()), dtype=float)
+    keep = np.isfinite(dev) & np.isfinite(node_values)
+    return {"points": pts, "triangles": tri, "values": values, "markers": nodes[keep],
+            "marker_values": node_values[keep]}
+
+
+class ViewProviderCompensation:
+    """View provider of ``SurfComp_Compensation``: Part display modes plus ``Map``."""
+
+    def __init__(self, vobj):
+        add_map_properties(vobj)
+        vobj.Proxy = self
+
+    # transient state only (never saved)
+    def _reset(self):
+        self._data = {}
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+        self.vobj = vobj
+        self._data = {}
+        self.scene = MapScene()
+        vobj.addDisplayMode(self.scene.root, "Map")
+
+    def getDisplayModes(self, vobj):
+        return ["Map"]
+
+    def getDefaultDisplayMode(self):
+        return "Map"
+
+    def setDisplayMode(self, mode):
+        if mode == "Map":
+            self.redraw()
+        return mode
+
+    def getIcon(self):
+        return paths.icon("SurfComp_DeviationMap.svg")
+
+    def claimChildren(self):
+        meas = getattr(self.Object, "Measurement", None)
+        return [meas] if meas is not None else []
+
+    def updateData(self, obj, prop):
+        if prop not in RESULT_PROPERTIES:
+            return
+        self._data = {}
+        if getattr(self, "vobj", None) is None or self.vobj.DisplayMode != "Map":
+            return
+        if getattr(obj.Document, "Restoring", False):
+            self._schedule()        # properties arrive one by one: draw once they are all in
+        elif prop == "Shape":       # written last by a recompute
+            self.redraw()
+
+    def _schedule(self):
+        if not getattr(self, "_pending", False):
+            self._pending = True
+            QtCore.QTimer.singleShot(0, self._deferred)
+
+    def _deferred(self):
+        self._pending = False
+        if getattr(self, "vobj", None) is not None and self.vobj.DisplayMode == "Map":
+            self.redraw()
+
+    def finishRestoring(self):
+        self._schedule()
+
+    def onChanged(self, vobj, prop):
+        if getattr(self, "_syncing", False) or not hasattr(self, "scene") \
+                or not has_map_properties(vobj):
+            return
+        if prop in STYLE_PROPERTIES:
+            self.restyle()
+        elif prop == "Map" and vobj.DisplayMode == "Map":
+            self.redraw()
+
+    def onDocumentRestored(self, vobj):
+        add_map_properties(vobj, from_preferences=False)
+
+    def redraw(self):
+        """Draw the current quantity (mesh and values are cached per Shape)."""
+        vobj = getattr(self, "vobj", None)
+        if vobj is None or not has_map_properties(vobj):
+            return
+        obj = vobj.Object
+        q = vobj.Map
+        if not obj.GridRows or not obj.GridCols or obj.Shape.isNull():
+            self.scene.clear()      # not computed yet: nothing to draw
+            return
+        try:
+            if q not in self._data:
+                self._data[q] = map_data(obj, q)
+        except SurfcompError as exc:
+            self.scene.clear()
+            FreeCAD.Console.PrintWarning("%s: no map: %s\n" % (obj.Label, exc))
+            return
+        d = self._data[q]
+        self.scene.set_data(d["points"], d["triangles"], d["values"], d["markers"],
+                            d["marker_values"], title=TITLES[q])
+        self.restyle()
+
+    def restyle(self):
+        """Recolour from the view properties (no new geometry, no recompute)."""
+        vobj = self.vobj
+        self.scene.set_style(style_of(vobj))
+        if vobj.AutoRange and self.scene.range is not None:
+            # show the automatic range in the (then unused) manual fields
+            self._syncing = True
+            try:
+                vobj.RangeMin, vobj.RangeMax = self.scene.range
+            finally:
+                self._syncing = False
+
+    def setEdit(self, vobj, mode=0):
+        if mode != 0:
+            return None
+        from .panels import FilterPanel
+        import FreeCADGui
+
+        FreeCADGui.Control.showDialog(FilterPanel(vobj.Object))
+        return True
+
+    def unsetEdit(self, vobj, mode=0):
+        import FreeCADGui
+
+        FreeCADGui.Control.closeDialog()
+        return True
+
+    def doubleClicked(self, vobj):
+        import FreeCADGui
+
+        FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name, 0)
+        return True
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    __getstate__ = dumps
+
+    def __setstate__(self, state):
+        return None
+
+
+class ViewProviderMeasurement:
+    """View provider of ``SurfComp_Measurement``: the points as markers, coloured by the
+    file's deviation when it has one."""
+
+    def __init__(self, vobj):
+        add_map_properties(vobj)
+        vobj.Proxy = self
+
+    def attach(self, vobj):
+        self.Object = vobj.Object
+        self.vobj = vobj
+        self.scene = MapScene()
+        vobj.addDisplayMode(self.scene.root, "Points")
+
+    def getDisplayModes(self, vobj):
+        return ["Points"]
+
+    def getDefaultDisplayMode(self):
+        return "Points"
+
+    def setDisplayMode(self, mode):
+        self.redraw()
+        return mode
+
+    def getIcon(self):
+        return paths.icon("SurfComp_ImportMeasurements.svg")
+
+    def updateData(self, obj, prop):
+        if prop in ("NominalX", "MeasuredX", "Deviation") and hasattr(self, "scene"):
+            self.redraw()
+
+    def onChanged(self, vobj, prop):
+        if prop in STYLE_PROPERTIES and hasattr(self, "scene") and has_map_properties(vobj):
+            self.redraw()
+
+    def onDocumentRestored(self, vobj):
+        add_map_properties(vobj, from_preferences=False)
+
+    def redraw(self):
+        vobj = getattr(self, "vobj", None)
+        if vobj is None or not has_map_properties(vobj):
+            return
+        obj = vobj.Object
+        ms = features.measurement_set(obj)
+        pts = ms.nominal if ms.nominal is not None else ms.measured
+        if pts is None or len(pts) == 0:
+            self.scene.clear()
+            return
+        values = ms.deviation if ms.deviation is not None else np.zeros(len(pts))
+        self.scene.set_data(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int32), values,
+                            pts, values, title="Deviation (file)")
+        style = style_of(vobj)
+        if ms.deviation is None:
+            style.show_legend = style.show_labels = False
+        self.scene.set_style(style)
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    __getstate__ = dumps
+
+    def __setstate__(self, state):
+        return None
+
+
+def attach(obj):
+    """Give a surfcomp object its view provider (called by the commands' macros)."""
+    if obj.ViewObject is None:
+        return
+    if features.is_compensation(obj):
+        ViewProviderCompensation(obj.ViewObject)
+    elif features.is_measurement(obj):
+        ViewProviderMeasurement(obj.ViewObject)

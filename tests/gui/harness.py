@@ -1,0 +1,104 @@
+"""Run a script inside the real FreeCAD GUI (``freecad script.py``) and collect its results.
+
+Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cfg, and a
+``Mod`` folder that holds only what the test puts there (a link to this checkout, or an
+Addon-Manager-like clone). The script writes a JSON report to ``$SURFCOMP_GUI_OUT``;
+the report view's text and the process output come back too, for the "no traceback"
+checks. Without a DISPLAY the run is wrapped in ``xvfb-run``.
+"""
+
+import json
+import os
+import shutil
+import subprocess
+
+from tests.conftest import ROOT
+
+FREECAD = shutil.which("freecad") or "/usr/bin/freecad"
+SCREEN = "1600x1200x24"
+
+#: prologue/epilogue wrapped around every GUI script: results dict, report view text,
+#: clean shut-down (documents closed without asking, then the main window)
+PROLOGUE = r'''
+import json, os, sys, traceback
+import FreeCAD, FreeCADGui
+from PySide import QtGui, QtCore
+RESULTS = {"errors": []}
+OUT = os.environ["SURFCOMP_GUI_OUT"]
+
+def report_view_text():
+    mw = FreeCADGui.getMainWindow()
+    for w in mw.findChildren(QtGui.QTextEdit):
+        if w.objectName() == "Report view" or type(w).__name__ == "ReportOutput":
+            return w.toPlainText()
+    texts = [w.toPlainText() for w in mw.findChildren(QtGui.QTextEdit)]
+    return "\n".join(texts)
+
+def _finish():
+    RESULTS["report_view"] = report_view_text()
+    with open(OUT, "w") as f:
+        json.dump(RESULTS, f, indent=1, default=str)
+    for name in list(FreeCAD.listDocuments()):
+        FreeCAD.closeDocument(name)
+    FreeCADGui.getMainWindow().close()
+    QtGui.QApplication.instance().quit()
+
+try:
+'''
+
+EPILOGUE = r'''
+except BaseException:
+    RESULTS["errors"].append(traceback.format_exc())
+_finish()
+'''
+
+
+def make_home(tmp_path, link_checkout=True):
+    """A FreeCAD user home under ``tmp_path``; with ``link_checkout`` its Mod folder
+    links this checkout (as tools/install.sh does for the real user)."""
+    home = tmp_path / "fchome"
+    (home / "Mod").mkdir(parents=True, exist_ok=True)
+    if link_checkout:
+        os.symlink(ROOT, home / "Mod" / "surfcomp")
+    return home
+
+
+def run_gui(body, tmp_path, home=None, timeout=240, env=None):
+    """Run ``body`` (Python code, indented by the caller's ``textwrap`` as top level) in
+    the FreeCAD GUI; return ``(results, output)``.
+
+    ``body`` sees ``RESULTS`` (a dict written to JSON at the end), ``FreeCAD``,
+    ``FreeCADGui``, ``QtGui``, ``QtCore``. Any exception lands in ``RESULTS['errors']``.
+    """
+    home = home or make_home(tmp_path)
+    script = tmp_path / "gui_script.py"
+    indented = "\n".join(("    " + line) if line.strip() else line for line in body.splitlines())
+    script.write_text(PROLOGUE + indented + "\n    pass\n" + EPILOGUE)
+    out = tmp_path / "gui_results.json"
+    e = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    e.update({"FREECAD_USER_HOME": str(home), "SURFCOMP_GUI_OUT": str(out),
+              "SURFCOMP_ROOT": ROOT, "SURFCOMP_TMP": str(tmp_path),
+              "QTWEBENGINE_CHROMIUM_FLAGS": e.get("QTWEBENGINE_CHROMIUM_FLAGS", "--no-sandbox")})
+    e.update(env or {})
+    cmd = [FREECAD, str(script)]
+    if not e.get("DISPLAY"):
+        cmd = ["xvfb-run", "-a", "-s", "-screen 0 " + SCREEN] + cmd
+    proc = subprocess.run(cmd, env=e, cwd=str(tmp_path), capture_output=True, text=True,
+                          timeout=timeout)
+    output = proc.stdout + proc.stderr
+    if not out.exists():
+        raise AssertionError("the GUI script wrote no results (exit %d):\n%s"
+                             % (proc.returncode, output[-4000:]))
+    with open(out) as f:
+        results = json.load(f)
+    return results, output
+
+
+def read_image(path):
+    """An RGB image as floats in [0, 1], shape (H, W, 3)."""
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(str(path))
+    if img.dtype.kind in "ui":
+        img = img / 255.0
+    return img[..., :3]

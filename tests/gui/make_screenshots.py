@@ -1,0 +1,88 @@
+"""Regenerate the README's screenshots (docs/screenshots/*.png) in the real FreeCAD GUI.
+
+    xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 tests/gui/make_screenshots.py
+
+Not a test: it runs the bundled example through the workbench's commands and saves
+the deviation map, the tolerance-band map, the random component and the whole window
+with the filter task panel open.
+"""
+
+import os
+import pathlib
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, ROOT)
+
+from tests.gui.harness import run_gui  # noqa: E402
+
+BODY = r'''
+from surfcomp.gui import dialogs, panels
+Gui = FreeCADGui
+root = os.environ["SURFCOMP_ROOT"]
+outdir = os.path.join(root, "docs", "screenshots")
+os.makedirs(outdir, exist_ok=True)
+files = [os.path.join(root, "examples", "nominal.step"),
+         os.path.join(root, "examples", "measurements.csv")]
+dialogs.ask_open_file = lambda *a: files.pop(0)
+dialogs.run_dialog = lambda dlg: True
+mw = Gui.getMainWindow()
+mw.resize(1400, 900)
+Gui.activateWorkbench("SurfCompWorkbench")
+doc = FreeCAD.newDocument("Example")
+Gui.runCommand("SurfComp_LoadNominal")
+Gui.runCommand("SurfComp_ImportMeasurements")
+Gui.Selection.addSelection(doc.Name, "Nominal", "Face1")
+Gui.Selection.addSelection(doc.Name, "Measurement")
+Gui.runCommand("SurfComp_DeviationMap")
+comp = doc.getObject("Compensation")
+Gui.Selection.clearSelection()
+view = Gui.ActiveDocument.ActiveView
+view.viewIsometric()
+view.fitAll()
+Gui.updateGui()
+vobj = comp.ViewObject
+vobj.LegendUnit = "um"
+view.saveImage(os.path.join(outdir, "deviation_map.png"), 1000, 650, "White")
+vobj.ToleranceBand = True
+vobj.ToleranceLower = -0.01
+vobj.ToleranceUpper = 0.01
+view.saveImage(os.path.join(outdir, "tolerance_band.png"), 1000, 650, "White")
+vobj.ToleranceBand = False
+Gui.Selection.addSelection(doc.Name, comp.Name)
+Gui.runCommand("SurfComp_Filter")
+panels.FilterPanel.instance.show.setCurrentIndex(1)
+Gui.updateGui()
+view.fitAll()
+for _ in range(5):
+    Gui.updateGui()
+# a widget grab leaves the OpenGL view empty: paint the view's own render into it
+shot = mw.grab()
+gl = [w for w in mw.findChildren(QtGui.QWidget)
+      if w.metaObject().className() == "QOpenGLWidget" and w.isVisible()]
+if gl:
+    w = gl[0]
+    tmp_png = os.path.join(os.environ["SURFCOMP_TMP"], "view.png")
+    view.saveImage(tmp_png, w.width(), w.height(), "Current")
+    painter = QtGui.QPainter(shot)
+    painter.drawImage(w.mapTo(mw, QtCore.QPoint(0, 0)), QtGui.QImage(tmp_png))
+    painter.end()
+RESULTS["gl_widgets"] = len(gl)
+shot.save(os.path.join(outdir, "workbench_filter_panel.png"))
+panels.FilterPanel.instance.reject()
+RESULTS["written"] = sorted(os.listdir(outdir))
+'''
+
+
+def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        res, _out = run_gui(BODY, pathlib.Path(tmp))
+    if res["errors"]:
+        print("\n".join(res["errors"]))
+        raise SystemExit(1)
+    print("docs/screenshots:", ", ".join(res["written"]))
+
+
+if __name__ == "__main__":
+    main()

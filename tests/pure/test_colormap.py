@@ -1,0 +1,137 @@
+"""Colour mapping of the GUI's maps (surfcomp.core.colormap), without FreeCAD."""
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from matplotlib.colors import LinearSegmentedColormap
+
+from surfcomp.core import colormap as cm
+from surfcomp.core.bspline import Surface, evaluate_grid
+
+
+def test_rainbow_ends_and_zero():
+    c = cm.map_colors([-2.0, 0.0, 2.0, -5.0, 7.0], -2.0, 2.0, "rainbow")
+    assert_allclose(c, [[0, 0, 1], [0, 1, 0], [1, 0, 0], [0, 0, 1], [1, 0, 0]], atol=1e-12)
+
+
+@pytest.mark.parametrize("name", sorted(cm.SCHEMES))
+def test_schemes_match_matplotlib_linear_segmented(name):
+    """Linear interpolation between equally spaced control colours, as matplotlib's
+    LinearSegmentedColormap.from_list does (N large so its lookup table is fine)."""
+    ref = LinearSegmentedColormap.from_list(name, cm.SCHEMES[name], N=100001)
+    rng = np.random.default_rng(4)
+    v = rng.uniform(-0.05, 0.03, 500)
+    got = cm.map_colors(v, -0.05, 0.03, name)
+    want = ref((v + 0.05) / 0.08)[:, :3]
+    assert_allclose(got, want, atol=5e-5)  # LUT step 1e-5 x slope <= 4
+
+
+def test_nan_is_grey_and_bad_range_raises():
+    c = cm.map_colors([np.nan, 0.0], -1.0, 1.0)
+    assert_allclose(c[0], cm.NAN_COLOR)
+    with pytest.raises(ValueError, match="vmin < vmax"):
+        cm.map_colors([0.0], 1.0, 1.0)
+    with pytest.raises(ValueError, match="unknown colour scheme"):
+        cm.map_colors([0.0], -1, 1, "jet")
+
+
+def test_symmetric_range():
+    assert cm.symmetric_range([-0.03, 0.045, np.nan]) == (-0.045, 0.045)
+    assert cm.symmetric_range([-0.07, 0.01]) == (-0.07, 0.07)
+    assert cm.symmetric_range([0.0, 0.0]) == (-cm.MIN_HALF_RANGE, cm.MIN_HALF_RANGE)
+
+
+def test_tolerance_band_colours():
+    v = np.array([-0.02, -0.01, 0.0, 0.0099, 0.0101, np.nan])
+    c = cm.tolerance_colors(v, -0.01, 0.01)
+    t = cm.TOLERANCE_COLORS
+    assert_allclose(c, [t["below"], t["inside"], t["inside"], t["inside"], t["above"],
+                        cm.NAN_COLOR])
+    with pytest.raises(ValueError, match="lower <= upper"):
+        cm.tolerance_colors(v, 0.01, -0.01)
+
+
+def test_format_value_units():
+    assert cm.format_value(0.045) == "+0.0450 mm"
+    assert cm.format_value(-0.0123, "um") == "-12.3 um"
+    assert cm.format_value(-1e-9, "um") == "0.0 um"
+    assert cm.format_value(0.0) == "0.0000 mm"
+    with pytest.raises(ValueError, match="display unit"):
+        cm.format_value(1.0, "in")
+
+
+def test_legend_levels_and_colours():
+    lg = cm.legend(-0.04, 0.04, "rainbow", unit="um", levels=8)
+    fr = [f for f, _ in lg["labels"]]
+    assert_allclose(fr, np.linspace(0, 1, 9), atol=1e-15)
+    assert lg["labels"][0][1] == "-40.0 um"
+    assert lg["labels"][4][1] == "0.0 um"
+    assert lg["labels"][-1][1] == "+40.0 um"
+    stops = dict(lg["stops"])
+    assert_allclose(stops[0.0], (0, 0, 1))
+    assert_allclose(stops[0.5], (0, 1, 0))
+    assert_allclose(stops[1.0], (1, 0, 0))
+    # every stop colour is the mapped colour of its value
+    f = np.array([s[0] for s in lg["stops"]])
+    assert_allclose(np.array([s[1] for s in lg["stops"]]),
+                    cm.map_colors(-0.04 + 0.08 * f, -0.04, 0.04), atol=1e-12)
+
+
+def test_legend_tolerance_blocks():
+    lg = cm.legend(-0.04, 0.04, tolerance=(-0.01, 0.02))
+    t = cm.TOLERANCE_COLORS
+    assert [f for f, _ in lg["stops"]] == pytest.approx([0, 0.375, 0.375, 0.75, 0.75, 1])
+    assert [c for _, c in lg["stops"]] == [t["below"], t["below"], t["inside"], t["inside"],
+                                           t["above"], t["above"]]
+    assert [s for _, s in lg["labels"]] == ["-0.0400 mm", "-0.0100 mm", "+0.0200 mm",
+                                            "+0.0400 mm"]
+
+
+def test_extremes():
+    assert cm.extremes([0.1, -0.3, np.nan, 0.5, -0.2]) == (3, 1)
+    assert cm.extremes([-0.1, -0.2]) == (None, 1)
+    assert cm.extremes([np.nan, np.nan]) == (None, None)
+
+
+def test_mesh_resolution():
+    assert cm.mesh_resolution((45, 45)) == (90, 90)
+    assert cm.mesh_resolution((10, 200)) == (80, 240)
+    assert cm.mesh_resolution(None) == (80, 80)
+
+
+def _bilinear_patch():
+    """A degree-1 patch x = 10 u, y = 20 v, z = u v: an analytic reference."""
+    poles = np.array([[[0, 0, 0], [0, 20, 0]], [[10, 0, 0], [10, 20, 1]]], dtype=float)
+    k = np.array([0.0, 0.0, 1.0, 1.0])
+    return Surface(poles, k, k, 1, 1)
+
+
+def test_uv_grid_mesh_points_and_triangles():
+    surf = _bilinear_patch().with_range((0.2, 0.8), (0.0, 0.5))
+    pts, tri, u, v = cm.uv_grid_mesh(surf, (4, 3))
+    assert pts.shape == (12, 3) and tri.shape == (12, 3)
+    assert_allclose(u.reshape(4, 3)[:, 0], np.linspace(0.2, 0.8, 4))
+    assert_allclose(v.reshape(4, 3)[0], np.linspace(0.0, 0.5, 3))
+    assert_allclose(pts, np.stack([10 * u, 20 * v, u * v], axis=1), atol=1e-12)
+    # triangles are counter-clockwise seen from Su x Sv (+z here) and cover the range
+    p = pts[tri]
+    n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    assert np.all(n[:, 2] > 0)
+    assert_allclose(0.5 * n[:, 2].sum(), 10 * 0.6 * 20 * 0.5, rtol=1e-12)
+    assert np.array_equal(np.unique(tri), np.arange(12))
+    with pytest.raises(ValueError, match="2 x 2"):
+        cm.uv_grid_mesh(surf, (1, 5))
+
+
+def test_uv_grid_mesh_matches_evaluate_grid_on_a_cubic():
+    rng = np.random.default_rng(7)
+    poles = np.zeros((5, 6, 3))
+    poles[..., 0], poles[..., 1] = np.meshgrid(np.arange(5.0), np.arange(6.0), indexing="ij")
+    poles[..., 2] = rng.normal(0, 1, (5, 6))
+    ku = np.array([0, 0, 0, 0, 0.5, 1, 1, 1, 1.0])
+    kv = np.array([0, 0, 0, 0, 0.3, 0.6, 1, 1, 1, 1.0])
+    surf = Surface(poles, ku, kv, 3, 3)
+    pts, _, u, v = cm.uv_grid_mesh(surf, (7, 9))
+    ref = evaluate_grid(surf, np.linspace(0, 1, 7), np.linspace(0, 1, 9)).reshape(-1, 3)
+    assert_allclose(pts, ref, atol=1e-12)
