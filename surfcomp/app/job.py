@@ -92,7 +92,8 @@ def run_job(job, progress=None):
     outputs = {k: os.path.abspath(getattr(job, k)) for k in ("output", "report", "points", "curves",
                                                                "html")
                if getattr(job, k)}
-    rep = report_io.build_report(job.command, inputs, comp, prepared.warnings, outputs)
+    rep = report_io.build_report(job.command, inputs, comp, prepared.warnings, outputs,
+                                 points=bool(job.report or job.html))
     with Transaction() as tx:
         if build and job.output:
             write_face(tx.stage(job.output), corrected_face(comp, nominal))

@@ -47,6 +47,40 @@ def refinement_knots(knots, degree, lo, hi, spacing):
     return np.asarray(new, dtype=float)
 
 
+def node_line_knots(knots, lo, hi, lines, keep_off=0.25):
+    """Knots at the measurement grid's node lines (one span per grid step), for dense
+    grids whose rows and columns run along parameter lines: the space's Greville
+    samples then fall on the nodes, where the correction must be met exactly.
+
+    Node lines closer than ``keep_off`` of their step to one of the nominal's own
+    knots (which stay, so the space still contains the nominal) are left out; beyond
+    the outermost lines the spans are split to the same step.
+    """
+    lines = np.sort(np.asarray(lines, dtype=float))
+    step = np.median(np.diff(lines))
+    own = np.unique(np.asarray(knots, dtype=float))
+    lines = np.concatenate([lines[0] - step * np.arange(int((lines[0] - lo) / step), 0, -1),
+                            lines, lines[-1] + step * np.arange(1, int((hi - lines[-1]) / step) + 1)])
+    near = np.min(np.abs(lines[:, None] - own[None, :]), axis=1) < keep_off * step
+    return lines[(lines > lo) & (lines < hi) & ~near]
+
+
+def aligned_lines(U, V, refine, tol=0.02):
+    """The grid's u per row and v per column when nodes lie on parameter lines within
+    ``tol`` of a grid step and the grid is dense enough that :data:`MAX_SPANS` caps the
+    refinement; else None (the general construction applies)."""
+    if U.ndim != 2 or min(U.shape) < 4 or refine * (max(U.shape) - 1) <= MAX_SPANS:
+        return None
+    lu, lv = np.median(U, axis=1), np.median(V, axis=0)
+    du, dv = np.diff(lu), np.diff(lv)
+    if min(np.min(np.abs(du)), np.min(np.abs(dv))) <= 0:
+        return None
+    if (np.max(np.abs(U - lu[:, None])) > tol * np.min(np.abs(du))
+            or np.max(np.abs(V - lv[None, :])) > tol * np.min(np.abs(dv))):
+        return None
+    return lu, lv
+
+
 def _span(width, spacing, refine):
     """Largest knot span: ``spacing / refine``, and on coarse grids at most
     ``width / MIN_SPANS`` (more spans damp the ringing of the fit between nodes;
@@ -61,12 +95,16 @@ def _span(width, spacing, refine):
 class _Sampling:
     """The refined space of the nominal and its samples (computed once per construction)."""
 
-    def __init__(self, nominal, outward, spacing_u, spacing_v, refine):
+    def __init__(self, nominal, outward, spacing_u, spacing_v, refine, lines=None):
         (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
-        new_u = refinement_knots(nominal.knots_u, nominal.degree_u, u0, u1,
-                                 _span(u1 - u0, spacing_u, refine)) if spacing_u else ()
-        new_v = refinement_knots(nominal.knots_v, nominal.degree_v, v0, v1,
-                                 _span(v1 - v0, spacing_v, refine)) if spacing_v else ()
+        if lines is not None:
+            new_u = node_line_knots(nominal.knots_u, u0, u1, lines[0])
+            new_v = node_line_knots(nominal.knots_v, v0, v1, lines[1])
+        else:
+            new_u = refinement_knots(nominal.knots_u, nominal.degree_u, u0, u1,
+                                     _span(u1 - u0, spacing_u, refine)) if spacing_u else ()
+            new_v = refinement_knots(nominal.knots_v, nominal.degree_v, v0, v1,
+                                     _span(v1 - v0, spacing_v, refine)) if spacing_v else ()
         self.nominal = nominal
         self.fine = bspline.insert_knots(nominal, new_u, new_v)
         self.us = bspline.greville(self.fine.knots_u, self.fine.degree_u)
@@ -150,7 +188,8 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     """
     U, V = np.asarray(U, dtype=float), np.asarray(V, dtype=float)
     report(progress, 0.0, "sampling the nominal")
-    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine,
+                    lines=aligned_lines(U, V, refine) if field_factory is GridField else None)
     surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
                                   field_factory, sub(progress, 0.1, 0.75))
     report(progress, 0.75, "checking the corrected surface")

@@ -272,7 +272,19 @@ class GridField:
         if out.size:
             _, ds, dt = self._eval(sc[out], tc[out], slice(2, None), deriv=True)
             es, et = (s - sc)[out, None], (t - tc)[out, None]
-            val[out] += ds * _L * np.tanh(es / _L) + dt * _L * np.tanh(et / _L)
+            b = val[out]
+            # each direction's excursion g L tanh(e / L) is kept inside the node range by
+            # shortening L where the border value is near a bound (still C1 at the border:
+            # its slope there stays g); a hard clip alone would leave a kink that the
+            # spline space rings around
+            share = np.where((es != 0) & (et != 0), 0.5, 1.0)
+
+            def excursion(g, e):
+                head = np.where(g * e > 0, self._hi - b, b - self._lo) * share
+                L = np.clip(head / np.maximum(np.abs(g), 1e-300), 1e-12, _L)
+                return g * L * np.tanh(e / L)
+
+            val[out] = b + excursion(ds, es) + excursion(dt, et)
         val = np.clip(val, self._lo, self._hi)
         return val[:, 0] if self._scalar else val
 

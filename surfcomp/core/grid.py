@@ -84,13 +84,17 @@ def grid_from_indices(row, col, u, v, lines=None, source=None):
     return _oriented(Grid(index, "row/col columns"), u, v, source)
 
 
-def _clusters(x, count):
-    """Split sorted values into ``count`` groups at the largest gaps; return (order, labels, ratio)."""
-    order = np.argsort(x, kind="stable")
-    xs = x[order]
-    gaps = np.diff(xs)
+def _clusters(x, count, order=None):
+    """Split sorted values into ``count`` groups at the largest gaps; return (order, labels, ratio).
+
+    ``order`` (``argsort(x)``) may be given when the same values are split several times.
+    """
+    if order is None:
+        order = np.argsort(x, kind="stable")
     if count <= 1:
         return order, np.zeros(x.size, dtype=int), 0.0
+    xs = x[order]
+    gaps = np.diff(xs)
     cut = np.sort(np.argpartition(gaps, -(count - 1))[-(count - 1):])
     labels_sorted = np.zeros(x.size, dtype=int)
     labels_sorted[cut + 1] = 1
@@ -108,23 +112,24 @@ def _try_rows(a, b, name_a, name_b):
     """Points in rows of nearly constant ``a``; within a row ordered by ``b``."""
     n_pts = a.size
     best = None
+    order = np.argsort(a, kind="stable")
     for rows in range(2, n_pts // 2 + 1):
         if n_pts % rows:
             continue
-        _, labels, ratio = _clusters(a, rows)
+        _, labels, ratio = _clusters(a, rows, order)
+        if ratio <= 3.0 or (best is not None and ratio <= best[0]):
+            continue
         sizes = np.bincount(labels, minlength=rows)
-        if np.all(sizes == n_pts // rows) and ratio > 3.0 and (best is None or ratio > best[0]):
+        if np.all(sizes == n_pts // rows):
             best = (ratio, rows, labels)
     if best is None:
         return None
     _, rows, labels = best
     cols = n_pts // rows
-    mean_a = np.array([a[labels == r].mean() for r in range(rows)])
-    index = np.empty((rows, cols), dtype=np.int64)
-    for new_r, r in enumerate(np.argsort(mean_a)):
-        members = np.nonzero(labels == r)[0]
-        index[new_r] = members[np.argsort(b[members], kind="stable")]
-    return index
+    # labels grow with a, so rows are consecutive runs of the points sorted by a
+    members = order.reshape(rows, cols)
+    within = np.argsort(b[members], axis=1, kind="stable")
+    return np.take_along_axis(members, within, axis=1)
 
 
 def _describe_incomplete(a, b, name_a, name_b):

@@ -27,6 +27,8 @@ from .scattered import ScatteredField, smooth
 NORMAL_WARNING_DEG = 5.0
 #: a corrected face that misses the intended correction at a point by more is reported
 MISS_WARNING = 1e-4
+#: ... and one that moves more than the largest intended correction plus this anywhere
+OVERSHOOT_WARNING = 1e-3
 #: how the points are arranged: found automatically (a complete grid, else scattered),
 #: or forced
 LAYOUTS = ("auto", "grid", "scattered")
@@ -329,6 +331,13 @@ def build_surface(result, surface, outward, delta, progress=None):
             "spacing with different corrections (raw data?); the filtered method or a larger "
             "--refine helps" % (prepared.source, built.checks.max_error_at_points * 1e3,
                                 MISS_WARNING * 1e3))
+    over = built.checks.max_realised - built.checks.max_intended
+    if over > OVERSHOOT_WARNING:
+        prepared.warnings.append(
+            "%s: somewhere on the face the corrected face moves %.2f um more than the largest "
+            "intended correction (more than %.1f um; usually beyond the measured region, "
+            "where noisy raw data are continued): the filtered method or a larger --refine "
+            "helps" % (prepared.source, over * 1e3, OVERSHOOT_WARNING * 1e3))
     return result
 
 

@@ -18,7 +18,7 @@ def _list(a, digits=9):
     return np.round(a, digits).tolist()
 
 
-def build_report(command, inputs, comp, warnings=(), outputs=None):
+def build_report(command, inputs, comp, warnings=(), outputs=None, points=True):
     """Assemble the report dict.
 
     Parameters
@@ -30,6 +30,9 @@ def build_report(command, inputs, comp, warnings=(), outputs=None):
     warnings : list of str
     outputs : dict, optional
         Paths of the files written.
+    points : bool
+        Include the per-point arrays (``points``); without them the report is the
+        summary (the CLI's printout needs no more; a million points take seconds).
     """
     p, c, o = comp.prepared, comp.correction, comp.options
     g = p.grid
@@ -57,7 +60,7 @@ def build_report(command, inputs, comp, warnings=(), outputs=None):
                           "row = first grid index (along u), col = second (along v)")},
         "statistics": {k: v.as_dict() for k, v in comp.statistics.items()},
         "statistics_ddof": 1,
-        "points": {
+        "points": None if not points else {
             "line": [int(x) for x in p.lines],
             "row": None if row is None else row.tolist(),
             "col": None if col is None else col.tolist(),
