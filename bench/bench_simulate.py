@@ -12,29 +12,12 @@ import os
 import sys
 import time
 
-import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core import bspline  # noqa: E402
 from surfcomp.core import simulate as sm  # noqa: E402
-
-Z = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
-              [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
-              [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
-              [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
-              [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
-              [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
-              [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
-
-
-def example_surface():
-    x = np.linspace(0.0, 45.0, 7)
-    P = np.stack(np.meshgrid(x, x, indexing="ij") + [Z], axis=-1)
-    k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
-    return bspline.Surface(P, k, k, 3, 3)
-
+from examples.make_example import example_surface  # noqa: E402
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

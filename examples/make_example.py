@@ -25,26 +25,33 @@ SEED = 20221
 GRID = 45
 
 
-def nominal_surface():
-    """The example's Part.BSplineSurface (7 x 7 poles, bicubic, interior knots)."""
-    fcenv.import_freecad()
-    import FreeCAD
-    import Part
+#: heights (mm) of the 7 x 7 poles on a regular 45 mm x-y grid
+HEIGHTS = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
+                    [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
+                    [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
+                    [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
+                    [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
+                    [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
+                    [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
+
+
+def example_surface():
+    """The example face as a core :class:`surfcomp.core.bspline.Surface` (no FreeCAD):
+    7 x 7 poles, bicubic, interior knots 0.25, 0.5, 0.75."""
+    from surfcomp.core import bspline
 
     x = np.linspace(0.0, 45.0, 7)
-    z = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
-                  [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
-                  [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
-                  [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
-                  [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
-                  [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
-                  [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
-    poles = [[FreeCAD.Vector(x[i], x[j], z[i, j]) for j in range(7)] for i in range(7)]
-    knots = [0.0, 0.25, 0.5, 0.75, 1.0]
-    mults = [4, 1, 1, 1, 4]
-    bs = Part.BSplineSurface()
-    bs.buildFromPolesMultsKnots(poles, mults, mults, knots, knots, False, False, 3, 3)
-    return bs
+    P = np.stack(np.meshgrid(x, x, indexing="ij") + [HEIGHTS], axis=-1)
+    k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
+    return bspline.Surface(P, k, k, 3, 3)
+
+
+def nominal_surface():
+    """The example's Part.BSplineSurface (:func:`example_surface` for OCCT)."""
+    fcenv.import_freecad()
+    from surfcomp.app.convert import surface_to_part
+
+    return surface_to_part(example_surface())
 
 
 def deviation_field(x, y):

@@ -249,8 +249,13 @@ class GridField:
             det = np.where(np.abs(det) < 1e-300, 1e-300, det)
             dS = (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
             dT = (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
+            # steps are limited to one cell inside the grid; beyond its border, where the
+            # map is continued linearly, to one cell more than the distance to the border
+            sa, ta = s[act], t[act]
+            sc, tc = self._clamped(sa, ta)
+            room = 1.0 + np.maximum(np.abs(sa - sc), np.abs(ta - tc))
             step = np.maximum(np.abs(dS), np.abs(dT))
-            lim = np.where(step > 1.0, 1.0 / np.maximum(step, 1e-300), 1.0)
+            lim = np.where(step > room, room / np.maximum(step, 1e-300), 1.0)
             s[act] += lim * dS
             t[act] += lim * dT
         if act.size:

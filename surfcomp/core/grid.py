@@ -28,24 +28,12 @@ class Grid:
         return np.asarray(values)[self.index]
 
 
-@dataclass(frozen=True)
-class Scattered:
-    """A layout that is not a complete grid: the points in file order (``shape`` (N,)).
+class Scattered(Grid):
+    """A layout that is not a complete grid: ``index`` (N,) is the points in file order.
 
-    Same interface as :class:`Grid` (``index``, ``shape``, ``take``) so per-point and
-    per-node arrays convert alike; ``rows_from`` says why the points are scattered.
+    The :class:`Grid` interface (``index``, ``shape`` (N,), ``take``) keeps per-point and
+    per-node arrays converting alike; ``rows_from`` says why the points are scattered.
     """
-
-    index: np.ndarray
-    rows_from: str
-
-    @property
-    def shape(self):
-        return self.index.shape
-
-    def take(self, values):
-        """Per-point ``values`` (N, ...) in node order (the file order)."""
-        return np.asarray(values)[self.index]
 
 
 def _where(source, lines, k):

@@ -12,6 +12,7 @@ from numpy.testing import assert_allclose
 from scipy.interpolate import CloughTocher2DInterpolator, RBFInterpolator
 from scipy.sparse.linalg import spsolve
 
+from examples.make_example import example_surface
 from surfcomp.core import bspline, corrected
 from surfcomp.core import scattered as sc
 from surfcomp.core.scattered import ScatteredField, smooth
@@ -20,17 +21,7 @@ from surfcomp.errors import InputError
 
 def werner_like():
     """The bundled example's face: 45 x 45 mm, 7 x 7 poles, bicubic, interior knots."""
-    x = np.linspace(0.0, 45.0, 7)
-    z = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
-                  [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
-                  [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
-                  [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
-                  [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
-                  [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
-                  [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
-    P = np.stack(np.meshgrid(x, x, indexing="ij") + [z], axis=-1)
-    k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
-    return bspline.Surface(P, k, k, 3, 3)
+    return example_surface()
 
 
 def mirror_layout(seed=5):

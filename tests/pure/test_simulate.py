@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from examples.make_example import example_surface
 from surfcomp.core import bspline
 from surfcomp.core import simulate as sm
 from surfcomp.core.axis_errors import AxisErrorModel
@@ -23,18 +24,8 @@ def plane(slope=0.2, lx=40.0, ly=20.0):
 
 
 def werner_like():
-    """The bundled example's face (examples/make_example.py): 45 x 45 mm, 7 x 7 poles, bicubic."""
-    x = np.linspace(0.0, 45.0, 7)
-    z = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
-                  [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
-                  [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
-                  [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
-                  [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
-                  [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
-                  [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
-    P = np.stack(np.meshgrid(x, x, indexing="ij") + [z], axis=-1)
-    k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
-    return bspline.Surface(P, k, k, 3, 3)
+    """The bundled example's face: 45 x 45 mm, 7 x 7 poles, bicubic, interior knots."""
+    return example_surface()
 
 
 # ------------------------------------------------------------------ model equations
