@@ -497,7 +497,7 @@ def _read_xyz(path, lines, units, warnings):
     usecols = sorted(roles.values())
     arr = _parse_rows(path, rows, sep, decimal_comma, ncols, names, expected, usecols)
     pos = {r: usecols.index(k) for r, k in roles.items()}
-    unit_name, factor = _resolve_units(units, file_units, warnings, hline)
+    unit_name, factor = _resolve_units(units, file_units, warnings, header[0] if header else 0)
     measured = arr[:, [pos["x"], pos["y"], pos["z"]]] * factor
     normal = None
     if "i" in roles:
