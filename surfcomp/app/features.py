@@ -150,6 +150,9 @@ COMPENSATION_PROPERTIES = (
      "(0: chosen by generalized cross-validation)", 0.0, 0),
     ("App::PropertyLength", "TipRadius", _IN,
      "Stylus ball radius when the measured points are tip centres (probe logs)", 0.0, 0),
+    ("App::PropertyBool", "Preview", _IN,
+     "Filter preview (task panel): compute deviations and components only and keep the "
+     "last corrected shape; the panel clears it when it closes", False, _HIDDEN),
     ("App::PropertyInteger", "GridRows", _RES,
      "Rows of the measurement grid (scattered layouts: the number of points)", 0, _RO),
     ("App::PropertyInteger", "GridCols", _RES,
@@ -369,10 +372,7 @@ def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample
     if fmt not in FORMATS:
         raise InputError("unknown format %r (expected one of %s)" % (fmt, ", ".join(FORMATS)))
     ms = read_any(os.fspath(path), units=units, fmt=fmt, sample=sample)
-    obj = doc.addObject("App::FeaturePython", name)
-    MeasurementFeature(obj)
-    set_measurement_data(obj, ms)
-    return obj
+    return make_measurement_from_set(doc, ms, name)
 
 
 def make_measurement_from_set(doc, ms, name="Measurement"):
@@ -380,6 +380,18 @@ def make_measurement_from_set(doc, ms, name="Measurement"):
     obj = doc.addObject("App::FeaturePython", name)
     MeasurementFeature(obj)
     set_measurement_data(obj, ms)
+    return _created(obj)
+
+
+#: callables ``hook(obj)`` run on every new surfcomp object: the GUI registers one that
+#: gives the object its view provider (app code never imports the GUI), so objects made
+#: from the Python console or a macro get their colour map too
+NEW_OBJECT_HOOKS = []
+
+
+def _created(obj):
+    for hook in NEW_OBJECT_HOOKS:
+        hook(obj)
     return obj
 
 
@@ -408,6 +420,8 @@ class CompensationFeature(_Proxy):
     def execute(self, obj):
         result = _compute(obj)
         _write_results(obj, result)
+        if result.shape is None:  # preview: the components changed, the face did not
+            return
         # during a recompute Part::Feature gives the Shape the Placement property's value:
         # the feature sits where its nominal sits
         obj.Placement = result.shape.Placement
@@ -513,18 +527,22 @@ def _compute(obj):
     options = options_of(obj)
     prepared = prepare(nominal.surface, nominal.outward, ms, options)
     base = obj.Base
-    comp = compensate(nominal.surface, nominal.outward, prepared, options, build=base is None)
+    preview = bool(getattr(obj, "Preview", False))
+    comp = compensate(nominal.surface, nominal.outward, prepared, options,
+                      build=base is None and not preview)
     increment = comp.correction.delta
     if base is not None:
         U, V = prepared.grid.take(prepared.u), prepared.grid.take(prepared.v)
         total = increment + deviation_field(base, "correction")(U, V)
-        comp = _build(nominal, prepared, comp, total)
+        comp = _build(nominal, prepared, comp, total, build=not preview)
+    if preview:
+        return _Result(comp, nominal, increment, None, obj.EdgeTolerance.Value, len(links))
     shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     shape.Placement = placement
     return _Result(comp, nominal, increment, shape, tol, len(links))
 
 
-def _build(nominal, prepared, comp, total):
+def _build(nominal, prepared, comp, total, build=True):
     """Build the corrected surface for an accumulated correction ``total`` (n, m) the
     way :func:`surfcomp.core.pipeline.compensate` builds it for its own correction."""
     corr = _dc_replace(comp.correction, delta=total)
@@ -532,6 +550,8 @@ def _build(nominal, prepared, comp, total):
     comp.statistics = dict(comp.statistics)
     comp.statistics["increment"] = comp.statistics["correction"]
     comp.statistics["correction"] = statistics(total)
+    if not build:
+        return comp
     return build_surface(comp, nominal.surface, nominal.outward, total)
 
 
@@ -642,7 +662,8 @@ def _write_results(obj, r):
     obj.Correction = _flat(c.delta)
     obj.Statistics = json.dumps({k: s.as_dict() for k, s in comp.statistics.items()},
                                 sort_keys=True)
-    obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
+    if comp.checks is not None or not obj.Preview:  # a preview keeps the face's checks
+        obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
     obj.Warnings = [str(w) for w in p.warnings]
     obj.Round = r.round
     obj.EdgeTolerance = float(r.edge_tolerance)
@@ -697,7 +718,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     if not obj.FaceName:
         from .nominal import pick_face
         obj.FaceName = pick_face(nominal.Shape, None, source=nominal.Label)[1]
-    return obj
+    return _created(obj)
 
 
 def _grid(obj, name):

@@ -180,6 +180,8 @@ class FilterPanel:
         for name, value in self.values().items():
             if getattr(self.obj, name) != value:
                 setattr(self.obj, name, value)
+        if not self.obj.Preview:  # live maps without rebuilding the face on every change
+            self.obj.Preview = True
         self.doc.recompute()
         return self._show_state()
 
@@ -195,6 +197,7 @@ class FilterPanel:
         applied = all(getattr(self.obj, k) == v for k, v in self.values().items())
         if applied and not self._show_state():
             return False        # these values already failed: keep the panel open
+        self.obj.Preview = False  # the final recompute builds the corrected face
         lines = ["obj = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]
         lines += ["obj.%s = %r" % (k, v) for k, v in self.values().items()]
         lines.append("App.getDocument(%r).recompute()" % self.doc.Name)

@@ -333,10 +333,16 @@ class ViewProviderMeasurement:
 
 
 def attach(obj):
-    """Give a surfcomp object its view provider (called by the commands' macros)."""
-    if obj.ViewObject is None:
+    """Give a surfcomp object its view provider (registered as a creation hook of
+    :mod:`surfcomp.app.features`, and called by the commands' macros; idempotent)."""
+    if obj.ViewObject is None or isinstance(getattr(obj.ViewObject, "Proxy", None),
+                                            (ViewProviderCompensation, ViewProviderMeasurement)):
         return
     if features.is_compensation(obj):
         ViewProviderCompensation(obj.ViewObject)
     elif features.is_measurement(obj):
         ViewProviderMeasurement(obj.ViewObject)
+
+
+if attach not in features.NEW_OBJECT_HOOKS:
+    features.NEW_OBJECT_HOOKS.append(attach)

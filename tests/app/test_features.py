@@ -176,6 +176,28 @@ def test_changing_an_input_recomputes(doc):
         features.compensation_result(c)
 
 
+def test_preview_updates_components_and_keeps_the_face(doc):
+    """The filter panel's live preview: deviations and components follow the inputs,
+    the corrected face and its checks stay until Preview is cleared."""
+    nom_obj = add_part(doc, Part.read(EXAMPLE_STEP))
+    m = features.make_measurement(doc, EXAMPLE_CSV)
+    c = features.make_compensation(doc, nom_obj, "Face1", m)
+    c.Refine = 1
+    doc.recompute()
+    face, checks = poles(c.Shape), c.Checks
+    c.Preview = True
+    c.MaskSize = 3
+    doc.recompute()
+    d = np.reshape(c.Deviation, (45, 45))
+    np.testing.assert_allclose(np.reshape(c.Determined, (45, 45)),
+                               mask_filter(d, make_mask(3), "renormalize"), atol=1e-15)
+    np.testing.assert_array_equal(poles(c.Shape), face)
+    assert c.Checks == checks
+    c.Preview = False
+    doc.recompute()
+    assert np.abs(poles(c.Shape) - face).max() > 1e-4 and c.Checks != checks
+
+
 def test_nominal_with_a_placement(doc):
     """Measurements in document coordinates of a placed nominal give the same correction."""
     shape = Part.read(EXAMPLE_STEP)
