@@ -44,10 +44,12 @@ from ..core.field import GridField  # noqa: E402
 from ..core.filters import EDGE_MODES  # noqa: E402
 from ..core.methods import METHODS  # noqa: E402
 from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare  # noqa: E402
+from ..core.progress import sub  # noqa: E402
 from ..core.scattered import ScatteredField  # noqa: E402
 from ..errors import GeometryError, InputError  # noqa: E402
 from ..io.measurements import MeasurementSet  # noqa: E402
 from ..io.readers import FORMATS, read_any  # noqa: E402
+from .progress import freecad_progress  # noqa: E402
 
 #: version of the property sets; onDocumentRestored upgrades older objects
 VERSION = 1
@@ -525,16 +527,19 @@ def _compute(obj):
     nominal, placement = nominal_of(obj)
     ms = _local_measurements(measurement_set(obj.Measurement), placement)
     options = options_of(obj)
-    prepared = prepare(nominal.surface, nominal.outward, ms, options)
     base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
-    comp = compensate(nominal.surface, nominal.outward, prepared, options,
-                      build=base is None and not preview)
-    increment = comp.correction.delta
-    if base is not None:
-        U, V = prepared.grid.take(prepared.u), prepared.grid.take(prepared.v)
-        total = increment + deviation_field(base, "correction")(U, V)
-        comp = _build(nominal, prepared, comp, total, build=not preview)
+    with freecad_progress("%s: compensating" % obj.Label) as progress:
+        prepared = prepare(nominal.surface, nominal.outward, ms, options,
+                           progress=sub(progress, 0.0, 0.3))
+        comp = compensate(nominal.surface, nominal.outward, prepared, options,
+                          build=base is None and not preview, progress=sub(progress, 0.3, 1.0))
+        increment = comp.correction.delta
+        if base is not None:
+            U, V = prepared.grid.take(prepared.u), prepared.grid.take(prepared.v)
+            total = increment + deviation_field(base, "correction")(U, V)
+            comp = _build(nominal, prepared, comp, total, build=not preview,
+                          progress=sub(progress, 0.3, 1.0))
     if preview:
         return _Result(comp, nominal, increment, None, obj.EdgeTolerance.Value, len(links))
     shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
@@ -542,7 +547,7 @@ def _compute(obj):
     return _Result(comp, nominal, increment, shape, tol, len(links))
 
 
-def _build(nominal, prepared, comp, total, build=True):
+def _build(nominal, prepared, comp, total, build=True, progress=None):
     """Build the corrected surface for an accumulated correction ``total`` (n, m) the
     way :func:`surfcomp.core.pipeline.compensate` builds it for its own correction."""
     corr = _dc_replace(comp.correction, delta=total)
@@ -552,7 +557,7 @@ def _build(nominal, prepared, comp, total, build=True):
     comp.statistics["correction"] = statistics(total)
     if not build:
         return comp
-    return build_surface(comp, nominal.surface, nominal.outward, total)
+    return build_surface(comp, nominal.surface, nominal.outward, total, progress=progress)
 
 
 def rebuild_face(face, bs):
