@@ -300,3 +300,25 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
             assert np.abs(want - d).max() > 0.002
         np.testing.assert_allclose(realised_by_occt(face, P, N), want, atol=1e-4)
         assert 'id="maps"' in (tmp_path / "r.html").read_text()
+
+
+def test_interrupt_leaves_no_outputs(tmp_path):
+    """Ctrl-C while the corrected surface is being built: exit 130, nothing written."""
+    import signal
+
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, U, V = grid_on_face(nom, 150, 150)
+    write_cmm_csv(tmp_path / "m.csv", P, N, 0.02 * np.sin(U / U.max() * 3))
+    proc = subprocess.Popen([sys.executable, "-m", "surfcomp", "compensate", EXAMPLE_STEP,
+                             tmp_path / "m.csv", "-o", tmp_path / "c.step", "--report",
+                             tmp_path / "r.json"], cwd=ROOT, stderr=subprocess.PIPE, text=True)
+    seen = []
+    for line in proc.stderr:
+        seen.append(line)
+        if "building the corrected surface" in line:
+            proc.send_signal(signal.SIGINT)
+            break
+    rest = proc.stderr.read()
+    assert proc.wait(timeout=300) == 130, "".join(seen) + rest
+    assert "interrupted; nothing was written" in rest
+    assert sorted(os.listdir(tmp_path)) == ["m.csv"]
