@@ -790,6 +790,33 @@ def compensation_result(obj):
     return _compute(obj).comp
 
 
+def report_of(obj):
+    """The JSON report (schema ``surfcomp-report/1``, as the CLI writes it) of a
+    compensation object, recomputed from its properties and links."""
+    from ..io import report as report_io
+
+    comp = compensation_result(obj)
+    nominal = nominal_of(obj)[0]
+    m = obj.Measurement
+    inputs = {
+        "nominal": {"path": obj.Document.FileName or obj.Document.Name,
+                    "object": obj.Nominal.Label, "face": obj.FaceName,
+                    "poles": list(nominal.surface.shape),
+                    "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
+                    "rational": nominal.surface.weights is not None},
+        "measurements": {"path": m.SourceName, "sha256": m.SourceSha256, "units": m.Units,
+                         "points": int(m.PointCount), "object": m.Label},
+    }
+    return report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
+
+
+def write_html_report(obj, path):
+    """Write the self-contained HTML report of a compensation object (atomically)."""
+    from ..io.html_report import write_html_report as write
+
+    return write(path, report_of(obj))
+
+
 def corrected_surface(obj):
     """The corrected surface of a computed compensation object as a core
     :class:`~surfcomp.core.bspline.Surface` (from its Shape, in document coordinates:

@@ -33,6 +33,12 @@ def ask_open_file(title, filters):
     return path or None
 
 
+def ask_save_file(title, filters, default=""):
+    """A file to write, or None when the user cancels."""
+    path, _ = QtGui.QFileDialog.getSaveFileName(_parent(), title, default, filters)
+    return path or None
+
+
 def ask_float(title, label, value, minimum, maximum, decimals=4):
     """A number, or None when the user cancels."""
     val, ok = QtGui.QInputDialog.getDouble(_parent(), title, label, value, minimum, maximum,

@@ -12,10 +12,11 @@ import FreeCADGui
 
 from PySide import QtCore, QtGui
 
+from ..app import features
 from ..core.deviations import Statistics, format_table
 from ..core.filters import EDGE_MODES
 from ..errors import SurfcompError
-from . import prefs
+from . import dialogs, prefs
 
 translate = FreeCAD.Qt.translate
 
@@ -101,6 +102,10 @@ class ReportDialog(QtGui.QDialog):
         box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Close)
         copy = box.addButton(translate("SurfComp", "Copy"), QtGui.QDialogButtonBox.ActionRole)
         copy.clicked.connect(self.copy)
+        html = box.addButton(translate("SurfComp", "Save HTML report..."),
+                             QtGui.QDialogButtonBox.ActionRole)
+        html.clicked.connect(self.save_html)
+        self.obj = obj
         box.rejected.connect(self.reject)
         lay.addWidget(box)
         self.resize(760, 320)
@@ -108,6 +113,20 @@ class ReportDialog(QtGui.QDialog):
     def copy(self):
         """Put the table as text (the CLI's format) on the clipboard."""
         QtGui.QApplication.clipboard().setText(self.text)
+
+    def save_html(self):
+        """Write the self-contained HTML report (maps, histograms, tables, checks), as
+        ``compensate --html`` does; returns the path or None."""
+        path = dialogs.ask_save_file(translate("SurfComp", "Save HTML report"),
+                                     "HTML (*.html *.htm)", self.obj.Label + ".html")
+        if not path:
+            return None
+        try:
+            features.write_html_report(self.obj, path)
+        except SurfcompError as exc:
+            dialogs.show_error(translate("SurfComp", "Report"), str(exc))
+            return None
+        return path
 
 
 class FilterPanel:

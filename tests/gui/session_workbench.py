@@ -35,6 +35,7 @@ FILES = []
 dialogs.show_error = lambda title, message: ERRORS.append([title, message])
 dialogs.ask_open_file = lambda title, filters: FILES.pop(0)
 dialogs.ask_float = lambda *a, **k: 0.1
+dialogs.ask_save_file = lambda title, filters, default="": os.path.join(TMP, "report.html")
 def _run_dialog(dlg):
     DIALOGS.append(dlg)
     if isinstance(dlg, panels.PreviewDialog):
@@ -225,6 +226,9 @@ if rep is not None:
                                      for j in range(rep.table.columnCount())],
                          "max_neg": rep.table.item(1, 0).text(),
                          "clipboard": QtGui.QApplication.clipboard().text()}
+    saved = rep.save_html()
+    RESULTS["report_html"] = {"path": saved, "errors": list(ERRORS),
+                              "text": open(saved, encoding="utf-8").read() if saved else ""}
 RESULTS["statistics"] = comp.Statistics
 
 # -- mirror (stock) ------------------------------------------------------------------------

@@ -215,6 +215,17 @@ def test_report_table_and_clipboard(session):
     assert ("%.4f" % stats["random"]["std"]) in rep["clipboard"]
 
 
+
+def test_report_saves_the_html_report(session):
+    """The GUI's Report writes the same self-contained HTML report as compensate --html."""
+    rep = session["report_html"]
+    assert rep["path"] and rep["path"].endswith("report.html") and rep["errors"] == []
+    html = rep["text"]
+    for section in ("inputs", "method", "maps", "histograms", "statistics", "checks"):
+        assert 'id="%s"' % section in html
+    assert html.count("data:image/png;base64,") >= 5
+    assert "measurements.csv" in html and "Face1" in html
+
 def test_mirror_build_replace_restore(session):
     method, stock, quantity, state = session["mirror"]
     assert (method, quantity) == ("mirror", "correction") and "Up-to-date" in state
