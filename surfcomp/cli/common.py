@@ -141,9 +141,10 @@ def print_summary(comp, rep, out=sys.stdout):
     print("", file=out)
     if comp.fit is not None:
         f = comp.fit
-        how = ("thin-plate smoothing fit, smoothing length %.3g mm (%s); fit residual RMS "
-               "%.2f um, leave-one-out RMS %.2f um" % (f.smoothing, f.chosen_by, f.fit_rms * 1e3,
-                                                      f.loo_rms * 1e3))
+        kind = "thin-plate spline" if f.method == "tps" else "penalised B-spline"
+        how = ("%s smoothing fit, smoothing length %.3g mm (%s); fit residual RMS %.2f um, "
+               "leave-one-out RMS %.2f um" % (kind, f.smoothing, f.chosen_by, f.fit_rms * 1e3,
+                                              f.loo_rms * 1e3))
     else:
         how = "%dx%d %s filter, eq. 4-5" % (c.mask.shape[0], c.mask.shape[0],
                                             rep["method"]["mask_kind"])

@@ -67,7 +67,8 @@ def grid_from_indices(row, col, u, v, lines=None, source=None):
         names = ", ".join("(row %s, col %s)" % (ru[i], cu[j]) for i, j in miss[:10])
         more = "" if len(miss) <= 10 else " and %d more" % (len(miss) - 10)
         raise GridError("the row/col indices do not form a complete %d x %d grid: missing %s%s "
-                        "(expected every row/col pair; scattered layouts are not supported yet)"
+                        "(expected every row/col pair; without row/col columns the points can be used as "
+                        "a scattered layout)"
                         % (n, m, names, more), file=source)
     return _oriented(Grid(index, "row/col columns"), u, v, source)
 
@@ -171,8 +172,8 @@ def grid_from_uv(u, v, lines=None, source=None):
                 index = index.T  # (rows of v, points along u) -> first axis along u
             return _oriented(Grid(np.ascontiguousarray(index), how + " on the face"), u, v, source)
     raise GridError("the %d measured points do not form a complete n x m grid on the face: %s "
-                    "(expected rows of equal length; add row/col columns, or use a scattered "
-                    "layout when it is supported)" % (u.size, _describe_incomplete(v, u, "v", "u")),
+                    "(expected rows of equal length; add row/col columns, or --layout "
+                    "scattered)" % (u.size, _describe_incomplete(v, u, "v", "u")),
                     file=source)
 
 

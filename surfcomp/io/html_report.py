@@ -194,9 +194,10 @@ def _section_method(report):
     fit = report.get("scattered_fit")
     if fit is not None:
         filt = ("Smoothing fit (scattered points)",
-                _e("thin-plate smoothing length %.3g mm (%s); fit residual RMS %.2f µm, "
+                _e("%s, smoothing length %.3g mm (%s); fit residual RMS %.2f µm, "
                    "leave-one-out RMS %.2f µm, estimated field error RMS %.2f µm"
-                   % (fit["smoothing"], fit["chosen_by"], fit["fit_rms"] * 1e3,
+                   % ("thin-plate spline" if fit.get("method") == "tps" else "penalised B-spline",
+                      fit["smoothing"], fit["chosen_by"], fit["fit_rms"] * 1e3,
                       fit["loo_rms"] * 1e3, (fit.get("field_error_rms") or 0.0) * 1e3)))
     else:
         mask = np.asarray(m.get("mask") or [[1]], dtype=float)
