@@ -39,6 +39,7 @@ from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors  # noqa: E40
 from ..errors import InputError  # noqa: E402
 from ..io.axis_csv import AxisErrorTable, read_axis_errors  # noqa: E402
 from ..io.gcode import compensate_commands  # noqa: E402
+from .proxies import Proxy  # noqa: E402
 
 #: version of the document object's property set; onDocumentRestored upgrades older ones
 VERSION = 1
@@ -90,24 +91,6 @@ PROPERTIES = (
     ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
      VERSION, 2),
 )
-
-
-def _add_properties(obj):
-    """Add every missing property (new objects and old documents alike)."""
-    added = []
-    for typ, name, group, tip, default, mode in PROPERTIES:
-        if name in obj.PropertiesList:
-            continue
-        obj.addProperty(typ, name, group, tip)
-        if typ == "App::PropertyEnumeration":
-            setattr(obj, name, default)
-            setattr(obj, name, default[0])
-        elif default is not None:
-            setattr(obj, name, default)
-        if mode:
-            obj.setEditorMode(name, mode)
-        added.append(name)
-    return added
 
 
 def set_measurements(obj, source):
@@ -205,31 +188,15 @@ def compensate_path(obj):
     return Path.Path(out), (model, prog_model, res)
 
 
-class DressupAxisErrors:
+class DressupAxisErrors(Proxy):
     """Proxy of the axis-error compensation dressup (state lives in properties)."""
 
+    PROPERTIES = PROPERTIES
+    VERSION = VERSION
+
     def __init__(self, obj, base):
-        _add_properties(obj)
+        super().__init__(obj)
         obj.Base = base
-        obj.Proxy = self
-
-    # 1.x uses dumps/loads, 0.20 __getstate__/__setstate__: no state on the proxy
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def onDocumentRestored(self, obj):
-        _add_properties(obj)
-        if obj.Version < VERSION:
-            obj.Version = VERSION
 
     def onDelete(self, obj, args):
         if obj.Base:

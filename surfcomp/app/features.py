@@ -50,6 +50,8 @@ from ..errors import GeometryError, InputError  # noqa: E402
 from ..io.measurements import MeasurementSet  # noqa: E402
 from ..io.readers import FORMATS, read_any  # noqa: E402
 from .progress import freecad_progress  # noqa: E402
+from .proxies import Proxy  # noqa: E402
+from .proxies import migrate as _migrate  # noqa: E402
 
 #: version of the property sets; onDocumentRestored upgrades older objects
 VERSION = 1
@@ -201,49 +203,11 @@ COMPENSATION_PROPERTIES = (
 )
 
 
-def _add_properties(obj, table):
-    """Add every missing property of ``table`` (new objects and old documents alike)."""
-    added = []
-    for typ, name, group, tip, default, mode in table:
-        if name in obj.PropertiesList:
-            continue
-        obj.addProperty(typ, name, group, tip)
-        if typ == "App::PropertyEnumeration":
-            setattr(obj, name, default)
-            setattr(obj, name, default[0])
-        elif default is not None:
-            setattr(obj, name, default)
-        if mode:
-            obj.setEditorMode(name, mode)
-        added.append(name)
-    return added
-
-
-class _Proxy:
-    """Common proxy behaviour: no state on the proxy, properties upgraded on restore."""
+class _Proxy(Proxy):
+    """The features' proxy base (see :class:`surfcomp.app.proxies.Proxy`)."""
 
     Type = None
-    PROPERTIES = ()
-
-    def __init__(self, obj):
-        _add_properties(obj, self.PROPERTIES)
-        obj.Proxy = self
-
-    # FreeCAD 1.x calls dumps/loads, 0.20 __getstate__/__setstate__: nothing to store
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
-
-    def onDocumentRestored(self, obj):
-        migrate(obj, self.PROPERTIES)
+    VERSION = VERSION
 
 
 def migrate(obj, table):
@@ -251,10 +215,7 @@ def migrate(obj, table):
 
     Returns the names of the properties that were added.
     """
-    added = _add_properties(obj, table)
-    if obj.Version < VERSION:
-        obj.Version = VERSION
-    return added
+    return _migrate(obj, table, VERSION)
 
 
 # -- measurement object --------------------------------------------------------------------
