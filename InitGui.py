@@ -18,9 +18,10 @@ class SurfCompWorkbench(Workbench):  # noqa: F821  (Workbench is provided by Fre
         import FreeCADGui
 
         from surfcomp import paths
-        from surfcomp.gui import commands
+        from surfcomp.gui import commands, viewproviders
 
         commands.register()
+        viewproviders.install_observer()
         items = list(commands.TOOLBAR)
         tools = [c for c in items if c is not None]
         self.appendToolbar("SurfComp", [c if c is not None else "Separator" for c in items])

@@ -344,5 +344,55 @@ def attach(obj):
         ViewProviderMeasurement(obj.ViewObject)
 
 
+
+def attach_all(doc):
+    """Give every surfcomp object of ``doc`` its view provider and show its map (for
+    documents made headless, e.g. by ``compensate ... --save`` in ``freecadcmd``, whose
+    objects have no view provider yet); returns the objects given one."""
+    done = []
+    for obj in doc.Objects:
+        if not (features.is_compensation(obj) or features.is_measurement(obj)):
+            continue
+        vobj = obj.ViewObject
+        # a view object whose proxy was never set reports 0 (FreeCAD 0.20), not None
+        if vobj is None or isinstance(vobj.Proxy, (ViewProviderCompensation,
+                                                   ViewProviderMeasurement)):
+            continue
+        attach(obj)
+        proxy = vobj.Proxy
+        if not hasattr(proxy, "scene"):  # an existing view object: FreeCAD does not attach
+            proxy.attach(vobj)
+        mode = proxy.getDisplayModes(vobj)[0]
+        modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
+        if mode not in modes:  # the enumeration was made before the proxy existed
+            vobj.DisplayMode = modes + [mode]
+        vobj.DisplayMode = mode
+        done.append(obj)
+    return done
+
+
+class _RestoreObserver:
+    """App document observer: view providers for surfcomp objects of opened documents
+    (0.20 has no restore slot for Python observers: an opened document is activated)."""
+
+    def slotActivateDocument(self, doc):
+        attach_all(doc)
+
+    def slotRecomputedDocument(self, doc):
+        attach_all(doc)
+
+
+_OBSERVER = []
+
+
+def install_observer():
+    """Watch opened documents (once per session) and treat those already open."""
+    if not _OBSERVER:
+        _OBSERVER.append(_RestoreObserver())
+        FreeCAD.addDocumentObserver(_OBSERVER[0])
+    for doc in FreeCAD.listDocuments().values():
+        attach_all(doc)
+
+
 if attach not in features.NEW_OBJECT_HOOKS:
     features.NEW_OBJECT_HOOKS.append(attach)

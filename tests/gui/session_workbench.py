@@ -316,5 +316,11 @@ Gui.updateGui()
 c = doc.getObject(comp_name)
 RESULTS["reopened"] = [type(c.ViewObject.Proxy).__name__, c.ViewObject.DisplayMode,
                        c.ViewObject.Proxy.scene.surface_coords.point.getNum()]
+# -- a document made headless (no view providers saved) gets its maps when opened ----------
+hdoc = FreeCAD.openDocument(os.path.join(TMP, "headless.FCStd"))
+Gui.updateGui()
+hc = [o for o in hdoc.Objects if o.Name.startswith("Compensation")][0]
+RESULTS["headless_opened"] = [type(hc.ViewObject.Proxy).__name__, hc.ViewObject.DisplayMode,
+                              hc.ViewObject.Proxy.scene.surface_coords.point.getNum()]
 RESULTS["legend_layout"] = {"bar_x": list(mapscene.BAR_X), "bar_y": list(mapscene.BAR_Y),
                             "label_x": mapscene.LABEL_X}

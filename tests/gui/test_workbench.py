@@ -22,9 +22,33 @@ COMMAND_IDS = ["SurfComp_BuildFace", "SurfComp_DeviationMap", "SurfComp_Filter",
                "SurfComp_ReplaceInDocument", "SurfComp_Report", "SurfComp_RestoreNominal"]
 
 
+def make_headless_document(path):
+    """A document with a compensation made without the GUI (as the batch route saves
+    them): its objects carry no view providers."""
+    import subprocess
+    import sys
+
+    script = ("import sys; sys.path.insert(0, %r)\n"
+              "from surfcomp.app import fcenv; FreeCAD = fcenv.import_freecad()\n"
+              "import Part\n"
+              "from surfcomp.app import features\n"
+              "doc = FreeCAD.newDocument('headless')\n"
+              "nom = doc.addObject('Part::Feature', 'Nominal')\n"
+              "nom.Shape = Part.read(%r)\n"
+              "m = features.make_measurement(doc, %r)\n"
+              "c = features.make_compensation(doc, nom, 'Face1', m)\n"
+              "c.Refine = 1\n"
+              "doc.recompute()\n"
+              "assert c.Shape.isValid()\n"
+              "doc.saveAs(%r)\n" % (ROOT, os.path.join(ROOT, "examples", "nominal.step"),
+                                     os.path.join(ROOT, "examples", "measurements.csv"), path))
+    subprocess.run([sys.executable, "-c", script], check=True, timeout=300)
+
+
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("gui_session")
+    make_headless_document(str(tmp / "headless.FCStd"))
     with open(os.path.join(os.path.dirname(__file__), "session_workbench.py")) as f:
         body = f.read()
     results, output = run_gui(body, tmp)
@@ -252,6 +276,12 @@ def test_preferences_page_and_defaults(session):
 
 def test_saved_document_reopens_with_its_map(session):
     assert session["reopened"] == ["ViewProviderCompensation", "Map", 8100]
+
+
+def test_headless_document_gets_its_maps(session):
+    """Objects saved by freecadcmd/the batch route have no view provider; opening the
+    document in the GUI gives them one and shows the map."""
+    assert session["headless_opened"] == ["ViewProviderCompensation", "Map", 8100]
 
 
 def test_no_python_traceback_in_the_report_view(session):
