@@ -9,8 +9,8 @@ seconds per stage (read, locate + grid, filter + corrected surface + checks, STE
 the whole job, peak RSS of that job, the corrected face's poles and check figures, and
 the time of an ``inspect --report OUT.json`` run (the JSON with every point). Grids run
 along the face's parameter lines (dense ones get knots on the node lines, one span per
-grid step) or are turned by 20 degrees ("scat": their rows are not along parameter
-lines, so without row/col columns they go the scattered-layout way).
+grid step) or are turned by 20 degrees ("turn": rows found from the file order; the
+construction across parameter lines needs more than one span per grid step).
 The synthetic cases use the example's face and a Werner-like deviation field with noise.
 """
 
@@ -97,9 +97,8 @@ def main():
     ap.add_argument("--sizes", default="45,200,500,1000",
                     help="grids along the face's parameter lines")
     ap.add_argument("--rotated", default="500,1000",
-                    help="grids turned by 20 degrees to the parameter lines: without row/col "
-                         "columns their rows are not found, so they take the scattered-layout "
-                         "path (smoothing fit + Clough-Tocher field)")
+                    help="grids turned by 20 degrees to the parameter lines (rows found from "
+                         "the file order; the construction across parameter lines)")
     ap.add_argument("--keep", help="keep generated files in this folder")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -112,7 +111,7 @@ def main():
     for n in [int(x) for x in args.sizes.split(",") if x]:
         cases.append(("%dx%d" % (n, n), make_case(n, folder)))
     for n in [int(x) for x in args.rotated.split(",") if x]:
-        cases.append(("%dx%d scat" % (n, n), make_case(n, folder, rotated=True)))
+        cases.append(("%dx%d turn" % (n, n), make_case(n, folder, rotated=True)))
     print("%-12s %8s %6s %7s %8s %6s %8s %8s %7s %9s %10s %9s" % (
         "case", "points", "read", "locate", "surface", "STEP", "job[s]", "peak MB", "poles",
         "err@pts", "zero", "+JSON[s]"))
@@ -135,7 +134,7 @@ def main():
     for name, n, sec in per_point:
         print("  %-12s %.4f" % (name, 1000 * sec / n))
     whole = {name: sec for name, _, sec in per_point}
-    for a, b in (("1000x1000", "500x500"), ("1000x1000 scat", "500x500 scat")):
+    for a, b in (("1000x1000", "500x500"), ("1000x1000 turn", "500x500 turn")):
         if a in whole and b in whole:
             print("time(%s) / time(%s) = %.2f (4x the points)" % (a, b, whole[a] / whole[b]))
     print("\nreference: the mirror paper's NX program needed about 30 s per compensation.")

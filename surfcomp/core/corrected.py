@@ -25,6 +25,12 @@ DEFAULT_REFINE = 4
 #: target of the residual iteration at the measured points (mm)
 MATCH_TOL = 2e-5
 MATCH_ITERATIONS = 8
+#: a dense grid's one-span-per-step surface is kept when it meets the points this well
+#: (the pipeline's requirement, 0.1 um) even if the iteration has not reached MATCH_TOL
+ACCEPT_TOL = 1e-4
+#: poles of the finer space a dense grid across the parameter lines falls back to (two
+#: spans per grid step, fewer (at least 1.25) where that would exceed this)
+POLE_BUDGET = 4.5e6
 #: knot spans per direction at least (coarse grids), see _span
 MIN_SPANS = 120
 #: knot spans per direction beyond which dense grids get fewer spans per grid step
@@ -194,28 +200,44 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     U, V = np.asarray(U, dtype=float), np.asarray(V, dtype=float)
     report(progress, 0.0, "sampling the nominal")
     lines = aligned_lines(U, V, refine) if field_factory is GridField else None
-    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, lines, per_step=1)
-    if lines is None and ([len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)]
-                          != [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine,
-                                                           per_step=1)]):
-        # a dense grid across the parameter lines: one span per step is tried first
-        # (enough for smooth corrections), two when the nodes are not met that way
-        surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, 2, field_factory,
-                                      sub(progress, 0.1, 0.3))
-        if np.max(np.abs(np.asarray(delta) - real)) > MATCH_TOL:
-            smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, per_step=2)
-            surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL,
-                                          MATCH_ITERATIONS, field_factory,
-                                          sub(progress, 0.3, 0.75))
-    else:
+    capped = lines is None and (
+        [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)]
+        != [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine, per_step=1)])
+    if not capped:
+        smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, lines)
         surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
                                       field_factory, sub(progress, 0.1, 0.75))
+    else:
+        smp, surf, field, k, real = _dense_across(nominal, outward, U, V, delta, spacing_u,
+                                                  spacing_v, refine, field_factory, progress)
     report(progress, 0.75, "checking the corrected surface")
     zero = smp.build(np.zeros((smp.us.size, smp.vs.size)))
     checks = check_figures(nominal, surf, zero, U.ravel(), V.ravel(), np.ravel(delta), outward,
                            grid_shape or U.shape, realised=real.ravel())
     report(progress, 1.0, "corrected surface checked")
     return Construction(surf, zero, field, k, checks)
+
+
+def _dense_across(nominal, outward, U, V, delta, spacing_u, spacing_v, refine, field_factory,
+                  progress):
+    """A dense grid across the parameter lines (MAX_SPANS caps the refinement): the
+    space with at most MAX_SPANS spans is tried first when it still has >= 1.2 spans per
+    grid step (enough for smooth, filtered corrections); otherwise, or when it misses the
+    points by more than ACCEPT_TOL, two spans per step (fewer, >= 1.25, within
+    POLE_BUDGET). Returns ``(sampling, surface, field, iterations, realised)``."""
+    (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
+    steps = max((u1 - u0) / spacing_u, (v1 - v0) / spacing_v)
+    if MAX_SPANS >= 1.2 * steps:
+        smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, per_step=1)
+        surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, 4, field_factory,
+                                      sub(progress, 0.1, 0.3))
+        if np.max(np.abs(np.asarray(delta) - real)) <= ACCEPT_TOL:
+            return smp, surf, field, k, real
+    per_step = min(2.0, max(1.25, np.sqrt(POLE_BUDGET) / steps))
+    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, per_step=per_step)
+    surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
+                                  field_factory, sub(progress, 0.3, 0.75))
+    return smp, surf, field, k, real
 
 
 def build_matching_surface(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,

@@ -261,11 +261,34 @@ class GridField:
         if act.size:
             val, _, _ = self._map(s[act], t[act])
             miss = np.abs(uv[act] - val)
-            if np.any(miss > 1e-9 * self._scale):
-                bad = act[int(np.argmax(miss.max(axis=1)))]
-                raise ComputationError("could not locate (u, v) = (%g, %g) on the measurement grid"
-                                       % tuple(uv[bad]))
+            failed = act[np.any(miss > 1e-9 * self._scale, axis=1)]
+            if failed.size:
+                s[failed], t[failed] = self._beyond(uv[failed])
         return s, t
+
+    def _beyond(self, uv):
+        """Index coordinates of points where Newton failed: allowed only beyond the grid
+        (a distorted border can make its linear continuation fold there); each point is
+        placed by one linear step from the nearest border sample, so the bounded outside
+        continuation applies. Points that have a sample inside the grid nearest raise."""
+        n, m = self.shape
+        _, k = self._tree.query(uv / self._scale)
+        s0, t0 = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
+        border = (s0 == 0) | (s0 == n - 1) | (t0 == 0) | (t0 == m - 1)
+        if not np.all(border):
+            bad = int(np.argmin(border))
+            raise ComputationError("could not locate (u, v) = (%g, %g) on the measurement grid"
+                                   % tuple(uv[bad]))
+        val, ds, dt = self._map(s0, t0)
+        r = uv - val
+        det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
+        det = np.where(np.abs(det) < 1e-300, 1e-300, det)
+        dS = (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
+        dT = (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
+        # only outward steps: the point stays beyond the border it is nearest to
+        dS = np.where(s0 == 0, np.minimum(dS, 0), np.where(s0 == n - 1, np.maximum(dS, 0), 0))
+        dT = np.where(t0 == 0, np.minimum(dT, 0), np.where(t0 == m - 1, np.maximum(dT, 0), 0))
+        return s0 + dS, t0 + dT
 
     def at_index(self, s, t):
         """Field values at index coordinates (continued outside, clipped to the node range)."""

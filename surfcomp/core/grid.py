@@ -171,10 +171,53 @@ def grid_from_uv(u, v, lines=None, source=None):
             if how.endswith("v"):
                 index = index.T  # (rows of v, points along u) -> first axis along u
             return _oriented(Grid(np.ascontiguousarray(index), how + " on the face"), u, v, source)
+    index = _rows_in_file_order(u, v)
+    if index is not None:
+        try:
+            return _oriented(Grid(index, "scan lines in file order (across the parameter lines)"),
+                             u, v, source)
+        except GridError:
+            pass  # not a proper grid after all: report why the other ways failed
     raise GridError("the %d measured points do not form a complete n x m grid on the face: %s "
                     "(expected rows of equal length; add row/col columns, or --layout "
                     "scattered)" % (u.size, _describe_incomplete(v, u, "v", "u")),
                     file=source)
+
+
+def _rows_in_file_order(u, v, turn=np.cos(np.radians(45.0))):
+    """Rows of a raster or serpentine scan written line by line, whatever their angle to
+    the parameter lines: a row ends where the scan direction turns by more than 45
+    degrees on both sides of one step (the step to the next line). Returns the index
+    (n, m) with every row running the first row's way, or None when the points are not
+    n equal lines of m >= 3 evenly spaced points (within 25 %; n >= 2)."""
+    x = np.stack([u / (np.ptp(u) or 1.0), v / (np.ptp(v) or 1.0)], axis=1)
+    d = np.diff(x, axis=0)
+    length = np.linalg.norm(d, axis=1)
+    if d.shape[0] < 3 or np.any(length == 0):
+        return None
+    e = d / length[:, None]
+    cos = np.einsum("ij,ij->i", e[:-1], e[1:])     # turn between step k and step k + 1
+    turned = cos < turn
+    # step k (1..N-3) links two lines when the direction turns before and after it
+    links = np.nonzero(turned[:-1] & turned[1:])[0] + 1
+    starts = np.concatenate([[0], links + 1])
+    sizes = np.diff(np.concatenate([starts, [u.size]]))
+    if sizes.size < 2 or sizes[0] < 3 or np.any(sizes != sizes[0]):
+        return None
+    index = np.arange(u.size).reshape(sizes.size, sizes[0])
+    # a scan grid steps evenly along its lines; points placed adaptively along curves
+    # (the mirror paper's layouts) are a scattered layout, not a grid
+    along = np.linalg.norm(np.diff(x[index], axis=1), axis=2)
+    if np.any(np.abs(along / np.median(along) - 1.0) > 0.25):
+        return None
+    first = x[index[0, -1]] - x[index[0, 0]]
+    back = np.einsum("ij,j->i", x[index[:, -1]] - x[index[:, 0]], first) < 0
+    index[back] = index[back, ::-1]
+    # the lines must follow each other across the face (no line out of place)
+    gaps = np.linalg.norm(x[index[1:, 0]] - x[index[:-1, 0]], axis=1)
+    if np.max(gaps) > 3.0 * np.median(gaps):
+        return None
+    return np.ascontiguousarray(index)
 
 
 def _oriented(grid, u, v, source):

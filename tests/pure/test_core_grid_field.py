@@ -135,3 +135,51 @@ def test_pole_net_is_capped_for_dense_grids():
     assert [a.size for a in dense_parameters(Box, (45, 45))] == [177, 177]
     assert [a.size for a in dense_parameters(Box, (500, 500))] == [1997, 1997]
     assert [a.size for a in dense_parameters(Box, (1000, 1000))] == [1999, 1999]
+
+
+@pytest.mark.parametrize("serpentine", [False, True])
+def test_grid_turned_across_parameter_lines_from_file_order(serpentine):
+    """A 5 x 7 grid turned by 25 degrees in (u, v): no rows of constant u or v, so its
+    scan lines are found from the file order (raster or serpentine)."""
+    s_, t_ = np.meshgrid(np.linspace(0, 1, 5), np.linspace(0, 1, 7), indexing="ij")
+    a = np.radians(25.0)
+    U = 0.5 + 0.6 * ((s_ - 0.5) * np.cos(a) - (t_ - 0.5) * np.sin(a))
+    V = 0.5 + 0.6 * ((s_ - 0.5) * np.sin(a) + (t_ - 0.5) * np.cos(a))
+    fu, fv = U.copy(), V.copy()
+    if serpentine:
+        fu[1::2], fv[1::2] = fu[1::2, ::-1], fv[1::2, ::-1]
+    g = grid_from_uv(fu.ravel(), fv.ravel())
+    assert g.shape == (5, 7) and g.rows_from.startswith("scan lines in file order")
+    assert_allclose(fu.ravel()[g.index], U, atol=0)
+    assert_allclose(fv.ravel()[g.index], V, atol=0)
+    # a scan with one short line is not a grid: the error names the rows it found
+    with pytest.raises(GridError, match="do not form a complete n x m grid"):
+        grid_from_uv(fu.ravel()[:-1], fv.ravel()[:-1])
+
+
+def test_locate_beyond_a_distorted_border():
+    """Wavy, unevenly spaced grid lines (like points placed along curves) covering part of
+    the face: the linear continuation of such a border can fold far outside, where Newton
+    then fails; those points are placed by one outward step from the nearest border
+    sample, so the whole face gets bounded field values."""
+    rng = np.random.default_rng(5)
+    curves = np.linspace(0.06, 0.94, 7) + rng.uniform(-0.02, 0.02, 7)
+    U, V = [], []
+    for c in curves:
+        t = np.linspace(0.04, 0.96, 10) + rng.uniform(-0.03, 0.03, 10)
+        U.append(c + 0.05 * np.sin(6 * t))
+        V.append(t)
+    U, V = np.array(U), np.array(V)
+    vals = rng.normal(size=U.shape)
+    f = GridField(U, V, vals)
+    us = np.linspace(0, 1, 121)
+    s, t = f.locate_grid(us, us)
+    out = f.at_index(s, t)
+    assert np.all(np.isfinite(out))
+    assert out.min() >= vals.min() - 1e-12 and out.max() <= vals.max() + 1e-12
+    # inside the grid the located points map back exactly
+    uu, vv = np.meshgrid(us, us, indexing="ij")
+    inside = (s > 0) & (s < 6) & (t > 0) & (t < 9)
+    back = f._map(s[inside], t[inside], deriv=False)[0]
+    # within the tensor-grid locator's 1e-7 grid cells (cells ~0.1 wide here)
+    assert_allclose(back, np.stack([uu.ravel()[inside], vv.ravel()[inside]], axis=1), atol=5e-8)
