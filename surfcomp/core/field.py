@@ -48,6 +48,14 @@ def _dpowers(a):
     return np.stack([np.zeros_like(a), np.ones_like(a), 2.0 * a, 3.0 * a * a], axis=1)
 
 
+def _solve2(ds, dt, r):
+    """Solve ``[ds dt] x = r`` for each point (2 x 2 Jacobian columns ds, dt; (N, 2) each)."""
+    det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
+    det = np.where(np.abs(det) < 1e-300, 1e-300, det)
+    return ((r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det,
+            (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det)
+
+
 def _pchip_slopes(F, axis):
     n = F.shape[axis]
     x = np.arange(n, dtype=float)
@@ -245,10 +253,7 @@ class GridField:
             if act.size == 0:
                 break
             _, ds, dt = self._map(s[act], t[act])
-            det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
-            det = np.where(np.abs(det) < 1e-300, 1e-300, det)
-            dS = (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
-            dT = (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
+            dS, dT = _solve2(ds, dt, r)
             # steps are limited to one cell inside the grid; beyond its border, where the
             # map is continued linearly, to one cell more than the distance to the border
             sa, ta = s[act], t[act]
@@ -281,10 +286,7 @@ class GridField:
                                    % tuple(uv[bad]))
         val, ds, dt = self._map(s0, t0)
         r = uv - val
-        det = ds[:, 0] * dt[:, 1] - ds[:, 1] * dt[:, 0]
-        det = np.where(np.abs(det) < 1e-300, 1e-300, det)
-        dS = (r[:, 0] * dt[:, 1] - r[:, 1] * dt[:, 0]) / det
-        dT = (ds[:, 0] * r[:, 1] - ds[:, 1] * r[:, 0]) / det
+        dS, dT = _solve2(ds, dt, r)
         # only outward steps: the point stays beyond the border it is nearest to
         dS = np.where(s0 == 0, np.minimum(dS, 0), np.where(s0 == n - 1, np.maximum(dS, 0), 0))
         dT = np.where(t0 == 0, np.minimum(dT, 0), np.where(t0 == m - 1, np.maximum(dT, 0), 0))
