@@ -12,6 +12,9 @@ def add_parser(subparsers):
     p.add_argument("--mask", type=int, default=5, metavar="N",
                    help="mask size of the filter used to split determined/random (default 5)")
     p.add_argument("--weights", metavar="W", help="custom mask weights (see compensate)")
+    p.add_argument("--smoothing", type=float, metavar="MM",
+                   help="scattered layouts: smoothing length of the fit (default: GCV)")
+    p.add_argument("--html", metavar="OUT.html", help="also write the HTML inspection report")
     p.set_defaults(run=run)
     return p
 

@@ -39,11 +39,14 @@ def test_compensate_example_writes_step_and_report(tmp_path):
 
 
 def test_inspect_prints_statistics_only(tmp_path):
-    out = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--report", tmp_path / "r.json", "--quiet")
+    out = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--report", tmp_path / "r.json",
+                  "--html", tmp_path / "r.html", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "Standard deviation (ddof=1)" in out.stdout
     assert "Corrected face" not in out.stdout
     assert "corrected_face" not in json.loads((tmp_path / "r.json").read_text())
+    html = (tmp_path / "r.html").read_text()
+    assert 'id="maps"' in html and "No corrected face was built (inspect)" in html
 
 
 def _bad(tmp_path, *args):
