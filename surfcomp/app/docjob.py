@@ -142,6 +142,7 @@ def _same_file(a, b):
 def run_document_job(document, measurements, object_name, face=None, save=None, replace=True,
                      gcode=None, post="linuxcnc", post_args="--no-show-editor", job_name=None,
                      units="mm", options=None, output=None, overwrite_input=False,
+                     fmt="auto", sample=None,
                      progress=None):
     """Compensate face ``face`` of ``object_name`` in the FreeCAD document ``document``.
 
@@ -176,6 +177,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         (so ``FaceN`` links of Path operations stay valid), else ``face``.
     overwrite_input : bool
         Allow ``save`` to be the input document.
+    fmt, sample : str, optional
+        Measurement file format and QIF sample (see :func:`surfcomp.io.readers.read_any`).
 
     Returns
     -------
@@ -234,7 +237,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         if output is None:
             output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
         report(progress, 0.1, "reading the measurements")
-        meas = features.make_measurement(doc, measurements, units=units)
+        meas = features.make_measurement(doc, measurements, units=units, fmt=fmt,
+                                         sample=sample)
         comp = features.make_compensation(
             doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
             weights=options.weights if isinstance(options.weights, str) else "",

@@ -59,17 +59,14 @@ def run_document(args):
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
                          "'compensate' without them for the files" % other[0])
-    if args.fmt != "auto" or args.sample is not None:
-        raise InputError("--format/--sample are not supported with --replace/--save/--gcode "
-                         "yet; convert the file to a table first")
     from ..app.docjob import run_document_job, summary_lines
 
     res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,
                            save=args.save, replace=args.replace, gcode=args.gcode,
                            post=args.post, post_args=args.post_args, job_name=args.job,
                            units=args.units or "mm", options=options_from_args(args),
-                           overwrite_input=args.overwrite_input,
-                           progress=ProgressLine(args.quiet))
+                           overwrite_input=args.overwrite_input, fmt=args.fmt,
+                           sample=args.sample, progress=ProgressLine(args.quiet))
     for line in summary_lines(res):
         print(line)
     return 0

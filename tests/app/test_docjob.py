@@ -177,7 +177,7 @@ def test_the_batch_command_line(shop, tmp_path):
     cmd = [sys.executable, "-m", "surfcomp", "compensate", shop["doc"], shop["meas"],
            "--object", "Block", "--face", "Face2", "--replace", "--save", str(out),
            "--gcode", str(ngc), "--post", "linuxcnc", "--post-args", POST_ARGS, "--refine", "1",
-           "--quiet"]
+           "--format", "table", "--quiet"]
     run = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     assert "replaced the nominal in: Clone.Objects" in run.stdout
@@ -194,3 +194,7 @@ def test_the_batch_command_line(shop, tmp_path):
     bad = subprocess.run(cmd[:10] + ["--save", shop["doc"], "--quiet"], cwd=ROOT,
                          capture_output=True, text=True, timeout=600)
     assert bad.returncode == 2 and sha(shop["doc"]) == digest
+    # the reader options reach the measurement reader: a CSV read as XYZIJK is refused
+    bad = subprocess.run(cmd[:-3] + ["--format", "xyzijk", "--quiet"], cwd=ROOT,
+                         capture_output=True, text=True, timeout=600)
+    assert bad.returncode == 2 and "XYZIJK" in bad.stderr and sha(shop["doc"]) == digest
