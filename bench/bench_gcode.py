@@ -19,8 +19,7 @@ sys.path.insert(0, ROOT)
 from surfcomp.core.axis_errors import AxisErrorModel  # noqa: E402
 from surfcomp.io.gcode import compensate_gcode, parse_gcode, read_gcode  # noqa: E402
 
-BEAR = os.path.join(os.path.dirname(ROOT), "shared", "realdata", "gcode", "CAMotics_GPL",
-                    "bear.nc")
+BEAR = os.path.join(ROOT, "tests", "data", "real", "gcode", "CAMotics_GPL", "bear.nc")
 
 
 def best(fn, repeat):

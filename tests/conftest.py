@@ -1,4 +1,4 @@
-"""Shared test set-up: the repository root on sys.path and paths to shared data."""
+"""Shared test set-up: the repository root on sys.path and the path to the real test data."""
 
 import os
 import sys
@@ -7,5 +7,5 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
 
-#: ../shared/realdata next to the checkout (read by path, never copied)
-REALDATA = os.path.join(os.path.dirname(ROOT), "shared", "realdata")
+#: public CAD, QIF and G-code files copied into the repository (see its README.md)
+REALDATA = os.path.join(ROOT, "tests", "data", "real")
