@@ -41,7 +41,7 @@ def example_surface():
     from surfcomp.core import bspline
 
     x = np.linspace(0.0, 45.0, 7)
-    P = np.stack(np.meshgrid(x, x, indexing="ij") + [HEIGHTS], axis=-1)
+    P = np.stack([*np.meshgrid(x, x, indexing="ij"), HEIGHTS], axis=-1)
     k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
     return bspline.Surface(P, k, k, 3, 3)
 

@@ -58,6 +58,7 @@ Two parts, the scattered counterparts of the grid path's mask filter
     value beyond the largest given one.
 """
 
+import inspect
 import math
 from dataclasses import dataclass
 
@@ -72,6 +73,10 @@ from scipy.spatial.distance import cdist
 from . import bspline
 from ..errors import ComputationError, InputError
 from .progress import report
+
+#: the relative-tolerance keyword of ``cg``: ``tol`` up to scipy 1.11, ``rtol`` from 1.12
+#: (``tol`` was removed in 1.14)
+_CG_RTOL = "rtol" if "rtol" in inspect.signature(cg).parameters else "tol"
 
 #: largest number of points fitted with the exact thin-plate smoothing spline
 EXACT_MAX = 1000
@@ -599,7 +604,7 @@ def _solve_gradients(M, precond, rhs):
     relative residual 1e-13: linear in the values to that precision)."""
     if not np.any(rhs):
         return np.zeros_like(rhs)
-    g, info = cg(M, rhs, tol=GRADIENT_RTOL, atol=0.0, M=precond, maxiter=20000)
+    g, info = cg(M, rhs, atol=0.0, M=precond, maxiter=20000, **{_CG_RTOL: GRADIENT_RTOL})
     if info != 0:
         raise ComputationError("the gradient system of the scattered field did not converge "
                                "(%d iterations); the node layout is too degenerate" % info)
