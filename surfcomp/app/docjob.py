@@ -7,7 +7,7 @@ let Path regenerate, save a new document and (optionally) post the G-code.
 Safety rules (issue 3):
 
 - Path and OpenCamLib are set up *before* the document is opened
-  (:func:`surfcomp.app.fcenv.setup_path_workbench`): an object whose module cannot be
+  (:func:`surfcomp.app.cam.setup_workbench`): an object whose module cannot be
   imported at open time loses its proxy silently, and a document saved like that can never
   recompute that object again. Such documents are refused (nothing is written).
 - The input document is never overwritten unless ``overwrite_input=True``.
@@ -25,7 +25,7 @@ from ..core.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction
-from . import fcenv
+from . import cam
 
 
 @dataclass
@@ -61,10 +61,12 @@ def _xml_objects(path):
 def preload_proxy_modules(path):
     """Import the modules of the Python proxies stored in an FCStd before opening it.
 
-    Opened from a plain ``python3``, FreeCAD 0.20 restores a proxy only when its module
-    is already imported (Path's ``PathScripts.PathJob`` is not, and the Job would lose its
-    proxy silently). Returns ``{module: error text}`` for the modules that cannot be
-    imported (their objects will be reported by :func:`restore_failures`).
+    Opened from a plain ``python3``, FreeCAD restores a proxy only when its module is
+    already imported (Path's ``PathScripts.PathJob`` is not, and the Job would lose its
+    proxy silently). On FreeCAD 1.x the CAM modules a 0.20 document names are aliased to
+    their 1.x homes first (:func:`surfcomp.app.cam.alias_legacy_modules`). Returns
+    ``{module: error text}`` for the modules that cannot be imported (their objects will be
+    reported by :func:`restore_failures`).
     """
     import importlib
 
@@ -73,8 +75,10 @@ def preload_proxy_modules(path):
             root = ET.fromstring(z.read("Document.xml"))
     except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as exc:
         raise InputError("not a FreeCAD document (%s)" % exc, file=path) from exc
+    names = sorted({el.get("module") for el in root.iter("Python") if el.get("module")})
+    cam.alias_legacy_modules(names)
     failed = {}
-    for name in sorted({el.get("module") for el in root.iter("Python") if el.get("module")}):
+    for name in names:
         try:
             importlib.import_module(name)
         except Exception as exc:  # any import-time error means the proxy cannot restore
@@ -212,7 +216,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         raise InputError("the G-code and the document cannot be the same file", file=gcode)
 
     report(progress, 0.0, "setting up Path and OpenCamLib")
-    fcenv.setup_path_workbench()
+    cam.setup_workbench()
     import FreeCAD
 
     from . import features, pathjob

@@ -22,15 +22,6 @@ fcenv.setup_paths()
 import FreeCAD  # noqa: E402
 import Path  # noqa: E402
 
-try:  # FreeCAD 1.x
-    import Path.Dressup.Utils as PathDressup  # noqa: E402
-except ImportError:  # FreeCAD 0.20
-    import PathScripts.PathDressup as PathDressup  # noqa: E402
-try:  # FreeCAD 0.20 and 1.x both keep PathUtils here
-    import PathScripts.PathUtils as PathUtils  # noqa: E402
-except ImportError:  # pragma: no cover - a Path without PathScripts
-    PathUtils = None
-
 import os  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -39,6 +30,7 @@ from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors  # noqa: E40
 from ..errors import InputError  # noqa: E402
 from ..io.axis_csv import AxisErrorTable, read_axis_errors  # noqa: E402
 from ..io.gcode import compensate_commands  # noqa: E402
+from . import cam  # noqa: E402
 from .proxies import Proxy  # noqa: E402
 
 #: version of the document object's property set; onDocumentRestored upgrades older ones
@@ -164,21 +156,15 @@ def model_of(obj):
     return model, model.in_program_coordinates(_vec(obj.WorkOffset))
 
 
-def _base_commands(base):
-    if PathUtils is not None and hasattr(PathUtils, "getPathWithPlacement"):
-        return PathUtils.getPathWithPlacement(base).Commands
-    return base.Path.Commands
-
-
 def compensate_path(obj):
     """Compute the dressup's Path from its base (what ``execute`` does), return the result."""
     base = obj.Base
     if base is None or not base.isDerivedFrom("Path::Feature"):
         return Path.Path(), None
-    cmds = _base_commands(base)
+    cmds = cam.placed_commands(base)
     model, prog_model = model_of(obj)
     # messages name the dressup and the operation under it; "line" = base command number
-    source = "%s (on %s)" % (obj.Label, PathDressup.baseOp(base).Label)
+    source = "%s (on %s)" % (obj.Label, cam.base_operation(base).Label)
     res = compensate_commands([(c.Name, c.Parameters) for c in cmds], prog_model,
                               segment_length=float(obj.SegmentLength.Value),
                               tolerance=float(obj.Tolerance.Value),
@@ -200,7 +186,7 @@ class DressupAxisErrors(Proxy):
 
     def onDelete(self, obj, args):
         if obj.Base:
-            job = PathUtils.findParentJob(obj) if PathUtils is not None else None
+            job = cam.find_parent_job(obj)
             if job:
                 job.Proxy.addOperation(obj.Base, obj)
             if obj.Base.ViewObject:
@@ -249,7 +235,7 @@ def Create(base, model_csv_or_data, name="DressupAxisErrors"):
     obj = doc.addObject("Path::FeaturePython", name)
     DressupAxisErrors(obj, base)
     set_measurements(obj, model_csv_or_data)
-    job = PathUtils.findParentJob(base) if PathUtils is not None else None
+    job = cam.find_parent_job(base)
     if job is not None:
         job.Proxy.addOperation(obj, base, True)
     if FreeCAD.GuiUp and base.ViewObject:

@@ -3,13 +3,14 @@
 Importing FreeCAD as a library (``/usr/bin/python3`` with the FreeCAD lib folder on
 ``sys.path``) leaves FreeCAD's ``Mod`` and ``Ext`` folders off ``sys.path``, so Path,
 its post-processors and ``freecad.*`` namespace packages are only half there. This
-module puts them on the path. It is idempotent and cheap to call repeatedly.
+module puts them on the path. It is idempotent and cheap to call repeatedly. The folders
+are the same for every FreeCAD version; what differs between versions is in
+:mod:`surfcomp.app.cam`.
 
 This is the one module of ``surfcomp.app`` that may be imported before FreeCAD is.
 """
 
 import glob
-import importlib
 import os
 import sys
 
@@ -38,7 +39,7 @@ def freecad_lib_dir():
 
 
 def setup_paths():
-    """Put FreeCAD's lib, Mod/* and Ext folders and OpenCamLib on ``sys.path``."""
+    """Put FreeCAD's lib, Mod/* and Ext folders on ``sys.path``."""
     if "FreeCAD" not in sys.modules:
         lib = freecad_lib_dir()
         if lib:
@@ -48,30 +49,6 @@ def setup_paths():
             _add(mod)
         _add(os.path.join(share, "Ext"))
         _add(os.path.join(share, "Mod"))
-    setup_ocl()
-
-
-def setup_ocl():
-    """Make ``import ocl`` work with the PyPI ``opencamlib`` wheel.
-
-    The wheel ships the extension as ``opencamlib/ocl.so`` while FreeCAD's Path
-    does ``import ocl``; we register the packaged module under the plain name.
-    Returns True when ``ocl`` is importable afterwards.
-    """
-    if "ocl" in sys.modules:
-        return True
-    try:
-        spec = importlib.util.find_spec("ocl")
-    except (ImportError, ValueError):
-        spec = None
-    if spec is not None:
-        return True
-    try:
-        mod = importlib.import_module("opencamlib.ocl")
-    except ImportError:
-        return False
-    sys.modules["ocl"] = mod
-    return True
 
 
 def import_freecad():
@@ -92,61 +69,3 @@ def import_freecad():
         ) from exc
     import FreeCAD
     return FreeCAD
-
-
-#: folders (relative to FreeCAD's home) of the Path workbench: 0.20 ``Mod/Path``, 1.x ``Mod/CAM``
-PATH_MODULE_DIRS = (os.path.join("Mod", "Path"), os.path.join("Mod", "CAM"))
-
-
-def freecad_home():
-    """The FreeCAD resource folder that holds ``Mod/Path`` (or ``Mod/CAM``), or None."""
-    for share in SHARE_CANDIDATES:
-        if any(os.path.isdir(os.path.join(share, d)) for d in PATH_MODULE_DIRS):
-            return share
-    return None
-
-
-def setup_path_workbench(require_ocl=True):
-    """Make Path (CAM) work from a plain ``python3`` as it works in ``freecadcmd``.
-
-    - puts FreeCAD's ``Mod/*`` and ``Ext`` folders and OpenCamLib on ``sys.path``
-      (:func:`setup_paths`);
-    - when FreeCAD is imported as a library, ``FreeCAD.getHomePath()`` is the library
-      folder, where Path finds no post-processors, tool bits or tool shapes: it is made
-      to return the resource folder that holds ``Mod/Path`` (inside ``freecadcmd`` it
-      already does and is left alone).
-
-    Call it before opening a document with Path objects: an operation whose module
-    cannot be imported at open time (e.g. the 3D Surface operation without ``ocl``)
-    loses its proxy silently.
-
-    Parameters
-    ----------
-    require_ocl : bool
-        Raise when OpenCamLib is not importable as ``ocl``.
-
-    Returns
-    -------
-    str
-        FreeCAD's home folder as Path now sees it.
-
-    Raises
-    ------
-    ImportError
-        FreeCAD, its Path workbench or (with ``require_ocl``) OpenCamLib is missing, with
-        what to install.
-    """
-    FreeCAD = import_freecad()
-    home = FreeCAD.getHomePath()
-    if not any(os.path.isdir(os.path.join(home, d)) for d in PATH_MODULE_DIRS):
-        share = freecad_home()
-        if share is None:
-            raise ImportError("FreeCAD's Path workbench is not installed (looked for Mod/Path "
-                              "in %s)" % ", ".join(SHARE_CANDIDATES))
-        home = share.rstrip("/") + "/"
-        FreeCAD.getHomePath = lambda: home
-    if require_ocl and not setup_ocl():
-        raise ImportError("OpenCamLib is not importable as 'ocl' (needed by Path's 3D Surface "
-                          "operation): run tools/install.sh or 'python3 -m pip install "
-                          "opencamlib'")
-    return home

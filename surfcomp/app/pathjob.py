@@ -1,84 +1,16 @@
-"""Path (CAM) helpers: a Job with a 3D Surface finishing operation, post-processing to text.
+"""CAM helpers: a Job with a 3D Surface finishing operation, post-processing to text.
 
-Works with FreeCAD 0.20 (``PathScripts.*``) and FreeCAD 1.x CAM (``Path.Main.*``,
-``Path.Op.*``, ``Path.Tool.*``, ``Path.Post.*``); the modules are looked up once by
-:func:`modules`. No FreeCADGui: everything runs in ``freecadcmd`` and in a plain
-``python3`` after :func:`surfcomp.app.fcenv.setup_path_workbench`.
+Written once for every FreeCAD version: what differs between 0.20 (``PathScripts.*``)
+and 1.x (``Path.*``, 1.1's tool-bit library) is behind :mod:`surfcomp.app.cam`. No
+FreeCADGui: everything runs in ``freecadcmd`` and in a plain ``python3``.
 """
 
-import os
-from types import SimpleNamespace
-
-from . import fcenv
-
 from ..errors import GCodeError, InputError
-
-_MODULES = None
-
-#: tool bit file of a ball end mill shipped with Path (its Diameter is set on creation)
-BALL_END_BIT = "6mm_Ball_End.fctb"
+from . import cam
 
 
-def modules():
-    """The Path modules this project uses, for FreeCAD 0.20 or 1.x.
-
-    Returns
-    -------
-    types.SimpleNamespace
-        ``Job``, ``Surface``, ``ToolBit``, ``ToolController``, ``PostProcessor`` (the
-        class with ``load(name)``), ``PathUtils``, ``Preferences``, ``version``
-        (``'0.20'`` or ``'1.x'``).
-    """
-    global _MODULES
-    if _MODULES is not None:
-        return _MODULES
-    fcenv.setup_path_workbench()
-    try:  # FreeCAD 1.x CAM
-        import Path.Main.Job as Job
-        import Path.Op.Surface as Surface
-        import Path.Tool.Bit as ToolBit
-        import Path.Tool.Controller as ToolController
-        import Path.Post.Processor as Processor
-        import Path.Preferences as Preferences
-        import PathScripts.PathUtils as PathUtils
-        version = "1.x"
-    except ImportError:  # FreeCAD 0.20
-        import PathScripts.PathJob as Job
-        import PathScripts.PathSurface as Surface
-        import PathScripts.PathToolBit as ToolBit
-        import PathScripts.PathToolController as ToolController
-        import PathScripts.PathPostProcessor as Processor
-        import PathScripts.PathPreferences as Preferences
-        import PathScripts.PathUtils as PathUtils
-        version = "0.20"
-    _MODULES = SimpleNamespace(Job=Job, Surface=Surface, ToolBit=ToolBit,
-                               ToolController=ToolController,
-                               PostProcessor=Processor.PostProcessor, PathUtils=PathUtils,
-                               Preferences=Preferences, version=version)
-    return _MODULES
-
-
-def _tool_bit_file(name):
-    import FreeCAD
-
-    for sub in ("Mod/Path/Tools/Bit", "Mod/CAM/Tools/Bit"):
-        path = os.path.join(FreeCAD.getHomePath(), sub, name)
-        if os.path.isfile(path):
-            return path
-    raise InputError("Path's tool bit %s is not installed (looked under %s)"
-                     % (name, FreeCAD.getHomePath()))
-
-
-def create_job(doc, models, name="Job"):
-    """A Path Job on ``models`` (document objects); Path clones them into ``Job.Model``."""
-    m = modules()
-    import FreeCAD
-
-    if FreeCAD.ActiveDocument is None or FreeCAD.ActiveDocument.Name != doc.Name:
-        FreeCAD.setActiveDocument(doc.Name)
-    job = m.Job.Create(name, list(models), None)
-    doc.recompute()
-    return job
+#: a Job on document objects (the adapter's, for callers of this module)
+create_job = cam.create_job
 
 
 def model_clone(job, obj):
@@ -96,9 +28,8 @@ def ball_end_tool_controller(job, diameter=6.0, spindle=10000.0, horiz_feed=20.0
     Path's headless operations take the job's only tool controller, so the job's default
     controller (if any) gets the ball end mill and its old bit is removed. Feeds in mm/s.
     """
-    m = modules()
     doc = job.Document
-    bit = m.ToolBit.Factory.CreateFrom(_tool_bit_file(BALL_END_BIT), "BallEnd")
+    bit = cam.create_tool_bit(doc, cam.BALL_END_BIT, "BallEnd")
     bit.Diameter = float(diameter)
     bit.Label = "Ball end %g mm" % diameter
     tcs = list(job.Tools.Group)
@@ -112,7 +43,7 @@ def ball_end_tool_controller(job, diameter=6.0, spindle=10000.0, horiz_feed=20.0
             job.Tools.removeObject(extra)
             doc.removeObject(extra.Name)
     else:
-        tc = m.ToolController.Create("TC: Ball end", bit, 1)
+        tc = cam.create_tool_controller("TC: Ball end", bit, 1)
         job.Proxy.addToolController(tc)
     tc.Label = "TC: Ball end %g mm" % diameter
     tc.SpindleSpeed = float(spindle)
@@ -142,11 +73,10 @@ def surface_operation(job, obj, faces, tool_controller=None, step_over=50.0,
     Every sampled point is kept (``OptimizeLinearPaths`` off), so the cutter-location
     points of two runs can be compared point by point.
     """
-    m = modules()
     clone = model_clone(job, obj)
     if clone is None:
         raise InputError("%s is not in the model of job %s" % (obj.Label, job.Label))
-    op = m.Surface.Create(name, parentJob=job)
+    op = cam.create_operation("Surface", name, job)
     op.Base = [(clone, tuple(faces))]
     if tool_controller is not None:
         op.ToolController = tool_controller
@@ -222,12 +152,7 @@ def post_process(job, post="linuxcnc", args="--no-show-editor"):
     GCodeError
         Unknown post-processor, or it produced nothing.
     """
-    m = modules()
-    if not m.PostProcessor.exists(post):
-        raise GCodeError("unknown post-processor %r (available: %s)"
-                         % (post, ", ".join(sorted(m.Preferences.allAvailablePostProcessors()))))
-    proc = m.PostProcessor.load(post)
-    text = proc.export(post_list(job), "-", args)
+    text = cam.load_post(post).export(post_list(job), "-", args)
     if not text:
         raise GCodeError("post-processor %r produced no output (arguments %r)" % (post, args))
     return text

@@ -162,6 +162,46 @@ def plan(doc, comp):
     return changes
 
 
+def _plain(subs):
+    """Sub-element names without FreeCAD 1.x's ``'?'`` mark of an unresolved name."""
+    return [x.lstrip("?") for x in (subs if isinstance(subs, (list, tuple)) else [subs])]
+
+
+def _element_links(obj):
+    """``(user, property, value)`` of every sub-element link to ``obj``, names plain."""
+    out = []
+    for user in obj.InList:
+        for prop in user.PropertiesList:
+            kind = None if prop in SKIP_PROPERTIES else _kind(user.getTypeIdOfProperty(prop))
+            if kind not in ("sub", "sublist"):
+                continue
+            value = getattr(user, prop)
+            if kind == "sub" and value and value[0] is obj:
+                out.append((user, prop, (obj, _plain(value[1]))))
+            elif kind == "sublist" and any(x is obj for x, _subs in value):
+                out.append((user, prop, [(x, tuple(_plain(subs))) for x, subs in value]))
+    return out
+
+
+def _relink_elements(undo, changes):
+    """Keep ``(clone, 'FaceN')`` links valid when a clone's shape is swapped.
+
+    FreeCAD 1.x traces sub-element links through the topological naming's element map.
+    A clone (Path's model) whose source changes from the nominal to the compensation gets
+    an unrelated shape, so at its next recompute its users' links become ``'?Face1'``
+    (unresolved) and the operations fail. The clones are recomputed here and their users'
+    links set again by name: the faces keep their names (same faces, same order). On 0.20
+    this sets the same values again.
+    """
+    reshaped = [o for o, _prop, kind, _old, _new in changes
+                if kind in ("link", "list") and o.isDerivedFrom("Part::Feature")]
+    for obj in reshaped:
+        links = _element_links(obj)
+        obj.recompute()
+        for user, prop, value in links:
+            undo.set(user, prop, value)
+
+
 def _snapshot(doc, objs):
     return {o.Name: ("Touched" in o.State) for o in objs}
 
@@ -241,6 +281,7 @@ def replace(doc, comp):
             record["links"].append({"object": o.Name, "property": prop, "kind": kind,
                                     "old": _encode(kind, old)})
             undo.set(o, prop, new)
+        _relink_elements(undo, changes)
         for o, vis in ((nominal, False), (comp, True)):
             if "Visibility" in o.PropertiesList:
                 record["visibility"][o.Name] = bool(o.Visibility)
@@ -274,12 +315,16 @@ def restore(doc, comp):
 
     def work(undo):
         done = []
+        changes = []
         for item in record.get("links", []):
             o = doc.getObject(item["object"])
             if o is None:
                 continue    # the user deleted it meanwhile: nothing to put back
-            undo.set(o, item["property"], _decode(doc, item["kind"], item["old"]))
+            old = _decode(doc, item["kind"], item["old"])
+            changes.append((o, item["property"], item["kind"], None, old))
+            undo.set(o, item["property"], old)
             done.append((o.Name, item["property"]))
+        _relink_elements(undo, changes)
         for name, vis in record.get("visibility", {}).items():
             o = doc.getObject(name)
             if o is not None and "Visibility" in o.PropertiesList:

@@ -48,4 +48,5 @@ def ask_float(title, label, value, minimum, maximum, decimals=4):
 
 def run_dialog(dialog):
     """Run a modal dialog; True when accepted."""
-    return dialog.exec_() == QtGui.QDialog.Accepted
+    run = getattr(dialog, "exec", None) or dialog.exec_     # Qt6 drops the exec_ alias
+    return run() == QtGui.QDialog.Accepted

@@ -245,4 +245,6 @@ class FilterPanel:
             FreeCADGui.ActiveDocument.resetEdit()
 
     def getStandardButtons(self):
-        return int(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
+        buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
+        # Qt5 flags convert with int(); Qt6 (PySide6) flags are Python enums with .value
+        return buttons.value if hasattr(buttons, "value") else int(buttons)

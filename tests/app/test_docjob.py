@@ -8,7 +8,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import docjob, features, fcenv, pathjob
+from surfcomp.app import cam, docjob, features, pathjob
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.pipeline import Options
 from surfcomp.errors import InputError, MeasurementFileError
@@ -27,7 +27,7 @@ def sha(path):
 def shop(tmp_path_factory):
     """shop.FCStd: a block under a Job with a 3D Surface op on Face2; meas.csv for Face2."""
     tmp = tmp_path_factory.mktemp("shop")
-    fcenv.setup_path_workbench()
+    cam.setup_workbench()
     doc = FreeCAD.newDocument("shop")
     solid = block_solid()
     add_part(doc, solid, "Block")

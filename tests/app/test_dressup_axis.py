@@ -10,7 +10,7 @@ import pytest
 
 import Part
 import Path
-from surfcomp.app import dressup_axis, fcenv
+from surfcomp.app import cam, dressup_axis
 from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine
 from surfcomp.errors import GCodeError
 from surfcomp.io.axis_csv import write_axis_errors
@@ -35,8 +35,8 @@ def measured(model):
 @pytest.fixture
 def home():
     """Path finds its post-processors and tool-bit shapes under FreeCAD.getHomePath(),
-    which is the library folder when FreeCAD is imported from python3 (fcenv fixes it)."""
-    return fcenv.setup_path_workbench(require_ocl=False)
+    which is the library folder when FreeCAD is imported from python3 (cam fixes it)."""
+    return cam.setup_workbench(require_ocl=False)
 
 
 @pytest.fixture
@@ -47,16 +47,14 @@ def doc():
 
 
 def profile_job(doc):
-    import PathScripts.PathJob as PathJob
-    import PathScripts.PathProfile as PathProfile
     box = doc.addObject("Part::Box", "Box")
     box.Length, box.Width, box.Height = 40, 30, 10
     doc.recompute()
-    job = PathJob.Create("Job", [box], None)
+    job = cam.create_job(doc, [box])
     tc = job.Tools.Group[0]
     tc.HorizFeed = 600       # a bare number is taken in the internal unit, mm/s
     tc.VertFeed = 120
-    op = PathProfile.Create("Profile")
+    op = cam.create_operation("Profile", "Profile", job)
     doc.recompute()
     assert len(op.Path.Commands) > 20
     return job, op
@@ -76,15 +74,14 @@ def move_points(cmds):
 
 
 def base_edges(cmds):
-    import PathScripts.PathGeom as PathGeom
     pos = FreeCAD.Vector(0, 0, 0)
     edges = []
     for c in cmds:
         if c.Name in MOVES:
-            e = PathGeom.edgeForCmd(c, pos)
+            e = cam.edge_for_command(c, pos)
             if e is not None:
                 edges.append(e)
-            pos = PathGeom.commandEndPoint(c, pos)
+            pos = cam.command_end_point(c, pos)
     return Part.Compound(edges)
 
 
@@ -201,16 +198,14 @@ import json, sys
 sys.path.insert(0, ROOT)
 import FreeCAD, Path
 import numpy as np
-from surfcomp.app import dressup_axis
+from surfcomp.app import cam, dressup_axis
 from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine
 doc = FreeCAD.newDocument("cmd")
-import PathScripts.PathJob as PathJob
-import PathScripts.PathProfile as PathProfile
 box = doc.addObject("Part::Box", "Box")
 doc.recompute()
-job = PathJob.Create("Job", [box], None)
+job = cam.create_job(doc, [box])
 job.Tools.Group[0].HorizFeed = 600
-op = PathProfile.Create("Profile")
+op = cam.create_operation("Profile", "Profile", job)
 doc.recompute()
 m = AxisErrorModel.from_components(scale={"x": 1e-3}, positional={"z": (0.0, 2e-5)})
 data = SimulatedMachine(m).measure({"x": np.linspace(0, 20, 5), "z": np.linspace(-5, 15, 5)})

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import Part
-from surfcomp.app import features, fcenv, pathjob, replace
+from surfcomp.app import cam, features, pathjob, replace
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.corrected import realised_correction
 from surfcomp.core.projection import project
@@ -72,7 +72,7 @@ def g1_points(gcode):
 @pytest.fixture(scope="module")
 def regenerated():
     """The document before and after replace (one Path computation each, ~15 s)."""
-    fcenv.setup_path_workbench()
+    cam.setup_workbench()
     doc = FreeCAD.newDocument("pathregen")
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)

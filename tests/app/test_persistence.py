@@ -16,7 +16,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import docjob, features, fcenv, pathjob, replace
+from surfcomp.app import cam, docjob, features, pathjob, replace
 from surfcomp.app.nominal import nominal_from_face
 from tests.app.helpers import grid_on_face, write_cmm_csv
 from tests.app.test_features import add_part, block_solid, error_model
@@ -27,8 +27,8 @@ POST_ARGS = "--no-show-editor --no-header --precision=4"
 SCRIPT = r"""
 import json, os, sys
 sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
-from surfcomp.app import fcenv
-fcenv.setup_ocl()                     # before opening: the 3D Surface op imports ocl
+from surfcomp.app import cam
+cam.setup_ocl()                   # before opening: the 3D Surface op imports ocl
 import FreeCAD
 path = os.environ["SURFCOMP_DOC"]
 doc = FreeCAD.openDocument(path)
@@ -67,7 +67,7 @@ def _poles(shape, k):
 @pytest.fixture(scope="module")
 def saved(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("persist")
-    fcenv.setup_path_workbench()
+    cam.setup_workbench()
     doc = FreeCAD.newDocument("persist")
     solid = block_solid()
     nom = add_part(doc, solid, "Block")

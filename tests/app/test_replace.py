@@ -6,7 +6,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import features, fcenv, replace
+from surfcomp.app import cam, features, replace
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.errors import GeometryError, InputError
 from tests.app.helpers import grid_on_face, write_cmm_csv
@@ -53,7 +53,7 @@ def snapshot(doc):
 def setup():
     """A block (Face2 free-form), a compensation with solid output, a Draft clone of the
     block and a user with links of every kind; all computed."""
-    fcenv.setup_path_workbench(require_ocl=False)
+    cam.setup_workbench(require_ocl=False)
     import Draft
 
     doc = FreeCAD.newDocument("replace")

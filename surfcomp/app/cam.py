@@ -1,0 +1,340 @@
+"""The one place that knows how FreeCAD versions differ: Path (0.20) versus CAM (1.0, 1.1).
+
+Every branch is chosen by looking at what the installed FreeCAD has, never by parsing its
+version string, so a build between the releases takes the branch its modules support.
+
+- workbench folder: ``Mod/Path`` (0.20), ``Mod/CAM`` (1.0, 1.1);
+- Job, operations, tool controller, preferences, geometry and dressup helpers:
+  ``PathScripts.PathJob``, ``PathScripts.PathSurface``, ... (0.20); ``Path.Main.Job``,
+  ``Path.Op.Surface``, ``Path.Tool.Controller``, ``Path.Geom``, ``Path.Dressup.Utils``, ...
+  (1.x); ``PathScripts.PathUtils`` in all three;
+- tool bits: ``Factory.CreateFrom`` of ``PathScripts.PathToolBit`` (0.20) or
+  ``Path.Tool.Bit`` (1.0); the asset library ``Path.Tool.toolbit`` with
+  ``ToolBit.from_file(...).attach_to_doc(...)`` (1.1);
+- post-processors: ``<name>_post.py`` scripts on the workbench's post search path in all
+  three, but 0.20 loads them with ``PostProcessor.load`` and 1.x through a factory bound to
+  a Job; :func:`load_post` loads the script itself, the same way everywhere;
+- OpenCamLib: the PyPI wheel (Debian 12) and Debian's ``python3-opencamlib`` (13 and later)
+  both ship ``opencamlib/ocl.so``; 0.20 imports ``ocl``, so it is registered under that name;
+- Qt: PySide2/Qt5 (0.20, 1.0) or PySide6/Qt6 (1.1); GUI code imports FreeCAD's ``PySide``
+  shim only, so it needs no branch here.
+
+No FreeCADGui: everything here works in ``freecadcmd`` and in a plain ``python3`` once
+:func:`setup_workbench` has run.
+"""
+
+import importlib
+import importlib.util
+import os
+import sys
+from types import SimpleNamespace
+
+from ..errors import GCodeError, InputError
+from . import fcenv
+
+#: folders (relative to FreeCAD's home) of the CAM workbench: 0.20 ``Mod/Path``, 1.x ``Mod/CAM``
+WORKBENCH_DIRS = (os.path.join("Mod", "Path"), os.path.join("Mod", "CAM"))
+
+#: tool bit file of a ball end mill shipped with every version (its Diameter is set on use)
+BALL_END_BIT = "6mm_Ball_End.fctb"
+
+_API = None
+
+
+# --------------------------------------------------------------------------- environment
+def setup_ocl():
+    """Make ``import ocl`` work with either OpenCamLib package.
+
+    The PyPI wheel and Debian's ``python3-opencamlib`` both ship the extension as
+    ``opencamlib/ocl.so``; FreeCAD 0.20's 3D Surface operation does ``import ocl`` (1.x
+    falls back to ``import opencamlib``). The packaged module is registered under the plain
+    name. Returns True when ``ocl`` is importable afterwards.
+    """
+    if "ocl" in sys.modules:
+        return True
+    try:
+        spec = importlib.util.find_spec("ocl")
+    except (ImportError, ValueError):
+        spec = None
+    if spec is not None:
+        return True
+    try:
+        mod = importlib.import_module("opencamlib.ocl")
+    except ImportError:
+        return False
+    sys.modules["ocl"] = mod
+    return True
+
+
+def freecad_home():
+    """The FreeCAD resource folder that holds the CAM workbench, or None."""
+    for share in fcenv.SHARE_CANDIDATES:
+        if any(os.path.isdir(os.path.join(share, d)) for d in WORKBENCH_DIRS):
+            return share.rstrip("/") + "/"
+    return None
+
+
+def setup_workbench(require_ocl=True):
+    """Make the CAM workbench work from a plain ``python3`` as it works in ``freecadcmd``.
+
+    - puts FreeCAD's ``Mod/*`` and ``Ext`` folders on ``sys.path`` (:func:`fcenv.setup_paths`)
+      and OpenCamLib under the name ``ocl``;
+    - when FreeCAD is imported as a library, ``FreeCAD.getHomePath()`` is the library
+      folder, where the workbench finds no post-processors, tool bits or tool shapes: it is
+      made to return the resource folder (inside ``freecadcmd`` it already does).
+
+    Call it before opening a document with CAM objects: an operation whose module cannot be
+    imported at open time (e.g. the 3D Surface operation without ``ocl``) loses its proxy.
+
+    Returns
+    -------
+    str
+        FreeCAD's home folder as the workbench now sees it.
+
+    Raises
+    ------
+    ImportError
+        FreeCAD, its CAM workbench or (with ``require_ocl``) OpenCamLib is missing, with
+        what to install.
+    """
+    FreeCAD = fcenv.import_freecad()
+    home = FreeCAD.getHomePath()
+    if not any(os.path.isdir(os.path.join(home, d)) for d in WORKBENCH_DIRS):
+        share = freecad_home()
+        if share is None:
+            raise ImportError("FreeCAD's CAM (Path) workbench is not installed (looked for "
+                              "Mod/Path and Mod/CAM in %s)" % ", ".join(fcenv.SHARE_CANDIDATES))
+        home = share
+        FreeCAD.getHomePath = lambda: home
+    if require_ocl and not setup_ocl():
+        raise ImportError("OpenCamLib is not importable as 'ocl' (needed by the 3D Surface "
+                          "operation): run tools/install.sh (Debian 13 and later: apt-get "
+                          "install python3-opencamlib; Debian 12: python3 -m pip install "
+                          "opencamlib)")
+    return home
+
+
+# --------------------------------------------------------------------------- modules
+def _has_module(name):
+    """Whether ``name`` can be imported (False also when a parent is not a package, as
+    0.20's ``Path``, a plain extension module, is for ``Path.Main``)."""
+    try:
+        return importlib.util.find_spec(name) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+#: the CAM modules this project uses, by role, for 1.x and for 0.20
+_MODULES_1X = {"Job": "Path.Main.Job", "Surface": "Path.Op.Surface",
+               "Profile": "Path.Op.Profile", "ToolController": "Path.Tool.Controller",
+               "Preferences": "Path.Preferences", "Geom": "Path.Geom",
+               "Dressup": "Path.Dressup.Utils", "PathUtils": "PathScripts.PathUtils",
+               "ToolBit": "Path.Tool.Bit", "toolbit": "Path.Tool.toolbit"}
+_MODULES_020 = {"Job": "PathScripts.PathJob", "Surface": "PathScripts.PathSurface",
+                "Profile": "PathScripts.PathProfile",
+                "ToolController": "PathScripts.PathToolController",
+                "Preferences": "PathScripts.PathPreferences", "Geom": "PathScripts.PathGeom",
+                "Dressup": "PathScripts.PathDressup", "PathUtils": "PathScripts.PathUtils",
+                "ToolBit": "PathScripts.PathToolBit"}
+
+
+def api():
+    """Which branch each difference takes on the installed FreeCAD, found once.
+
+    Returns
+    -------
+    types.SimpleNamespace
+        ``modules``: ``'Path'`` (1.x: ``Path.Main``, ``Path.Op``, ...) or ``'PathScripts'``
+        (0.20); ``toolbits``: ``'library'`` (1.1's ``Path.Tool.toolbit``) or ``'Factory'``
+        (``Factory.CreateFrom``); ``names``: module name by role (see :func:`module`).
+    """
+    global _API
+    if _API is None:
+        setup_workbench(require_ocl=False)
+        setup_ocl()      # the 3D Surface operation's module needs it at import time
+        if _has_module("Path.Main"):
+            modules, names = "Path", dict(_MODULES_1X)
+        else:
+            modules, names = "PathScripts", dict(_MODULES_020)
+        toolbits = "library" if _has_module(names.get("toolbit", "")) else "Factory"
+        _API = SimpleNamespace(modules=modules, toolbits=toolbits, names=names)
+    return _API
+
+
+def module(role):
+    """The CAM module that plays ``role`` (``'Job'``, ``'Surface'``, ``'Profile'``,
+    ``'ToolController'``, ``'Preferences'``, ``'Geom'``, ``'Dressup'``, ``'PathUtils'``,
+    ``'ToolBit'``, ``'toolbit'``) on this FreeCAD, imported on first use."""
+    return importlib.import_module(api().names[role])
+
+
+def branches():
+    """``{'modules': ..., 'toolbits': ..., 'qt': ...}``: which branch each difference takes
+    on this FreeCAD (for messages, the test matrix and bug reports)."""
+    a = api()
+    qt = "PySide6" if _has_module("PySide6") else "PySide2"
+    return {"modules": a.modules, "toolbits": a.toolbits, "qt": qt}
+
+
+# --------------------------------------------------------------------------- objects
+def create_job(doc, models, name="Job"):
+    """A Job on ``models`` (document objects); CAM clones them into ``Job.Model``."""
+    import FreeCAD
+
+    if FreeCAD.ActiveDocument is None or FreeCAD.ActiveDocument.Name != doc.Name:
+        FreeCAD.setActiveDocument(doc.Name)
+    job = module("Job").Create(name, list(models), None)
+    doc.recompute()
+    return job
+
+
+def create_operation(kind, name, job=None):
+    """A new operation of ``kind`` (``'Surface'`` or ``'Profile'``) in ``job`` (default:
+    the document's only job)."""
+    return module(kind).Create(name, parentJob=job)
+
+
+def workbench_file(*parts):
+    """A file shipped with the CAM workbench (e.g. ``('Tools', 'Bit', name)``)."""
+    import FreeCAD
+
+    home = FreeCAD.getHomePath()
+    for sub in WORKBENCH_DIRS:
+        path = os.path.join(home, sub, *parts)
+        if os.path.isfile(path):
+            return path
+    raise InputError("the CAM workbench file %s is not installed (looked under %s)"
+                     % (os.path.join(*parts), home))
+
+
+def create_tool_bit(doc, bit_file, label):
+    """A tool bit document object made from a shipped ``.fctb`` file."""
+    path = workbench_file("Tools", "Bit", bit_file)
+    if api().toolbits == "library":
+        return module("toolbit").ToolBit.from_file(path).attach_to_doc(doc, label=label)
+    import FreeCAD
+
+    if FreeCAD.ActiveDocument is None or FreeCAD.ActiveDocument.Name != doc.Name:
+        FreeCAD.setActiveDocument(doc.Name)
+    return module("ToolBit").Factory.CreateFrom(path, label)
+
+
+def create_tool_controller(name, bit, number=1):
+    """A tool controller for ``bit`` (in the active document)."""
+    return module("ToolController").Create(name, bit, number)
+
+
+def find_parent_job(obj):
+    """The Job an operation or dressup belongs to, or None."""
+    return module("PathUtils").findParentJob(obj)
+
+
+def placed_commands(op):
+    """The commands of an operation's Path with its placement applied (0.20 has no
+    ``getPathWithPlacement``: its operations carry no placement of their own)."""
+    placed = getattr(module("PathUtils"), "getPathWithPlacement", None)
+    return (placed(op) if placed is not None else op.Path).Commands
+
+
+def base_operation(obj):
+    """The operation under a chain of dressups (``obj`` itself for an operation)."""
+    return module("Dressup").baseOp(obj)
+
+
+def edge_for_command(cmd, start):
+    """The Part edge a move command draws from ``start`` (FreeCAD.Vector), or None."""
+    return module("Geom").edgeForCmd(cmd, start)
+
+
+def command_end_point(cmd, start):
+    """Where a command leaves the tool, from ``start``."""
+    return module("Geom").commandEndPoint(cmd, start)
+
+
+# --------------------------------------------------------------------------- post-processing
+def available_posts():
+    """Names of the post-processors the workbench finds (without ``_post``)."""
+    return sorted(module("Preferences").allAvailablePostProcessors())
+
+
+def load_post(name):
+    """A fresh copy of the post-processor script ``<name>_post.py``.
+
+    Scripts keep their options in module globals, so each call loads the file anew (as
+    0.20's ``PostProcessor.load`` reloads it); the module's ``export(objects, filename,
+    argstring)`` returns the G-code text when ``filename`` is ``'-'``.
+
+    Raises
+    ------
+    GCodeError
+        No such post-processor, or it is not a script with ``export``.
+    """
+    names = available_posts()
+    if name not in names:
+        raise GCodeError("unknown post-processor %r (available: %s)" % (name, ", ".join(names)))
+    for folder in list(module("Preferences").searchPathsPost()) + list(sys.path):
+        path = os.path.join(folder or ".", "%s_post.py" % name)
+        if not os.path.isfile(path):
+            continue
+        spec = importlib.util.spec_from_file_location("%s_post" % name, path)
+        script = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(script)
+        if not callable(getattr(script, "export", None)):
+            raise GCodeError("post-processor %r (%s) has no export() function; only script "
+                             "post-processors are supported" % (name, path))
+        return script
+    raise GCodeError("post-processor %r is listed but its file was not found" % name)
+
+
+# --------------------------------------------------------------------------- 0.20 documents
+#: modules of FreeCAD 0.20's Path workbench named by the proxies in documents it saved, and
+#: the 1.x modules holding the same classes (FreeCAD 1.x itself restores none of them)
+LEGACY_MODULES = {
+    "PathScripts.PathJob": "Path.Main.Job",
+    "PathScripts.PathStock": "Path.Main.Stock",
+    "PathScripts.PathSetupSheet": "Path.Base.SetupSheet",
+    "PathScripts.PathToolController": "Path.Tool.Controller",
+    "PathScripts.PathToolBit": "Path.Tool.Bit",
+    "PathScripts.PathSurface": "Path.Op.Surface",
+    "PathScripts.PathWaterline": "Path.Op.Waterline",
+    "PathScripts.PathProfile": "Path.Op.Profile",
+    "PathScripts.PathPocket": "Path.Op.Pocket",
+    "PathScripts.PathPocketShape": "Path.Op.PocketShape",
+    "PathScripts.PathMillFace": "Path.Op.MillFace",
+    "PathScripts.PathAdaptive": "Path.Op.Adaptive",
+    "PathScripts.PathDrilling": "Path.Op.Drilling",
+    "PathScripts.PathHelix": "Path.Op.Helix",
+    "PathScripts.PathEngrave": "Path.Op.Engrave",
+    "PathScripts.PathDeburr": "Path.Op.Deburr",
+    "PathScripts.PathVcarve": "Path.Op.Vcarve",
+    "PathScripts.PathSlot": "Path.Op.Slot",
+    "PathScripts.PathCustom": "Path.Op.Custom",
+    "PathScripts.PathProbe": "Path.Op.Probe",
+    "PathScripts.PathThreadMilling": "Path.Op.ThreadMilling",
+    "PathScripts.PathDressupPathBoundary": "Path.Dressup.Boundary",
+    "PathScripts.PathDressupHoldingTags": "Path.Dressup.Tags",
+}
+
+
+def alias_legacy_modules(names):
+    """Let a document saved by FreeCAD 0.20 restore its CAM objects on 1.x.
+
+    ``names``: the proxy modules the document names (its ``Document.xml``).
+
+    0.20 saved each Path object's proxy as ``PathScripts.PathJob.ObjectJob`` and so on;
+    1.x moved the classes (same names) to ``Path.*`` and cannot restore those proxies, so the
+    Job, its tools and operations come back as dead objects. Each such name that this
+    FreeCAD cannot import is registered as an alias of the module that holds the classes now;
+    the classes' own ``onDocumentRestored`` then bring the properties up to date. Does nothing
+    on 0.20. Returns ``{old: new}`` for the names aliased.
+    """
+    done = {}
+    if api().modules != "Path":
+        return done
+    for old in names:
+        new = LEGACY_MODULES.get(old)
+        if new is None or old in sys.modules or _has_module(old) or not _has_module(new):
+            continue
+        sys.modules[old] = importlib.import_module(new)
+        done[old] = new
+    return done
