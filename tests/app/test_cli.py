@@ -305,6 +305,23 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
         assert 'id="maps"' in (tmp_path / "r.html").read_text()
 
 
+#: runs the CLI with the corrected-surface construction held at its first progress report,
+#: so the interrupt lands there however loaded the machine is
+HOLD_IN_BUILD = r"""
+import sys, time
+import surfcomp.core.corrected as corrected
+from surfcomp.cli import main
+report = corrected.report
+def held(progress, fraction, message=""):
+    report(progress, fraction, message)
+    if message == "building the corrected surface":
+        sys.stderr.write("HELD\n"); sys.stderr.flush()
+        time.sleep(120)
+corrected.report = held
+sys.exit(main(sys.argv[1:]))
+"""
+
+
 def test_interrupt_leaves_no_outputs(tmp_path):
     """Ctrl-C while the corrected surface is being built: exit 130, nothing written."""
     import signal
@@ -312,13 +329,13 @@ def test_interrupt_leaves_no_outputs(tmp_path):
     nom = load_nominal(EXAMPLE_STEP)
     P, N, U, V = grid_on_face(nom, 150, 150)
     write_cmm_csv(tmp_path / "m.csv", P, N, 0.02 * np.sin(U / U.max() * 3))
-    proc = subprocess.Popen([sys.executable, "-m", "surfcomp", "compensate", EXAMPLE_STEP,
+    proc = subprocess.Popen([sys.executable, "-c", HOLD_IN_BUILD, "compensate", EXAMPLE_STEP,
                              tmp_path / "m.csv", "-o", tmp_path / "c.step", "--report",
                              tmp_path / "r.json"], cwd=ROOT, stderr=subprocess.PIPE, text=True)
     seen = []
     for line in proc.stderr:
         seen.append(line)
-        if "building the corrected surface" in line:
+        if line.strip() == "HELD":
             proc.send_signal(signal.SIGINT)
             break
     rest = proc.stderr.read()
