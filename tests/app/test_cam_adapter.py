@@ -1,0 +1,90 @@
+"""The version adapter (surfcomp.app.cam) takes the branch the installed FreeCAD needs, and
+each branch works: the version matrix runs this file on 0.20 (PathScripts, Factory tool
+bits, PySide2), 1.0 (Path, Factory, PySide2) and 1.1 (Path, tool-bit library, PySide6)."""
+
+import importlib.util
+import os
+
+import FreeCAD
+import pytest
+
+from surfcomp.app import cam
+from surfcomp.errors import GCodeError
+
+
+@pytest.fixture(scope="module")
+def home():
+    return cam.setup_workbench()
+
+
+@pytest.fixture
+def doc():
+    d = FreeCAD.newDocument("camadapter")
+    yield d
+    FreeCAD.closeDocument(d.Name)
+
+
+def test_branches_follow_what_is_installed(home):
+    b = cam.branches()
+    has_cam_folder = os.path.isdir(os.path.join(home, "Mod", "CAM"))
+    assert b["modules"] == ("Path" if has_cam_folder else "PathScripts")
+    assert b["toolbits"] == ("library" if cam._has_module("Path.Tool.toolbit") else "Factory")
+    assert b["qt"] == ("PySide6" if importlib.util.find_spec("PySide6") else "PySide2")
+    # what the releases of the matrix have (the branch is never chosen from this number)
+    version = tuple(int(x) for x in FreeCAD.Version()[:2])
+    expected = {(0, 20): ("PathScripts", "Factory"), (1, 0): ("Path", "Factory"),
+                (1, 1): ("Path", "library")}
+    if version in expected:
+        assert (b["modules"], b["toolbits"]) == expected[version]
+    # every module the adapter uses on this branch imports
+    unused = "ToolBit" if b["toolbits"] == "library" else "toolbit"
+    for role, name in cam.api().names.items():
+        if role != unused:
+            assert cam.module(role) is importlib.import_module(name)
+
+
+def test_ball_end_bit_and_tool_controller(home, doc):
+    bit = cam.create_tool_bit(doc, cam.BALL_END_BIT, "Ball")
+    bit.Diameter = 4.0
+    tc = cam.create_tool_controller("TC: Ball", bit, 3)
+    doc.recompute()
+    assert tc.Tool is bit and tc.ToolNumber == 3
+    assert abs(float(tc.Tool.Diameter) - 4.0) < 1e-12
+    # the bit's shape: BitShape file (0.20, 1.0) or ShapeID of the asset library (1.1)
+    shape = bit.ShapeID if "ShapeID" in bit.PropertiesList else bit.BitShape
+    assert "ball" in str(shape).lower()
+    with pytest.raises(Exception, match="not installed"):
+        cam.create_tool_bit(doc, "no_such_bit.fctb", "x")
+
+
+def test_post_processor_scripts_load_fresh(home):
+    posts = cam.available_posts()
+    assert {"linuxcnc", "grbl"} <= set(posts)
+    a, b = cam.load_post("linuxcnc"), cam.load_post("linuxcnc")
+    assert callable(a.export) and a is not b          # options live in module globals
+    with pytest.raises(GCodeError, match="unknown post-processor 'nope'.*linuxcnc"):
+        cam.load_post("nope")
+
+
+def test_profile_operation_and_helpers(home, doc):
+    import Part
+
+    box = doc.addObject("Part::Box", "Box")
+    doc.recompute()
+    job = cam.create_job(doc, [box])
+    op = cam.create_operation("Profile", "Profile", job)
+    doc.recompute()
+    assert cam.find_parent_job(op) is job
+    assert cam.base_operation(op) is op
+    cmds = cam.placed_commands(op)
+    assert len(cmds) > 10
+    # the geometry helpers draw the profile around the 10 x 10 box (offset by the tool)
+    pos = FreeCAD.Vector(0, 0, 0)
+    edges = []
+    for c in cmds:
+        e = cam.edge_for_command(c, pos) if c.Name in ("G1", "G2", "G3") else None
+        if e is not None:
+            edges.append(e)
+        pos = cam.command_end_point(c, pos)
+    box_xy = Part.Compound(edges).BoundBox
+    assert 10.0 < box_xy.XLength < 20.0 and 10.0 < box_xy.YLength < 20.0
