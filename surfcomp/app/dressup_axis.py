@@ -13,25 +13,24 @@ becomes the command ``X'`` with ``X' + E(X') = X``.
 The error measurements live in the document (float-list properties), not only as a path
 to a CSV file: the model is refitted from them on every recompute, so ``Model``,
 ``Reference`` and ``WorkOffset`` can be changed without the file.
+
+Import this module where FreeCAD is importable: inside FreeCAD, or from a plain ``python3``
+after :func:`surfcomp.app.fcenv.import_freecad` (which puts the CAM workbench's ``Path``
+package of 1.x on the path too).
 """
 
-from . import fcenv
+import os
 
-fcenv.setup_paths()
+import FreeCAD
+import numpy as np
+import Path
 
-import FreeCAD  # noqa: E402
-import Path  # noqa: E402
-
-import os  # noqa: E402
-
-import numpy as np  # noqa: E402
-
-from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors  # noqa: E402
-from ..errors import InputError  # noqa: E402
-from ..io.axis_csv import AxisErrorTable, read_axis_errors  # noqa: E402
-from ..io.gcode import compensate_commands  # noqa: E402
-from . import cam  # noqa: E402
-from .proxies import Proxy  # noqa: E402
+from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors
+from ..errors import InputError
+from ..io.axis_csv import AxisErrorTable, read_axis_errors
+from ..io.gcode import compensate_commands
+from . import cam
+from .proxies import Proxy
 
 #: version of the document object's property set; onDocumentRestored upgrades older ones
 VERSION = 1

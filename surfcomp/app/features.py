@@ -25,33 +25,31 @@ with the chosen method, and the corrections accumulate:
 ``S(u, v) - Correction(u, v) n(u, v)`` of the nominal ``S``.
 
 The proxy module path ``surfcomp.app.features`` is permanent once documents exist.
+
+Import this module where FreeCAD is importable: inside FreeCAD, or from a plain ``python3``
+after :func:`surfcomp.app.fcenv.import_freecad`.
 """
 
 import json
 import os
 from dataclasses import replace as _dc_replace
 
+import FreeCAD
 import numpy as np
 
-from . import fcenv
-
-fcenv.setup_paths()
-
-import FreeCAD  # noqa: E402
-
-from ..core.deviations import statistics  # noqa: E402
-from ..core.field import GridField  # noqa: E402
-from ..core.filters import EDGE_MODES  # noqa: E402
-from ..core.methods import METHODS  # noqa: E402
-from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare  # noqa: E402
-from ..core.progress import sub  # noqa: E402
-from ..core.scattered import ScatteredField  # noqa: E402
-from ..errors import GeometryError, InputError  # noqa: E402
-from ..io.measurements import MeasurementSet  # noqa: E402
-from ..io.readers import FORMATS, read_any  # noqa: E402
-from .progress import freecad_progress  # noqa: E402
-from .proxies import Proxy  # noqa: E402
-from .proxies import migrate as _migrate  # noqa: E402
+from ..core.deviations import statistics
+from ..core.field import GridField
+from ..core.filters import EDGE_MODES
+from ..core.methods import METHODS
+from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare
+from ..core.progress import sub
+from ..core.scattered import ScatteredField
+from ..errors import GeometryError, InputError
+from ..io.measurements import MeasurementSet
+from ..io.readers import FORMATS, read_any
+from .progress import freecad_progress
+from .proxies import Proxy
+from .proxies import migrate as _migrate
 
 #: version of the property sets; onDocumentRestored upgrades older objects
 VERSION = 1
