@@ -28,7 +28,8 @@ def surface_from_part(bs, u_range=None, v_range=None):
         if bs.isVPeriodic():
             bs.setVNotPeriodic()
     poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float)
-    weights = np.array(bs.getWeights(), dtype=float) if bs.isURational() or bs.isVRational() else None
+    weights = (np.array(bs.getWeights(), dtype=float) if bs.isURational() or bs.isVRational()
+               else None)
     ku = _flat_knots(bs.getUKnots(), bs.getUMultiplicities())
     kv = _flat_knots(bs.getVKnots(), bs.getVMultiplicities())
     return Surface(poles, ku, kv, bs.UDegree, bs.VDegree, weights, u_range, v_range)

@@ -73,7 +73,8 @@ def run_job(job, progress=None):
             raise InputError("an output would overwrite an input file", file=out)
     nominal = load_nominal(job.nominal, job.face, job.object)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample)
-    prepared = prepare(nominal.surface, nominal.outward, ms, job.options, progress=sub(progress, 0, 0.3))
+    prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
+                       progress=sub(progress, 0, 0.3))
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
                       progress=sub(progress, 0.3, 0.95))
@@ -84,7 +85,8 @@ def run_job(job, progress=None):
                     "poles": list(nominal.surface.shape),
                     "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
                     "rational": nominal.surface.weights is not None,
-                    "u_range": list(nominal.surface.u_range), "v_range": list(nominal.surface.v_range)},
+                    "u_range": list(nominal.surface.u_range),
+                    "v_range": list(nominal.surface.v_range)},
         "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
                          "units": ms.units, "kind": ms.kind(), "points": len(ms),
                          "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
@@ -149,7 +151,8 @@ def write_face(path, shape):
     elif ext in (".brep", ".brp"):
         shape.exportBrep(path)
     else:
-        raise InputError("unsupported output type %r (expected .step, .iges or .brep)" % ext, file=path)
+        raise InputError("unsupported output type %r (expected .step, .iges or .brep)" % ext,
+                         file=path)
 
 
 def corrected_points_csv(comp):
@@ -164,7 +167,8 @@ def corrected_points_csv(comp):
     rows = ["row,col,x_nom,y_nom,z_nom,i,j,k,correction,x_cor,y_cor,z_cor"]
     for k in range(p.u.size):
         rows.append("%d,%d,%.6f,%.6f,%.6f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f,%.6f"
-                    % ((row[k], col[k]) + tuple(p.nominal[k]) + tuple(p.normal[k]) + (delta[k],) + tuple(cor[k])))
+                    % ((row[k], col[k]) + tuple(p.nominal[k]) + tuple(p.normal[k]) + (delta[k],)
+                       + tuple(cor[k])))
     return "\n".join(rows) + "\n"
 
 

@@ -128,7 +128,8 @@ def pick_face(shape, face_name=None, source=None):
         return bs[0][1], "Face%d" % bs[0][0]
     kinds = {}
     for f in faces:
-        kinds[f.Surface.TypeId.split("::Geom")[-1]] = kinds.get(f.Surface.TypeId.split("::Geom")[-1], 0) + 1
+        kind = f.Surface.TypeId.split("::Geom")[-1]
+        kinds[kind] = kinds.get(kind, 0) + 1
     raise GeometryError("%s B-spline faces among %d faces (%s): choose one with --face FaceN"
                         % ("no" if not bs else "%d" % len(bs), len(faces),
                            ", ".join("%d %s" % (c, k) for k, c in sorted(kinds.items())))

@@ -165,7 +165,8 @@ def print_summary(comp, rep, out=sys.stdout):
     ch = comp.checks
     print("Corrected face: %d x %d poles, degree %d x %d%s"
           % (ch.poles_shape + (comp.corrected.degree_u, comp.corrected.degree_v,
-                               ", rational" if comp.corrected.weights is not None else "")), file=out)
+                               ", rational" if comp.corrected.weights is not None else "")),
+          file=out)
     print("  realised - intended correction at the %d measured points: max %.4f um"
           % (p.u.size, ch.max_error_at_points * 1e3), file=out)
     print("  zero correction reproduces the nominal within %.4f um (on a %d x %d check grid)"

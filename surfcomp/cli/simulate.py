@@ -65,11 +65,13 @@ def add_parser(subparsers):
                "along/across the feed). See README 'Virtual machining'.")
     p.add_argument("nominal", metavar="NOMINAL",
                    help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)")
-    p.add_argument("--face", metavar="FaceN", help="the nominal face (default: the only B-spline face)")
+    p.add_argument("--face", metavar="FaceN",
+                   help="the nominal face (default: the only B-spline face)")
     p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
     g = p.add_argument_group("loop")
     g.add_argument("--grid", default="45x45", metavar="NxM",
-                   help="measurement grid, uniform in the face parameters (default 45x45, Werner 2022)")
+                   help="measurement grid, uniform in the face parameters (default 45x45, "
+                        "Werner 2022)")
     g.add_argument("--margin", type=float, default=0.02, metavar="FRACTION",
                    help="parameter range left free at each border (default 0.02)")
     g.add_argument("--between", type=int, default=2, metavar="K",
@@ -181,7 +183,8 @@ def run(args):
     try:
         masks = [int(x) for x in args.mask.split(",")]
     except ValueError:
-        raise InputError("--mask %r: expected odd whole numbers, e.g. 5 or 3,5,7" % args.mask) from None
+        raise InputError("--mask %r: expected odd whole numbers, e.g. 5 or 3,5,7"
+                         % args.mask) from None
     methods = [x.strip() for x in args.methods.split(",") if x.strip()]
     specs = sim.method_specs(methods, masks, args.stock, args.mask_kind, args.edge, args.refine)
     labels = [s.label for s in specs]
@@ -192,7 +195,8 @@ def run(args):
             raise InputError("--html needs a compensating method in --methods (the report "
                              "shows a compensation)")
         if report_label is None:
-            report_label = next((x for x in comp_labels if x.startswith("filtered")), comp_labels[0])
+            report_label = next((x for x in comp_labels if x.startswith("filtered")),
+                                comp_labels[0])
         elif report_label not in comp_labels:
             raise InputError("--report-method %r: expected one of %s"
                              % (report_label, ", ".join(comp_labels)))
@@ -205,7 +209,8 @@ def run(args):
     res = sim.simulate(nominal.surface, nominal.outward, model, grid=grid, specs=specs,
                        replicas=args.replicas, seed=args.seed, margin=args.margin,
                        between=args.between, keep=bool(args.html), progress=sub(progress, 0, 0.95))
-    inputs = {"nominal": {"path": os.path.abspath(args.nominal), "sha256": sha256_file(args.nominal),
+    inputs = {"nominal": {"path": os.path.abspath(args.nominal),
+                          "sha256": sha256_file(args.nominal),
                           "face": nominal.face_name, "object": nominal.object_name,
                           "surface": nominal.converted or "BSplineSurface",
                           "poles": list(nominal.surface.shape),
@@ -225,15 +230,18 @@ def run(args):
             comp = res.compensations[report_label]
             meas = {"path": "<simulated: replica 1, %s>" % report_label,
                     "sha256": _array_sha256(comp.prepared.deviation), "units": "mm",
-                    "kind": "simulated nominal+normal+deviation", "points": int(comp.prepared.u.size),
+                    "kind": "simulated nominal+normal+deviation",
+                    "points": int(comp.prepared.u.size),
                     "columns": {}, "ignored_columns": []}
             rep = report_io.build_report("simulate", dict(inputs, measurements=meas), comp,
                                          comp.prepared.warnings,
                                          {"html": os.path.abspath(args.html)})
             tx.stage_text(args.html, render_html(rep, data))
         tx.commit()
-    print("Nominal:   %s (%s, %d x %d poles)" % (args.nominal, nominal.face_name, *nominal.surface.shape))
-    print("Grid:      %d x %d measured, %d x %d evaluated (nodes and between); %d replica(s), seed %d"
+    print("Nominal:   %s (%s, %d x %d poles)"
+          % (args.nominal, nominal.face_name, *nominal.surface.shape))
+    print("Grid:      %d x %d measured, %d x %d evaluated (nodes and between); "
+          "%d replica(s), seed %d"
           % (grid + res.eval_shape + (res.replicas, res.seed)))
     print("Methods:   %s" % ", ".join(labels))
     print("")

@@ -363,7 +363,8 @@ class AxisErrorModel:
                 xc[bad] -= np.linalg.solve(J, r[bad][:, :, None])[:, :, 0]
             except np.linalg.LinAlgError as exc:
                 raise ComputationError("axis error compensation: singular Jacobian (%s); the "
-                                       "error model's slopes make a slide stand still" % exc)
+                                       "error model's slopes make a slide stand still"
+                                       % exc) from exc
         raise ComputationError("axis error compensation did not converge in %d Newton steps "
                                "(largest residual %.3g mm)" % (max_iter, np.abs(r).max()))
 

@@ -55,9 +55,11 @@ class Surface:
                 raise ValueError("weights must be positive with shape (nu, nv)")
             object.__setattr__(self, "weights", w)
         if self.u_range is None:
-            object.__setattr__(self, "u_range", (float(ku[self.degree_u]), float(ku[-self.degree_u - 1])))
+            object.__setattr__(self, "u_range",
+                               (float(ku[self.degree_u]), float(ku[-self.degree_u - 1])))
         if self.v_range is None:
-            object.__setattr__(self, "v_range", (float(kv[self.degree_v]), float(kv[-self.degree_v - 1])))
+            object.__setattr__(self, "v_range",
+                               (float(kv[self.degree_v]), float(kv[-self.degree_v - 1])))
 
     @property
     def rational(self):
@@ -270,8 +272,9 @@ def _ders_chunk(surf, Pw, u, v, order):
     G = Pw[iu[:, :, None], iv[:, None, :]].reshape(n, k_u * k_v, -1)  # (n, (pu+1)(pv+1), dim)
     # one contraction per derivative with the outer product of the two bases (faster
     # than two chained einsums over these short axes)
-    A = {(k, l): np.einsum("nk,nkc->nc", (Nu[k][:, :, None] * Nv[l][:, None, :]).reshape(n, -1), G)
-         for (k, l) in _ORDER_KEYS[order]}
+    A = {(k, kv): np.einsum("nk,nkc->nc",
+                            (Nu[k][:, :, None] * Nv[kv][:, None, :]).reshape(n, -1), G)
+         for (k, kv) in _ORDER_KEYS[order]}
     if surf.weights is None:
         return {key: val[:, :3] for key, val in A.items()}
     return _rational_quotient(A, order)
@@ -440,9 +443,10 @@ def evaluate_grid(surf, us, vs, order=0):
     Bv = [basis_matrix(surf.knots_v, surf.degree_v, nv, vs, k) for k in range(order + 1)]
     # first contract along v: (nv, nu*dim) -> (Mv, nu, dim)
     flat = np.ascontiguousarray(Pw.transpose(1, 0, 2)).reshape(nv, nu * dim)
-    Tv = [(Bv[l] @ flat).reshape(vs.size, nu, dim).transpose(1, 0, 2).reshape(nu, vs.size * dim)
-          for l in range(order + 1)]
-    A = {(k, l): (Bu[k] @ Tv[l]).reshape(us.size * vs.size, dim) for (k, l) in _ORDER_KEYS[order]}
+    Tv = [(Bv[kv] @ flat).reshape(vs.size, nu, dim).transpose(1, 0, 2).reshape(nu, vs.size * dim)
+          for kv in range(order + 1)]
+    A = {(k, kv): (Bu[k] @ Tv[kv]).reshape(us.size * vs.size, dim)
+         for (k, kv) in _ORDER_KEYS[order]}
     if surf.weights is None:
         res = {key: val for key, val in A.items()}
     else:

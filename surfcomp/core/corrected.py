@@ -66,7 +66,8 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.25):
     step = np.median(np.diff(lines))
     own = np.unique(np.asarray(knots, dtype=float))
     lines = np.concatenate([lines[0] - step * np.arange(int((lines[0] - lo) / step), 0, -1),
-                            lines, lines[-1] + step * np.arange(1, int((hi - lines[-1]) / step) + 1)])
+                            lines,
+                            lines[-1] + step * np.arange(1, int((hi - lines[-1]) / step) + 1)])
     near = np.min(np.abs(lines[:, None] - own[None, :]), axis=1) < keep_off * step
     return lines[(lines > lo) & (lines < hi) & ~near]
 
@@ -125,7 +126,8 @@ class _Sampling:
         self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
 
     def build(self, delta):
-        """The surface through ``S - delta n`` at the samples; ``delta`` shape (len(us), len(vs))."""
+        """The surface through ``S - delta n`` at the samples; ``delta`` shape
+        (len(us), len(vs))."""
         f = self.fine
         target = self.S - np.asarray(delta, dtype=float)[..., None] * self.n
         poles = bspline.interpolate_grid(self.us, self.vs, target, f.knots_u, f.knots_v,
@@ -435,7 +437,8 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
         zero_dev = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(zero, ub, vs), n)
         max_real = max(max_real, float(np.max(np.abs(real))))
         max_zero = max(max_zero, float(np.max(np.abs(zero_dev))))
-    return CheckFigures(max_error_at_points=float(np.max(np.abs(np.ravel(realised) - np.ravel(delta)))),
+    return CheckFigures(max_error_at_points=float(np.max(np.abs(np.ravel(realised)
+                                                                - np.ravel(delta)))),
                         max_zero_deviation=max_zero, max_realised=max_real,
                         max_intended=float(np.max(np.abs(delta))),
                         dense_shape=(us.size, vs.size), poles_shape=tuple(corrected.shape))

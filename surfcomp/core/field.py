@@ -165,8 +165,10 @@ class GridField:
             val[sl] = np.einsum("nk,nkc->nc", (A[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
             if deriv:
                 dA, dB = _dpowers(a), _dpowers(b)
-                ds[sl] = np.einsum("nk,nkc->nc", (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
-                dt[sl] = np.einsum("nk,nkc->nc", (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
+                ds[sl] = np.einsum("nk,nkc->nc",
+                                   (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
+                dt[sl] = np.einsum("nk,nkc->nc",
+                                   (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
         return val, ds, dt
 
     def _clamped(self, s, t):

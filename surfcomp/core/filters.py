@@ -57,7 +57,8 @@ def parse_weights(text):
             values.append([float(x) for x in re.split(r"[\s,]+", row.strip())])
         except ValueError:
             raise InputError("mask weights row %d %r is not a list of numbers "
-                             "(expected rows like '1 2 1; 2 4 2; 1 2 1')" % (k, row.strip())) from None
+                             "(expected rows like '1 2 1; 2 4 2; 1 2 1')"
+                             % (k, row.strip())) from None
     n = len(values)
     if any(len(r) != n for r in values):
         raise InputError("mask weights %r are not square: %d rows of lengths %s (expected "
@@ -135,7 +136,8 @@ def mask_filter(d, mask, edge="renormalize"):
     """
     mask = check_mask(mask)
     if edge not in EDGE_MODES:
-        raise InputError("unknown edge handling %r (expected one of %s)" % (edge, ", ".join(EDGE_MODES)))
+        raise InputError("unknown edge handling %r (expected one of %s)"
+                         % (edge, ", ".join(EDGE_MODES)))
     d = np.asarray(d, dtype=float)
     valid = np.isfinite(d)
     values = np.where(valid, d, 0.0)

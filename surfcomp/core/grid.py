@@ -59,7 +59,8 @@ def grid_from_indices(row, col, u, v, lines=None, source=None):
     if dup.size:
         a, b = order[dup[0]], order[dup[0] + 1]
         raise GridError("grid node (row %s, col %s) given twice (also on line %s) (expected each "
-                        "row/col pair once)" % (row[b], col[b], lines[a] if lines is not None else "?"),
+                        "row/col pair once)"
+                        % (row[b], col[b], lines[a] if lines is not None else "?"),
                         **_where(source, lines, b))
     index.ravel()[flat] = np.arange(row.size)
     if np.any(index < 0):
@@ -67,8 +68,8 @@ def grid_from_indices(row, col, u, v, lines=None, source=None):
         names = ", ".join("(row %s, col %s)" % (ru[i], cu[j]) for i, j in miss[:10])
         more = "" if len(miss) <= 10 else " and %d more" % (len(miss) - 10)
         raise GridError("the row/col indices do not form a complete %d x %d grid: missing %s%s "
-                        "(expected every row/col pair; without row/col columns the points can be used as "
-                        "a scattered layout)"
+                        "(expected every row/col pair; without row/col columns the points can be "
+                        "used as a scattered layout)"
                         % (n, m, names, more), file=source)
     return _oriented(Grid(index, "row/col columns"), u, v, source)
 
@@ -184,7 +185,11 @@ def grid_from_uv(u, v, lines=None, source=None):
                     file=source)
 
 
-def _rows_in_file_order(u, v, turn=np.cos(np.radians(45.0))):
+#: cosine of the direction change (45 degrees) that ends a scan line in file order
+_ROW_TURN = np.cos(np.radians(45.0))
+
+
+def _rows_in_file_order(u, v, turn=_ROW_TURN):
     """Rows of a raster or serpentine scan written line by line, whatever their angle to
     the parameter lines: a row ends where the scan direction turns by more than 45
     degrees on both sides of one step (the step to the next line). Returns the index

@@ -86,6 +86,6 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
         delta = d - float(stock)
     else:
         delta = np.where(np.isfinite(d), np.nanmean(d), np.nan)
-    return CorrectionResult(method=method, deviation=d, determined=determined, random=d - determined,
-                            delta=delta, mask=mask, edge=edge,
+    return CorrectionResult(method=method, deviation=d, determined=determined,
+                            random=d - determined, delta=delta, mask=mask, edge=edge,
                             stock=None if stock is None else float(stock))

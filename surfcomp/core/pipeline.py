@@ -136,7 +136,8 @@ def prepare(surface, outward, ms, options=None, progress=None):
     warnings = list(getattr(ms, "warnings", []) or [])
     base = ms.nominal if ms.nominal is not None else ms.measured
     if base is None:
-        raise InputError("the measurement set has neither nominal nor measured points", file=ms.source)
+        raise InputError("the measurement set has neither nominal nor measured points",
+                         file=ms.source)
     tip = float(options.tip_radius or 0.0)
     if tip < 0:
         raise InputError("the tip radius must be >= 0 mm, got %g" % tip, file=ms.source)
@@ -164,7 +165,8 @@ def prepare(surface, outward, ms, options=None, progress=None):
     if outside.size:
         k = outside[0]
         raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
-                   "(%d point(s) do; expected points on the face)" % (tuple(base[k]) + (outside.size,)))
+                   "(%d point(s) do; expected points on the face)"
+                   % (tuple(base[k]) + (outside.size,)))
     n_face = proj.normal * outward
     if ms.normal is not None:
         given = np.asarray(ms.normal, dtype=float)

@@ -146,21 +146,21 @@ class _SpanTable:
         n = u.size
         pu, pv, dim = self.pu, self.pv, self.dim
         G = self._table[:, key].reshape(pv + 1, (pu + 1) * dim, n)
-        W = _horner(G, t, order)  # W[l]: d^l/dt^l, (A*C, n)
+        W = _horner(G, t, order)  # W[kv]: d^kv/dt^kv, (A*C, n)
         keys = bspline._ORDER_KEYS[order]
         A = {}
         inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
-        for l in range(order + 1):
-            Ws = W[l].reshape(pu + 1, dim, n)
-            D = _horner(Ws, s, order - l)
-            for k in range(order - l + 1):
-                if (k, l) in keys:
+        for kv in range(order + 1):
+            Ws = W[kv].reshape(pu + 1, dim, n)
+            D = _horner(Ws, s, order - kv)
+            for k in range(order - kv + 1):
+                if (k, kv) in keys:
                     val = D[k]
                     if k:
                         val = val * inv_hu ** k
-                    if l:
-                        val = val * inv_hv ** l
-                    A[(k, l)] = val
+                    if kv:
+                        val = val * inv_hv ** kv
+                    A[(k, kv)] = val
         if not self.rational:
             return [A[key_] for key_ in keys]
         return _quotient_soa(A, order)

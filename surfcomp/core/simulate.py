@@ -187,7 +187,8 @@ class MachiningModel:
         xi, eta = pf / frame.half[0], pc / frame.half[1]
         s = self.slope(n)
         e = (self.offset + self.slope_gain * s + self.abs_slope_gain * np.abs(s)
-             + self.tilt[0] * xi + self.tilt[1] * eta + self.bow[0] * xi ** 2 + self.bow[1] * eta ** 2)
+             + self.tilt[0] * xi + self.tilt[1] * eta
+             + self.bow[0] * xi ** 2 + self.bow[1] * eta ** 2)
         if self.waviness:
             e = e + self.waviness * np.sin(2.0 * np.pi * pf / self.wavelength)
         if self.axis_errors is not None:
@@ -201,12 +202,14 @@ class MachiningModel:
             return np.zeros(P.shape[0])
         if self.correlation_length == 0:
             return rng.normal(0.0, self.sigma, P.shape[0])
-        return self.sigma * correlated_field(frame.coords(P), frame.half, self.correlation_length, rng)
+        return self.sigma * correlated_field(frame.coords(P), frame.half,
+                                             self.correlation_length, rng)
 
 
 @dataclass
 class Frame:
-    """Work-area frame: ``center`` (3,), unit ``feed``, ``cross``, ``axis`` (3,), ``half`` (2,) mm."""
+    """Work-area frame: ``center`` (3,), unit ``feed``, ``cross``, ``axis`` (3,), ``half``
+    (2,) mm."""
 
     center: np.ndarray
     feed: np.ndarray
@@ -299,21 +302,24 @@ def method_specs(methods=("none", "offset", "raw", "filtered", "mirror"), masks=
     for m in methods:
         m = m.strip()
         if m not in SIM_METHODS:
-            raise InputError("unknown method %r (expected some of %s)" % (m, ", ".join(SIM_METHODS)))
+            raise InputError("unknown method %r (expected some of %s)"
+                             % (m, ", ".join(SIM_METHODS)))
         kw = {} if refine is None else {"refine": int(refine)}
         if m == "none":
             specs.append(MethodSpec("none", "none"))
         elif m == "filtered":
             for k in masks:
-                opt = Options(method="filtered", mask_size=int(k), mask_kind=mask_kind, edge=edge, **kw)
+                opt = Options(method="filtered", mask_size=int(k), mask_kind=mask_kind, edge=edge,
+                              **kw)
                 opt.mask()  # validates the size
                 specs.append(MethodSpec("filtered %dx%d" % (k, k) if len(masks) > 1 or k != 5
                                         else "filtered", "filtered", opt))
         elif m == "mirror":
             if stock is None or not np.isfinite(stock) or stock < 0:
                 raise InputError("the mirror method needs a stock >= 0 mm, got %r" % (stock,))
-            specs.append(MethodSpec("mirror", "mirror", Options(method="mirror", stock=float(stock),
-                                                                 mask_kind=mask_kind, edge=edge, **kw)))
+            specs.append(MethodSpec("mirror", "mirror",
+                                    Options(method="mirror", stock=float(stock),
+                                            mask_kind=mask_kind, edge=edge, **kw)))
         else:
             specs.append(MethodSpec(m, m, Options(method=m, mask_kind=mask_kind, edge=edge, **kw)))
     labels = [s.label for s in specs]
@@ -613,7 +619,8 @@ class SimulationResult:
             d.update(block(self.after[spec.label]))
             if spec.label in self.semi_finish:
                 d["semi_finish"] = {"replicas": [s.as_dict() for s in self.semi_finish[spec.label]],
-                                    "note": "measured before the mirror correction; includes the stock"}
+                                    "note": "measured before the mirror correction; includes "
+                                            "the stock"}
             if spec.label in self.checks:
                 d["max_error_at_points_mm"] = [float(x) for x in self.checks[spec.label]]
             methods.append(d)
@@ -667,7 +674,8 @@ def format_simulation_table(columns, replicas, unit="um"):
     cells = [[fmt % (np.mean([getattr(s, key) for s in lst]) * f,
                      np.ptp([getattr(s, key) for s in lst]) * f) for key, _ in TABLE_ROWS]
              for _, lst in columns]
-    colw = max(14, max(len(h) for h, _ in columns) + 2, max(len(c) for col in cells for c in col) + 2)
+    colw = max(14, max(len(h) for h, _ in columns) + 2,
+               max(len(c) for col in cells for c in col) + 2)
     out = ["Simulated machining, %d replica(s): mean (range) over replicas, %s"
            % (replicas, "µm" if unit == "um" else "mm"),
            "Deviations".ljust(width) + "".join(h.rjust(colw) for h, _ in columns)]

@@ -1,1 +1,2 @@
-"""FreeCAD GUI layer of surfcomp: commands, task panels, view providers, colour maps (imported lazily by InitGui.py)."""
+"""FreeCAD GUI layer of surfcomp: commands, task panels, view providers, colour maps
+(imported lazily by InitGui.py)."""

@@ -156,9 +156,9 @@ def read_axis_errors(path, units="mm", text=None):
                 text = fh.read()
         except OSError as exc:
             raise MeasurementFileError("cannot read the axis error file: %s" % exc.strerror,
-                                       file=path)
+                                       file=path) from exc
         except UnicodeDecodeError as exc:
-            raise MeasurementFileError("not UTF-8 text (byte %d)" % exc.start, file=path)
+            raise MeasurementFileError("not UTF-8 text (byte %d)" % exc.start, file=path) from exc
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     first = next((k for k, s in enumerate(lines) if not _is_comment(s)), None)
     if first is None:

@@ -436,7 +436,7 @@ def interpret(line_words, source=None, start=None, line_numbers=None, path=False
                                  "(see docs/axis_errors.md for the supported codes)"
                                  % _code_text(code), file=source, line=ln, column=col)
         stop = False
-        for code, k, w in ms:
+        for code, _k, w in ms:
             if code in (98, 99):
                 raise GCodeError("M%d: subprograms cannot be compensated; expand the program "
                                  "first" % code, file=source, line=ln,
@@ -603,7 +603,7 @@ def read_gcode(path):
         with open(path, "rb") as fh:
             return fh.read()
     except OSError as exc:
-        raise GCodeError("cannot read the G-code file: %s" % exc.strerror, file=path)
+        raise GCodeError("cannot read the G-code file: %s" % exc.strerror, file=path) from exc
 
 
 # ------------------------------------------------------------------------ the planner
@@ -631,14 +631,14 @@ def arc_points(start, end, centre, plane, clockwise, turns, n):
     """
     s, e, c = (np.asarray(v, dtype=float) for v in (start, end, centre))
     theta, r0, r1, a0 = _arc_params(s, e, c, plane, clockwise, turns)
-    p, q, l = PLANES[int(plane)]
+    p, q, w = PLANES[int(plane)]
     f = np.arange(1, n + 1) / n
     ang = a0 + theta * f
     r = r0 + (r1 - r0) * f
     out = np.empty((n, 3))
     out[:, p] = c[p] + r * np.cos(ang)
     out[:, q] = c[q] + r * np.sin(ang)
-    out[:, l] = s[l] + (e[l] - s[l]) * f
+    out[:, w] = s[w] + (e[w] - s[w]) * f
     out[-1] = e
     return out
 
@@ -669,9 +669,9 @@ def arc_steps(start, end, centre, plane, clockwise, turns, segment_length, arc_t
     least 4 per full turn."""
     s, e, c = (np.asarray(v, dtype=float) for v in (start, end, centre))
     theta, r0, r1, _a0 = _arc_params(s, e, c, plane, clockwise, turns)
-    _p, _q, l = PLANES[int(plane)]
+    _p, _q, w = PLANES[int(plane)]
     r = max(r0, r1)
-    length = math.hypot(0.5 * (r0 + r1) * theta, e[l] - s[l])
+    length = math.hypot(0.5 * (r0 + r1) * theta, e[w] - s[w])
     dphi = math.pi / 2
     if arc_tolerance < r:
         dphi = min(dphi, 2.0 * math.acos(1.0 - arc_tolerance / r))
@@ -1051,7 +1051,7 @@ def _emit(lines, prog, plan, dmin_mm, dmin_in, source):
                 elif float(inc) != 0.0:
                     first_words[a] = (None, inc)
                     out_val[a] += float(inc)
-        for a, (k, s) in first_words.items():
+        for _a, (k, s) in first_words.items():
             if k is not None:
                 w = words[k]
                 edits.append((w.end - len(w.text), w.end, s))

@@ -153,14 +153,16 @@ def _hist(values_um, title, color):
     ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color=color, edgecolor="white")
     ax.set_xlabel("µm")
     ax.set_ylabel("points")
-    ax.set_title("%s (mean %.2f µm, std %.2f µm)" % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
+    ax.set_title("%s (mean %.2f µm, std %.2f µm)"
+                 % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
                  fontsize=10)
     return fig
 
 
 def _stat_table(columns):
     """``columns``: list of (header, statistics dict in mm)."""
-    out = ["<table><tr><th>Deviations (µm)</th>%s</tr>" % "".join("<th>%s</th>" % _e(h) for h, _ in columns)]
+    out = ["<table><tr><th>Deviations (µm)</th>%s</tr>"
+           % "".join("<th>%s</th>" % _e(h) for h, _ in columns)]
     for key, label, f in _STAT_ROWS:
         cells = []
         for _, st in columns:
@@ -178,7 +180,8 @@ def _section_inputs(report):
         info = ["<b>%s</b>" % _e(d.get("path", ""))]
         if d.get("sha256"):
             info.append("SHA-256 <code>%s</code>" % _e(d["sha256"]))
-        extra = {k: v for k, v in d.items() if k not in ("path", "sha256") and v not in (None, [], {})}
+        extra = {k: v for k, v in d.items()
+                 if k not in ("path", "sha256") and v not in (None, [], {})}
         if extra:
             info.append(", ".join("%s: %s" % (_e(k), _e(v)) for k, v in extra.items()))
         rows.append((name, "<br>".join(info)))
@@ -211,7 +214,8 @@ def _section_method(report):
     rows = [("Method", _e(m.get("name"))),
             filt,
             ("Edge handling", _e(m.get("edge"))),
-            ("Stock (mirror)", _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
+            ("Stock (mirror)",
+             _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
             ("Refinement", _e("%s knot spans per grid step" % m.get("refine"))),
             ("Layout", _e(layout))]
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
@@ -219,7 +223,8 @@ def _section_method(report):
 
 def _section_maps(arrays):
     figs = []
-    for key, title in (("deviation", "Raw deviation d"), ("determined", "Determined (filtered) d_f"),
+    for key, title in (("deviation", "Raw deviation d"),
+                       ("determined", "Determined (filtered) d_f"),
                        ("random", "Random d - d_f"), ("correction", "Correction applied delta"),
                        ("residual", "Predicted residual")):
         figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]"),
@@ -235,13 +240,15 @@ def _section_histograms(arrays):
             for k, t, c in (("deviation", "Raw deviation", "#4477aa"),
                             ("random", "Random component", "#cc6677"),
                             ("residual", "Predicted residual", "#228833"))]
-    return '<section id="histograms"><h2>Histograms</h2><div class="figs">%s</div></section>' % "".join(figs)
+    return ('<section id="histograms"><h2>Histograms</h2><div class="figs">%s</div></section>'
+            % "".join(figs))
 
 
 def _section_statistics(report, arrays):
     st = report.get("statistics", {})
     cols = [(h, st[k]) for k, h in (("deviation", "Raw deviations"), ("determined", "Determined"),
-                                    ("random", "Random"), ("correction", "Correction"))] if st else []
+                                    ("random", "Random"),
+                                    ("correction", "Correction"))] if st else []
     res = arrays["residual"][np.isfinite(arrays["residual"])]
     if res.size:
         std = float(np.std(res, ddof=1)) if res.size > 1 else 0.0
@@ -259,10 +266,12 @@ def _section_checks(report):
     if not ch:
         body = "<p>No corrected face was built (%s).</p>" % _e(report.get("command", "inspection"))
     else:
-        labels = {"max_error_at_points_mm": ("Realised - intended correction at the measured points, max", 1e3, "µm"),
+        labels = {"max_error_at_points_mm":
+                      ("Realised - intended correction at the measured points, max", 1e3, "µm"),
                   "max_deviation_from_nominal_with_zero_correction_mm":
                       ("Zero correction reproduces the nominal within", 1e3, "µm"),
-                  "max_abs_realised_correction_on_face_mm": ("Largest correction anywhere on the face", 1e3, "µm"),
+                  "max_abs_realised_correction_on_face_mm":
+                      ("Largest correction anywhere on the face", 1e3, "µm"),
                   "max_abs_intended_correction_mm": ("Largest intended correction", 1e3, "µm")}
         rows = []
         for key, val in ch.items():
@@ -280,7 +289,8 @@ def _bar_chart(sim):
     fig = _figure((7.5, 3.6))
     axes = fig.subplots(1, 2)
     x = np.arange(len(cols))
-    for ax, key, title in zip(axes, ("std", "profile"), ("Standard deviation", "Profile error ISO 1101")):
+    for ax, key, title in zip(axes, ("std", "profile"),
+                              ("Standard deviation", "Profile error ISO 1101")):
         vals = np.array([[r["all"][key] for r in c["replicas"]] for _, c in cols], dtype=object)
         mean = np.array([np.mean(v) for v in vals]) * 1e3
         lo = mean - np.array([np.min(v) for v in vals]) * 1e3
@@ -317,10 +327,11 @@ def _section_simulation(sim):
     params = _kv_table([(k, _e(v)) for k, v in model.items() if k != "axis_errors"]
                        + [("axis_errors", _e("yes" if model.get("axis_errors") else "none"))])
     return ('<section id="simulation"><h2>Simulated machining: before / after</h2>'
-            '<p>%d replica(s), seed %s, measured on a %s grid and evaluated on %s points (grid nodes '
-            'and between). Cells: mean over replicas (range max - min), µm; mirror paper '
+            '<p>%d replica(s), seed %s, measured on a %s grid and evaluated on %s points (grid '
+            'nodes and between). Cells: mean over replicas (range max - min), µm; mirror paper '
             'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div><h3>Model parameters</h3>%s</section>'
-            % (sim.get("replicas", 0), _e(sim.get("seed")), _e("x".join(map(str, sim.get("grid", [])))),
+            % (sim.get("replicas", 0), _e(sim.get("seed")),
+               _e("x".join(map(str, sim.get("grid", [])))),
                _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
                _img(_bar_chart(sim), "before and after bar chart", "Spread per method"), params))
 
@@ -337,8 +348,10 @@ def render_html(report, simulation=None):
     """
     arrays = grid_arrays(report)
     warn = report.get("warnings") or []
-    warn_html = ("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(w) for w in warn)) if warn else "<p>None.</p>"
-    title = "surfcomp report: %s, method %s" % (report.get("command", ""), report.get("method", {}).get("name", ""))
+    warn_html = (("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(w) for w in warn)) if warn
+                 else "<p>None.</p>")
+    title = "surfcomp report: %s, method %s" % (report.get("command", ""),
+                                                report.get("method", {}).get("name", ""))
     parts = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
              "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
              "<h1>%s</h1>" % _e(title),

@@ -526,7 +526,7 @@ class _Parser:
             raise self.error("the header names no known column: %s (expected names such as "
                              "x_nom y_nom z_nom, i j k, dev, x_meas y_meas z_meas; see the alias "
                              "table)%s" % (shown, hint), h)
-        for group, rs in GROUPS.items():
+        for _group, rs in GROUPS.items():
             present = [r for r in rs if r in first]
             if present and len(present) < len(rs):
                 missing = [r for r in rs if r not in first]
@@ -670,7 +670,8 @@ class _Parser:
                              columns[0])
         off = np.flatnonzero(np.abs(length - 1.0) > NORMAL_LENGTH_TOL)
         self._point_warnings(off, data, lambda k: "the normal (%g, %g, %g) has length %.6g "
-                             "(expected a unit vector; used renormalised)" % (tuple(n[k]) + (length[k],)),
+                             "(expected a unit vector; used renormalised)"
+                             % (tuple(n[k]) + (length[k],)),
                              "normals are not of unit length (renormalised)")
         return n / length[:, None]
 

@@ -1,4 +1,5 @@
-"""The batch CLI: exit codes, messages, atomic outputs (subprocesses of /usr/bin/python3 -m surfcomp)."""
+"""The batch CLI: exit codes, messages, atomic outputs (subprocesses of
+/usr/bin/python3 -m surfcomp)."""
 
 import json
 import os
@@ -119,8 +120,8 @@ def test_bad_options(tmp_path, args, words):
 
 
 def test_ambiguous_face_lists_the_choices(tmp_path):
-    err = _bad(tmp_path, "compensate", os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step"),
-               EXAMPLE_CSV)
+    err = _bad(tmp_path, "compensate",
+               os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step"), EXAMPLE_CSV)
     assert "42 B-spline faces among 192 faces" in err and "--face FaceN" in err
 
 
@@ -296,7 +297,8 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
         cf = rep["corrected_face"]
         assert cf["max_error_at_points_mm"] < 1e-4
         assert cf["max_deviation_from_nominal_with_zero_correction_mm"] < 1e-4
-        assert cf["max_abs_realised_correction_on_face_mm"] <= cf["max_abs_intended_correction_mm"] + 1e-3
+        assert (cf["max_abs_realised_correction_on_face_mm"]
+                <= cf["max_abs_intended_correction_mm"] + 1e-3)
         face = Part.read(str(tmp_path / "c.step")).Faces[0]
         want = np.array(rep["points"]["correction"])
         if method == "filtered":   # the smoothed values, not the raw ones

@@ -43,7 +43,8 @@ def add_part(doc, shape, name="Nominal"):
 def error_model(P):
     """Systematic machining error (mm) at points P (..., 3): smooth, -16 .. +36 um."""
     x, y = P[..., 0], P[..., 1]
-    return 0.010 + 0.025 * np.sin(np.pi * x / 45.0) * np.cos(np.pi * y / 60.0) - 0.012 * (y / 45.0) ** 2
+    return (0.010 + 0.025 * np.sin(np.pi * x / 45.0) * np.cos(np.pi * y / 60.0)
+            - 0.012 * (y / 45.0) ** 2)
 
 
 def poles(shape_or_face):
@@ -214,7 +215,8 @@ def test_nominal_with_a_placement(doc):
     c1 = features.make_compensation(doc, plain, "Face1",
                                     features.make_measurement(doc, doc.TransientDir + "/plain.csv"))
     c2 = features.make_compensation(doc, placed, "Face1",
-                                    features.make_measurement(doc, doc.TransientDir + "/placed.csv"))
+                                    features.make_measurement(doc,
+                                                              doc.TransientDir + "/placed.csv"))
     doc.recompute()
     np.testing.assert_allclose(c2.Correction, c1.Correction, atol=1e-12)
     np.testing.assert_allclose(np.array(c2.Placement.toMatrix().A), np.array(pl.toMatrix().A),
@@ -226,7 +228,8 @@ def test_nominal_with_a_placement(doc):
 
 def test_deviation_field_passes_through_the_nodes(doc):
     nom_obj = add_part(doc, Part.read(EXAMPLE_STEP))
-    c = features.make_compensation(doc, nom_obj, "Face1", features.make_measurement(doc, EXAMPLE_CSV))
+    c = features.make_compensation(doc, nom_obj, "Face1",
+                                   features.make_measurement(doc, EXAMPLE_CSV))
     doc.recompute()
     U, V = np.reshape(c.U, (45, 45)), np.reshape(c.V, (45, 45))
     for q, prop in (("deviation", "Deviation"), ("random", "Random"), ("correction", "Correction")):

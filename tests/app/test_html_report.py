@@ -36,16 +36,18 @@ def _report(method="filtered", stock=None, n=11, build=True, seed=1):
     nrm = np.cross(Su, Sv)
     nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
     rng = np.random.default_rng(seed)
-    d = 0.02 * np.sin(S[..., 0] / 9.0) - 0.01 * (S[..., 1] / 30.0) ** 2 + rng.normal(0, 0.002, (n, n))
+    d = (0.02 * np.sin(S[..., 0] / 9.0) - 0.01 * (S[..., 1] / 30.0) ** 2
+         + rng.normal(0, 0.002, (n, n)))
     d = d + (stock or 0.0)
     rows, cols = np.indices((n, n))
-    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3), deviation=d.ravel(),
-                             row=rows.ravel(), col=cols.ravel())
+    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                             deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
     opt = Options(method=method, stock=stock)
     comp = compensate(surf, 1, prepare(surf, 1, ms, opt), opt, build=build)
     inputs = {"nominal": {"path": "/data/nominal.step", "sha256": "ab" * 32, "face": "Face1"},
               "measurements": {"path": "/data/m<1>.csv", "sha256": "cd" * 32, "points": n * n}}
-    return report_io.build_report("compensate" if build else "inspect", inputs, comp, ["a <b> warning"])
+    return report_io.build_report("compensate" if build else "inspect", inputs, comp,
+                                  ["a <b> warning"])
 
 
 @pytest.fixture(scope="module")
@@ -63,10 +65,12 @@ def rendered(tmp_path_factory):
                          timeout=120)
     assert dom.returncode == 0, dom.stderr
     shot = str(folder / "shot.png")
-    out = subprocess.run(base + ["--screenshot=%s" % shot, "--window-size=1200,2600", "file://" + path],
+    out = subprocess.run(base + ["--screenshot=%s" % shot, "--window-size=1200,2600",
+                                 "file://" + path],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and os.path.isfile(shot), out.stderr
-    return {"path": path, "dom": dom.stdout, "shot": shot, "report": rep, "sim": sim, "folder": folder}
+    return {"path": path, "dom": dom.stdout, "shot": shot, "report": rep, "sim": sim,
+            "folder": folder}
 
 
 def test_every_section_is_in_the_dom(rendered):
@@ -110,7 +114,8 @@ def test_screenshot_shows_the_colour_maps(rendered):
 
 
 def test_predicted_residual_by_method():
-    """d - s - delta: 0 for raw and mirror, the random component for filtered, d - mean for offset."""
+    """d - s - delta: 0 for raw and mirror, the random component for filtered, d - mean for
+    offset."""
     for method, stock in (("raw", None), ("mirror", 0.25)):
         arr = grid_arrays(_report(method, stock, n=7, build=False))
         assert_allclose(arr["residual"], 0.0, atol=1e-9)

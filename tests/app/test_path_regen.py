@@ -90,11 +90,13 @@ def regenerated():
     # so that only the compensation changes the program
     pathjob.model_clone(job, nom).touch()
     doc.recompute()
-    before = {"cl": pathjob.cutter_locations(op), "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
+    before = {"cl": pathjob.cutter_locations(op),
+              "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
               "state": list(op.State), "nominal": nom.Shape.copy()}
     links = replace.replace(doc, comp)
     doc.recompute()
-    after = {"cl": pathjob.cutter_locations(op), "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
+    after = {"cl": pathjob.cutter_locations(op),
+             "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
              "invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in o.State],
              "links": links}
     yield doc, nom, comp, job, op, before, after
@@ -111,8 +113,9 @@ def test_replace_regenerates_the_operation(regenerated):
     assert job.Proxy.baseObjects(job) == [comp]
     # the nominal is hidden and unchanged
     assert nom.Visibility is False and comp.Visibility is True
-    poles = lambda shape: np.array([[tuple(p) for p in row]
-                                    for row in shape.Faces[0].Surface.getPoles()])
+
+    def poles(shape):
+        return np.array([[tuple(p) for p in row] for row in shape.Faces[0].Surface.getPoles()])
     np.testing.assert_array_equal(poles(nom.Shape), poles(before["nominal"]))
     assert nom.Shape.Faces[0].ParameterRange == before["nominal"].Faces[0].ParameterRange
     n0, n1 = len(before["cl"]), len(after["cl"])
@@ -160,7 +163,9 @@ def test_posted_gcode_follows(regenerated):
     np.testing.assert_allclose(g0, before["cl"], atol=0.51e-4)
     np.testing.assert_allclose(g1, after["cl"], atol=0.51e-4)
     assert before["gcode"] != after["gcode"]
-    head = lambda text: [s for s in text.splitlines() if not s.startswith(("G1 ", "G0 "))][:12]
+
+    def head(text):
+        return [s for s in text.splitlines() if not s.startswith(("G1 ", "G0 "))][:12]
     assert head(before["gcode"]) == head(after["gcode"])
     assert "M6 T1" in after["gcode"] and "(TC: Ball end 6 mm)" in after["gcode"]
 

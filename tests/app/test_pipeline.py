@@ -135,7 +135,8 @@ def test_mirror_and_offset_methods(tmp_path):
     comp, _ = run_job(Job(nominal=EXAMPLE_STEP, measurements=str(meas),
                           options=Options(method="mirror", stock=stock)))
     # PR = PP + (s + e) n  ->  PC = PP - e n
-    assert_allclose(comp.prepared.grid.take(comp.corrected_points()), P - e[..., None] * N, atol=1e-9)
+    assert_allclose(comp.prepared.grid.take(comp.corrected_points()), P - e[..., None] * N,
+                    atol=1e-9)
     comp, _ = run_job(Job(nominal=EXAMPLE_STEP, measurements=str(meas),
                           options=Options(method="offset")))
     us, vs = dense_parameters(nom.surface, (n, m), 2)

@@ -1,4 +1,5 @@
-"""``python3 -m surfcomp simulate`` on the bundled example: exit codes, JSON content, model options."""
+"""``python3 -m surfcomp simulate`` on the bundled example: exit codes, JSON content, model
+options."""
 
 import hashlib
 import json
@@ -31,14 +32,16 @@ def test_simulate_example_writes_json_with_every_replica(tmp_path):
     assert "Profile error ISO 1101" in out.stdout and "per replica" in out.stdout
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["schema"] == "surfcomp-simulation/1" and d["command"] == "simulate"
-    assert d["inputs"]["nominal"]["sha256"] == hashlib.sha256(open(EXAMPLE_STEP, "rb").read()).hexdigest()
+    assert (d["inputs"]["nominal"]["sha256"]
+            == hashlib.sha256(open(EXAMPLE_STEP, "rb").read()).hexdigest())
     assert d["grid"] == [15, 15] and d["evaluation_grid"] == [29, 29] and d["replicas"] == 2
     methods = {m["label"]: m for m in d["methods"]}
     assert list(methods) == ["none", "offset", "raw", "filtered", "mirror"]
     assert methods["mirror"]["stock_mm"] == 0.3 and methods["filtered"]["mask_size"] == 5
     for m in methods.values():
         assert len(m["replicas"]) == 2
-        assert m["replicas"][1]["all"]["count"] == 29 * 29 and m["replicas"][1]["grid"]["count"] == 225
+        assert (m["replicas"][1]["all"]["count"] == 29 * 29
+                and m["replicas"][1]["grid"]["count"] == 225)
     none_std = np.array([r["all"]["std"] for r in methods["none"]["replicas"]])
     # the default model on the example face: Werner Tab. 1-like, std about 16.5 um
     assert_allclose(none_std, 0.0165, atol=0.0015)
@@ -57,13 +60,14 @@ def test_model_options_reach_the_model(tmp_path):
     """Only a constant 10 um error, no noise: before mean 10 um, offset removes it exactly."""
     out = run_cli(EXAMPLE_STEP, "--grid", "7x7", "--replicas", "1", "--methods", "none,offset,raw",
                   "--offset", "0.01", "--slope-gain", "0", "--abs-slope-gain", "0", "--tilt", "0,0",
-                  "--bow", "0,0", "--sigma", "0", "--probe-sigma", "0", "--json", tmp_path / "s.json",
-                  "--quiet")
+                  "--bow", "0,0", "--sigma", "0", "--probe-sigma", "0",
+                  "--json", tmp_path / "s.json", "--quiet")
     assert out.returncode == 0, out.stderr
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["model"]["offset"] == 0.01 and d["model"]["sigma"] == 0.0
     before = d["before"]["replicas"][0]["all"]
-    assert_allclose([before["mean"], before["max_negative"], before["max_positive"]], 0.01, atol=1e-9)
+    assert_allclose([before["mean"], before["max_negative"], before["max_positive"]], 0.01,
+                    atol=1e-9)
     for m in d["methods"][1:]:
         r = m["replicas"][0]["all"]
         assert max(abs(r["max_negative"]), abs(r["max_positive"])) < 2e-6, m["label"]

@@ -198,7 +198,8 @@ panel = panels.FilterPanel.instance
 panel.mask.setValue(9)
 panel.update()
 RESULTS["filter_live_mask"] = comp.MaskSize
-RESULTS["filter_live_changed"] = bool(np.nanmax(np.abs(np.array(comp.Determined) - det_before)) > 1e-6)
+RESULTS["filter_live_changed"] = bool(np.nanmax(np.abs(np.array(comp.Determined) - det_before))
+                                      > 1e-6)
 panel.mask.setValue(4)          # even: not a valid mask
 panel.update()
 RESULTS["filter_invalid"] = [panel.status.text(), panel.accept()]

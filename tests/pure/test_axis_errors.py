@@ -203,7 +203,7 @@ def test_compensation_solves_the_fixed_point_equation():
     assert_allclose(C + model.error(C), P, rtol=0, atol=1e-10)
     # against a library root finder on a few points
     for k in range(5):
-        ref = optimize.fsolve(lambda x: x + model.error(x) - P[k], P[k], xtol=1e-14)
+        ref = optimize.fsolve(lambda x, k=k: x + model.error(x) - P[k], P[k], xtol=1e-14)
         assert_allclose(C[k], ref, rtol=0, atol=1e-9)
     # analytic: a pure scale error s gives X' = X / (1 + s)
     s = 2.5e-3

@@ -402,7 +402,7 @@ def reference_projection(surf, P, n_grid=120, n_starts=6):
         best = None
         for k in np.argsort(np.sum((G - p) ** 2, axis=1))[:n_starts]:
             x0 = [us[k // n_grid], vs[k % n_grid]]
-            fun = lambda x: bs.evaluate(surf, x[:1], x[1:])[0] - p  # noqa: E731
+            fun = lambda x, p=p: bs.evaluate(surf, x[:1], x[1:])[0] - p  # noqa: E731
 
             def jac(x):
                 _, Su, Sv = bs.derivatives(surf, x[:1], x[1:])

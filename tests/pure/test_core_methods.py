@@ -60,7 +60,8 @@ def test_weighted_mask_orientation_and_gaps():
     assert f2[1, 1] == pytest.approx((d[0:3, 0:3].sum() - d[2, 2]) / 8, abs=1e-12)
 
 
-@pytest.mark.parametrize("mask", [box_mask(5), gaussian_mask(7), parse_weights("1 2 1; 2 4 2; 1 2 1")])
+@pytest.mark.parametrize("mask", [box_mask(5), gaussian_mask(7),
+                                  parse_weights("1 2 1; 2 4 2; 1 2 1")])
 @pytest.mark.parametrize("edge", ["renormalize", "reflect", "nearest"])
 def test_constant_field_passes_unchanged(mask, edge):
     d = np.full((12, 8), 0.0123)

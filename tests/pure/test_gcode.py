@@ -345,7 +345,7 @@ def test_incremental_steps_do_not_drift():
     model = AxisErrorModel.from_components(scale={"x": 3.3e-4})
     prog = "G21 G90\nG0 X0 Y0 Z0\nG91\n" + "G1 X0.1 F100\n" * 1000
     res = comp(prog, model)
-    incs = [float(l.split()[1][1:]) for l in output_lines(res)[3:-1]]
+    incs = [float(line.split()[1][1:]) for line in output_lines(res)[3:-1]]
     assert len(incs) == 1000
     assert round(sum(incs), 4) == round(100.0 / (1 + 3.3e-4), 4)
     assert abs(sum(incs) - 100.0 / (1 + 3.3e-4)) <= 0.5e-4 + 1e-9

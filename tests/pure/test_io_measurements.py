@@ -396,7 +396,8 @@ def test_not_enough_columns_says_which_are_missing():
 ])
 def test_not_enough_columns_variants(header, missing):
     e = parse_error(header + "\n")
-    assert e.line == 1 and missing in e.message and "(expected nominal+normal+deviation" in e.message
+    assert (e.line == 1 and missing in e.message
+            and "(expected nominal+normal+deviation" in e.message)
 
 
 def test_not_enough_columns_lists_ignored_ones():
@@ -538,7 +539,8 @@ def test_round_trip_200k_rows():
     meas = nom + dev[:, None] * nrm
     cols = np.column_stack([nom, meas, nrm, dev])
     body = np.char.mod("%.17g", cols).tolist()
-    out = ["# written by test_round_trip_200k_rows", "X_NOM;Y_NOM;Z_NOM;X_MEAS;Y_MEAS;Z_MEAS;I;J;K;DEV"]
+    out = ["# written by test_round_trip_200k_rows",
+           "X_NOM;Y_NOM;Z_NOM;X_MEAS;Y_MEAS;Z_MEAS;I;J;K;DEV"]
     lines = []
     for q, r in enumerate(body):
         if q % 1000 == 999:

@@ -31,8 +31,9 @@ def werner_like():
 # ------------------------------------------------------------------ model equations
 def test_systematic_error_on_tilted_plane_by_hand():
     surf = plane(0.2)
-    model = sm.MachiningModel(offset=0.001, slope_gain=0.01, abs_slope_gain=0.02, tilt=(0.004, 0.006),
-                              bow=(0.008, -0.002), waviness=0.003, wavelength=40.0, sigma=0.0)
+    model = sm.MachiningModel(offset=0.001, slope_gain=0.01, abs_slope_gain=0.02,
+                              tilt=(0.004, 0.006), bow=(0.008, -0.002), waviness=0.003,
+                              wavelength=40.0, sigma=0.0)
     frame = model.frame(surf)
     # work area x 0..40 (centre 20, half 20), y 0..20 (centre 10, half 10)
     assert_allclose(frame.half, (20.0, 10.0), atol=1e-12)
@@ -62,8 +63,8 @@ def test_slope_is_clipped_on_vertical_walls_and_sign_independent_of_normal_side(
 def test_axis_errors_enter_along_the_normal():
     surf = plane(0.2)
     axis = AxisErrorModel(offset=(0.0, 0.0, 0.003))  # the tool lands 3 um higher everywhere
-    model = sm.MachiningModel(offset=0.0, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0, 0), bow=(0, 0),
-                              sigma=0.0, axis_errors=axis)
+    model = sm.MachiningModel(offset=0.0, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0, 0),
+                              bow=(0, 0), sigma=0.0, axis_errors=axis)
     n = np.array([[-0.2, 0.0, 1.0]]) / np.sqrt(1.04)
     e = model.systematic(model.frame(surf), np.array([[10.0, 10.0, 2.0]]), n)
     assert_allclose(e, [0.003 / np.sqrt(1.04)], atol=1e-15)
@@ -170,8 +171,8 @@ def test_spread_and_table_by_hand():
 # ------------------------------------------------------------------ the loop
 def test_zero_error_machine_gives_zero_deviation_for_every_method():
     surf = werner_like()
-    model = sm.MachiningModel(offset=0.0, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0, 0), bow=(0, 0),
-                              sigma=0.0, probe_sigma=0.0)
+    model = sm.MachiningModel(offset=0.0, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0, 0),
+                              bow=(0, 0), sigma=0.0, probe_sigma=0.0)
     res = sm.simulate(surf, 1, model, grid=(7, 7), replicas=1, seed=3,
                       specs=sm.method_specs(stock=0.3))
     for label in ["before"] + res.labels:
@@ -262,7 +263,8 @@ def test_filtered_beats_raw_only_when_the_random_part_matters():
     # raw: sqrt(2) sigma (two random realisations); filtered: ~sigma plus the filter's bias
     assert_allclose(raw, np.sqrt(2 * 0.004 ** 2 + 2 * 0.0005 ** 2), rtol=0.1)
     assert np.all(filt < raw - 0.0003), (filt, raw)
-    assert np.all(noisy.values("filtered", "profile").mean() < noisy.values("raw", "profile").mean())
+    assert np.all(noisy.values("filtered", "profile").mean()
+                  < noisy.values("raw", "profile").mean())
     quiet = sm.simulate(surf, 1, sm.MachiningModel(sigma=0.0003), grid=(23, 23), replicas=4,
                         seed=5, specs=specs)
     assert np.all(quiet.values("raw", "std") < quiet.values("filtered", "std") - 0.0005)
