@@ -10,9 +10,9 @@ restyled (range change: recolour only). Prints seconds; the issue's goal is < 1 
 """
 
 import os
+import pathlib
 import sys
 import tempfile
-import pathlib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)

@@ -12,12 +12,12 @@ import os
 import sys
 import time
 
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core import simulate as sm  # noqa: E402
 from examples.make_example import example_surface  # noqa: E402
+from surfcomp.core import simulate as sm  # noqa: E402
+
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])

@@ -8,7 +8,6 @@ FreeCADGui: everything runs in ``freecadcmd`` and in a plain ``python3``.
 from ..errors import GCodeError, InputError
 from . import cam
 
-
 #: a Job on document objects (the adapter's, for callers of this module)
 create_job = cam.create_job
 

@@ -4,9 +4,9 @@ import sys
 import time
 
 from ..core.deviations import format_table
-from ..core.pipeline import Options
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
+from ..core.pipeline import Options
 from ..io.readers import FORMATS
 
 

@@ -1,8 +1,13 @@
 """``python3 -m surfcomp compensate``: nominal + measurements -> corrected face."""
 
 from ..errors import InputError
-from .common import (ProgressLine, add_input_options, add_method_options, options_from_args,
-                     run_job_command)
+from .common import (
+    ProgressLine,
+    add_input_options,
+    add_method_options,
+    options_from_args,
+    run_job_command,
+)
 
 
 def add_parser(subparsers):

@@ -12,11 +12,11 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
-from .corrected import DEFAULT_REFINE, construct
-from .field import GridField
-from .deviations import deviation_components, statistics
-from .filters import make_mask
 from . import bspline
+from .corrected import DEFAULT_REFINE, construct
+from .deviations import deviation_components, statistics
+from .field import GridField
+from .filters import make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
 from .methods import compute_correction
 from .progress import report, sub

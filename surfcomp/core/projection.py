@@ -26,9 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..errors import GeometryError, InputError
 from . import bspline
 from .progress import report
-from ..errors import GeometryError, InputError
 
 #: Newton stops when a full (second-order) step moves the foot point less than
 #: this (mm): the error left after applying it is O(step^2 / R) ~ 1e-13 mm

@@ -70,8 +70,8 @@ from scipy.sparse.linalg import LinearOperator, cg
 from scipy.spatial import Delaunay, cKDTree
 from scipy.spatial.distance import cdist
 
-from . import bspline
 from ..errors import ComputationError, InputError
+from . import bspline
 from .progress import report
 
 #: the relative-tolerance keyword of ``cg``: ``tol`` up to scipy 1.11, ``rtol`` from 1.12

@@ -12,7 +12,6 @@ import os
 
 import FreeCAD
 import FreeCADGui
-
 from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths

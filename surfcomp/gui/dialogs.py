@@ -7,7 +7,6 @@ without a blocking dialog.
 
 import FreeCAD
 import FreeCADGui
-
 from PySide import QtGui
 
 translate = FreeCAD.Qt.translate

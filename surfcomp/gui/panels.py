@@ -9,7 +9,6 @@ import json
 
 import FreeCAD
 import FreeCADGui
-
 from PySide import QtCore, QtGui
 
 from ..app import features

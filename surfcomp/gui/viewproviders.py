@@ -10,9 +10,8 @@ the mesh and values (rebuilt whenever the object's Shape changes).
 The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
 """
 
-import numpy as np
-
 import FreeCAD
+import numpy as np
 from PySide import QtCore
 
 from .. import paths
@@ -234,8 +233,9 @@ class ViewProviderCompensation:
     def setEdit(self, vobj, mode=0):
         if mode != 0:
             return None
-        from .panels import FilterPanel
         import FreeCADGui
+
+        from .panels import FilterPanel
 
         FreeCADGui.Control.showDialog(FilterPanel(vobj.Object))
         return True

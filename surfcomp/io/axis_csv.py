@@ -152,7 +152,7 @@ def read_axis_errors(path, units="mm", text=None):
     """
     if text is None:
         try:
-            with open(path, "r", encoding="utf-8-sig", newline="") as fh:
+            with open(path, encoding="utf-8-sig", newline="") as fh:
                 text = fh.read()
         except OSError as exc:
             raise MeasurementFileError("cannot read the axis error file: %s" % exc.strerror,

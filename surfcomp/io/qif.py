@@ -62,8 +62,13 @@ from xml.parsers import expat
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .measurements import (DEV_CHECK_TOL, MAX_POINT_WARNINGS, NORMAL_LENGTH_TOL, NORMAL_ZERO,
-                           MeasurementSet)
+from .measurements import (
+    DEV_CHECK_TOL,
+    MAX_POINT_WARNINGS,
+    NORMAL_LENGTH_TOL,
+    NORMAL_ZERO,
+    MeasurementSet,
+)
 from .units import unit_factor
 
 #: namespace URIs of QIF documents start with this (QIF 3: ``.../qif3``)

@@ -2,12 +2,11 @@
 
 import os
 
+import FreeCAD
 import numpy as np
+import Part
 import pytest
 from numpy.testing import assert_allclose
-
-import FreeCAD
-import Part
 
 from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.core import bspline as bs

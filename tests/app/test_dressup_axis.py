@@ -6,10 +6,10 @@ import subprocess
 
 import FreeCAD
 import numpy as np
-import pytest
-
 import Part
 import Path
+import pytest
+
 from surfcomp.app import cam, dressup_axis
 from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine
 from surfcomp.errors import GCodeError

@@ -7,9 +7,9 @@ import shutil
 
 import FreeCAD
 import numpy as np
+import Part
 import pytest
 
-import Part
 from surfcomp.app import features
 from surfcomp.app.job import corrected_face
 from surfcomp.app.nominal import load_nominal, nominal_from_face
@@ -19,7 +19,6 @@ from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.errors import GeometryError, InputError
 from surfcomp.io.readers import read_any
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, grid_on_face, write_cmm_csv
-
 
 # -- shared with the other issue-3 test files ----------------------------------------------
 

@@ -16,9 +16,9 @@ import re
 
 import FreeCAD
 import numpy as np
+import Part
 import pytest
 
-import Part
 from surfcomp.app import cam, features, pathjob, replace
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.corrected import realised_correction

@@ -141,9 +141,10 @@ def test_reopen_in_a_fresh_freecadcmd(saved, tmp_path):
 
 
 def test_old_documents_are_migrated(tmp_path):
+    import Part
+
     from surfcomp.app.nominal import load_nominal
     from tests.app.helpers import EXAMPLE_STEP
-    import Part
 
     doc = FreeCAD.newDocument("olddoc")
     nom = add_part(doc, Part.read(EXAMPLE_STEP))

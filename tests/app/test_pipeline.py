@@ -16,11 +16,16 @@ from numpy.testing import assert_allclose
 
 from surfcomp.app.job import Job, run_job
 from surfcomp.app.nominal import load_nominal
-from surfcomp.core import bspline
 from surfcomp.core.corrected import dense_parameters, realised_correction
 from surfcomp.core.pipeline import Options
-from tests.app.helpers import (EXAMPLE_CSV, EXAMPLE_STEP, face_nominal, grid_on_face,
-                               realised_by_occt, write_cmm_csv)
+from tests.app.helpers import (
+    EXAMPLE_CSV,
+    EXAMPLE_STEP,
+    face_nominal,
+    grid_on_face,
+    realised_by_occt,
+    write_cmm_csv,
+)
 from tests.conftest import REALDATA
 
 UM = 1e-3

@@ -8,12 +8,11 @@ OCCT takes ~30 ms a point here, so each case uses ~100 points.
 
 import os
 
+import FreeCAD
 import numpy as np
+import Part
 import pytest
 from numpy.testing import assert_allclose
-
-import FreeCAD
-import Part
 
 from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.core import bspline as bs

@@ -13,8 +13,8 @@ NOMINAL = os.path.join(ROOT, "examples", "nominal.step")
 MEAS = os.path.join(ROOT, "examples", "measurements.csv")
 
 import surfcomp
-from surfcomp.gui import commands, dialogs, panels, prefs, mapscene
 from surfcomp.core import colormap
+from surfcomp.gui import commands, dialogs, mapscene, panels, prefs
 
 RESULTS["surfcomp_file"] = surfcomp.__file__
 RESULTS["workbenches"] = sorted(Gui.listWorkbenches())
@@ -74,8 +74,9 @@ Gui.Selection.clearSelection()
 bad = os.path.join(TMP, "bad.csv")
 with open(bad, "w") as f:
     f.write("id,x_nom,y_nom,z_nom,i,j,k,dev\nP1,1,2,3,0,0,1,0.01\nP2,1,2,x,0,0,1,0.02\n")
-from surfcomp.io.readers import read_any
 from surfcomp.errors import SurfcompError
+from surfcomp.io.readers import read_any
+
 try:
     read_any(bad)
     RESULTS["cli_message"] = None

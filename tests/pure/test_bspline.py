@@ -14,7 +14,6 @@ from surfcomp.core import bspline as bs
 from surfcomp.core.bspline import Surface
 from surfcomp.errors import GeometryError, GridError
 
-
 # --------------------------------------------------------------------------- helpers
 
 def casteljau(ctrl, t):

@@ -2,9 +2,8 @@
 
 import numpy as np
 import pytest
-from numpy.testing import assert_allclose
-
 from matplotlib.colors import LinearSegmentedColormap
+from numpy.testing import assert_allclose
 
 from surfcomp.core import colormap as cm
 from surfcomp.core.bspline import Surface, evaluate_grid

@@ -9,8 +9,16 @@ from numpy.testing import assert_allclose
 
 from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine, fit_axis_errors
 from surfcomp.errors import GCodeError
-from surfcomp.io.gcode import (_fmt, arc_points, arc_steps, compensate_commands,
-                               compensate_gcode, parse_gcode, read_gcode, tokenize)
+from surfcomp.io.gcode import (
+    _fmt,
+    arc_points,
+    arc_steps,
+    compensate_commands,
+    compensate_gcode,
+    parse_gcode,
+    read_gcode,
+    tokenize,
+)
 from tests.conftest import REALDATA, ROOT
 
 DATA = os.path.join(ROOT, "tests", "data", "gcode")
@@ -443,6 +451,7 @@ def _cli(argv, capsys):
 
 def test_cli_compensates_bear_and_writes_a_report(tmp_path, capsys):
     import json
+
     from surfcomp.io.axis_csv import write_axis_errors
     machine = SimulatedMachine(golden_model())
     csv = tmp_path / "err.csv"

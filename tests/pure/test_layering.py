@@ -1,6 +1,5 @@
 """core/ and io/ must import without FreeCAD, Part or Qt on the path."""
 
-import os
 import subprocess
 import sys
 
