@@ -66,14 +66,6 @@ def _decode(doc, kind, data):
     return [(obj(n), tuple(subs)) for n, subs in data]
 
 
-def _get(o, prop):
-    return getattr(o, prop)
-
-
-def _set(o, prop, value):
-    setattr(o, prop, value)
-
-
 def _map_subs(subs, mapping, where, label):
     if mapping is None:
         return list(subs)
@@ -102,6 +94,29 @@ def _sub_mapping(comp):
     return {comp.FaceName: "Face1"}
 
 
+def _rebound(value, kind, names, comp, mapping, where):
+    """``value`` of a link property with the targets (``names``) replaced by ``comp``, or
+    None when it links none of them."""
+    def subs_of(old):
+        return _map_subs(old, mapping, where, comp.Label)
+
+    if kind == "link":
+        return comp if value is not None and value.Name in names else None
+    if kind == "list":
+        if not any(x.Name in names for x in value):
+            return None
+        return [comp if x.Name in names else x for x in value]
+    if kind == "sub":
+        if not value or value[0].Name not in names:
+            return None
+        return (comp, subs_of(list(value[1])))
+    pairs = [(x, list(subs) if isinstance(subs, (list, tuple)) else [subs]) for x, subs in value]
+    if not any(x.Name in names for x, _subs in pairs):
+        return None
+    return [(comp, tuple(subs_of(subs))) if x.Name in names else (x, tuple(subs))
+            for x, subs in pairs]
+
+
 def plan(doc, comp):
     """What :func:`replace` would change: a list of ``(object, property, kind, old, new)``.
 
@@ -110,8 +125,7 @@ def plan(doc, comp):
     GeometryError
         A sub-element link to a face that the compensation's output does not have.
     """
-    targets = _targets(comp)
-    names = {t.Name for t in targets}
+    names = {t.Name for t in _targets(comp)}
     mapping = _sub_mapping(comp)
     clones = set()
     changes = []
@@ -119,38 +133,16 @@ def plan(doc, comp):
         if o is comp or features.is_compensation(o) or features.is_measurement(o):
             continue
         for prop in o.PropertiesList:
-            if prop in SKIP_PROPERTIES:
-                continue
-            kind = _kind(o.getTypeIdOfProperty(prop))
+            kind = None if prop in SKIP_PROPERTIES else _kind(o.getTypeIdOfProperty(prop))
             if kind is None:
                 continue
-            old = _get(o, prop)
-            where = "%s.%s" % (o.Label, prop)
-            if kind == "link":
-                if old is not None and old.Name in names:
-                    changes.append((o, prop, kind, old, comp))
-            elif kind == "list":
-                if any(x.Name in names for x in old):
-                    changes.append((o, prop, kind, old,
-                                    [comp if x.Name in names else x for x in old]))
-                    if o.isDerivedFrom("Part::Feature") and len(old) == 1:
-                        clones.add(o.Name)      # a clone of the nominal (Draft, Path model)
-            elif kind == "sub":
-                if old and old[0].Name in names:
-                    changes.append((o, prop, kind, old,
-                                    (comp, _map_subs(list(old[1]), mapping, where, comp.Label))))
-            else:
-                new = []
-                hit = False
-                for x, subs in old:
-                    subs = list(subs) if isinstance(subs, (list, tuple)) else [subs]
-                    if x.Name in names:
-                        hit = True
-                        new.append((comp, tuple(_map_subs(subs, mapping, where, comp.Label))))
-                    else:
-                        new.append((x, tuple(subs)))
-                if hit:
-                    changes.append((o, prop, kind, old, new))
+            old = getattr(o, prop)
+            new = _rebound(old, kind, names, comp, mapping, "%s.%s" % (o.Label, prop))
+            if new is None:
+                continue
+            changes.append((o, prop, kind, old, new))
+            if kind == "list" and o.isDerivedFrom("Part::Feature") and len(old) == 1:
+                clones.add(o.Name)      # a clone of the nominal (Draft, Path model)
     if mapping is not None and clones:
         # a clone of the nominal (Path's model, Draft) gets the face output's single face,
         # so links to the clone's FaceN would point elsewhere

@@ -502,7 +502,7 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     rows, cols = np.indices((n, m))
     ms = GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
                           deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
-    prepared = prepare(surface, outward, ms, Options(max_offset=np.inf))
+    prepared = prepare(surface, outward, ms, Options(max_offset=100.0))
     result = SimulationResult(model=model, specs=specs, grid=(n, m), eval_shape=layout.eval_shape,
                               between=b, margin=margin, replicas=int(replicas), seed=int(seed))
     steps = replicas * (1 + len(specs))
