@@ -46,6 +46,7 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .atomic import write_text
+from .files import read_bytes
 from .units import split_unit_suffix, unit_factor
 
 AXES = ("x", "y", "z")
@@ -151,12 +152,9 @@ def read_axis_errors(path, units="mm", text=None):
         Unreadable file, unknown header, bad value, or no data rows.
     """
     if text is None:
+        raw = read_bytes(path, "the axis error file")
         try:
-            with open(path, encoding="utf-8-sig", newline="") as fh:
-                text = fh.read()
-        except OSError as exc:
-            raise MeasurementFileError("cannot read the axis error file: %s" % exc.strerror,
-                                       file=path) from exc
+            text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             raise MeasurementFileError("not UTF-8 text (byte %d)" % exc.start, file=path) from exc
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
