@@ -38,18 +38,18 @@ import FreeCAD
 import numpy as np
 
 from ..core.deviations import statistics
-from ..core.field import GridField
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
 from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare
 from ..core.progress import sub
-from ..core.scattered import ScatteredField
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
 from .progress import freecad_progress
 from .proxies import Proxy
 from .proxies import migrate as _migrate
+from .reports import deviation_field
+from .shapes import corrected_shape
 
 #: version of the property sets; onDocumentRestored upgrades older objects
 VERSION = 1
@@ -59,12 +59,6 @@ COMPENSATION_TYPE = "SurfComp_Compensation"
 
 OUTPUTS = ("face", "solid")
 MASK_KINDS = ("box", "gaussian")
-#: quantities of :func:`deviation_field`
-QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
-
-#: a solid whose face was replaced gets its edges' tolerance raised to cover the shift of
-#: the face border inside the neighbouring faces (mm): refuse larger shifts
-MAX_EDGE_TOLERANCE = 1.0
 
 _RO = 1      # editor mode: read-only
 _HIDDEN = 2  # editor mode: hidden
@@ -519,89 +513,6 @@ def _build(nominal, prepared, comp, total, build=True, progress=None):
     return build_surface(comp, nominal.surface, nominal.outward, total, progress=progress)
 
 
-def rebuild_face(face, bs):
-    """The face ``face`` with its surface replaced by ``bs`` (same parametrisation).
-
-    The boundary is rebuilt from the face's own 2D curves (pcurves) on the new surface,
-    so trimmed faces and holes keep their place in parameter space; edges come in the
-    order of ``face.Edges``.
-    """
-    import Part
-
-    outer = face.OuterWire
-    wires = [outer] + [w for w in face.Wires if not w.isSame(outer)]
-    new_wires = []
-    for w in wires:
-        edges = []
-        for e in w.Edges:
-            c2d, a, b = face.curveOnSurface(e)[:3]
-            edges.append(c2d.toShape(bs, a, b))
-        new_wires.append(Part.Wire(edges))
-    out = Part.Face(bs, new_wires[0])
-    if len(new_wires) > 1:
-        out = out.cutHoles(new_wires[1:]) or out
-    if face.Orientation == "Reversed":
-        out.reverse()
-    if not out.isValid():
-        out.fix(1e-7, 1e-7, 1e-4)
-    if not out.isValid() or len(out.Edges) != len(face.Edges):
-        raise GeometryError("cannot rebuild %s on the corrected surface (%d edges instead of "
-                            "%d)" % ("the face", len(out.Edges), len(face.Edges)))
-    return out
-
-
-def corrected_shape(nominal, corrected, output="face", label="compensation"):
-    """The output shape of a compensation: ``(shape, max_edge_tolerance)``.
-
-    Parameters
-    ----------
-    nominal : surfcomp.app.nominal.Nominal
-        ``nominal.face`` is the face in ``nominal.shape``.
-    corrected : surfcomp.core.bspline.Surface
-    output : {'face', 'solid'}
-        ``solid``: ``nominal.shape`` with the face (and its edges and vertices) replaced;
-        the neighbouring faces keep their surfaces, their shared edges get the tolerance
-        that covers the shift of the border (reported, at most
-        :data:`MAX_EDGE_TOLERANCE`). Same number and order of faces.
-    """
-    from .convert import surface_to_part
-
-    bs = surface_to_part(corrected)
-    old = nominal.face
-    new = rebuild_face(old, bs)
-    if output == "face":
-        return new, max(e.Tolerance for e in new.Edges)
-    shape = nominal.shape
-    idx = int(nominal.face_name[4:]) - 1
-    old = shape.Faces[idx]
-    new = rebuild_face(old, bs)
-    pairs = [(old, new)]
-    for a, b in zip(old.Edges, new.Edges):
-        pairs.append((a, b))
-    for a, b in zip(old.Vertexes, new.Vertexes):
-        pairs.append((a, b))
-    out = shape.replaceShape(pairs)
-    out.fix(1e-7, 1e-7, MAX_EDGE_TOLERANCE)
-    problems = []
-    if not out.isValid():
-        problems.append("not valid")
-    if len(out.Faces) != len(shape.Faces):
-        problems.append("%d faces instead of %d" % (len(out.Faces), len(shape.Faces)))
-    if len(out.Solids) != len(shape.Solids):
-        problems.append("%d solids instead of %d" % (len(out.Solids), len(shape.Solids)))
-    if not problems:
-        for k, (a, b) in enumerate(zip(shape.Faces, out.Faces)):
-            if k != idx and a.Surface.TypeId != b.Surface.TypeId:
-                problems.append("Face%d changed its type" % (k + 1))
-                break
-        if out.Faces[idx].Surface.TypeId != "Part::GeomBSplineSurface":
-            problems.append("%s is not the corrected surface" % nominal.face_name)
-    if problems:
-        raise GeometryError("%s: cannot replace %s in the nominal's shape (%s); use Output = "
-                            "face" % (label, nominal.face_name, ", ".join(problems)))
-    return out, max(e.Tolerance for e in out.Edges)
-
-
 def _flat(a):
     return np.asarray(a, dtype=float).ravel().tolist()
 
@@ -685,60 +596,6 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     return _created(obj)
 
 
-def _grid(obj, name):
-    a = np.asarray(getattr(obj, name), dtype=float)
-    n, m = obj.GridRows, obj.GridCols
-    if n * m == 0 or a.size != n * m:
-        raise InputError("%s has no computed %s (recompute it first)" % (obj.Label, name))
-    return a.reshape(n, m)
-
-
-def _fill_gaps(values):
-    """Unmeasured nodes (NaN) take the value of the nearest measured node."""
-    bad = ~np.isfinite(values)
-    if not bad.any():
-        return values
-    if bad.all():
-        raise InputError("no measured node to build a field from")
-    from scipy import ndimage
-
-    idx = ndimage.distance_transform_edt(bad, return_distances=False, return_indices=True)
-    return values[tuple(idx)]
-
-
-def deviation_field(obj, quantity):
-    """A C1 field ``f(u, v)`` of a compensation's node values over the face's parameters.
-
-    Parameters
-    ----------
-    obj : ``SurfComp_Compensation`` (computed)
-    quantity : str
-        ``deviation``, ``determined``, ``random``, ``correction`` (total, accumulated),
-        ``increment`` (this round's correction) or ``residual``
-        (``deviation - increment``: what this round leaves uncorrected).
-
-    Returns
-    -------
-    surfcomp.core.field.GridField
-        Callable on arrays of u, v (face parameters); values in mm. Unmeasured nodes
-        take the value of their nearest measured node.
-    """
-    names = {"deviation": "Deviation", "determined": "Determined", "random": "Random",
-             "correction": "Correction", "increment": "Increment"}
-    if quantity == "residual":
-        values = _grid(obj, "Deviation") - _grid(obj, "Increment")
-    elif quantity in names:
-        values = _grid(obj, names[quantity])
-    else:
-        raise InputError("unknown quantity %r (expected one of %s)"
-                         % (quantity, ", ".join(QUANTITIES)))
-    if obj.Scattered:
-        surf = nominal_of(obj)[0].surface
-        return ScatteredField(_grid(obj, "U").ravel(), _grid(obj, "V").ravel(), values.ravel(),
-                              scale=tuple(obj.FieldScale), box=(surf.u_range, surf.v_range))
-    return GridField(_grid(obj, "U"), _grid(obj, "V"), _fill_gaps(values))
-
-
 def compensation_result(obj):
     """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
     recomputed from its properties and links (nothing is cached on the proxy).
@@ -749,51 +606,8 @@ def compensation_result(obj):
     return _compute(obj).comp
 
 
-def report_of(obj):
-    """The JSON report (schema ``surfcomp-report/1``, as the CLI writes it) of a
-    compensation object, recomputed from its properties and links."""
-    from ..io import report as report_io
-
-    comp = compensation_result(obj)
-    nominal = nominal_of(obj)[0]
-    m = obj.Measurement
-    inputs = {
-        "nominal": {"path": obj.Document.FileName or obj.Document.Name,
-                    "object": obj.Nominal.Label, "face": obj.FaceName,
-                    "poles": list(nominal.surface.shape),
-                    "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
-                    "rational": nominal.surface.weights is not None},
-        "measurements": {"path": m.SourceName, "sha256": m.SourceSha256, "units": m.Units,
-                         "points": int(m.PointCount), "object": m.Label},
-    }
-    return report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
-
-
-def write_html_report(obj, path):
-    """Write the self-contained HTML report of a compensation object (atomically)."""
-    from ..io.html_report import write_html_report as write
-
-    return write(path, report_of(obj))
-
-
-def corrected_surface(obj):
-    """The corrected surface of a computed compensation object as a core
-    :class:`~surfcomp.core.bspline.Surface` (from its Shape, in document coordinates:
-    the feature's Placement applied)."""
-    from .convert import surface_from_part
-
-    shape = obj.Shape
-    if obj.Output == "solid":
-        face = shape.Faces[int(obj.FaceName[4:]) - 1]
-    else:
-        face = shape.Faces[0]
-    u0, u1, v0, v1 = face.ParameterRange
-    return surface_from_part(face.Surface, (u0, u1), (v0, v1))
-
-
 __all__ = ["VERSION", "MEASUREMENT_TYPE", "COMPENSATION_TYPE", "MeasurementFeature",
            "CompensationFeature", "make_measurement", "make_measurement_from_set",
            "set_measurement_data", "measurement_set", "make_compensation",
-           "compensation_result", "deviation_field", "options_of", "chain", "migrate",
-           "is_compensation", "is_measurement", "corrected_shape", "rebuild_face",
-           "nominal_of", "corrected_surface"]
+           "compensation_result", "options_of", "chain", "migrate", "is_compensation",
+           "is_measurement", "nominal_of"]

@@ -143,15 +143,11 @@ def _inputs_record(job, nominal, ms):
 
 
 def corrected_face(comp, nominal):
-    """The corrected ``Part.Face`` with the nominal face's orientation."""
-    import Part
+    """The corrected face: the nominal face's boundary (trim, holes) on the corrected
+    surface, with the nominal's orientation (:func:`surfcomp.app.shapes.corrected_shape`)."""
+    from .shapes import corrected_shape
 
-    from .convert import surface_to_part
-
-    face = Part.Face(surface_to_part(comp.corrected))
-    if nominal.outward < 0:
-        face.reverse()
-    return face
+    return corrected_shape(nominal, comp.corrected, "face", nominal.face_name)[0]
 
 
 def curve_net(comp):

@@ -11,7 +11,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
-from ..app import features
+from ..app import reports
 from ..core.deviations import Statistics, format_table
 from ..core.filters import EDGE_MODES
 from ..errors import SurfcompError
@@ -121,7 +121,7 @@ class ReportDialog(QtGui.QDialog):
         if not path:
             return None
         try:
-            features.write_html_report(self.obj, path)
+            reports.write_html_report(self.obj, path)
         except SurfcompError as exc:
             dialogs.show_error(translate("SurfComp", "Report"), str(exc))
             return None

@@ -15,7 +15,7 @@ import numpy as np
 from PySide import QtCore
 
 from .. import paths
-from ..app import features
+from ..app import features, reports
 from ..core import colormap
 from ..errors import SurfcompError
 from . import prefs
@@ -111,14 +111,10 @@ def map_data(obj, quantity, samples=None):
     n, m = int(obj.GridRows), int(obj.GridCols)
     samples = samples or colormap.mesh_resolution((n, m))
     pts, tri, u, v = colormap.uv_grid_mesh(nominal.surface, samples)
-    field = features.deviation_field(obj, quantity)
-    values = field(u, v)
+    values = reports.deviation_field(obj, quantity)(u, v)
     nodes = np.asarray(obj.NominalPoints, dtype=float).reshape(-1, 3)
     dev = np.asarray(obj.Deviation, dtype=float)
-    if quantity == "residual":
-        node_values = dev - np.asarray(obj.Increment, dtype=float)
-    else:
-        node_values = np.asarray(getattr(obj, quantity.capitalize()), dtype=float)
+    node_values = reports.quantity_values(obj, quantity).ravel()
     keep = np.isfinite(dev) & np.isfinite(node_values)
     return {"points": pts, "triangles": tri, "values": values, "markers": nodes[keep],
             "marker_values": node_values[keep]}
