@@ -122,6 +122,308 @@ def _arc_geometry(fn, source, line, *args):
         raise GCodeError(exc.message, file=source, line=line) from None
 
 
+def _column(w):
+    return w.start + 1 if w.start >= 0 else None
+
+
+def _classify(words, source, ln):
+    """Split a line's words: G codes and M codes as ``(code, index, word)``, and the index
+    of every other word by letter (one word per letter)."""
+    gs, ms, vals = [], [], {}
+    for k, w in enumerate(words):
+        L = w.letter
+        if L == "G":
+            gs.append((int(round(w.value * 10)), k, w))
+        elif L == "M":
+            ms.append((int(round(w.value)), k, w))
+        elif L in "XYZIJKRFSTHDPQLN":
+            if L in vals:
+                raise GCodeError("two %s words on one line" % L, file=source, line=ln,
+                                 column=_column(w))
+            vals[L] = k
+        elif L in "ABCUVW":
+            raise GCodeError("axis word %s: only X, Y, Z programs can be compensated "
+                             "(no rotary or secondary axes)" % L, file=source, line=ln,
+                             column=_column(w))
+        else:
+            raise GCodeError("unsupported word %s%s (expected G M N X Y Z I J K R F S T H "
+                             "D P Q L)" % (L, w.text or ""), file=source, line=ln,
+                             column=_column(w))
+    return gs, ms, vals
+
+
+def _program_stop(ms, source, ln):
+    """Whether the M codes of a line stop the program; subprogram calls are refused."""
+    stop = False
+    for code, _k, w in ms:
+        if code in (98, 99):
+            raise GCodeError("M%d: subprograms cannot be compensated; expand the program "
+                             "first" % code, file=source, line=ln, column=_column(w))
+        if code in _STOP_M:
+            stop = True
+    return stop
+
+
+class _LineCodes:
+    """What the G codes of one line asked for (besides the modal state they set)."""
+
+    __slots__ = ("motion", "motion_word", "nonmodal")
+
+    def __init__(self):
+        self.motion = None          # motion code of the line (0, 10, 20, 30, 800) or None
+        self.motion_word = None     # its index in the line's words
+        self.nonmodal = None        # G53, G28 or G30
+
+
+#: G code -> name of the :class:`_Interpreter` method handling its group
+_G_HANDLERS = {}
+for _name, _codes in (("_g_pass", _PASS_G), ("_g_motion", (0, 10, 20, 30, 800)),
+                      ("_g_units", (200, 210)), ("_g_distance", (900, 910)),
+                      ("_g_arc_distance", (901, 911)), ("_g_plane", (170, 180, 190)),
+                      ("_g_nonmodal", (530, 280, 300)),
+                      ("_g_wcs", (540, 550, 560, 570, 580, 590, 591, 592, 593))):
+    _G_HANDLERS.update(dict.fromkeys(_codes, _name))
+
+
+class _Interpreter:
+    """Modal state while walking a program, and the moves collected so far."""
+
+    def __init__(self, source, start, path):
+        self.source = source
+        self.start = start
+        self.path = path
+        self.factor = 1.0
+        self.units_set = self.dist_set = False
+        self.absolute = True
+        self.arc_abs = False
+        self.plane = 17
+        self.motion = None
+        self.wcs = None
+        self.moved = False
+        self.known = [start is not None] * 3
+        self.pos = ([0.0, 0.0, 0.0] if start is None
+                    else [float(v) for v in np.reshape(start, 3)])
+        self.moves = {k: [] for k in ("kind", "start", "end", "centre", "plane", "turns",
+                                      "line", "known", "factor")}
+        self.warnings = []
+        self.unknown_use = {}
+
+    # ------------------------------------------------------------------ G code groups
+    def _g_pass(self, code, k, w, ln, cur):
+        pass
+
+    def _g_motion(self, code, k, w, ln, cur):
+        if cur.motion is not None:
+            raise GCodeError("two motion codes on one line", file=self.source, line=ln,
+                             column=_column(w))
+        cur.motion, cur.motion_word = code, k
+
+    def _g_units(self, code, k, w, ln, cur):
+        if code == 200 and self.path:
+            raise GCodeError("G20 (inch) in a FreeCAD Path: Path coordinates are always "
+                             "mm; the compensation cannot tell which unit is meant",
+                             file=self.source, line=ln)
+        self.factor = 25.4 if code == 200 else 1.0
+        self.units_set = True
+
+    def _g_distance(self, code, k, w, ln, cur):
+        self.absolute = code == 900
+        self.dist_set = True
+
+    def _g_arc_distance(self, code, k, w, ln, cur):
+        self.arc_abs = code == 901
+
+    def _g_plane(self, code, k, w, ln, cur):
+        self.plane = code // 10
+
+    def _g_nonmodal(self, code, k, w, ln, cur):
+        cur.nonmodal = code
+
+    def _g_wcs(self, code, k, w, ln, cur):
+        if self.wcs is not None and code != self.wcs and self.moved:
+            raise GCodeError("G%s selects a second work coordinate system after moves in "
+                             "G%s: the error model's positions cannot follow; compensate "
+                             "each work offset's part separately"
+                             % (_code_text(code), _code_text(self.wcs)), file=self.source,
+                             line=ln, column=_column(w))
+        self.wcs = code
+
+    def _g_codes(self, gs, ln):
+        cur = _LineCodes()
+        for code, k, w in gs:
+            handler = _G_HANDLERS.get(code)
+            if handler is not None:
+                getattr(self, handler)(code, k, w, ln, cur)
+            elif code in _REFUSED_G_MSG:
+                raise GCodeError("G%s: %s" % (_code_text(code), _REFUSED_G_MSG[code]),
+                                 file=self.source, line=ln, column=_column(w))
+            else:
+                raise GCodeError("G%s is not supported by the axis error compensation "
+                                 "(see docs/axis_errors.md for the supported codes)"
+                                 % _code_text(code), file=self.source, line=ln,
+                                 column=_column(w))
+        return cur
+
+    # --------------------------------------------------------------------------- lines
+    def line(self, idx, words, block, ln):
+        """Interpret one line with words; return its :class:`LineInfo`."""
+        gs, ms, vals = _classify(words, self.source, ln)
+        cur = self._g_codes(gs, ln)
+        stop = _program_stop(ms, self.source, ln)
+        if cur.motion is not None:
+            self.motion = None if cur.motion == 800 else _MOTION[cur.motion]
+        axis_idx = tuple(vals.get(a) for a in AXIS_LETTERS)
+        info = LineInfo(words, self.factor, self.absolute, self.motion, cur.motion_word,
+                        stop=stop, axis_words=axis_idx)
+        if cur.nonmodal is not None:
+            # G53 moves in machine coordinates, G28/G30 go home: positions are lost
+            lost = tuple(a for a in range(3) if axis_idx[a] is not None)
+            if cur.nonmodal != 530 and not lost:
+                lost = (0, 1, 2)
+            for a in lost:
+                self.known[a] = False
+            info.unknown = lost
+        else:
+            self._line_move(idx, ln, words, vals, block, info)
+        return info
+
+    def _line_move(self, idx, ln, words, vals, block, info):
+        """The move of a line, if it has one."""
+        arc_letters = [L for L in "IJKR" if L in vals]
+        is_arc = self.motion in (2, 3)
+        if arc_letters and not is_arc:
+            raise GCodeError("%s word on a line without G2/G3 (arc words need an arc)"
+                             % arc_letters[0], file=self.source, line=ln)
+        if all(k is None for k in info.axis_words) and not (is_arc and arc_letters):
+            return
+        if self.motion is None:
+            raise GCodeError("axis words but no motion mode (G0/G1/G2/G3) is active",
+                             file=self.source, line=ln)
+        if block:
+            raise GCodeError("block delete '/' on a move: the result would depend on the "
+                             "operator's switch", file=self.source, line=ln, column=1)
+        self._first_move(ln)
+        target = self._target(words, info.axis_words, ln)
+        centre, turns = [math.nan, math.nan, math.nan], 1
+        if is_arc:
+            centre, turns, info.arc_words = self._arc(words, vals, target, ln)
+        if self.motion != 0:
+            for a in range(3):
+                if not self.known[a]:
+                    first, count = self.unknown_use.get(a, (ln, 0))
+                    self.unknown_use[a] = (first, count + 1)
+        mv = self.moves
+        info.move = len(mv["kind"])
+        for key, value in (("kind", self.motion), ("start", self.pos), ("end", target),
+                           ("centre", centre), ("plane", self.plane), ("turns", turns),
+                           ("line", idx), ("known", tuple(self.known)),
+                           ("factor", self.factor)):
+            mv[key].append(value)
+        self.pos = target
+
+    def _first_move(self, ln):
+        """Warn about modes the program left to the controller's defaults."""
+        if not self.moved and not self.path:
+            if not self.units_set:
+                self.warnings.append("no G20/G21 before the first move (line %d): millimetres "
+                                     "assumed" % ln)
+            if not self.dist_set:
+                self.warnings.append("no G90/G91 before the first move (line %d): absolute "
+                                     "(G90) assumed" % ln)
+        self.moved = True
+
+    def _target(self, words, axis_idx, ln):
+        """End point (mm) of the move; marks the programmed axes known."""
+        target = list(self.pos)
+        for a in range(3):
+            k = axis_idx[a]
+            if k is None:
+                continue
+            v = words[k].value * self.factor
+            if self.absolute:
+                target[a] = v
+                self.known[a] = True
+            elif not self.known[a]:
+                raise GCodeError("incremental (G91) %s move before any absolute %s position: "
+                                 "the compensation needs absolute positions; program an "
+                                 "absolute position first (or give the start position)"
+                                 % (AXIS_LETTERS[a], AXIS_LETTERS[a]), file=self.source,
+                                 line=ln, column=_column(words[k]))
+            else:
+                target[a] = self.pos[a] + v
+        return target
+
+    def _arc(self, words, vals, target, ln):
+        """Centre (mm), turns and the arc words (I J K R P) of an arc move."""
+        p, q, _l = PLANES[self.plane]
+        off_letters = ("IJK"[p], "IJK"[q])
+        arc_idx = [vals[L] for L in "IJK" if L in vals]
+        if "R" in vals:
+            if any(L in vals for L in off_letters):
+                raise GCodeError("arc with both R and %s/%s" % off_letters, file=self.source,
+                                 line=ln)
+            centre = _arc_geometry(centre_from_radius, self.source, ln, self.pos, target,
+                                   words[vals["R"]].value * self.factor, self.plane,
+                                   self.motion == 2)
+            arc_idx.append(vals["R"])
+        else:
+            centre = self._centre_ijk(words, vals, off_letters, (p, q), target, ln)
+        turns = 1
+        if "P" in vals:
+            pv = words[vals["P"]].value
+            if pv < 1 or pv != int(pv):
+                raise GCodeError("arc turns P%s must be a positive whole number"
+                                 % words[vals["P"]].text, file=self.source, line=ln)
+            turns = int(pv)
+            arc_idx.append(vals["P"])
+        return centre, turns, tuple(sorted(arc_idx))
+
+    def _centre_ijk(self, words, vals, off_letters, axes, target, ln):
+        """Centre of an arc given by its offsets (G91.1) or coordinates (G90.1)."""
+        if not any(L in vals for L in off_letters):
+            raise GCodeError("arc (G%d) in the G%d plane without %s/%s or R"
+                             % (self.motion, self.plane, off_letters[0], off_letters[1]),
+                             file=self.source, line=ln)
+        centre = list(self.pos)
+        for a, L in zip(axes, off_letters):
+            if self.arc_abs:
+                if L not in vals:
+                    raise GCodeError("absolute arc centre (G90.1) without %s" % L,
+                                     file=self.source, line=ln)
+                centre[a] = words[vals[L]].value * self.factor
+            elif L in vals:
+                centre[a] = self.pos[a] + words[vals[L]].value * self.factor
+        _arc_geometry(check_centre, self.source, ln, self.pos, target, centre, self.plane)
+        return centre
+
+    # -------------------------------------------------------------------------- result
+    def program(self, infos):
+        """The :class:`Program` of the lines interpreted."""
+        start = self.start
+        for a, (first, count) in sorted(self.unknown_use.items()):
+            self.warnings.append(
+                "%d cutting move(s) from line %d on ran before the program gave an absolute "
+                "%s position: the compensation assumed %s = %g mm there and did not write %s "
+                "(give the start position if it is known)"
+                % (count, first, AXIS_LETTERS[a], AXIS_LETTERS[a],
+                   (np.zeros(3) if start is None else np.asarray(start))[a], AXIS_LETTERS[a]))
+        mv = self.moves
+        m = len(mv["kind"])
+        return Program(
+            infos,
+            np.array(mv["kind"], dtype=int),
+            np.array(mv["start"], dtype=float).reshape(m, 3),
+            np.array(mv["end"], dtype=float).reshape(m, 3),
+            np.array(mv["centre"], dtype=float).reshape(m, 3),
+            np.array(mv["plane"], dtype=int),
+            np.array(mv["turns"], dtype=int),
+            np.array(mv["line"], dtype=int),
+            np.array(mv["known"], dtype=bool).reshape(m, 3),
+            np.array(mv["factor"], dtype=float),
+            self.warnings, self.source, start is not None,
+            np.zeros(3) if start is None else np.array(start, dtype=float).reshape(3))
+
+
 def interpret(line_words, source=None, start=None, line_numbers=None, path=False):
     """Interpret the words of every line; collect the moves.
 
@@ -144,224 +446,15 @@ def interpret(line_words, source=None, start=None, line_numbers=None, path=False
     -------
     Program
     """
-    factor = 1.0
-    units_set = dist_set = False
-    absolute = True
-    arc_abs = False
-    plane = 17
-    motion = None
-    wcs = None
-    moved = False
-    known = [start is not None] * 3
-    pos = [0.0, 0.0, 0.0] if start is None else [float(v) for v in np.reshape(start, 3)]
+    state = _Interpreter(source, start, path)
     infos = []
-    mv = {k: [] for k in ("kind", "start", "end", "centre", "plane", "turns", "line", "known",
-                          "factor")}
-    warnings = []
-    unknown_use = {}
     for idx, (words, block) in enumerate(line_words):
         if not words:
             infos.append(None)
             continue
         ln = idx + 1 if line_numbers is None else line_numbers[idx]
-        gs, ms, vals = [], [], {}
-        for k, w in enumerate(words):
-            L = w.letter
-            if L == "G":
-                gs.append((int(round(w.value * 10)), k, w))
-            elif L == "M":
-                ms.append((int(round(w.value)), k, w))
-            elif L in "XYZIJKRFSTHDPQLN":
-                if L in vals:
-                    raise GCodeError("two %s words on one line" % L, file=source, line=ln,
-                                     column=w.start + 1 if w.start >= 0 else None)
-                vals[L] = k
-            elif L in "ABCUVW":
-                raise GCodeError("axis word %s: only X, Y, Z programs can be compensated "
-                                 "(no rotary or secondary axes)" % L, file=source, line=ln,
-                                 column=w.start + 1 if w.start >= 0 else None)
-            else:
-                raise GCodeError("unsupported word %s%s (expected G M N X Y Z I J K R F S T H "
-                                 "D P Q L)" % (L, w.text or ""), file=source, line=ln,
-                                 column=w.start + 1 if w.start >= 0 else None)
-        motion_here = motion_word = None
-        nonmodal = None
-        for code, k, w in gs:
-            col = w.start + 1 if w.start >= 0 else None
-            if code in _MOTION or code == 800:
-                if motion_here is not None:
-                    raise GCodeError("two motion codes on one line", file=source, line=ln,
-                                     column=col)
-                motion_here, motion_word = code, k
-            elif code in (200, 210):
-                if code == 200 and path:
-                    raise GCodeError("G20 (inch) in a FreeCAD Path: Path coordinates are always "
-                                     "mm; the compensation cannot tell which unit is meant",
-                                     file=source, line=ln)
-                factor = 25.4 if code == 200 else 1.0
-                units_set = True
-            elif code in (900, 910):
-                absolute = code == 900
-                dist_set = True
-            elif code in (901, 911):
-                arc_abs = code == 901
-            elif code in (170, 180, 190):
-                plane = code // 10
-            elif code in (530, 280, 300):
-                nonmodal = code
-            elif code in (540, 550, 560, 570, 580, 590, 591, 592, 593):
-                if wcs is not None and code != wcs and moved:
-                    raise GCodeError("G%s selects a second work coordinate system after moves "
-                                     "in G%s: the error model's positions cannot follow; "
-                                     "compensate each work offset's part separately"
-                                     % (_code_text(code), _code_text(wcs)), file=source,
-                                     line=ln, column=col)
-                wcs = code
-            elif code in _PASS_G:
-                pass
-            elif code in _REFUSED_G_MSG:
-                raise GCodeError("G%s: %s" % (_code_text(code), _REFUSED_G_MSG[code]),
-                                 file=source, line=ln, column=col)
-            else:
-                raise GCodeError("G%s is not supported by the axis error compensation "
-                                 "(see docs/axis_errors.md for the supported codes)"
-                                 % _code_text(code), file=source, line=ln, column=col)
-        stop = False
-        for code, _k, w in ms:
-            if code in (98, 99):
-                raise GCodeError("M%d: subprograms cannot be compensated; expand the program "
-                                 "first" % code, file=source, line=ln,
-                                 column=w.start + 1 if w.start >= 0 else None)
-            if code in _STOP_M:
-                stop = True
-        if motion_here is not None:
-            motion = None if motion_here == 800 else _MOTION[motion_here]
-        axis_idx = tuple(vals.get(a) for a in AXIS_LETTERS)
-        has_axis = any(k is not None for k in axis_idx)
-        info = LineInfo(words, factor, absolute, motion, motion_word, stop=stop,
-                        axis_words=axis_idx)
-        infos.append(info)
-        if nonmodal is not None:
-            lost = tuple(a for a in range(3) if axis_idx[a] is not None)
-            if nonmodal != 530 and not lost:
-                lost = (0, 1, 2)
-            for a in lost:
-                known[a] = False
-            info.unknown = lost
-            continue
-        arc_letters = [L for L in "IJKR" if L in vals]
-        is_arc = motion in (2, 3)
-        if arc_letters and not is_arc:
-            raise GCodeError("%s word on a line without G2/G3 (arc words need an arc)"
-                             % arc_letters[0], file=source, line=ln)
-        if not has_axis and not (is_arc and arc_letters):
-            continue
-        if motion is None:
-            raise GCodeError("axis words but no motion mode (G0/G1/G2/G3) is active",
-                             file=source, line=ln)
-        if block:
-            raise GCodeError("block delete '/' on a move: the result would depend on the "
-                             "operator's switch", file=source, line=ln, column=1)
-        if not moved and not path:
-            if not units_set:
-                warnings.append("no G20/G21 before the first move (line %d): millimetres "
-                                "assumed" % ln)
-            if not dist_set:
-                warnings.append("no G90/G91 before the first move (line %d): absolute (G90) "
-                                "assumed" % ln)
-        moved = True
-        target = list(pos)
-        for a in range(3):
-            k = axis_idx[a]
-            if k is None:
-                continue
-            v = words[k].value * factor
-            if absolute:
-                target[a] = v
-                known[a] = True
-            else:
-                if not known[a]:
-                    raise GCodeError("incremental (G91) %s move before any absolute %s "
-                                     "position: the compensation needs absolute positions; "
-                                     "program an absolute position first (or give the start "
-                                     "position)" % (AXIS_LETTERS[a], AXIS_LETTERS[a]),
-                                     file=source, line=ln,
-                                     column=words[k].start + 1 if words[k].start >= 0 else None)
-                target[a] = pos[a] + v
-        centre = [math.nan, math.nan, math.nan]
-        turns = 1
-        if is_arc:
-            p, q, _l = PLANES[plane]
-            clockwise = motion == 2
-            off_letters = ("IJK"[p], "IJK"[q])
-            arc_idx = [vals[L] for L in "IJK" if L in vals]
-            if "R" in vals:
-                if any(L in vals for L in off_letters):
-                    raise GCodeError("arc with both R and %s/%s" % off_letters, file=source,
-                                     line=ln)
-                centre = _arc_geometry(centre_from_radius, source, ln, pos, target,
-                                       words[vals["R"]].value * factor, plane, clockwise)
-                arc_idx.append(vals["R"])
-            else:
-                if not any(L in vals for L in off_letters):
-                    raise GCodeError("arc (G%d) in the G%d plane without %s/%s or R"
-                                     % (motion, plane, off_letters[0], off_letters[1]),
-                                     file=source, line=ln)
-                centre = list(pos)
-                for a, L in ((p, off_letters[0]), (q, off_letters[1])):
-                    if arc_abs:
-                        if L not in vals:
-                            raise GCodeError("absolute arc centre (G90.1) without %s" % L,
-                                             file=source, line=ln)
-                        centre[a] = words[vals[L]].value * factor
-                    elif L in vals:
-                        centre[a] = pos[a] + words[vals[L]].value * factor
-                _arc_geometry(check_centre, source, ln, pos, target, centre, plane)
-            if "P" in vals:
-                pv = words[vals["P"]].value
-                if pv < 1 or pv != int(pv):
-                    raise GCodeError("arc turns P%s must be a positive whole number"
-                                     % words[vals["P"]].text, file=source, line=ln)
-                turns = int(pv)
-                arc_idx.append(vals["P"])
-            info.arc_words = tuple(sorted(arc_idx))
-        if motion != 0:
-            for a in range(3):
-                if not known[a]:
-                    first, count = unknown_use.get(a, (ln, 0))
-                    unknown_use[a] = (first, count + 1)
-        info.move = len(mv["kind"])
-        mv["kind"].append(motion)
-        mv["start"].append(pos)
-        mv["end"].append(target)
-        mv["centre"].append(centre)
-        mv["plane"].append(plane)
-        mv["turns"].append(turns)
-        mv["line"].append(idx)
-        mv["known"].append(tuple(known))
-        mv["factor"].append(factor)
-        pos = target
-    for a, (first, count) in sorted(unknown_use.items()):
-        warnings.append("%d cutting move(s) from line %d on ran before the program gave an "
-                        "absolute %s position: the compensation assumed %s = %g mm there and "
-                        "did not write %s (give the start position if it is known)"
-                        % (count, first, AXIS_LETTERS[a], AXIS_LETTERS[a],
-                           (np.zeros(3) if start is None else np.asarray(start))[a],
-                           AXIS_LETTERS[a]))
-    m = len(mv["kind"])
-    return Program(
-        infos,
-        np.array(mv["kind"], dtype=int),
-        np.array(mv["start"], dtype=float).reshape(m, 3),
-        np.array(mv["end"], dtype=float).reshape(m, 3),
-        np.array(mv["centre"], dtype=float).reshape(m, 3),
-        np.array(mv["plane"], dtype=int),
-        np.array(mv["turns"], dtype=int),
-        np.array(mv["line"], dtype=int),
-        np.array(mv["known"], dtype=bool).reshape(m, 3),
-        np.array(mv["factor"], dtype=float),
-        warnings, source, start is not None,
-        np.zeros(3) if start is None else np.array(start, dtype=float).reshape(3))
+        infos.append(state.line(idx, words, block, ln))
+    return state.program(infos)
 
 
 def parse_gcode(data, source=None, start=None):

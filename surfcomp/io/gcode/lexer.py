@@ -64,62 +64,72 @@ def tokenize(content, source=None, line=None):
         c = content[i]
         if c in " \t\r":
             i += 1
-            continue
-        if c == "(":
-            j = content.find(")", i + 1)
-            if j < 0:
-                raise GCodeError("comment opened with '(' is not closed", file=source,
-                                 line=line, column=i + 1)
-            k = content.find("(", i + 1, j)
-            if k >= 0:
-                raise GCodeError("nested '(' inside a comment", file=source, line=line,
-                                 column=k + 1)
-            i = j + 1
-            continue
-        if c == ";":
+        elif c == "(":
+            i = _comment_end(content, i, source, line)
+        elif c == ";" or (c == "%" and not words and content.strip() == "%"):
             break
-        if c == "/" and not words and not block:
+        elif c == "/" and not words and not block:
             block = True
             i += 1
-            continue
-        if c == "%" and not words and content.strip() == "%":
-            break
-        m = _WORD.match(content, i)
-        if m:
-            letter = m.group(1).upper()
-            if letter == "O":
-                raise GCodeError("O word %r: subroutines and flow control (O-words) cannot be "
-                                 "compensated; expand the program first"
-                                 % content[i:m.end()], file=source, line=line, column=i + 1)
-            text = m.group(2)
-            end = m.end()
-            if end < n and (content[end] == "." or content[end].isdigit()):
-                raise GCodeError("malformed number in %r" % content[i:end + 1], file=source,
-                                 line=line, column=i + 1)
-            words.append(Word(letter, float(text), text, i, end))
-            i = end
-            continue
-        if c == "#" or c == "[":
-            raise GCodeError("LinuxCNC parameter or expression %r: parameters and expressions "
-                             "cannot be compensated; expand them to plain numbers first"
-                             % content[i:i + 16].strip(), file=source, line=line, column=i + 1)
-        if c.isalpha():
-            rest = content[i + 1:].lstrip(" \t")
-            if rest[:1] in ("#", "["):
-                raise GCodeError("LinuxCNC parameter or expression in %r: parameters and "
-                                 "expressions cannot be compensated; expand them to plain "
-                                 "numbers first" % content[i:i + 16].strip(), file=source,
-                                 line=line, column=i + 1)
-            if c.upper() == "O":
-                raise GCodeError("O word %r: subroutines and flow control (O-words) cannot be "
-                                 "compensated; expand the program first"
-                                 % content[i:i + 16].strip(), file=source, line=line,
-                                 column=i + 1)
-            raise GCodeError("word %r without a number" % c, file=source, line=line,
-                             column=i + 1)
-        raise GCodeError("unexpected character %r (expected G-code words, comments in "
-                         "parentheses or after ';')" % c, file=source, line=line, column=i + 1)
+        else:
+            m = _WORD.match(content, i)
+            if not m:
+                _refuse(content, i, source, line)
+            words.append(_word(content, m, source, line))
+            i = m.end()
     return words, block
+
+
+def _comment_end(content, i, source, line):
+    """Index after the comment ``( ... )`` that starts at ``i``."""
+    j = content.find(")", i + 1)
+    if j < 0:
+        raise GCodeError("comment opened with '(' is not closed", file=source, line=line,
+                         column=i + 1)
+    k = content.find("(", i + 1, j)
+    if k >= 0:
+        raise GCodeError("nested '(' inside a comment", file=source, line=line, column=k + 1)
+    return j + 1
+
+
+def _o_word(text, source, line, i):
+    return GCodeError("O word %r: subroutines and flow control (O-words) cannot be "
+                      "compensated; expand the program first" % text, file=source, line=line,
+                      column=i + 1)
+
+
+def _word(content, m, source, line):
+    """The :class:`Word` of the match ``m`` of :data:`_WORD`."""
+    i, end = m.start(), m.end()
+    letter = m.group(1).upper()
+    if letter == "O":
+        raise _o_word(content[i:end], source, line, i)
+    if end < len(content) and (content[end] == "." or content[end].isdigit()):
+        raise GCodeError("malformed number in %r" % content[i:end + 1], file=source,
+                         line=line, column=i + 1)
+    text = m.group(2)
+    return Word(letter, float(text), text, i, end)
+
+
+def _refuse(content, i, source, line):
+    """Raise the error for what starts at ``i`` and is neither a word nor a comment."""
+    c = content[i]
+    if c == "#" or c == "[":
+        raise GCodeError("LinuxCNC parameter or expression %r: parameters and expressions "
+                         "cannot be compensated; expand them to plain numbers first"
+                         % content[i:i + 16].strip(), file=source, line=line, column=i + 1)
+    if c.isalpha():
+        rest = content[i + 1:].lstrip(" \t")
+        if rest[:1] in ("#", "["):
+            raise GCodeError("LinuxCNC parameter or expression in %r: parameters and "
+                             "expressions cannot be compensated; expand them to plain "
+                             "numbers first" % content[i:i + 16].strip(), file=source,
+                             line=line, column=i + 1)
+        if c.upper() == "O":
+            raise _o_word(content[i:i + 16].strip(), source, line, i)
+        raise GCodeError("word %r without a number" % c, file=source, line=line, column=i + 1)
+    raise GCodeError("unexpected character %r (expected G-code words, comments in "
+                     "parentheses or after ';')" % c, file=source, line=line, column=i + 1)
 
 
 def split_lines(text):
