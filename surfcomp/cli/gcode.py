@@ -136,7 +136,7 @@ def run(args):
     with Transaction() as tr:
         tmp = tr.stage(args.output)
         with open(tmp, "wb") as fh:
-            fh.write(res.data)
+            fh.write(res.output)
         if args.report:
             outputs["report"] = os.path.abspath(args.report)
             rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,

@@ -72,11 +72,12 @@ from .commands import command_words, compensate_commands
 from .emitter import DEFAULT_DECIMALS, _fmt, compensate_gcode
 from .interpreter import LineInfo, Program, interpret, parse_gcode, read_gcode
 from .lexer import AXIS_LETTERS, Word, split_lines, tokenize
-from .result import CommandsResult, GCodeResult
+from .result import CommandsResult, CompensationResult, GCodeResult
 
 __all__ = [
     "ARC_RADIUS_TOL", "AXIS_LETTERS", "DEFAULT_DECIMALS", "FULL_CIRCLE_TOL", "PLANES",
-    "CommandsResult", "GCodeResult", "LineInfo", "MovePlan", "Program", "Word",
+    "CommandsResult", "CompensationResult", "GCodeResult", "LineInfo", "MovePlan", "Program",
+    "Word",
     "_fmt", "arc_points", "arc_steps", "command_words", "compensate_commands",
     "compensate_gcode", "interpret", "parse_gcode", "plan_moves", "read_gcode",
     "split_lines", "tokenize",

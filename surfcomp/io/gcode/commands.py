@@ -6,13 +6,11 @@ FreeCAD itself. Path coordinates are always mm and absolute unless ``G91``.
 
 import re
 
-import numpy as np
-
 from ...core.moves import plan_moves
 from ...errors import GCodeError
 from .interpreter import interpret
 from .lexer import AXIS_LETTERS, Word
-from .result import CommandsResult
+from .result import CommandsResult, OutputState
 
 _NAME = re.compile(r"^\s*([A-Za-z])\s*([+-]?(?:\d+(?:\.\d*)?|\.\d+))\s*$")
 
@@ -50,7 +48,7 @@ def compensate_commands(commands, model, segment_length=2.0, tolerance=1e-4,
     model : surfcomp.core.axis_errors.AxisErrorModel
         In the commands' coordinates (mm).
     segment_length, tolerance, arc_tolerance, start, source
-        As in :func:`compensate_gcode`.
+        As in :func:`surfcomp.io.gcode.compensate_gcode`.
 
     Returns
     -------
@@ -63,88 +61,77 @@ def compensate_commands(commands, model, segment_length=2.0, tolerance=1e-4,
                   for k, (n, p) in enumerate(commands)]
     prog = interpret(line_words, source=source, start=start, path=True)
     plan = plan_moves(prog, model, segment_length, tolerance, arc_tolerance, still=0.0)
+    writer = _CommandWriter(prog, plan, start)
     out = []
-    out_val = [None, None, None] if start is None else [float(v) for v in prog.start_pos]
-    nominal, emitted, known_pts = [], [], []
-    n_changed = n_added = n_split = n_conv = 0
-    comp_l = plan.compensated.tolist()
-    nom_l = plan.nominal.tolist()
-    off_l = plan.offsets.tolist()
     for idx, (name, params) in enumerate(commands):
-        info = prog.lines[idx]
-        if info is None:
-            out.append(idx)
-            continue
-        if info.unknown:
-            for a in info.unknown:
-                out_val[a] = None
-            out.append(idx)
-            continue
+        out.extend(writer.command(idx, name, params))
+    return writer.state.result(CommandsResult, out, len(commands), len(out), prog)
+
+
+class _CommandWriter:
+    """Turns each command into its output commands (mm, like Path itself)."""
+
+    def __init__(self, prog, plan, start):
+        self.prog = prog
+        self.plan = plan
+        self.state = OutputState(None if start is None else prog.start_pos)
+        self.comp_l = plan.compensated.tolist()
+        self.nom_l = plan.nominal.tolist()
+        self.off_l = plan.offsets.tolist()
+
+    def command(self, idx, name, params):
+        """The output of command ``idx``: ``[idx]`` when it is kept, else new commands."""
+        info = self.prog.lines[idx]
+        if info is not None and info.unknown:
+            self.state.forget(info.unknown)
+        if info is None or info.unknown or info.move < 0:
+            return [idx]
         j = info.move
-        if j < 0:
-            out.append(idx)
-            continue
-        known = prog.known[j].tolist()
-        all_known = all(known)
-        pts = comp_l[off_l[j]:off_l[j + 1]]
-        noms = nom_l[off_l[j]:off_l[j + 1]]
-        if plan.keep[j]:
-            for a in range(3):
-                k = info.axis_words[a]
-                if k is not None:
-                    v = info.words[k].value
-                    out_val[a] = v if info.absolute else out_val[a] + v
-            out.append(idx)
-            nominal.append(prog.end[j].tolist())
-            emitted.append(prog.end[j].tolist())
-            known_pts.append(all_known)
-            continue
-        convert = prog.kind[j] >= 2
+        known = self.prog.known[j].tolist()
+        if self.plan.keep[j]:
+            self.state.hold_programmed(info)
+            self.state.record_kept(self.prog.end[j].tolist(), known)
+            return [idx]
+        convert = bool(self.prog.kind[j] >= 2)
+        pieces = self._pieces(info, j, params, convert, known)
+        if len(pieces) == 1 and not convert and pieces[0] == dict(params):
+            return [idx]
+        self.state.changed += 1
+        self.state.added += len(pieces) - 1
+        if convert:
+            self.state.converted += 1
+        elif len(pieces) > 1:
+            self.state.split += 1
+        new_name = "G1" if convert else name
+        return [(new_name, par) for par in pieces]
+
+    def _pieces(self, info, j, params, convert, known):
+        """Parameters of every piece of move ``j``: the first keeps all the command's
+        parameters (arc words dropped when the arc becomes G1 pieces), the others carry
+        the axes that change and the feed."""
         base = dict(params)
         if convert:
             for key in list(base):
                 if str(key).upper() in "IJKRP":
                     del base[key]
         keys = {str(k).upper(): k for k in base}
+        held = self.state.held
         pieces = []
-        for p_idx, pt in enumerate(pts):
-            par = dict(base) if p_idx == 0 else {}
-            if p_idx > 0 and "F" in keys:
+        for p in range(self.off_l[j], self.off_l[j + 1]):
+            pt = self.comp_l[p]
+            first = not pieces
+            par = dict(base) if first else {}
+            if not first and "F" in keys:
                 par[keys["F"]] = base[keys["F"]]
             for a in range(3):
                 if not known[a]:
                     continue
-                L = AXIS_LETTERS[a]
-                present = info.axis_words[a] is not None and p_idx == 0
-                if info.absolute:
-                    if present or out_val[a] is None or out_val[a] != pt[a]:
-                        par[keys.get(L, L)] = pt[a]
-                    out_val[a] = pt[a]
-                else:
-                    inc = pt[a] - out_val[a]
-                    if present or inc != 0.0:
-                        par[keys.get(L, L)] = inc
-                    out_val[a] = pt[a]
+                letter = AXIS_LETTERS[a]
+                present = first and info.axis_words[a] is not None
+                value = pt[a] if info.absolute else pt[a] - held[a]
+                if present or held[a] is None or held[a] != pt[a]:
+                    par[keys.get(letter, letter)] = value
+                held[a] = pt[a]
             pieces.append(par)
-            nominal.append(noms[p_idx])
-            emitted.append([out_val[a] if (known[a] and out_val[a] is not None) else pt[a]
-                            for a in range(3)])
-            known_pts.append(all_known)
-        if len(pieces) == 1 and not convert and pieces[0] == dict(params):
-            out.append(idx)
-            continue
-        new_name = "G1" if convert else name
-        out.append((new_name, pieces[0]))
-        out.extend(("G1" if convert else name, par) for par in pieces[1:])
-        n_changed += 1
-        n_added += len(pieces) - 1
-        if convert:
-            n_conv += 1
-        elif len(pieces) > 1:
-            n_split += 1
-    stats = {"lines_in": len(commands), "lines_out": len(out), "lines_changed": n_changed,
-             "lines_added": n_added, "moves": prog.n_moves, "moves_split": n_split,
-             "arcs_converted": n_conv, "points": len(nominal)}
-    return CommandsResult(out, stats, np.array(nominal, dtype=float).reshape(-1, 3),
-                          np.array(emitted, dtype=float).reshape(-1, 3),
-                          np.array(known_pts, dtype=bool), list(prog.warnings), prog)
+            self.state.record(self.nom_l[p], pt, known)
+        return pieces

@@ -12,7 +12,7 @@ from ...core.progress import report
 from ...errors import GCodeError
 from .interpreter import parse_gcode
 from .lexer import AXIS_LETTERS, decode
-from .result import GCodeResult
+from .result import GCodeResult, OutputState
 
 #: default output decimals per unit system
 DEFAULT_DECIMALS = {"mm": 4, "in": 5}
@@ -97,12 +97,12 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
     Returns
     -------
     GCodeResult
-        ``data`` is the input unchanged, byte for byte, when the model is zero.
+        ``output`` (``data``) is the input unchanged, byte for byte, when the model is zero.
 
     Raises
     ------
     GCodeError
-        For anything the compensation cannot handle correctly (module docstring).
+        For anything the compensation cannot handle correctly (see :mod:`surfcomp.io.gcode`).
     """
     raw = data
     text = decode(data)
@@ -115,190 +115,198 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
     plan = plan_moves(prog, model, segment_length, tolerance, arc_tolerance, still,
                       progress=None)
     report(progress, 0.5, "writing")
-    out, stats, nominal, emitted, known = _emit(lines, prog, plan, dmin_mm, dmin_in, source)
-    text_out = "".join(out)
+    writer = _TextWriter(lines, prog, plan, dmin_mm, dmin_in, source)
+    text_out = "".join([writer.line(idx, content, eol)
+                        for idx, (content, eol) in enumerate(lines)])
     if text_out == text:
         data_out = bytes(raw) if isinstance(raw, (bytes, bytearray)) else text.encode("latin-1")
     else:
         data_out = text_out.encode("latin-1")
     report(progress, 1.0, "done")
-    return GCodeResult(data_out, stats, nominal, emitted, known, list(prog.warnings), prog)
+    return writer.state.result(GCodeResult, data_out, len(lines),
+                               len(lines) + writer.state.added, prog)
 
 
-def _emit(lines, prog, plan, dmin_mm, dmin_in, source):
-    eol_default = next((e for _c, e in lines if e), "\n")
-    file_sep = _file_sep(lines, prog)
-    out = []
-    out_val = [None, None, None]     # value the machine holds, program units
-    if prog.start_known:
-        out_val = [float(v) for v in prog.start_pos]
-    factor_prev = 1.0
-    last_dec = [3, 3, 3]
-    out_motion = None
-    n_changed = n_added = n_split = n_conv = 0
-    nominal, emitted, known_pts = [], [], []
-    known_l = prog.known.tolist()
-    kind_l = prog.kind.tolist()
-    end_l = prog.end.tolist()
-    comp_l = plan.compensated.tolist()
-    nom_l = plan.nominal.tolist()
-    off_l = plan.offsets.tolist()
-    keep_l = plan.keep.tolist()
-    split_l = plan.split.tolist()
-    for idx, (content, eol) in enumerate(lines):
-        info = prog.lines[idx]
+class _TextWriter:
+    """Writes the lines of a program with the compensated points of its plan.
+
+    Numbers are held in program units (``out.held``); ``factor`` is mm per program unit.
+    """
+
+    def __init__(self, lines, prog, plan, dmin_mm, dmin_in, source):
+        self.prog = prog
+        self.source = source
+        self.dmin_mm, self.dmin_in = dmin_mm, dmin_in
+        self.eol_default = next((e for _c, e in lines if e), "\n")
+        self.file_sep = _file_sep(lines, prog)
+        self.state = OutputState(prog.start_pos if prog.start_known else None)
+        self.factor_prev = 1.0
+        self.last_dec = [3, 3, 3]       # decimals of the last word of each axis
+        self.out_motion = None          # modal motion of the output so far
+        # plain lists: indexing them is much faster than indexing arrays
+        self.known_l = prog.known.tolist()
+        self.kind_l = prog.kind.tolist()
+        self.end_l = prog.end.tolist()
+        self.comp_l = plan.compensated.tolist()
+        self.nom_l = plan.nominal.tolist()
+        self.off_l = plan.offsets.tolist()
+        self.keep_l = plan.keep.tolist()
+        self.split_l = plan.split.tolist()
+
+    def line(self, idx, content, eol):
+        """The output text of line ``idx`` (its ending included)."""
+        info = self.prog.lines[idx]
         if info is None:
-            out.append(content + eol)
-            continue
+            return content + eol
         f = info.factor
-        if f != factor_prev:
-            out_val = [None if v is None else v * factor_prev / f for v in out_val]
-            factor_prev = f
-        dmin = dmin_mm if f == 1.0 else dmin_in
-        words = info.words
+        if f != self.factor_prev:
+            self.state.held = [None if v is None else v * self.factor_prev / f
+                               for v in self.state.held]
+            self.factor_prev = f
         for a in range(3):
             k = info.axis_words[a]
             if k is not None:
-                last_dec[a] = max(words[k].decimals, 1)
+                self.last_dec[a] = max(info.words[k].decimals, 1)
         if info.unknown:
-            for a in info.unknown:
-                out_val[a] = None
+            self.state.forget(info.unknown)
+        if info.unknown or info.move < 0:
             if info.motion_word is not None:
-                out_motion = info.motion
-            out.append(content + eol)
-            continue
+                self.out_motion = info.motion
+            return content + eol
+        return self._move_line(idx, content, eol, info)
+
+    def _move_line(self, idx, content, eol, info):
         j = info.move
-        if j < 0:
-            if info.motion_word is not None:
-                out_motion = info.motion
-            out.append(content + eol)
-            continue
-        ln = idx + 1
-        known = known_l[j]
-        all_known = known[0] and known[1] and known[2]
-        pts = comp_l[off_l[j]:off_l[j + 1]]
-        noms = nom_l[off_l[j]:off_l[j + 1]]
-        kind = kind_l[j]
-        edits = []
-        sep, asep = _word_sep(content, words, file_sep)
-        if keep_l[j]:
+        sep, asep = _word_sep(content, info.words, self.file_sep)
+        if self.keep_l[j]:
             # arc left as programmed (compensation below the output resolution)
-            for a in range(3):
-                k = info.axis_words[a]
-                if k is not None:
-                    v = words[k].value
-                    out_val[a] = v if info.absolute else out_val[a] + v
-            _restore_motion(content, words, info, out_motion, sep, edits)
-            out_motion = info.motion
-            nominal.append(end_l[j])
-            emitted.append(end_l[j])
-            known_pts.append(all_known)
+            self.state.hold_programmed(info)
+            edits = []
+            _restore_motion(content, info.words, info, self.out_motion, sep, edits)
+            self.out_motion = info.motion
+            self.state.record_kept(self.end_l[j], self.known_l[j])
             if edits:
-                n_changed += 1
-            out.append(_apply(content, edits) + eol)
-            continue
-        if split_l[j] and info.stop:
+                self.state.changed += 1
+            return _apply(content, edits) + eol
+        split = self.split_l[j]
+        if split and info.stop:
             raise GCodeError("a move with a program stop (M0/M1/M2/M30/M60) on its line must "
                              "be split for the compensation; put the stop on its own line",
-                             file=source, line=ln)
-        convert = kind >= 2
-        # ---- first point: on the original line
-        vals = [v / f for v in pts[0]]
-        first_words = {}
+                             file=self.source, line=idx + 1)
+        first = self._first_piece(content, info, j, sep, asep, split)
+        rest = self._further_pieces(info, j, eol, asep)
+        if split and self.kind_l[j] == 1:
+            self.state.split += 1
+        return first + rest
+
+    def _digits(self, info, a, dmin):
+        """(decimals written, decimals kept when dropping trailing zeros) for axis ``a``."""
+        k = info.axis_words[a]
+        dec = info.words[k].decimals if k is not None else self.last_dec[a]
+        return max(dmin, dec), max(dec, 1)
+
+    def _first_piece(self, content, info, j, sep, asep, split):
+        """The move's own line with its axis words rewritten (first piece of the move)."""
+        off = self.off_l[j]
+        pt = self.comp_l[off]
+        known = self.known_l[j]
+        f = info.factor
+        dmin = self.dmin_mm if f == 1.0 else self.dmin_in
+        new = {}
         for a in range(3):
-            if not known[a]:
-                continue
-            k = info.axis_words[a]
-            d = max(dmin, words[k].decimals if k is not None else last_dec[a])
-            keepd = words[k].decimals if k is not None else last_dec[a]
-            s_abs = _fmt(vals[a], d, max(keepd, 1))
-            v_abs = float(s_abs)
-            if info.absolute:
-                if k is not None:
-                    if v_abs != float("%.*f" % (d, words[k].value)):
-                        first_words[a] = (k, s_abs)
-                    out_val[a] = v_abs if v_abs != float("%.*f" % (d, words[k].value)) \
-                        else words[k].value
-                elif out_val[a] is None or float("%.*f" % (d, out_val[a])) != v_abs:
-                    first_words[a] = (None, s_abs)
-                    out_val[a] = v_abs
-            else:
-                inc = _fmt(v_abs - out_val[a], d, max(keepd, 1))
-                if k is not None:
-                    if float(inc) != float("%.*f" % (d, words[k].value)):
-                        first_words[a] = (k, inc)
-                        out_val[a] += float(inc)
-                    else:
-                        out_val[a] += words[k].value
-                elif float(inc) != 0.0:
-                    first_words[a] = (None, inc)
-                    out_val[a] += float(inc)
-        for _a, (k, s) in first_words.items():
+            if known[a]:
+                w = self._first_axis(info, a, pt[a] / f, dmin)
+                if w is not None:
+                    new[a] = w
+        edits = []
+        for k, s in new.values():
             if k is not None:
-                w = words[k]
+                w = info.words[k]
                 edits.append((w.end - len(w.text), w.end, s))
-        _add_words(content, words, info, [(a, s) for a, (k, s) in sorted(first_words.items())
-                                          if k is None], asep, edits)
-        if convert and split_l[j]:
-            _convert_arc(content, words, info, sep, edits, out_motion)
-            out_motion = 1
-            n_conv += 1
+        _add_words(content, info.words, info,
+                   [(a, s) for a, (k, s) in sorted(new.items()) if k is None], asep, edits)
+        if split and self.kind_l[j] >= 2:
+            _convert_arc(content, info.words, info, sep, edits, self.out_motion)
+            self.out_motion = 1
+            self.state.converted += 1
         else:
-            _restore_motion(content, words, info, out_motion, sep, edits)
-            out_motion = info.motion
-        nominal.append(noms[0])
-        emitted.append(_abs_mm(out_val, known, pts[0], f))
-        known_pts.append(all_known)
+            _restore_motion(content, info.words, info, self.out_motion, sep, edits)
+            self.out_motion = info.motion
+        self.state.record(self.nom_l[off], pt, known, f)
         if edits:
-            n_changed += 1
-        out.append(_apply(content, edits))
-        # ---- further pieces: new lines with axis words only
+            self.state.changed += 1
+        return _apply(content, edits)
+
+    def _first_axis(self, info, a, v, dmin):
+        """Axis ``a`` at ``v`` (program units) on the move's own line: ``(index of the
+        word to replace or None to add one, number text)``, or None when nothing changes."""
+        held = self.state.held
+        k = info.axis_words[a]
+        d, keep = self._digits(info, a, dmin)
+        s_abs = _fmt(v, d, keep)
+        v_abs = float(s_abs)
+        if info.absolute:
+            if k is not None:
+                prog_v = info.words[k].value
+                if v_abs != float("%.*f" % (d, prog_v)):
+                    held[a] = v_abs
+                    return k, s_abs
+                held[a] = prog_v
+            elif held[a] is None or float("%.*f" % (d, held[a])) != v_abs:
+                held[a] = v_abs
+                return None, s_abs
+            return None
+        inc = _fmt(v_abs - held[a], d, keep)
+        if k is not None:
+            if float(inc) != float("%.*f" % (d, info.words[k].value)):
+                held[a] += float(inc)
+                return k, inc
+            held[a] += info.words[k].value
+        elif float(inc) != 0.0:
+            held[a] += float(inc)
+            return None, inc
+        return None
+
+    def _further_pieces(self, info, j, eol, asep):
+        """New lines with the axis words of the further pieces of a split move."""
+        known = self.known_l[j]
+        f = info.factor
+        dmin = self.dmin_mm if f == 1.0 else self.dmin_in
         extra = []
-        for p_idx in range(1, len(pts)):
-            vals = [v / f for v in pts[p_idx]]
+        for p in range(self.off_l[j] + 1, self.off_l[j + 1]):
+            pt = self.comp_l[p]
             ws = []
             for a in range(3):
-                if not known[a]:
-                    continue
-                k = info.axis_words[a]
-                d = max(dmin, words[k].decimals if k is not None else last_dec[a])
-                keepd = max(words[k].decimals if k is not None else last_dec[a], 1)
-                s_abs = _fmt(vals[a], d, keepd)
-                v_abs = float(s_abs)
-                if info.absolute:
-                    if out_val[a] is None or float("%.*f" % (d, out_val[a])) != v_abs:
-                        ws.append(AXIS_LETTERS[a] + s_abs)
-                        out_val[a] = v_abs
-                else:
-                    inc = _fmt(v_abs - out_val[a], d, keepd)
-                    if float(inc) != 0.0:
-                        ws.append(AXIS_LETTERS[a] + inc)
-                        out_val[a] += float(inc)
+                if known[a]:
+                    w = self._next_axis(info, a, pt[a] / f, dmin)
+                    if w is not None:
+                        ws.append(w)
             if ws:
                 extra.append(asep.join(ws))
-                nominal.append(noms[p_idx])
-                emitted.append(_abs_mm(out_val, known, pts[p_idx], f))
-                known_pts.append(all_known)
-        if split_l[j] and kind == 1:
-            n_split += 1
-        if extra:
-            n_added += len(extra)
-            mid = eol if eol else eol_default
-            out.append(mid + mid.join(extra[:-1]) + (mid if len(extra) > 1 else "")
-                       + extra[-1] + eol)
-        else:
-            out.append(eol)
-    stats = {"lines_in": len(lines), "lines_out": len(lines) + n_added,
-             "lines_changed": n_changed, "lines_added": n_added, "moves": prog.n_moves,
-             "moves_split": n_split, "arcs_converted": n_conv, "points": len(nominal)}
-    return (out, stats, np.array(nominal, dtype=float).reshape(-1, 3),
-            np.array(emitted, dtype=float).reshape(-1, 3), np.array(known_pts, dtype=bool))
+                self.state.record(self.nom_l[p], pt, known, f)
+        if not extra:
+            return eol
+        self.state.added += len(extra)
+        mid = eol if eol else self.eol_default
+        return mid + mid.join(extra) + eol
 
-
-def _abs_mm(out_val, known, comp_mm, f):
-    """The commanded point after a line (mm): written values, compensation where unknown."""
-    return [out_val[a] * f if (known[a] and out_val[a] is not None) else comp_mm[a]
-            for a in range(3)]
+    def _next_axis(self, info, a, v, dmin):
+        """The word of axis ``a`` at ``v`` (program units) on a new line, or None when the
+        machine holds that value already."""
+        held = self.state.held
+        d, keep = self._digits(info, a, dmin)
+        s_abs = _fmt(v, d, keep)
+        v_abs = float(s_abs)
+        if info.absolute:
+            if held[a] is None or float("%.*f" % (d, held[a])) != v_abs:
+                held[a] = v_abs
+                return AXIS_LETTERS[a] + s_abs
+            return None
+        inc = _fmt(v_abs - held[a], d, keep)
+        if float(inc) != 0.0:
+            held[a] += float(inc)
+            return AXIS_LETTERS[a] + inc
+        return None
 
 
 def _apply(content, edits):

@@ -272,7 +272,7 @@ class _Interpreter:
         stop = _program_stop(ms, self.source, ln)
         if cur.motion is not None:
             self.motion = None if cur.motion == 800 else _MOTION[cur.motion]
-        axis_idx = tuple(vals.get(a) for a in AXIS_LETTERS)
+        axis_idx = (vals.get("X"), vals.get("Y"), vals.get("Z"))
         info = LineInfo(words, self.factor, self.absolute, self.motion, cur.motion_word,
                         stop=stop, axis_words=axis_idx)
         if cur.nonmodal is not None:
@@ -294,7 +294,7 @@ class _Interpreter:
         if arc_letters and not is_arc:
             raise GCodeError("%s word on a line without G2/G3 (arc words need an arc)"
                              % arc_letters[0], file=self.source, line=ln)
-        if all(k is None for k in info.axis_words) and not (is_arc and arc_letters):
+        if info.axis_words == (None, None, None) and not (is_arc and arc_letters):
             return
         if self.motion is None:
             raise GCodeError("axis words but no motion mode (G0/G1/G2/G3) is active",
@@ -314,11 +314,15 @@ class _Interpreter:
                     self.unknown_use[a] = (first, count + 1)
         mv = self.moves
         info.move = len(mv["kind"])
-        for key, value in (("kind", self.motion), ("start", self.pos), ("end", target),
-                           ("centre", centre), ("plane", self.plane), ("turns", turns),
-                           ("line", idx), ("known", tuple(self.known)),
-                           ("factor", self.factor)):
-            mv[key].append(value)
+        mv["kind"].append(self.motion)
+        mv["start"].append(self.pos)
+        mv["end"].append(target)
+        mv["centre"].append(centre)
+        mv["plane"].append(self.plane)
+        mv["turns"].append(turns)
+        mv["line"].append(idx)
+        mv["known"].append(tuple(self.known))
+        mv["factor"].append(self.factor)
         self.pos = target
 
     def _first_move(self, ln):

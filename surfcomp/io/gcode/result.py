@@ -1,40 +1,49 @@
-"""Results of a compensation: the rewritten program and the points it commands."""
+"""What a compensation returns, and the bookkeeping both writers share.
+
+Both writers (G-code text, :mod:`.emitter`; Path command lists, :mod:`.commands`) return
+a :class:`CompensationResult` with the same fields, so the command line and the Path
+dressup read one shape: the output, statistics, warnings, and for every output move end
+point the programmed point and the command written.
+"""
 
 from dataclasses import dataclass
 
 import numpy as np
 
 from ...core.axis_errors import error_stats
-from .interpreter import Program
 
 
 @dataclass
-class GCodeResult:
-    """The rewritten program and what was done.
+class CompensationResult:
+    """A compensated program and what was done.
 
     Attributes
     ----------
-    data : bytes
-        The output program.
+    output : bytes or list
+        The output program: G-code bytes (:class:`GCodeResult`) or a command list
+        (:class:`CommandsResult`).
     stats : dict
         ``lines_in``, ``lines_out``, ``lines_changed`` (input lines rewritten),
         ``lines_added``, ``moves``, ``moves_split`` (G1 moves split), ``arcs_converted``,
-        ``points`` (output move end points).
+        ``points`` (output move end points); for command lists the ``lines_*`` count
+        commands.
     nominal, emitted : ndarray (N, 3)
         For every output move end point: the programmed point on the path (mm) and the
         command written (mm, after rounding). Axes not yet known hold the assumed value.
     known : ndarray (N,) bool
         Every axis of the point had a known program position.
     warnings : list of str
+    program : surfcomp.io.gcode.Program
+        The interpreted input.
     """
 
-    data: bytes
+    output: object
     stats: dict
     nominal: np.ndarray
     emitted: np.ndarray
     known: np.ndarray
     warnings: list
-    program: Program = None
+    program: object = None
 
     def predicted(self, model):
         """Predicted positional error at the output points (known ones), before/after.
@@ -48,26 +57,87 @@ class GCodeResult:
         return {"before": error_stats(before), "after": error_stats(after),
                 "points_unknown_axes": int((~k).sum())}
 
+    def corrections(self):
+        """``|emitted - nominal|`` (mm) at the points whose axes are all known, shape (n,)."""
+        return np.linalg.norm(self.emitted[self.known] - self.nominal[self.known], axis=1)
 
-@dataclass
-class CommandsResult:
-    """Compensated command list.
+    def max_correction(self):
+        """Largest distance (mm) by which a known point was moved (0 without points)."""
+        corr = self.corrections()
+        return float(corr.max()) if corr.size else 0.0
 
-    Attributes
-    ----------
-    commands : list
-        Per output command either an ``int`` (index of an input command kept unchanged)
-        or a ``(name, parameters)`` pair.
-    stats, nominal, emitted, known, warnings
-        As in :class:`GCodeResult` (``lines_*`` count commands).
+
+class GCodeResult(CompensationResult):
+    """:class:`CompensationResult` of G-code text; ``output`` (also ``data``) is bytes."""
+
+    @property
+    def data(self):
+        return self.output
+
+
+class CommandsResult(CompensationResult):
+    """:class:`CompensationResult` of a command list.
+
+    ``output`` (also ``commands``) holds per output command either an ``int`` (index of an
+    input command kept unchanged) or a ``(name, parameters)`` pair.
     """
 
-    commands: list
-    stats: dict
-    nominal: np.ndarray
-    emitted: np.ndarray
-    known: np.ndarray
-    warnings: list
-    program: Program = None
+    @property
+    def commands(self):
+        return self.output
 
-    predicted = GCodeResult.predicted
+
+class OutputState:
+    """What the machine holds after the output written so far, and the points written.
+
+    Parameters
+    ----------
+    start : sequence of 3 float or None
+        Known start position (program units), or None (nothing held yet).
+    """
+
+    def __init__(self, start=None):
+        #: value of each axis the machine holds (program units), None when not known
+        self.held = [None, None, None] if start is None else [float(v) for v in start]
+        self.nominal, self.emitted, self.known = [], [], []
+        self.changed = self.added = self.split = self.converted = 0
+
+    def forget(self, axes):
+        """The program moved these axes to positions it does not know (G53, G28, G30)."""
+        for a in axes:
+            self.held[a] = None
+
+    def hold_programmed(self, info):
+        """A line written as programmed: the machine holds its axis words' values."""
+        for a in range(3):
+            k = info.axis_words[a]
+            if k is not None:
+                v = info.words[k].value
+                self.held[a] = v if info.absolute else self.held[a] + v
+
+    def record(self, nominal, compensated, known, factor=1.0):
+        """One output move end point: programmed point and compensated command (mm).
+
+        The command recorded is what the machine holds (the written value, ``factor`` mm
+        per program unit) on known axes, the compensated value on the others.
+        """
+        held = self.held
+        self.nominal.append(nominal)
+        self.emitted.append([held[a] * factor if (known[a] and held[a] is not None)
+                             else compensated[a] for a in range(3)])
+        self.known.append(known[0] and known[1] and known[2])
+
+    def record_kept(self, point, known):
+        """The end point (mm) of a move written as programmed."""
+        self.nominal.append(point)
+        self.emitted.append(point)
+        self.known.append(known[0] and known[1] and known[2])
+
+    def result(self, cls, output, lines_in, lines_out, prog):
+        """The :class:`CompensationResult` subclass ``cls`` of what was recorded."""
+        stats = {"lines_in": lines_in, "lines_out": lines_out, "lines_changed": self.changed,
+                 "lines_added": self.added, "moves": prog.n_moves, "moves_split": self.split,
+                 "arcs_converted": self.converted, "points": len(self.nominal)}
+        return cls(output, stats, np.array(self.nominal, dtype=float).reshape(-1, 3),
+                   np.array(self.emitted, dtype=float).reshape(-1, 3),
+                   np.array(self.known, dtype=bool), list(prog.warnings), prog)
