@@ -67,6 +67,17 @@ EXACT_RMS = 1e-9
 COMPENSATE_TOL = 1e-10
 
 
+def _finite_points(values, message, points=None):
+    """Raise InputError when a row of ``values`` (n, 3) is not finite; ``message`` gets
+    the count and the first such row of ``points`` (default ``values``)."""
+    ok = np.isfinite(values).all(axis=1)
+    if ok.all():
+        return
+    bad = np.flatnonzero(~ok)
+    at = (values if points is None else points)[bad[0]]
+    raise InputError(message % ((bad.size,) + tuple(at)))
+
+
 @dataclass
 class ComponentFit:
     """The least-squares fit of one error function ``delta_i(a)``.
@@ -333,14 +344,24 @@ class AxisErrorModel:
         ComputationError
             When Newton's method does not converge (an error model whose slopes reach
             -1, i.e. a slide that does not move).
+        InputError
+            Non-finite points, or points so far outside the measured travel that the
+            model's polynomials overflow there.
         """
         p = as_points(points)
         flat = p.reshape(-1, 3)
+        _finite_points(flat, "cannot compensate %d non-finite point(s) (the first: %.6g, "
+                             "%.6g, %.6g)")
         if self.is_zero() or flat.shape[0] == 0:
             return p.copy()
-        xc = flat - self.error(flat)
+        with np.errstate(over="ignore", invalid="ignore"):
+            xc = flat - self.error(flat)
         for _ in range(max_iter):
-            r = xc + self.error(xc) - flat
+            with np.errstate(over="ignore", invalid="ignore"):
+                r = xc + self.error(xc) - flat
+            _finite_points(r, "the axis error model has no finite compensation for %d "
+                           "point(s) (the first at %.6g, %.6g, %.6g mm): they lie too far "
+                           "outside the measured travel for its polynomials", flat)
             bad = np.abs(r).max(axis=1) > tol
             if not bad.any():
                 return xc.reshape(p.shape)
