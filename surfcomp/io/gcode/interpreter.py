@@ -14,6 +14,11 @@ from ...core.arcs import PLANES, centre_from_radius, check_centre
 from ...errors import GCodeError, InputError
 from .lexer import AXIS_LETTERS, decode, split_lines, tokenize
 
+#: largest position, arc radius or centre (mm) accepted: 1 km, beyond any machine's travel
+MAX_POSITION = 1e6
+#: most full turns of one arc (P word)
+MAX_TURNS = 1000000
+
 # codes are round(10 * number): G1 -> 10, G90.1 -> 901
 _MOTION = {0: 0, 10: 1, 20: 2, 30: 3}
 _PASS_G = {40, 400, 430, 490, 540, 550, 560, 570, 580, 590, 591, 592, 593, 610, 611, 640,
@@ -106,6 +111,10 @@ class Program:
     @property
     def n_moves(self):
         return int(self.kind.size)
+
+    def is_empty(self):
+        """No line has a word: nothing but blank lines, comments and ``%`` lines."""
+        return all(info is None for info in self.lines)
 
     def endpoints(self, known_only=False):
         """End points of all moves (mm), optionally only where every axis is known."""
@@ -355,7 +364,16 @@ class _Interpreter:
                                  line=ln, column=_column(words[k]))
             else:
                 target[a] = self.pos[a] + v
+            self._check_size(target[a], "position", words[k], ln)
         return target
+
+    def _check_size(self, value, what, word, ln):
+        """Refuse a position, radius or centre (mm) beyond :data:`MAX_POSITION`."""
+        if not abs(value) <= MAX_POSITION:
+            raise GCodeError("%s%s: %s %.6g mm is beyond any machine's travel (expected at "
+                             "most %g mm)" % (word.letter, word.text or "", what, value,
+                                              MAX_POSITION), file=self.source, line=ln,
+                             column=_column(word))
 
     def _arc(self, words, vals, target, ln):
         """Centre (mm), turns and the arc words (I J K R P) of an arc move."""
@@ -366,9 +384,10 @@ class _Interpreter:
             if any(L in vals for L in off_letters):
                 raise GCodeError("arc with both R and %s/%s" % off_letters, file=self.source,
                                  line=ln)
+            radius = words[vals["R"]].value * self.factor
+            self._check_size(radius, "arc radius", words[vals["R"]], ln)
             centre = _arc_geometry(centre_from_radius, self.source, ln, self.pos, target,
-                                   words[vals["R"]].value * self.factor, self.plane,
-                                   self.motion == 2)
+                                   radius, self.plane, self.motion == 2)
             arc_idx.append(vals["R"])
         else:
             centre = self._centre_ijk(words, vals, off_letters, (p, q), target, ln)
@@ -378,6 +397,10 @@ class _Interpreter:
             if pv < 1 or pv != int(pv):
                 raise GCodeError("arc turns P%s must be a positive whole number"
                                  % words[vals["P"]].text, file=self.source, line=ln)
+            if pv > MAX_TURNS:
+                raise GCodeError("arc turns P%s: expected at most %d turns"
+                                 % (words[vals["P"]].text, MAX_TURNS), file=self.source,
+                                 line=ln)
             turns = int(pv)
             arc_idx.append(vals["P"])
         return centre, turns, tuple(sorted(arc_idx))
@@ -397,6 +420,8 @@ class _Interpreter:
                 centre[a] = words[vals[L]].value * self.factor
             elif L in vals:
                 centre[a] = self.pos[a] + words[vals[L]].value * self.factor
+            if L in vals:
+                self._check_size(centre[a], "arc centre", words[vals[L]], ln)
         _arc_geometry(check_centre, self.source, ln, self.pos, target, centre, self.plane)
         return centre
 

@@ -4,6 +4,7 @@ The file is handled as Latin-1 text, which maps every byte to one character and 
 that lines the compensation leaves alone are written back byte for byte.
 """
 
+import math
 import re
 
 from ...errors import GCodeError
@@ -108,7 +109,12 @@ def _word(content, m, source, line):
         raise GCodeError("malformed number in %r" % content[i:end + 1], file=source,
                          line=line, column=i + 1)
     text = m.group(2)
-    return Word(letter, float(text), text, i, end)
+    value = float(text)
+    if not math.isfinite(value):
+        raise GCodeError("number %s%s... with %d digits is out of range (expected a "
+                         "number a machine can move by)" % (m.group(1), text[:12], len(text)),
+                         file=source, line=line, column=i + 1)
+    return Word(letter, value, text, i, end)
 
 
 def _refuse(content, i, source, line):
