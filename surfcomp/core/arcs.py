@@ -168,7 +168,8 @@ def arc_step_counts(start, end, centre, plane, clockwise, turns, segment_length,
     (by_length, by_angle)
         ``length / segment_length`` (the arc's length along the helix) and
         ``|theta| / dphi`` with ``dphi`` the largest angle step whose sagitta
-        ``r (1 - cos(dphi / 2))`` stays within ``arc_tolerance`` (at most a quarter turn).
+        ``r (1 - cos(dphi / 2))`` stays within ``arc_tolerance`` (at most a quarter turn;
+        infinite when the tolerance is too small for any chord).
     """
     s, e, c = (np.asarray(v, dtype=float) for v in (start, end, centre))
     theta, r0, r1, _a0 = arc_params(s, e, c, plane, clockwise, turns)
@@ -178,7 +179,8 @@ def arc_step_counts(start, end, centre, plane, clockwise, turns, segment_length,
     dphi = math.pi / 2
     if arc_tolerance < r:
         dphi = min(dphi, 2.0 * math.acos(1.0 - arc_tolerance / r))
-    return length / segment_length, abs(theta) / dphi
+    # a tolerance below the float resolution of the radius gives dphi = 0: no chord fits
+    return length / segment_length, (abs(theta) / dphi if dphi > 0 else math.inf)
 
 
 def arc_steps(start, end, centre, plane, clockwise, turns, segment_length, arc_tolerance):
