@@ -56,6 +56,12 @@ def compensate_commands(commands, model, segment_length=2.0, tolerance=1e-4,
         Moves are rewritten with every parameter they had (feed ``F`` included, on every
         piece of a split move); arcs that need compensation become ``G1`` pieces; every
         other command is kept. A zero model keeps every command.
+
+    Raises
+    ------
+    GCodeError
+        What the compensation cannot handle (as :func:`compensate_gcode`), naming the
+        1-based command number as the line.
     """
     line_words = [(command_words(n, p, source, k + 1), False)
                   for k, (n, p) in enumerate(commands)]
@@ -65,7 +71,9 @@ def compensate_commands(commands, model, segment_length=2.0, tolerance=1e-4,
     out = []
     for idx, (name, params) in enumerate(commands):
         out.extend(writer.command(idx, name, params))
-    return writer.state.result(CommandsResult, out, len(commands), len(out), prog)
+    res = writer.state.result(CommandsResult, out, len(commands), len(out), prog)
+    res.check_bounds(model, 0.0, source)
+    return res
 
 
 class _CommandWriter:
@@ -90,10 +98,10 @@ class _CommandWriter:
         known = self.prog.known[j].tolist()
         if self.plan.keep[j]:
             self.state.hold_programmed(info)
-            self.state.record_kept(self.prog.end[j].tolist(), known)
+            self.state.record_kept(idx + 1, self.prog.end[j].tolist(), known)
             return [idx]
         convert = bool(self.prog.kind[j] >= 2)
-        pieces = self._pieces(info, j, params, convert, known)
+        pieces = self._pieces(idx, info, j, params, convert, known)
         if len(pieces) == 1 and not convert and pieces[0] == dict(params):
             return [idx]
         self.state.changed += 1
@@ -105,7 +113,7 @@ class _CommandWriter:
         new_name = "G1" if convert else name
         return [(new_name, par) for par in pieces]
 
-    def _pieces(self, info, j, params, convert, known):
+    def _pieces(self, idx, info, j, params, convert, known):
         """Parameters of every piece of move ``j``: the first keeps all the command's
         parameters (arc words dropped when the arc becomes G1 pieces), the others carry
         the axes that change and the feed."""
@@ -133,5 +141,5 @@ class _CommandWriter:
                     par[keys.get(letter, letter)] = value
                 held[a] = pt[a]
             pieces.append(par)
-            self.state.record(self.nom_l[p], pt, known)
+            self.state.record(idx + 1, self.nom_l[p], pt, known)
         return pieces

@@ -5,6 +5,8 @@ keep their words, spacing, case and comments, with only the axis numbers replace
 motion words where an arc became G1 pieces). See :mod:`surfcomp.io.gcode`.
 """
 
+import math
+
 import numpy as np
 
 from ...core.moves import plan_moves
@@ -72,7 +74,8 @@ def _file_sep(lines, prog):
 
 
 def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e-3,
-                     decimals=None, start=None, source=None, progress=None):
+                     decimals=None, start=None, source=None, progress=None, parsed=None,
+                     max_error=None):
     """Compensate a G-code program for a machine's axis errors.
 
     Parameters
@@ -93,6 +96,12 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
         Known start position (mm, program coordinates).
     source : str, optional
         File name for messages.
+    parsed : (Program, list), optional
+        What :func:`surfcomp.io.gcode.parse_gcode` returned for the same ``data``,
+        ``source`` and ``start``, when the caller has parsed the program already.
+    max_error : float, optional
+        Largest plausible machine error (mm): a programmed point where the model predicts
+        more is refused (default no limit).
 
     Returns
     -------
@@ -102,12 +111,19 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
     Raises
     ------
     GCodeError
-        For anything the compensation cannot handle correctly (see :mod:`surfcomp.io.gcode`).
+        For anything the compensation cannot handle correctly (see :mod:`surfcomp.io.gcode`),
+        and for an output that moves a point farther than the model explains
+        (:meth:`CompensationResult.check_bounds`): then nothing should be written.
+    InputError
+        Settings outside their domain, or more segments than
+        :data:`surfcomp.core.moves.MAX_SEGMENTS` (:func:`surfcomp.core.moves.plan_moves`).
     """
     raw = data
     text = decode(data)
     report(progress, 0.0, "parsing")
-    prog, lines = parse_gcode(text, source=source, start=start)
+    if parsed is None:
+        parsed = parse_gcode(text, source=source, start=start)
+    prog, lines = parsed
     dmin_mm = DEFAULT_DECIMALS["mm"] if decimals is None else int(decimals)
     dmin_in = DEFAULT_DECIMALS["in"] if decimals is None else int(decimals)
     still = np.where(prog.factor == 1.0, 0.5 * 10.0 ** -dmin_mm,
@@ -122,9 +138,13 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
         data_out = bytes(raw) if isinstance(raw, (bytes, bytearray)) else text.encode("latin-1")
     else:
         data_out = text_out.encode("latin-1")
+    res = writer.state.result(GCodeResult, data_out, len(lines),
+                              len(lines) + writer.state.added, prog)
+    inch = bool((prog.factor != 1.0).any())
+    rounding = max(0.5 * 10.0 ** -dmin_mm, 25.4 * 0.5 * 10.0 ** -dmin_in if inch else 0.0)
+    res.check_bounds(model, math.sqrt(3.0) * rounding, source, max_error)
     report(progress, 1.0, "done")
-    return writer.state.result(GCodeResult, data_out, len(lines),
-                               len(lines) + writer.state.added, prog)
+    return res
 
 
 class _TextWriter:
@@ -184,7 +204,7 @@ class _TextWriter:
             edits = []
             _restore_motion(content, info.words, info, self.out_motion, sep, edits)
             self.out_motion = info.motion
-            self.state.record_kept(self.end_l[j], self.known_l[j])
+            self.state.record_kept(idx + 1, self.end_l[j], self.known_l[j])
             if edits:
                 self.state.changed += 1
             return _apply(content, edits) + eol
@@ -193,8 +213,8 @@ class _TextWriter:
             raise GCodeError("a move with a program stop (M0/M1/M2/M30/M60) on its line must "
                              "be split for the compensation; put the stop on its own line",
                              file=self.source, line=idx + 1)
-        first = self._first_piece(content, info, j, sep, asep, split)
-        rest = self._further_pieces(info, j, eol, asep)
+        first = self._first_piece(idx, content, info, j, sep, asep, split)
+        rest = self._further_pieces(idx, info, j, eol, asep)
         if split and self.kind_l[j] == 1:
             self.state.split += 1
         return first + rest
@@ -205,7 +225,7 @@ class _TextWriter:
         dec = info.words[k].decimals if k is not None else self.last_dec[a]
         return max(dmin, dec), max(dec, 1)
 
-    def _first_piece(self, content, info, j, sep, asep, split):
+    def _first_piece(self, idx, content, info, j, sep, asep, split):
         """The move's own line with its axis words rewritten (first piece of the move)."""
         off = self.off_l[j]
         pt = self.comp_l[off]
@@ -232,7 +252,7 @@ class _TextWriter:
         else:
             _restore_motion(content, info.words, info, self.out_motion, sep, edits)
             self.out_motion = info.motion
-        self.state.record(self.nom_l[off], pt, known, f)
+        self.state.record(idx + 1, self.nom_l[off], pt, known, f)
         if edits:
             self.state.changed += 1
         return _apply(content, edits)
@@ -267,7 +287,7 @@ class _TextWriter:
             return None, inc
         return None
 
-    def _further_pieces(self, info, j, eol, asep):
+    def _further_pieces(self, idx, info, j, eol, asep):
         """New lines with the axis words of the further pieces of a split move."""
         known = self.known_l[j]
         f = info.factor
@@ -283,7 +303,7 @@ class _TextWriter:
                         ws.append(w)
             if ws:
                 extra.append(asep.join(ws))
-                self.state.record(self.nom_l[p], pt, known, f)
+                self.state.record(idx + 1, self.nom_l[p], pt, known, f)
         if not extra:
             return eol
         self.state.added += len(extra)
