@@ -169,7 +169,7 @@ def compensate_path(obj):
                               tolerance=float(obj.Tolerance.Value),
                               arc_tolerance=float(obj.ArcTolerance.Value), source=source)
     out = [cmds[item] if isinstance(item, int) else Path.Command(item[0], item[1])
-           for item in res.commands]
+           for item in res.output]
     return Path.Path(out), (model, prog_model, res)
 
 
@@ -203,8 +203,7 @@ class DressupAxisErrors(Proxy):
         obj.FitSummary = model.summary_lines()
         obj.ErrorBefore = pred["before"]["max_mm"]
         obj.ErrorAfter = pred["after"]["max_mm"]
-        corr = np.abs(res.emitted - res.nominal)[res.known]
-        obj.MaxCorrection = float(np.linalg.norm(corr, axis=1).max()) if corr.size else 0.0
+        obj.MaxCorrection = res.max_correction()
         obj.Warnings = list(res.warnings)
 
 
