@@ -121,9 +121,10 @@ def predicted_stock(report):
     return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
 
 
-def _map(x, y, values_um, title, symmetric=True):
-    fig = _figure()
-    ax = fig.add_subplot()
+def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None):
+    if ax is None:
+        fig = _figure()
+        ax = fig.add_subplot()
     finite = values_um[np.isfinite(values_um)]
     lim = float(np.max(np.abs(finite))) if finite.size else 1.0
     lim = lim or 1.0
@@ -383,6 +384,25 @@ def _preset_html(sim):
         out.append("<h3>What the model contains and leaves out</h3><p>%s</p><p>Left out: %s</p>"
                    % (_e(summary.get("contains", "")), _e(summary.get("leaves_out", ""))))
     return "".join(out)
+
+
+def simulation_maps_figure(maps, columns=4, title=None):
+    """All :func:`simulation_maps` in one matplotlib Figure (``columns`` maps per row), e.g.
+    for the README; each map on its own symmetric scale in um."""
+    from matplotlib.figure import Figure
+
+    rows = -(-len(maps) // columns)
+    fig = Figure(figsize=(4.6 * columns, 3.7 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
+    for ax, m in zip(axes, maps):
+        v = np.asarray(m["values"]) * 1e3
+        _map(np.asarray(m["x"]), np.asarray(m["y"]), v,
+             "%s (std %.2f µm)" % (m["title"], np.std(v, ddof=1)), fig=fig, ax=ax)
+    for ax in axes[len(maps):]:
+        ax.set_axis_off()
+    if title:
+        fig.suptitle(title)
+    return fig
 
 
 def _simulated_maps_html(maps):
