@@ -20,13 +20,17 @@ simulated one.
     paper's 10 points on each of 7 curves (Fig. 5), the 49 of Surface two 7 x 7, and the
     68 of Surface three 17 x 4 (the paper gives only the count).
 
-What is calibrated and what is predicted: the deflection coefficients, the geometric
-terms and the random scatter of each preset were chosen so that the uncompensated
-parts match the paper's "before" figures (mean and std; Werner also the range); the
-figures after compensation (offset, raw, filtered, mirror) are the model's predictions.
-The three mirror presets share one machine (the same tool, cutting data and probe for
-the three surfaces, Sec. 2.6): the same random scatter and probe noise; their
-deflection coefficients differ.
+What is calibrated and what is predicted: the deflection coefficients and geometric
+terms of each preset were chosen so that the uncompensated parts match the paper's
+"before" figures (mean and std: Werner's finished part, Tab. 1 and 5; the mirror paper's
+semi-finished parts, Tab. 3), solving ``mean = a mean(g)`` and ``var = a^2 var(g) + sigma^2 +
+probe_sigma^2`` at the measured points for the mirror surfaces. The random scatter is
+calibrated too: Werner's to his corrected parts (Tab. 5: 1.8 and 1.4 um), the mirror
+presets' to the average of the paper's three mirror-after stds (Tab. 3: 2.0 um), one
+value for the three surfaces (the same tool, cutting data and probe, Sec. 2.6). What
+the model then predicts: the offset, raw and filtered figures, the mirror figures'
+differences between the surfaces and their means, every maximum, minimum and ISO 1101
+profile.
 """
 
 from dataclasses import dataclass, field
@@ -168,6 +172,9 @@ WERNER_TABLE = PaperTable(
      "Werner's mean stays at about 2 um after correction: the shop's error moved between "
      "parts, which the model leaves out."))
 
+_MIRROR_CALIBRATED = ("deflection: the semi-finished mean and std of Tab. 3 (mirror 'before'); "
+                      "sigma 1.3 um, shared by the three surfaces: the average of Tab. 3's "
+                      "mirror-after stds (2.0 um)")
 #: one machine for the three mirror surfaces: random scatter and probe (0.25 um at 2
 #: sigma, Sec. 2.1), stock 0.2 mm after semi-finishing, roughing 0.4 mm (Sec. 2.6)
 _MIRROR_MACHINE = dict(sigma=0.0013, probe_sigma=0.000125, stock=0.2, semi_engagement=0.2,
@@ -179,27 +186,27 @@ PRESETS = {p.name: p for p in (
                 bow=(0.0, 0.0), deflection=(0.02, 0.2, 0.15), stock=0.3, sigma=0.0012,
                 probe_sigma=0.0005),
            (45, 45), WERNER_TABLE,
-           calibrated="offset, deflection, tilt, bow: the uncompensated mean, std and range "
-                      "of Tab. 1; sigma and probe_sigma: CMM MPE 1.5 um and Tab. 5's "
-                      "corrected parts"),
+           calibrated="offset, deflection and tilt_c: the uncompensated mean and std of "
+                      "Tab. 1 and 5 (the range only roughly); sigma: Tab. 5's corrected parts; "
+                      "probe_sigma 0.5 um (the CMM's MPE is 1.5 + L/333 um)"),
     Preset("mirror2019-s1", "mirror paper 2019, Surface one (Fig. 2, 5, 10; Tab. 2-4)",
            lambda: mirror_surface("s1"),
            dict(_MIRROR_MACHINE, deflection=(0.0685, 0.132, 0.0)),
            (10, 7), _mirror_table("Surface one", (14.1, 6.2, 54.9), (2.0, 6.1, 30.1),
                                   (15.1, 6.2, 57.6), (0.1, 2.4, 12.8)),
-           calibrated="deflection: the before mean and std of Tab. 3"),
+           calibrated=_MIRROR_CALIBRATED),
     Preset("mirror2019-s2", "mirror paper 2019, Surface two (Fig. 3, 11; Tab. 2-4)",
            lambda: mirror_surface("s2"),
            dict(_MIRROR_MACHINE, deflection=(0.082, 0.415, 0.0)),
            (7, 7), _mirror_table("Surface two", (17.2, 3.8, 52.3), (0.9, 3.7, 20.0),
                                  (17.2, 3.8, 52.7), (0.7, 1.5, 8.3)),
-           calibrated="deflection: the before mean and std of Tab. 3"),
+           calibrated=_MIRROR_CALIBRATED),
     Preset("mirror2019-s3", "mirror paper 2019, Surface three (Fig. 4, 12; Tab. 2-4)",
            lambda: mirror_surface("s3"),
            dict(_MIRROR_MACHINE, deflection=(0.084, 0.159, 0.0)),
            (17, 4), _mirror_table("Surface three", (16.5, 3.2, 54.8), (-0.3, 3.1, 24.5),
                                   (16.8, 3.1, 53.2), (0.3, 2.1, 12.0)),
-           calibrated="deflection: the before mean and std of Tab. 3"),
+           calibrated=_MIRROR_CALIBRATED),
 )}
 
 
