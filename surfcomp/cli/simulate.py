@@ -82,7 +82,7 @@ _MODEL_OPTIONS = (
     ("probe-sigma", "MM", "measurement noise, standard deviation", 1, False),
     ("semi-engagement", "MM", "depth the semi-finishing pass removes", 1, False),
 )
-_LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4}
+_LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4, "between": 2}
 
 
 def _fmt(v):
@@ -121,9 +121,9 @@ def add_parser(subparsers):
                         % (sim.MAX_GRID, sim.MAX_GRID))
     g.add_argument("--margin", type=float, default=0.02, metavar="FRACTION",
                    help="parameter range left free at each border (default 0.02)")
-    g.add_argument("--between", type=int, default=2, metavar="K",
+    g.add_argument("--between", type=int, default=None, metavar="K",
                    help="the corrected parts are measured on a grid K times denser (grid nodes "
-                        "and points between them; default 2)")
+                        "and points between them; default 2, or the preset's)")
     g.add_argument("--replicas", type=int, default=None, metavar="N",
                    help="parts machined per method (default 4, as the mirror paper)")
     g.add_argument("--methods", default="none,offset,raw,filtered,mirror", metavar="LIST",
@@ -276,6 +276,7 @@ def run(args):
     grid = (parse_grid(args.grid) if args.grid is not None
             else (preset.grid if preset else _LOOP_DEFAULTS["grid"]))
     replicas = args.replicas or (preset.replicas if preset else _LOOP_DEFAULTS["replicas"])
+    between = args.between or (preset.between if preset else _LOOP_DEFAULTS["between"])
     try:
         masks = [int(x) for x in args.mask.split(",")]
     except ValueError:
@@ -291,7 +292,7 @@ def run(args):
     progress = ProgressLine(args.quiet)
     surface, outward, info, name = _nominal(args, preset)
     res = sim.simulate(surface, outward, model, grid=grid, specs=specs, replicas=replicas,
-                       seed=args.seed, margin=args.margin, between=args.between,
+                       seed=args.seed, margin=args.margin, between=between,
                        keep=bool(args.html), progress=sub(progress, 0, 0.95))
     res.preset = preset
     inputs = {"nominal": info}

@@ -9,8 +9,9 @@ simulated one.
 ``werner2022``
     Werner 2022, "Method for enhanced accuracy in machining free-form surfaces on CNC
     milling machines": the bicubic NURBS patch of Fig. 4 (49 control points, 45 x 45 mm;
-    the bundled example face), the 45 x 45 CMM grid of Fig. 6, 0.3 mm left for the
-    finishing cutter (Sec. 3), Tab. 1-5.
+    the bundled example face), the 45 x 45 CMM grid of Fig. 6 (the parts are evaluated
+    at those 2025 points only, ``between = 1``, as Werner measured them), 0.3 mm left for
+    the finishing cutter (Sec. 3), Tab. 1-5.
 ``mirror2019-s1``, ``-s2``, ``-s3``
     The mirror paper (2019; mirror compensation of free-form surfaces with on-machine
     measurement data): the three quadratic surfaces of Fig. 2-4 on the 75 x 63 mm
@@ -111,6 +112,7 @@ class Preset:
     grid: tuple
     paper: PaperTable
     replicas: int = 4
+    between: int = 2
     calibrated: str = ""
     notes: tuple = field(default_factory=tuple)
 
@@ -126,7 +128,8 @@ class Preset:
 
     def as_dict(self):
         return {"name": self.name, "imitates": self.imitates, "grid": list(self.grid),
-                "replicas": self.replicas, "model": self.machining_model().as_dict(),
+                "replicas": self.replicas, "between": self.between,
+                "model": self.machining_model().as_dict(),
                 "calibrated": self.calibrated, "notes": list(self.notes)}
 
 
@@ -185,7 +188,7 @@ PRESETS = {p.name: p for p in (
            dict(offset=-0.012, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0.0, 0.02),
                 bow=(0.0, 0.0), deflection=(0.02, 0.2, 0.15), stock=0.3, sigma=0.0012,
                 probe_sigma=0.0005),
-           (45, 45), WERNER_TABLE,
+           (45, 45), WERNER_TABLE, between=1,
            calibrated="offset, deflection and tilt_c: the uncompensated mean and std of "
                       "Tab. 1 and 5 (the range only roughly); sigma: Tab. 5's corrected parts; "
                       "probe_sigma 0.5 um (the CMM's MPE is 1.5 + L/333 um)"),
@@ -224,14 +227,15 @@ def run_preset(name, surface=None, outward=1, model=None, grid=None, replicas=No
     """Simulate a preset (:func:`surfcomp.core.simulate.simulate`) and attach it to the result.
 
     ``surface``/``outward`` replace the preset's nominal, ``model`` (a
-    :class:`MachiningModel`) its parameters, ``grid``/``replicas`` its layout; other
-    keywords go to ``simulate``.
+    :class:`MachiningModel`) its parameters, ``grid``/``replicas``/``between`` its
+    layout; other keywords go to ``simulate``.
     """
     from .simulate import simulate
 
     preset = get_preset(name) if isinstance(name, str) else name
     if surface is None:
         surface, outward = preset.surface()
+    kw.setdefault("between", preset.between)
     res = simulate(surface, outward, model or preset.machining_model(),
                    grid=grid or preset.grid, specs=specs,
                    replicas=replicas or preset.replicas, seed=seed, **kw)
