@@ -172,8 +172,8 @@ WERNER_TABLE = PaperTable(
      PaperRow("filtered", mean=0.0013, std=0.0014, max=0.007, min=-0.004, reference="none",
               source="Tab. 5 correction 2, filtered deviations, 5x5 box (Tab. 4)")),
     ("Werner gives no ISO 1101 profile; its maxima and minima are a single part's.",
-     "Werner's mean stays at about 2 um after correction: the shop's error moved between "
-     "parts, which the model leaves out."))
+     "Werner's mean stays at about 2 um after correction, a sign of some change between "
+     "parts (the paper does not say which); the model leaves such changes out."))
 
 _MIRROR_CALIBRATED = ("deflection: the semi-finished mean and std of Tab. 3 (mirror 'before'); "
                       "sigma 1.3 um, shared by the three surfaces: the average of Tab. 3's "
