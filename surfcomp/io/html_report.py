@@ -13,7 +13,10 @@ no external resources. Sections carry stable ids for tools and tests:
 ``histograms``  distributions of raw deviation, random component, predicted residual
 ``statistics``  the papers' table (Werner 2022 Tab. 1 and 3) for every quantity
 ``checks``      the corrected face's check figures (or why there are none)
-``simulation``  the before/after table over replicas (only with a simulation result)
+``simulation``  the before/after table over replicas (only with a simulation result); with
+                a preset the paper's table beside the simulated one (``id="side-by-side"``),
+                what the model contains and leaves out, and the simulated parts' maps
+                (``id="simulated-maps"``, :func:`simulation_maps`)
 ``warnings``    messages of the run
 
 The predicted residual is what is left if the machine repeats the measured error
@@ -118,9 +121,10 @@ def predicted_stock(report):
     return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
 
 
-def _map(x, y, values_um, title, symmetric=True):
-    fig = _figure()
-    ax = fig.add_subplot()
+def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None):
+    if ax is None:
+        fig = _figure()
+        ax = fig.add_subplot()
     finite = values_um[np.isfinite(values_um)]
     lim = float(np.max(np.abs(finite))) if finite.size else 1.0
     lim = lim or 1.0
@@ -302,6 +306,117 @@ def _bar_chart(sim):
     return fig
 
 
+def simulation_maps(result):
+    """The first replica's simulated parts as maps for :func:`render_html` (``sim['maps']``).
+
+    Parameters
+    ----------
+    result : surfcomp.core.simulate.SimulationResult
+        Run with ``keep=True``.
+
+    Returns
+    -------
+    list of dict
+        ``{'key', 'title', 'x', 'y', 'values'}``: nominal x, y (mm) and deviations along the
+        outward normal (mm) of the first machined part, the mirror method's semi-finished
+        part (its measured deviation minus the stock, at the grid nodes) and every method's
+        corrected part (on the evaluation grid).
+    """
+    if result.points is None:
+        return []
+    P = np.asarray(result.points)
+    b = result.between
+    out = [{"key": "before", "title": "Machined from the nominal", "x": P[..., 0],
+            "y": P[..., 1], "values": result.maps["before"]["after"]}]
+    for spec in result.specs:
+        mp = result.maps.get(spec.label)
+        if mp is None:
+            continue
+        if spec.label in result.semi_error:
+            out.append({"key": "semi-finished", "title": "Semi-finished (minus the stock)",
+                        "x": P[::b, ::b, 0], "y": P[::b, ::b, 1],
+                        "values": np.asarray(mp["measured"]) - result.model.stock})
+        out.append({"key": spec.label, "title": "After %s" % spec.label, "x": P[..., 0],
+                    "y": P[..., 1], "values": mp["after"]})
+    return out
+
+
+def _side_by_side_html(side):
+    cols = (("mean", "mean"), ("std", "std"), ("max", "max"), ("min", "min"),
+            ("profile", "ISO 1101"))
+    head = "".join("<th>%s</th>" % h for _, h in cols)
+    rows = ["<tr><th rowspan=\"2\">Method (µm)</th><th colspan=\"5\">Paper</th>"
+            "<th colspan=\"5\">Simulated</th></tr><tr>%s%s</tr>" % (head, head)]
+    for r in side["rows"]:
+        cells = []
+        for part in (r["paper"], r["simulated"]):
+            for key, _ in cols:
+                v = None if part is None else part.get(key)
+                cells.append('<td class="num">%s</td>' % ("-" if v is None else "%.1f" % (v * 1e3)))
+        rows.append("<tr><th>%s</th>%s</tr>" % (_e(r["method"]), "".join(cells)))
+    gains = ["<tr><th>Gain 1 - after/before</th><th>std, paper</th><th>std, simulated</th>"
+             "<th>ISO 1101, paper</th><th>ISO 1101, simulated</th></tr>"]
+    for g in side["gains"]:
+        vals = [g[k][w] for k in ("std", "profile") for w in ("paper", "simulated")]
+        gains.append("<tr><th>%s (vs %s)</th>%s</tr>" % (
+            _e(g["method"]), _e(g["reference"]),
+            "".join('<td class="num">%s</td>' % ("-" if v is None else "%.0f %%" % (100 * v))
+                    for v in vals)))
+    return ('<div id="side-by-side"><h3>Paper vs simulated</h3><p>Paper: %s. Simulated: at the '
+            'measured points; mean and std pooled over the replicas, max, min and ISO 1101 '
+            'averaged over them.</p><table>%s</table><table>%s</table></div>'
+            % (_e(side["citation"]), "".join(rows), "".join(gains)))
+
+
+def _preset_html(sim):
+    preset, paper = sim.get("preset"), sim.get("paper") or {}
+    notes = list(paper.get("notes", [])) + list((preset or {}).get("notes", []))
+    summary = sim.get("model_summary") or {}
+    out = []
+    if preset:
+        out.append("<h3>Preset %s</h3><p>Imitates %s. Calibrated: %s.</p>"
+                   % (_e(preset["name"]), _e(preset["imitates"]), _e(preset["calibrated"])))
+    if sim.get("side_by_side"):
+        out.append(_side_by_side_html(sim["side_by_side"]))
+    if notes:
+        out.append("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(n) for n in notes))
+    if summary:
+        out.append("<h3>What the model contains and leaves out</h3><p>%s</p><p>Left out: %s</p>"
+                   % (_e(summary.get("contains", "")), _e(summary.get("leaves_out", ""))))
+    return "".join(out)
+
+
+def simulation_maps_figure(maps, columns=4, title=None):
+    """All :func:`simulation_maps` in one matplotlib Figure (``columns`` maps per row), e.g.
+    for the README; each map on its own symmetric scale in um."""
+    from matplotlib.figure import Figure
+
+    rows = -(-len(maps) // columns)
+    fig = Figure(figsize=(4.6 * columns, 3.7 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
+    for ax, m in zip(axes, maps):
+        v = np.asarray(m["values"]) * 1e3
+        _map(np.asarray(m["x"]), np.asarray(m["y"]), v,
+             "%s (std %.2f µm)" % (m["title"], np.std(v, ddof=1)), fig=fig, ax=ax)
+    for ax in axes[len(maps):]:
+        ax.set_axis_off()
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _simulated_maps_html(maps):
+    if not maps:
+        return ""
+    figs = [_img(_map(np.asarray(m["x"]), np.asarray(m["y"]), np.asarray(m["values"]) * 1e3,
+                      "%s [µm]" % m["title"]), "simulated map of " + m["key"],
+                 "%s (std %.2f µm)" % (m["title"], np.std(np.asarray(m["values"]) * 1e3, ddof=1)))
+            for m in maps]
+    return ('<div id="simulated-maps"><h3>Simulated parts, replica 1</h3><p>Deviation from the '
+            'nominal along the outward normal, µm; each map on its own symmetric scale.</p>'
+            '<div class="figs">%s</div></div>' % "".join(figs))
+
+
 def _section_simulation(sim):
     if not sim:
         return ""
@@ -329,11 +444,13 @@ def _section_simulation(sim):
     return ('<section id="simulation"><h2>Simulated machining: before / after</h2>'
             '<p>%d replica(s), seed %s, measured on a %s grid and evaluated on %s points (grid '
             'nodes and between). Cells: mean over replicas (range max - min), µm; mirror paper '
-            'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div><h3>Model parameters</h3>%s</section>'
+            'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div>%s%s<h3>Model parameters</h3>%s'
+            '</section>'
             % (sim.get("replicas", 0), _e(sim.get("seed")),
                _e("x".join(map(str, sim.get("grid", [])))),
                _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
-               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"), params))
+               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"),
+               _preset_html(sim), _simulated_maps_html(sim.get("maps")), params))
 
 
 def render_html(report, simulation=None):
@@ -344,7 +461,8 @@ def render_html(report, simulation=None):
     report : dict
         From :func:`surfcomp.io.report.build_report` (schema ``surfcomp-report/1``).
     simulation : dict, optional
-        From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section).
+        From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section); a
+        ``'maps'`` entry (:func:`simulation_maps`) adds the simulated parts' maps.
     """
     arrays = grid_arrays(report)
     warn = report.get("warnings") or []

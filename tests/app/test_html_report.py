@@ -13,11 +13,17 @@ import pytest
 from numpy.testing import assert_allclose
 from PIL import Image
 
-from surfcomp.core import bspline
+from surfcomp.core import bspline, presets
 from surfcomp.core import simulate as sm
 from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.io import report as report_io
-from surfcomp.io.html_report import SECTIONS, grid_arrays, render_html, write_html_report
+from surfcomp.io.html_report import (
+    SECTIONS,
+    grid_arrays,
+    render_html,
+    simulation_maps,
+    write_html_report,
+)
 
 
 def _surface():
@@ -135,3 +141,31 @@ def test_inspection_report_without_simulation_and_atomic_write(tmp_path):
     write_html_report(str(path), rep)
     assert path.read_text() == page  # rendering is deterministic for one report dict
     assert os.listdir(tmp_path) == ["r.html"]  # no temporary file left
+
+
+def test_preset_simulation_shows_the_papers_table_and_the_parts_maps():
+    """A preset run: the paper's Tab. 3-4 figures beside the simulated ones in the same rows,
+    the model's contents and omissions, and one map per simulated part."""
+    res = presets.run_preset("mirror2019-s2", replicas=1, keep=True)
+    page = render_html(_report(), dict(res.as_dict(), maps=simulation_maps(res)))
+    assert re.findall(r'<section id="([a-z]+)">', page) == list(SECTIONS)
+    side = page.split('<div id="side-by-side">')[1].split("</div>")[0]
+    rows = dict(re.findall(r"<tr><th>([a-z-]+)</th>((?:<td[^>]*>[^<]*</td>){10})</tr>", side))
+    cells = {k: re.findall(r">([^<]*)</td>", v) for k, v in rows.items()}
+    assert list(cells) == ["none", "offset", "raw", "filtered", "semi-finished", "mirror"]
+    assert cells["none"][:5] == ["17.2", "3.8", "-", "-", "52.3"]
+    assert cells["mirror"][:5] == ["0.7", "1.5", "-", "-", "8.3"]
+    assert cells["raw"][:5] == ["-"] * 5
+    sim_none = res.side_rows("grid")["none"][1]
+    assert cells["none"][5:7] == ["%.1f" % (sim_none[k] * 1e3) for k in ("mean", "std")]
+    assert "What the model contains and leaves out" in page and "Left out: The correction" in page
+    alts = re.findall(r'<img alt="simulated map of ([^"]*)" src="data:image/png;base64,([^"]*)"',
+                      page)
+    assert [a for a, _ in alts] == ["before", "none", "offset", "raw", "filtered",
+                                    "semi-finished", "mirror"]
+    for _, src in alts:
+        img = Image.open(io.BytesIO(base64.b64decode(src)))
+        img.load()
+        assert img.format == "PNG" and img.size[0] > 300
+    # without maps (the JSON alone) the section has the tables but no map block
+    assert 'id="simulated-maps"' not in render_html(_report(), res.as_dict())
