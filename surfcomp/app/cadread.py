@@ -13,6 +13,7 @@ The child is this module run as a script::
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -74,12 +75,23 @@ def read_cad(path, label="NOMINAL"):
     return shape
 
 
+def _fatal_signals_kill():
+    """Let a crash kill the child with its signal. FreeCAD installs a SIGSEGV handler that
+    exits with code 1 and no message, which the parent could not tell from a reader error."""
+    for name in ("SIGSEGV", "SIGBUS", "SIGFPE", "SIGILL", "SIGABRT"):
+        sig = getattr(signal, name, None)
+        if sig is not None:
+            signal.signal(sig, signal.SIG_DFL)
+
+
 def _main(argv):
     src, dst = argv
     from . import fcenv
 
     fcenv.import_freecad()
     import Part
+
+    _fatal_signals_kill()
 
     try:
         shape = Part.read(src)
