@@ -6,7 +6,7 @@ table with a header (:mod:`surfcomp.io.measurements`), and, when its header name
 none of the table's columns, as plain measured XYZ points.
 """
 
-from ..errors import MeasurementFileError
+from ..errors import InputError, MeasurementFileError
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
 
@@ -33,13 +33,16 @@ def read_any(path, units="mm", fmt="auto", sample=None):
     if fmt not in FORMATS:
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)
+    if fmt != "auto" and fmt != "table":
+        return read_point_file(path, fmt=fmt, units=units, sample=sample)
+    detected = "table" if fmt == "table" else detect_format(path)
+    if detected not in ("xyz", "table"):
+        return read_point_file(path, fmt=detected, units=units, sample=sample)
+    if sample is not None:
+        raise InputError("sample=%r applies to QIF files only, this is a table or XYZ file"
+                         % (sample,), file=str(path))
     if fmt == "table":
         return read_measurements(path, units=units)
-    if fmt != "auto":
-        return read_point_file(path, fmt=fmt, units=units, sample=sample)
-    detected = detect_format(path)
-    if detected != "xyz":
-        return read_point_file(path, fmt=detected, units=units, sample=sample)
     try:
         return read_measurements(path, units=units)
     except MeasurementFileError as table_error:
