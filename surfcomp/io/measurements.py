@@ -101,6 +101,10 @@ DUPLICATE_TOL = 1e-9
 NORMAL_LENGTH_TOL = 1e-3
 #: a given normal shorter than this has no direction (an error)
 NORMAL_ZERO = 1e-9
+#: largest coordinate (mm) of a nominal or measured point: 1 km, beyond any part (and the
+#: bound of G-code positions); larger values are a wrong column or unit, and their
+#: squared distances would overflow
+MAX_COORDINATE = 1e6
 #: per-point warnings of one kind listed before they are only counted
 MAX_POINT_WARNINGS = 10
 
@@ -330,6 +334,36 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
     return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
 
 
+def check_coordinates(values, lines, source, columns=None, limit=MAX_COORDINATE,
+                      what="coordinate"):
+    """Refuse values (N, k) in mm that are not finite (a unit conversion can overflow) or
+    larger than ``limit``.
+
+    Parameters
+    ----------
+    values : ndarray (N, k)
+    lines : array_like (N,)
+        1-based line of every row.
+    source : str
+    columns : list of int, optional
+        1-based column of each of the k values.
+
+    Raises
+    ------
+    MeasurementFileError
+        ``file:line[:column]``, the value and the limit.
+    """
+    bad = ~(np.abs(values) <= limit)
+    if not bad.any():
+        return
+    k, c = (int(x) for x in np.argwhere(bad)[0])
+    beyond = ("beyond %g mm (1 km; expected a point of a part: wrong column or units?)"
+              % limit if np.isfinite(values[k, c]) else "not a finite number of mm after the "
+              "unit conversion")
+    raise MeasurementFileError("%s %.6g mm is %s" % (what, values[k, c], beyond), file=source,
+                               line=int(lines[k]), column=None if columns is None else columns[c])
+
+
 def decode_utf8(raw, source):
     """Decode file bytes as UTF-8 (a byte order mark is skipped); UTF-16/32 and invalid
     bytes raise MeasurementFileError naming the line."""
@@ -457,14 +491,20 @@ class _Parser:
                             warnings=self.warnings)
         have = {g for g, rs in GROUPS.items() if rs[0] in col_of}
         ms.nominal = take(GROUPS["nominal"])
+        check_coordinates(ms.nominal, line_numbers, self.source,
+                          [col_of[r] + 1 for r in GROUPS["nominal"]])
         self._check_duplicates(ms.nominal, data)
         if "measured" in have:
             ms.measured = take(GROUPS["measured"])
+            check_coordinates(ms.measured, line_numbers, self.source,
+                              [col_of[r] + 1 for r in GROUPS["measured"]])
         if "normal" in have:
             ms.normal = self._unit_normals(values[:, [pos[col_of[r]] for r in "ijk"]], data,
                                            [col_of[r] + 1 for r in "ijk"])
         if "deviation" in have:
             ms.deviation = take(("dev",))[:, 0]
+            check_coordinates(ms.deviation[:, None], line_numbers, self.source,
+                              [col_of["dev"] + 1], limit=np.inf, what="deviation")
         if "grid" in have:
             ms.row = self._integers(values[:, pos[col_of["row"]]], data, col_of["row"], names)
             ms.col = self._integers(values[:, pos[col_of["col"]]], data, col_of["col"], names)
@@ -663,6 +703,11 @@ class _Parser:
             raise self.error("the normal (%g, %g, %g) has zero length (expected a unit vector "
                              "i j k; %d such row(s))" % (tuple(n[k]) + (zero.size,)), data[k],
                              columns[0])
+        huge = np.flatnonzero(~np.isfinite(length))
+        if huge.size:
+            k = int(huge[0])
+            raise self.error("the normal (%g, %g, %g) is too long to be normalised (expected a "
+                             "unit vector i j k)" % tuple(n[k]), data[k], columns[0])
         off = np.flatnonzero(np.abs(length - 1.0) > NORMAL_LENGTH_TOL)
         self._point_warnings(off, data, lambda k: "the normal (%g, %g, %g) has length %.6g "
                              "(expected a unit vector; used renormalised)"

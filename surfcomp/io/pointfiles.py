@@ -42,7 +42,13 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .files import read_bytes
-from .measurements import NORMAL_LENGTH_TOL, NORMAL_ZERO, MeasurementSet, decode_utf8
+from .measurements import (
+    NORMAL_LENGTH_TOL,
+    NORMAL_ZERO,
+    MeasurementSet,
+    check_coordinates,
+    decode_utf8,
+)
 from .units import split_unit_suffix, unit_factor
 
 #: formats :func:`read_point_file` reads
@@ -247,6 +253,12 @@ def _unit_directions(path, ijk, line_numbers, warnings):
         k = int(np.argmax(zero))
         raise MeasurementFileError("the direction vector i j k is zero; expected a unit vector",
                                    file=str(path), line=int(line_numbers[k]))
+    huge = ~np.isfinite(length)
+    if huge.any():
+        k = int(np.argmax(huge))
+        raise MeasurementFileError("the direction vector i j k is too long to be normalised; "
+                                   "expected a unit vector", file=str(path),
+                                   line=int(line_numbers[k]))
     off = np.abs(length - 1.0)
     if off.max() > NORMAL_LENGTH_TOL:
         k = int(np.argmax(off > NORMAL_LENGTH_TOL))
@@ -392,6 +404,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     lines = _split_lines(text)
     reader = {"xyz": _read_xyz, "xyzijk": _read_xyzijk, "probe": _read_probe}[fmt]
     fields = reader(path, lines, units, warnings)
+    check_coordinates(fields["measured"], fields["lines"], str(path))
     fields["columns"] = {_ROLE_NAMES[r]: name for r, name in fields["columns"].items()}
     source = str(path)
     texts = ["%s:%d: %s" % (source, line, text) if line is not None else

@@ -69,6 +69,7 @@ from .measurements import (
     NORMAL_LENGTH_TOL,
     NORMAL_ZERO,
     MeasurementSet,
+    check_coordinates,
 )
 from .units import unit_factor
 
@@ -415,8 +416,12 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
     pts = _surface_points(doc, mr, ufac)
     nominal, measured, normal = (np.array(pts[key]) for key in ("nom", "act", "nrm"))
     ids, lines = pts["ids"], pts["lines"]
+    check_coordinates(nominal, lines, doc.source)
+    check_coordinates(measured, lines, doc.source)
     computed = np.einsum("ij,ij->i", measured - nominal, normal)
     deviation, from_file = _file_deviations(doc, mr, ufac, pts, computed, deviation_tol)
+    check_coordinates(np.asarray(deviation, dtype=float)[:, None], lines, doc.source,
+                      limit=np.inf, what="deviation")
 
     columns = {}
     for r in ("x_nom", "y_nom", "z_nom"):
@@ -470,6 +475,9 @@ def _surface_point(doc, fm, items, nominals, ufac, skipped, no_normal):
     if length < NORMAL_ZERO:
         raise doc.error("the <Normal> of <PointFeatureNominal id=%r> is zero; expected a "
                         "unit vector" % nominal_id, normal_el)
+    if not np.isfinite(length):
+        raise doc.error("the <Normal> of <PointFeatureNominal id=%r> is too long to be "
+                        "normalised; expected a unit vector" % nominal_id, normal_el)
     if abs(length - 1.0) > NORMAL_LENGTH_TOL:
         doc.warn("the normal of %s has length %.6g; used normalised" % (name, length),
                  normal_el)
