@@ -99,4 +99,8 @@ def parse_document(path):
     except xml.parsers.expat.ExpatError as exc:
         raise InputError("Document.xml is damaged: %s" % xml.parsers.expat.ErrorString(
             exc.code), file=path, line=exc.lineno) from None
+    except (LookupError, ValueError) as exc:  # the declared encoding cannot be decoded
+        raise InputError("Document.xml is damaged: its XML declaration names an encoding "
+                         "that cannot be read (%s; FreeCAD writes UTF-8)" % exc,
+                         file=path) from None
     return {"objects": objects, "modules": sorted(modules)}

@@ -164,6 +164,10 @@ class _Doc:
                                        "document)" % expat.ErrorString(exc.code),
                                        file=self.source, line=exc.lineno,
                                        column=exc.offset + 1) from exc
+        except (LookupError, ValueError) as exc:  # the declared encoding cannot be decoded
+            raise MeasurementFileError("the XML declaration names an encoding that cannot be "
+                                       "read (%s; expected UTF-8)" % exc, file=self.source,
+                                       line=1) from None
         return builder.close()
 
     # -- helpers ----------------------------------------------------------------------------
