@@ -34,9 +34,9 @@ Common rules
 - Unit suffixes as in :mod:`surfcomp.io.units`: ``position[mm]``, ``ex[um]``, ``EXX_um``,
   ``X(in)``. Columns without a suffix are in ``units`` (default mm). Values are returned in
   mm.
-- Every value must be finite; with ``max_error`` an error larger than it (mm, after the
-  unit conversion) is refused, since it is most likely a unit mistake (micrometres read as
-  millimetres).
+- Every value must be finite and every position within 1 km; with ``max_error`` an error
+  larger than it (mm, after the unit conversion) is refused, since it is most likely a unit
+  mistake (micrometres read as millimetres).
 - Every problem raises :class:`surfcomp.errors.MeasurementFileError` naming
   ``file:line[:column]``, what is wrong and what was expected.
 """
@@ -51,6 +51,7 @@ import numpy as np
 from ..errors import InputError, MeasurementFileError
 from .atomic import write_text
 from .files import read_bytes
+from .measurements import MAX_COORDINATE
 from .units import split_unit_suffix, unit_factor
 
 AXES = ("x", "y", "z")
@@ -136,6 +137,18 @@ def _number(text, path, line, col, what, factor=1.0):
     if not math.isfinite(v):
         raise MeasurementFileError("%s: %r is out of range (expected a finite number)"
                                    % (what, text), file=path, line=line, column=col)
+    return v
+
+
+def _position(text, path, line, col, what, factor):
+    """A slide position in mm, within 1 km (as G-code positions; larger ones are a wrong
+    column or unit, and their powers overflow in the fit)."""
+    v = _number(text, path, line, col, what, factor)
+    if not abs(v) <= MAX_COORDINATE:
+        raise MeasurementFileError("%s: %r = %.6g mm is beyond %g mm (1 km; expected a slide "
+                                   "position in mm: check the column and the units)"
+                                   % (what, text.strip(), v, MAX_COORDINATE), file=path,
+                                   line=line, column=col)
     return v
 
 
@@ -236,8 +249,8 @@ def _read_long(path, lines, first, units, max_error=None):
         if ax not in AXES:
             raise MeasurementFileError("axis %r (expected X, Y or Z)" % fields[role["axis"]],
                                        file=path, line=k + 1, column=role["axis"] + 1)
-        vals = [_number(fields[role["position"]], path, k + 1, role["position"] + 1,
-                        "position", factor["position"])]
+        vals = [_position(fields[role["position"]], path, k + 1, role["position"] + 1,
+                          "position", factor["position"])]
         vals += [_error(fields[role[c]], path, k + 1, role[c] + 1, c, factor[c], max_error)
                  for c in ("ex", "ey", "ez")]
         rows[ax][0].append(vals[0])
@@ -267,7 +280,7 @@ def _read_tables(path, lines, first, units, max_error=None):
         if len(fields) != ncols:
             raise MeasurementFileError("%d fields, expected %d like the table header"
                                        % (len(fields), ncols), file=path, line=k + 1)
-        pos = _number(fields[0], path, k + 1, 1, ax.upper(), pfac)
+        pos = _position(fields[0], path, k + 1, 1, ax.upper(), pfac)
         err = [0.0, 0.0, 0.0]
         for comp, fac, col in comps:
             err[comp] = _error(fields[col], path, k + 1, col + 1,
