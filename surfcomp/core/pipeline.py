@@ -282,9 +282,10 @@ def _check_deviations(ms, d, options):
     hint = ("are the deviations in um? Give the unit (--units um, or a column name like "
             "'dev [um]')" if np.isfinite(d[k]) and np.abs(d[k]) < 1e5 * allowed
             else "is this the right file?")
+    # 4 decimals as the other messages, but no 300-digit number for 1e308
+    shown = "%.4f" % d[k] if np.abs(d[k]) < 1e6 else "%.6g" % d[k]
     raise _err(ms, k, "deviation %s mm (expected at most --max-offset %g mm%s; %d point(s) "
-               "exceed it): %s" % ("%.4f" % d[k] if np.isfinite(d[k]) else d[k],
-                                    options.max_offset,
+               "exceed it): %s" % (shown, options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
                                     bad.size, hint))
 
