@@ -150,6 +150,9 @@ def add_parser(subparsers):
                         "Dobariya 2015 model adds its error along the normal")
     m.add_argument("--axis-units", choices=("mm", "um", "in"), default="mm",
                    help="units of the axis error file without unit suffixes (default mm)")
+    m.add_argument("--max-error", type=float, default=1.0, metavar="MM",
+                   help="largest plausible error in the axis error file: a larger one is "
+                        "refused as a likely unit mistake (default 1 mm, as for gcode)")
     m.add_argument("--reference", default="0,0,0", metavar="X,Y,Z",
                    help="reference point of the axis error measurements (default 0,0,0)")
     o = p.add_argument_group("output")
@@ -222,7 +225,11 @@ def model_from_args(args, preset=None):
         from ..core.axis_errors import fit_axis_errors
         from ..io.axis_csv import read_axis_errors
 
-        table = read_axis_errors(args.axis_errors, units=args.axis_units)
+        if not (np.isfinite(args.max_error) and args.max_error > 0):
+            raise InputError("--max-error %r: expected a positive length in mm"
+                             % (args.max_error,))
+        table = read_axis_errors(args.axis_errors, units=args.axis_units,
+                                 max_error=args.max_error)
         kw["axis_errors"] = fit_axis_errors(table.data, model="auto",
                                             reference=_numbers(args.reference, 3, "--reference"),
                                             source=args.axis_errors)
@@ -283,6 +290,9 @@ def run(args):
         raise InputError("--mask %r: expected odd whole numbers, e.g. 5 or 3,5,7"
                          % args.mask) from None
     methods = [x.strip() for x in args.methods.split(",") if x.strip()]
+    if not methods:
+        raise InputError("--methods %r: expected a comma-separated list of some of %s"
+                         % (args.methods, ", ".join(sim.SIM_METHODS)))
     specs = sim.method_specs(methods, masks, None, args.mask_kind, args.edge, args.refine)
     report_label = _report_label(args, specs)
     model = model_from_args(args, preset)

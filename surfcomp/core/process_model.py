@@ -104,6 +104,13 @@ SUMMARY = {
 _SCALARS = ("offset", "slope_gain", "abs_slope_gain", "waviness", "wavelength", "sigma",
             "correlation_length", "probe_sigma", "stock")
 _NON_NEGATIVE = ("sigma", "correlation_length", "probe_sigma", "stock")
+#: largest error (mm) of a pass and of each error term: the largest deviation a
+#: compensation accepts (``--max-offset`` at most 100 mm); more is a unit mistake
+MAX_ERROR = 100.0
+#: the terms bounded by MAX_ERROR in magnitude (the deflection's gains by MAX_GAIN)
+_ERRORS = ("offset", "slope_gain", "abs_slope_gain", "waviness", "sigma", "probe_sigma", "stock",
+           "tilt", "bow")
+MAX_GAIN = 10.0
 
 
 @dataclass
@@ -155,6 +162,7 @@ class MachiningModel:
         self.tilt = _finite_tuple(self.tilt, 2, "tilt")
         self.bow = _finite_tuple(self.bow, 2, "bow")
         self.deflection = _finite_tuple(self.deflection, 3, "deflection")
+        self._check_magnitudes()
         a = np.asarray(self.tool_axis, dtype=float)
         f = np.asarray(self.feed, dtype=float)
         if a.shape != (3,) or f.shape != (3,) or not np.linalg.norm(a) > 0:
@@ -165,6 +173,20 @@ class MachiningModel:
             raise InputError("the feed direction must not be parallel to the tool axis")
         self.tool_axis = tuple(a.tolist())
         self.feed = tuple((f / np.linalg.norm(f)).tolist())
+
+    def _check_magnitudes(self):
+        """Error terms of at most MAX_ERROR mm, deflection gains of at most MAX_GAIN: larger
+        ones are no machining error (and overflow the simulation)."""
+        limits = [(name, MAX_ERROR, "mm") for name in _ERRORS] + [("deflection", MAX_GAIN,
+                                                                   "mm per mm of engagement")]
+        if self.semi_engagement is not None:
+            limits.append(("semi_engagement", MAX_ERROR, "mm"))
+        for name, limit, unit in limits:
+            value = getattr(self, name)
+            if np.max(np.abs(value)) > limit:
+                raise InputError("machining model %s must be at most %g %s in magnitude (a "
+                                 "larger one is no machining error: a unit mistake?), got %s"
+                                 % (name, limit, unit, value))
 
     @property
     def deflects(self):
@@ -368,6 +390,12 @@ def machine_pass(model, frame, S, n, rng, offset=0.0, engagement=None):
         a = model.stock if engagement is None else engagement
         e = e + model.deflection_error(nn, np.broadcast_to(a, S.shape[:-1]))
     e = e + model.random(frame, G, rng)
+    worst = np.max(np.where(np.isfinite(e), np.abs(e), np.inf)) if e.size else 0.0
+    if not worst <= MAX_ERROR:
+        raise InputError("the machining model gives a pass an error of %.6g mm (expected at "
+                         "most %g mm, the largest deviation a compensation accepts): check the "
+                         "model's terms (offset, gains, tilt, bow, waviness, deflection, axis "
+                         "errors)" % (worst, MAX_ERROR))
     return (G + e[:, None] * nn).reshape(S.shape), e.reshape(S.shape[:-1])
 
 

@@ -63,6 +63,8 @@ SIM_METHODS = ("none",) + METHODS
 SCHEMA = "surfcomp-simulation/1"
 #: largest measurement grid per direction
 MAX_GRID = 4000
+#: largest evaluation grid per direction (the largest grid with the default between = 2)
+MAX_EVAL_GRID = 2 * (MAX_GRID - 1) + 1
 
 
 # ---------------------------------------------------------------------- methods
@@ -191,6 +193,10 @@ def make_layout(surface, grid=(45, 45), margin=0.02, between=2):
                          % (MAX_GRID, MAX_GRID, n, m))
     if int(between) != between or between < 1:
         raise InputError("between must be a whole number >= 1, got %r" % (between,))
+    size = (between * (n - 1) + 1, between * (m - 1) + 1)
+    if max(size) > MAX_EVAL_GRID:
+        raise InputError("--between %d: the evaluation grid would have %d x %d points (expected "
+                         "at most %d per direction)" % ((between,) + size + (MAX_EVAL_GRID,)))
     if not 0 <= margin < 0.5:
         raise InputError("margin must be in [0, 0.5), got %r" % (margin,))
     (u0, u1), (v0, v1) = surface.u_range, surface.v_range
