@@ -14,8 +14,13 @@ SCHEMA = "surfcomp-report/1"
 
 
 def _list(a, digits=9):
+    """``a`` rounded to ``digits`` decimals as a list; values too large to round (the
+    rounding multiplies by 10**digits, which overflows from about 1e296) are kept as they
+    are."""
     a = np.asarray(a, dtype=float)
-    return np.round(a, digits).tolist()
+    with np.errstate(over="ignore", invalid="ignore"):
+        r = np.round(a, digits)
+    return np.where(np.isfinite(r) | ~np.isfinite(a), r, a).tolist()
 
 
 def build_report(command, inputs, comp, warnings=(), outputs=None, points=True):
