@@ -331,7 +331,8 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
         text = decode_utf8(raw, source)
     if text.startswith("\ufeff"):
         text = text[1:]
-    return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
+    with np.errstate(over="ignore"):    # overflowing values are refused by the checks
+        return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
 
 
 def check_coordinates(values, lines, source, columns=None, limit=MAX_COORDINATE,
@@ -357,11 +358,14 @@ def check_coordinates(values, lines, source, columns=None, limit=MAX_COORDINATE,
     if not bad.any():
         return
     k, c = (int(x) for x in np.argwhere(bad)[0])
-    beyond = ("beyond %g mm (1 km; expected a point of a part: wrong column or units?)"
-              % limit if np.isfinite(values[k, c]) else "not a finite number of mm after the "
-              "unit conversion")
-    raise MeasurementFileError("%s %.6g mm is %s" % (what, values[k, c], beyond), file=source,
-                               line=int(lines[k]), column=None if columns is None else columns[c])
+    if np.isfinite(values[k, c]):
+        text = "%s %.6g mm is beyond %g mm (1 km; expected a point of a part: wrong column or " \
+               "units?)" % (what, values[k, c], limit)
+    else:
+        text = "the %s overflows when converted to mm (the value is too large for its unit; " \
+               "wrong column or units?)" % what
+    raise MeasurementFileError(text, file=source, line=int(lines[k]),
+                               column=None if columns is None else columns[c])
 
 
 def decode_utf8(raw, source):

@@ -403,7 +403,8 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
                                    file=str(path))
     lines = _split_lines(text)
     reader = {"xyz": _read_xyz, "xyzijk": _read_xyzijk, "probe": _read_probe}[fmt]
-    fields = reader(path, lines, units, warnings)
+    with np.errstate(over="ignore"):    # overflowing values are refused by the checks
+        fields = reader(path, lines, units, warnings)
     check_coordinates(fields["measured"], fields["lines"], str(path))
     fields["columns"] = {_ROLE_NAMES[r]: name for r, name in fields["columns"].items()}
     source = str(path)

@@ -417,13 +417,14 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
     k = _choose(doc, blocks, samples, sample)
     mr = blocks[k]
 
-    pts = _surface_points(doc, mr, ufac)
-    nominal, measured, normal = (np.array(pts[key]) for key in ("nom", "act", "nrm"))
-    ids, lines = pts["ids"], pts["lines"]
-    check_coordinates(nominal, lines, doc.source)
-    check_coordinates(measured, lines, doc.source)
-    computed = np.einsum("ij,ij->i", measured - nominal, normal)
-    deviation, from_file = _file_deviations(doc, mr, ufac, pts, computed, deviation_tol)
+    with np.errstate(over="ignore"):    # overflowing values are refused by the checks
+        pts = _surface_points(doc, mr, ufac)
+        nominal, measured, normal = (np.array(pts[key]) for key in ("nom", "act", "nrm"))
+        ids, lines = pts["ids"], pts["lines"]
+        check_coordinates(nominal, lines, doc.source)
+        check_coordinates(measured, lines, doc.source)
+        computed = np.einsum("ij,ij->i", measured - nominal, normal)
+        deviation, from_file = _file_deviations(doc, mr, ufac, pts, computed, deviation_tol)
     check_coordinates(np.asarray(deviation, dtype=float)[:, None], lines, doc.source,
                       limit=np.inf, what="deviation")
 
