@@ -163,8 +163,7 @@ class MachiningModel:
         self.bow = _finite_tuple(self.bow, 2, "bow")
         self.deflection = _finite_tuple(self.deflection, 3, "deflection")
         self._check_magnitudes()
-        a = np.asarray(self.tool_axis, dtype=float)
-        f = np.asarray(self.feed, dtype=float)
+        a, f = _scaled(self.tool_axis), _scaled(self.feed)
         if a.shape != (3,) or f.shape != (3,) or not np.linalg.norm(a) > 0:
             raise InputError("feed and tool axis must be 3-vectors, the tool axis non-zero")
         a = a / np.linalg.norm(a)
@@ -296,6 +295,14 @@ class MachiningModel:
         """
         g2 = float(np.mean(self.compliance(normal) ** 2))
         return float(np.sqrt(self.sigma ** 2 * (1.0 + g2) + self.probe_sigma ** 2))
+
+
+def _scaled(vector):
+    """A direction divided by its largest component (so its norm neither overflows nor
+    underflows: 1e308 and 1e-320 components keep their direction)."""
+    v = np.asarray(vector, dtype=float)
+    big = np.max(np.abs(v)) if v.size else 0.0
+    return v / big if 0 < big < np.inf else v
 
 
 def _finite_tuple(values, count, name):
