@@ -50,7 +50,7 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .atomic import write_text
-from .files import read_bytes
+from .files import clip, read_bytes
 from .measurements import MAX_COORDINATE
 from .units import split_unit_suffix, unit_factor
 
@@ -131,12 +131,12 @@ def _number(text, path, line, col, what, factor=1.0):
     s = text.strip()
     if not _NUMBER.match(s):
         raise MeasurementFileError("%s: %r is not a number (expected e.g. 12.5 or -0.003; "
-                                   "decimal point, no thousands separators)" % (what, text),
+                                   "decimal point, no thousands separators)" % (what, clip(text)),
                                    file=path, line=line, column=col)
     v = float(s) * factor
     if not math.isfinite(v):
         raise MeasurementFileError("%s: %r is out of range (expected a finite number)"
-                                   % (what, text), file=path, line=line, column=col)
+                                   % (what, clip(text)), file=path, line=line, column=col)
     return v
 
 

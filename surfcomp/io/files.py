@@ -6,6 +6,15 @@ from ..errors import MeasurementFileError
 MAX_INPUT_BYTES = 4 * 1024 ** 3
 
 
+def clip(text, limit=40):
+    """``text`` for a message: at most ``limit`` characters, with the full length when cut
+    (a field of a damaged file may be megabytes long)."""
+    text = str(text)
+    if len(text) <= limit:
+        return text
+    return "%s... (%d characters)" % (text[:limit - 8], len(text))
+
+
 def read_bytes(path, what="the file", error=MeasurementFileError, limit=None):
     """The bytes of ``path`` (at most ``limit`` of them when given).
 

@@ -90,7 +90,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError, MeasurementFileError
-from .files import read_bytes
+from .files import clip, read_bytes
 from .units import SUFFIX_BRACKET, UNIT_FACTORS, split_unit_suffix, unit_factor
 
 #: largest difference (mm) between a given deviation and (measured - nominal) . normal
@@ -665,7 +665,7 @@ class _Parser:
                 text = fields[c].strip()
                 if _NUMBER.fullmatch(text):
                     continue
-                shown = split(rows[k])[c].strip()
+                shown = clip(split(rows[k])[c].strip())
                 if not text:
                     what = "column '%s' is empty (expected a number)" % names[c]
                 elif _NONFINITE.fullmatch(text):
@@ -680,7 +680,8 @@ class _Parser:
                 if not np.isfinite(float(fields[c])):
                     raise self.error("column '%s' holds '%s', which is not a finite number "
                                      "(expected a finite number)"
-                                     % (names[c], split(rows[k])[c].strip()), data[k], c + 1)
+                                     % (names[c], clip(split(rows[k])[c].strip())), data[k],
+                                     c + 1)
 
     def _integers(self, values, data, c, names):
         whole = np.floor(values) == values

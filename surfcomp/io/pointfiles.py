@@ -41,7 +41,7 @@ import re
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .files import read_bytes
+from .files import clip, read_bytes
 from .measurements import (
     NORMAL_LENGTH_TOL,
     NORMAL_ZERO,
@@ -173,7 +173,7 @@ def _locate_bad_number(path, rows, sep, decimal_comma, usecols, names):
             if not _is_number(value):
                 what = ("empty field %d (%s); expected a number" % (c + 1, names[c]) if not tok
                         else "malformed number %r in field %d (%s); expected a decimal number "
-                        "such as -12.345 (%s)" % (tok, c + 1, names[c], "decimal comma"
+                        "such as -12.345 (%s)" % (clip(tok), c + 1, names[c], "decimal comma"
                                                   if decimal_comma else "decimal point"))
                 raise MeasurementFileError(what, file=str(path), line=lineno, column=col)
 
@@ -241,7 +241,7 @@ def _check_finite(path, arr, rows, sep, usecols, names):
         k = usecols[c]
         tok, col = _fields(text, sep)[k]
         raise MeasurementFileError("%r in field %d (%s) is not a finite number; expected a "
-                                   "finite decimal number" % (tok, k + 1, names[k]),
+                                   "finite decimal number" % (clip(tok), k + 1, names[k]),
                                    file=str(path), line=lineno, column=col)
 
 

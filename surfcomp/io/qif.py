@@ -62,7 +62,7 @@ from xml.parsers import expat
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
-from .files import read_bytes
+from .files import clip, read_bytes
 from .measurements import (
     DEV_CHECK_TOL,
     MAX_POINT_WARNINGS,
@@ -211,10 +211,10 @@ class _Doc:
         except ValueError:
             bad = next(t for t in toks if not _is_float(t))
             raise self.error("<%s> holds %r, which is not a number; expected %s"
-                             % (_local(el.tag), bad, what), el) from None
+                             % (_local(el.tag), clip(bad), what), el) from None
         if not np.all(np.isfinite(values)):
             raise self.error("<%s> holds %r; expected finite numbers (%s)"
-                             % (_local(el.tag), el.text.strip(), what), el)
+                             % (_local(el.tag), clip(el.text.strip()), what), el)
         return values
 
 

@@ -12,6 +12,7 @@ import numpy as np
 
 from ...core.arcs import PLANES, centre_from_radius, check_centre
 from ...errors import GCodeError, InputError
+from ..files import clip
 from .lexer import AXIS_LETTERS, decode, split_lines, tokenize
 
 #: largest position, arc radius or centre (mm) accepted: 1 km, beyond any machine's travel
@@ -156,7 +157,7 @@ def _classify(words, source, ln):
                              column=_column(w))
         else:
             raise GCodeError("unsupported word %s%s (expected G M N X Y Z I J K R F S T H "
-                             "D P Q L)" % (L, w.text or ""), file=source, line=ln,
+                             "D P Q L)" % (L, clip(w.text or "")), file=source, line=ln,
                              column=_column(w))
     return gs, ms, vals
 
@@ -371,7 +372,7 @@ class _Interpreter:
         """Refuse a position, radius or centre (mm) beyond :data:`MAX_POSITION`."""
         if not abs(value) <= MAX_POSITION:
             raise GCodeError("%s%s: %s %.6g mm is beyond any machine's travel (expected at "
-                             "most %g mm)" % (word.letter, word.text or "", what, value,
+                             "most %g mm)" % (word.letter, clip(word.text or ""), what, value,
                                               MAX_POSITION), file=self.source, line=ln,
                              column=_column(word))
 
@@ -396,10 +397,10 @@ class _Interpreter:
             pv = words[vals["P"]].value
             if pv < 1 or pv != int(pv):
                 raise GCodeError("arc turns P%s must be a positive whole number"
-                                 % words[vals["P"]].text, file=self.source, line=ln)
+                                 % clip(words[vals["P"]].text), file=self.source, line=ln)
             if pv > MAX_TURNS:
                 raise GCodeError("arc turns P%s: expected at most %d turns"
-                                 % (words[vals["P"]].text, MAX_TURNS), file=self.source,
+                                 % (clip(words[vals["P"]].text), MAX_TURNS), file=self.source,
                                  line=ln)
             turns = int(pv)
             arc_idx.append(vals["P"])

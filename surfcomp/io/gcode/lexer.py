@@ -8,6 +8,7 @@ import math
 import re
 
 from ...errors import GCodeError
+from ..files import clip
 
 #: the axis words the compensation handles, in output order
 AXIS_LETTERS = "XYZ"
@@ -95,7 +96,7 @@ def _comment_end(content, i, source, line):
 
 def _o_word(text, source, line, i):
     return GCodeError("O word %r: subroutines and flow control (O-words) cannot be "
-                      "compensated; expand the program first" % text, file=source, line=line,
+                      "compensated; expand the program first" % clip(text), file=source, line=line,
                       column=i + 1)
 
 
@@ -106,7 +107,7 @@ def _word(content, m, source, line):
     if letter == "O":
         raise _o_word(content[i:end], source, line, i)
     if end < len(content) and (content[end] == "." or content[end].isdigit()):
-        raise GCodeError("malformed number in %r" % content[i:end + 1], file=source,
+        raise GCodeError("malformed number in %r" % clip(content[i:end + 1]), file=source,
                          line=line, column=i + 1)
     text = m.group(2)
     value = float(text)
