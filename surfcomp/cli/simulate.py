@@ -175,7 +175,9 @@ def _numbers(text, count, option, negative=True):
     except ValueError:
         vals = []
     if len(vals) != count or not all(np.isfinite(vals)):
-        raise InputError("%s %r: expected %d comma-separated numbers" % (option, text, count))
+        raise InputError("%s %r: expected %s" % (option, text, "a finite number" if count == 1
+                                                 else "%d comma-separated numbers"
+                                                 % count))
     if not negative and any(v < 0 for v in vals):
         raise InputError("%s %r: %s must be >= 0 mm" % (option, text,
                                                          option.lstrip("-").replace("-", " ")))

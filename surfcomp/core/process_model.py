@@ -169,7 +169,8 @@ class MachiningModel:
         a = a / np.linalg.norm(a)
         f = f - np.dot(f, a) * a
         if not np.linalg.norm(f) > 1e-9:
-            raise InputError("the feed direction must not be parallel to the tool axis")
+            raise InputError("the feed direction must be non-zero and not parallel to the tool "
+                             "axis, got feed %s, tool axis %s" % (self.feed, self.tool_axis))
         self.tool_axis = tuple(a.tolist())
         self.feed = tuple((f / np.linalg.norm(f)).tolist())
 
