@@ -163,8 +163,9 @@ class MachiningModel:
         self.bow = _finite_tuple(self.bow, 2, "bow")
         self.deflection = _finite_tuple(self.deflection, 3, "deflection")
         self._check_magnitudes()
-        a, f = _scaled(self.tool_axis), _scaled(self.feed)
-        if a.shape != (3,) or f.shape != (3,) or not np.linalg.norm(a) > 0:
+        a = _scaled(_finite_tuple(self.tool_axis, 3, "tool_axis"))
+        f = _scaled(_finite_tuple(self.feed, 3, "feed"))
+        if not np.linalg.norm(a) > 0:
             raise InputError("feed and tool axis must be 3-vectors, the tool axis non-zero")
         a = a / np.linalg.norm(a)
         f = f - np.dot(f, a) * a
