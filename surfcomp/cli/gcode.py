@@ -18,6 +18,7 @@ from ..errors import GCodeError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
 from ..io.gcode import compensate_gcode, parse_gcode, read_gcode
+from ..io.gcode.interpreter import MAX_POSITION
 from ..io.hashing import sha256_file
 
 SCHEMA = "surfcomp-gcode-report/1"
@@ -79,6 +80,9 @@ def _triple(text, option):
         vals = []
     if len(vals) != 3 or not all(np.isfinite(vals)):
         raise InputError("%s %r: expected three numbers X,Y,Z in mm" % (option, text))
+    if not all(abs(v) <= MAX_POSITION for v in vals):
+        raise InputError("%s %r: expected three numbers X,Y,Z in mm, each within %g mm (1 km, "
+                         "as G-code positions)" % (option, text, MAX_POSITION))
     return np.array(vals)
 
 

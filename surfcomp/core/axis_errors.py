@@ -65,6 +65,9 @@ F_TEST_ALPHA = 0.05
 EXACT_RMS = 1e-9
 #: Newton tolerance (mm) of :meth:`AxisErrorModel.compensate`
 COMPENSATE_TOL = 1e-10
+#: largest position, error or reference coordinate (mm) the fit takes: 1 km, beyond any
+#: machine (as G-code positions); the squares of larger values overflow in the fit
+MAX_VALUE = 1e6
 
 
 def _finite_points(values, message, points=None):
@@ -454,6 +457,25 @@ def _polyfit(t, y, degree):
     return full, y - fitted
 
 
+def _axis_data(ax, data, source):
+    """Positions (n,) and errors (n, 3) of one slide, checked: as many rows as positions,
+    finite, within :data:`MAX_VALUE`."""
+    pos, err = data
+    pos = np.asarray(pos, dtype=float).reshape(-1)
+    err = np.asarray(err, dtype=float).reshape(-1, 3)
+    if err.shape[0] != pos.size:
+        raise InputError("axis %s: %d positions but %d error rows" % (ax, pos.size,
+                                                                       err.shape[0]),
+                         file=source)
+    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(err))):
+        raise InputError("axis %s: non-finite measured values" % ax.upper(), file=source)
+    if not (np.all(np.abs(pos) <= MAX_VALUE) and np.all(np.abs(err) <= MAX_VALUE)):
+        raise InputError("axis %s: measured positions or errors beyond %g mm (1 km; expected "
+                         "a machine's travel and errors in mm)" % (ax.upper(), MAX_VALUE),
+                         file=source)
+    return pos, err
+
+
 def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_ALPHA,
                     source=None):
     """Fit the nine 1-D error functions from per-axis measurements (Dobariya 2015, sec. 4).
@@ -488,6 +510,9 @@ def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_
         raise InputError("unknown axis error model %r (expected one of %s)"
                          % (model, ", ".join(MODEL_CHOICES)), file=source)
     ref = np.array(reference, dtype=float).reshape(3)
+    if not np.all(np.abs(ref) <= MAX_VALUE):
+        raise InputError("the reference point (%g, %g, %g) mm is not within %g mm (1 km) of the "
+                         "origin" % (tuple(ref) + (MAX_VALUE,)), file=source)
     slope = np.zeros((3, 3))
     curv = np.zeros((3, 3))
     travel = np.full((3, 2), np.nan)
@@ -504,15 +529,7 @@ def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_
     for a, ax in enumerate(AXES):
         if ax not in keys:
             continue
-        pos, err = keys[ax]
-        pos = np.asarray(pos, dtype=float).reshape(-1)
-        err = np.asarray(err, dtype=float).reshape(-1, 3)
-        if err.shape[0] != pos.size:
-            raise InputError("axis %s: %d positions but %d error rows" % (ax, pos.size,
-                                                                           err.shape[0]),
-                             file=source)
-        if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(err))):
-            raise InputError("axis %s: non-finite measured values" % ax.upper(), file=source)
+        pos, err = _axis_data(ax, keys[ax], source)
         n_distinct = np.unique(pos).size
         need = 3 if model == "quadratic" else 2
         if n_distinct < need:
