@@ -354,7 +354,7 @@ def check_coordinates(values, lines, source, columns=None, limit=MAX_COORDINATE,
     MeasurementFileError
         ``file:line[:column]``, the value and the limit.
     """
-    bad = ~(np.abs(values) <= limit)
+    bad = ~(np.isfinite(values) & (np.abs(values) <= limit))
     if not bad.any():
         return
     k, c = (int(x) for x in np.argwhere(bad)[0])
