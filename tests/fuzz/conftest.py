@@ -1,0 +1,41 @@
+"""Fixtures of the bad-input cases. FreeCAD is imported only by the tests that need it
+(the property-based tests of the readers stay pure)."""
+
+import hashlib
+
+import pytest
+
+from .harness import EXAMPLE_STEP, sha256
+
+_SHAPES = {}
+
+
+@pytest.fixture
+def cad_cache(monkeypatch):
+    """Read the unchanged example nominal through the CAD child process once per session.
+
+    Every other nominal (damaged STEP files, documents) is read as the product reads it;
+    the example's shape is the same for the same bytes, so the cases about measurements,
+    options and outputs need not start a child each (about 0.5 s apiece)."""
+    from surfcomp.app import fcenv
+
+    fcenv.import_freecad()
+    from surfcomp.app import nominal
+
+    real = nominal.read_cad
+    example = sha256(EXAMPLE_STEP)
+
+    def read_cad(path, label="NOMINAL"):
+        try:
+            with open(path, "rb") as fh:
+                key = hashlib.sha256(fh.read()).hexdigest()
+        except OSError:
+            key = None
+        if key != example:
+            return real(path, label)
+        if key not in _SHAPES:
+            _SHAPES[key] = real(path, label)
+        return _SHAPES[key].copy()
+
+    monkeypatch.setattr(nominal, "read_cad", read_cad)
+    return read_cad
