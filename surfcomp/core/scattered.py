@@ -5,18 +5,17 @@ modules by job and re-exported here:
 
 :mod:`surfcomp.core.scattered_fit`
     :func:`smooth` (:class:`SmoothFit`): the smoothing fit that splits deviations into a
-    determined and a random component (thin-plate smoothing spline, P-spline, GCV,
-    leave-one-out residuals).
+    determined and a random component (thin-plate smoothing spline, P-spline
+    (:mod:`surfcomp.core.pspline`), GCV, leave-one-out residuals).
 :mod:`surfcomp.core.scattered_field`
     :class:`ScatteredField`: the Clough-Tocher C1 field through the corrections.
 """
 
+from .pspline import LOO_SAMPLE, PSPLINE_MAX_COEFFS
 from .scattered_field import FRAME_MARGIN, GHOST_NEIGHBOURS, GRADIENT_RTOL, ScatteredField
 from .scattered_fit import (
     EXACT_MAX,
     LOG_ELL_RANGE,
-    LOO_SAMPLE,
-    PSPLINE_MAX_COEFFS,
     SmoothFit,
     loo_residuals,
     smooth,

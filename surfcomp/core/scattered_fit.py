@@ -27,10 +27,12 @@ The scattered counterpart of the grid path's mask filter
     nothing extra per smoothing value. Above it, the same functional is minimised
     over a cubic tensor-product B-spline space on a uniform knot grid ("P-spline"
     with the exact thin-plate energy of the spline as penalty, at most
-    :data:`PSPLINE_MAX_COEFFS` coefficients), again by one generalised
-    eigen-decomposition (Demmler-Reinsch); its leave-one-out residuals
-    ``e_k = r_k / (1 - H_kk)`` are exact, evaluated at a seeded random subsample
-    of :data:`LOO_SAMPLE` points.
+    :data:`~surfcomp.core.pspline.PSPLINE_MAX_COEFFS` coefficients; normal equations
+    from per-cell moments, time and memory linear in N), again by one generalised
+    eigen-decomposition (Demmler-Reinsch) on the coefficient grid; its leave-one-out
+    residuals ``e_k = r_k / (1 - H_kk)`` are exact, evaluated at a seeded random
+    subsample of :data:`~surfcomp.core.pspline.LOO_SAMPLE` points
+    (:mod:`surfcomp.core.pspline`).
 
     Default smoothing (``smoothing=None``): the ``ell`` minimising the GCV score
     ``N RSS / tr(I - H)^2``.
@@ -39,22 +41,16 @@ The scattered counterpart of the grid path's mask filter
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg as sla
-from scipy import sparse
 from scipy.optimize import minimize_scalar
 from scipy.spatial.distance import cdist
 
 from ..errors import InputError
-from . import bspline
 from .progress import report
+from .pspline import PSplineSolver
 from .uvpoints import check_duplicates, check_spread, scaled_points
 
 #: largest number of points fitted with the exact thin-plate smoothing spline
 EXACT_MAX = 1000
-#: largest number of tensor B-spline coefficients of the large-N smoothing fit
-PSPLINE_MAX_COEFFS = 1100
-#: leave-one-out residuals of the large-N fit are evaluated at this many points
-LOO_SAMPLE = 20000
 #: the GCV search spans ell = diameter * 10**[LOG_ELL_RANGE]
 LOG_ELL_RANGE = (-3.0, 2.0)
 
@@ -165,95 +161,6 @@ class _TPSSolver:
         return resid, loo, dof
 
 
-def _gauss_gram(knots, degree, n_poles, order):
-    """Gram matrices ``int B_i^(r) B_j^(r)`` for r = 0..order over the knot domain
-    (Gauss-Legendre, exact for the piecewise polynomials)."""
-    xg, wg = np.polynomial.legendre.leggauss(degree + 1)
-    brk = np.unique(knots[degree:n_poles + 1])
-    a, b = brk[:-1, None], brk[1:, None]
-    t = ((a + b) / 2 + (b - a) / 2 * xg).ravel()
-    w = ((b - a) / 2 * wg).ravel()
-    out = []
-    for r in range(order + 1):
-        B = bspline.basis_matrix(knots, degree, n_poles, t, deriv=r).toarray()
-        out.append(B.T @ (B * w[:, None]))
-    return out
-
-
-def _tensor_rows(ku, kv, nu, nv, x):
-    """Sparse tensor-product cubic basis rows at points x (N, 2)."""
-    bu, su = bspline.basis_functions(ku, 3, x[:, 0])
-    bv, sv = bspline.basis_functions(kv, 3, x[:, 1])
-    n = x.shape[0]
-    iu = su[:, None] - 3 + np.arange(4)
-    iv = sv[:, None] - 3 + np.arange(4)
-    cols = (iu[:, :, None] * nv + iv[:, None, :]).reshape(n, 16)
-    vals = (bu[0][:, :, None] * bv[0][:, None, :]).reshape(n, 16)
-    return sparse.csr_matrix((vals.ravel(), cols.ravel(), np.arange(0, 16 * n + 1, 16)),
-                             shape=(n, nu * nv))
-
-
-class _PSplineSolver:
-    """Penalised cubic tensor B-spline fit, decomposed once (Demmler-Reinsch).
-
-    ``min ||d - B c||^2 + rho c^T J c`` with J the exact thin-plate energy of the
-    spline over its knot box. With ``M = G + tau J`` (G = B^T B, tau tiny, M positive
-    definite) and the generalised eigenproblem ``J V = M V diag(s)``, ``V^T M V = I``:
-    ``c = V diag(1 / (1 + (rho - tau) s)) V^T B^T d``.
-    """
-
-    def __init__(self, x, d, lo, hi):
-        n = x.shape[0]
-        ext = hi - lo
-        # spans per direction: about N/4 coefficients, at most PSPLINE_MAX_COEFFS, aspect kept
-        total = min(PSPLINE_MAX_COEFFS, max(16, n // 4))
-        ratio = ext[0] / ext[1]
-        nsu = int(np.clip(np.sqrt(total * ratio) - 3, 2, 200))
-        nsv = int(np.clip(total / (nsu + 3) - 3, 2, 200))
-        self.ku = np.r_[[lo[0]] * 3, np.linspace(lo[0], hi[0], nsu + 1), [hi[0]] * 3]
-        self.kv = np.r_[[lo[1]] * 3, np.linspace(lo[1], hi[1], nsv + 1), [hi[1]] * 3]
-        self.nu, self.nv = nsu + 3, nsv + 3
-        B = _tensor_rows(self.ku, self.kv, self.nu, self.nv, x)
-        G = (B.T @ B).toarray()
-        h = B.T @ d
-        S0u, S1u, S2u = _gauss_gram(self.ku, 3, self.nu, 2)
-        S0v, S1v, S2v = _gauss_gram(self.kv, 3, self.nv, 2)
-        J = np.kron(S2u, S0v) + 2 * np.kron(S1u, S1v) + np.kron(S0u, S2v)
-        self.tau = 1e-9 * np.trace(G) / np.trace(J)
-        s, V = sla.eigh(J, G + self.tau * J)
-        self.s = np.maximum(s, 0.0)
-        self.V = V
-        self.y = V.T @ h
-        self.dd = float(d @ d)
-        self.B, self.d, self.n, self._J = B, d, n, J
-
-    def _f(self, rho):
-        return 1.0 / (1.0 + (rho - self.tau) * self.s)
-
-    def gcv(self, rho):
-        f = self._f(rho)
-        y2 = self.y ** 2
-        rss = max(self.dd - 2 * np.sum(y2 * f) + np.sum(y2 * (1 - self.tau * self.s) * f * f), 0.0)
-        tr = self.n - np.sum((1 - self.tau * self.s) * f)
-        return self.n * rss / tr ** 2
-
-    def solve(self, rho, rng_seed=0):
-        f = self._f(rho)
-        c = self.V @ (f * self.y)
-        resid = self.d - self.B @ c
-        dof = float(np.sum((1 - self.tau * self.s) * f))
-        if self.n > LOO_SAMPLE:
-            idx = np.sort(np.random.default_rng(rng_seed).choice(self.n, LOO_SAMPLE, replace=False))
-        else:
-            idx = np.arange(self.n)
-        Hkk = np.empty(idx.size)
-        for a in range(0, idx.size, 4096):
-            rows = self.B[idx[a:a + 4096]] @ self.V
-            Hkk[a:a + 4096] = (rows ** 2) @ f
-        loo = resid[idx] / np.maximum(1.0 - Hkk, 1e-12)
-        return resid, loo, dof
-
-
 def smooth(u, v, d, smoothing=None, scale=(1.0, 1.0), method="auto", progress=None):
     """Split scattered deviations into a smooth determined part and a random part.
 
@@ -306,7 +213,7 @@ def smooth(u, v, d, smoothing=None, scale=(1.0, 1.0), method="auto", progress=No
         solver = _TPSSolver(x - lo, d)
         to_par = 8 * np.pi * n / area / (2 * np.pi) ** 4   # s = to_par * ell^4
     else:
-        solver = _PSplineSolver(x, d, lo, hi)
+        solver = PSplineSolver(x, d, lo, hi)
         to_par = n / area / (2 * np.pi) ** 4               # rho = to_par * ell^4
     report(progress, 0.6, "choosing the smoothing")
     if smoothing is None:

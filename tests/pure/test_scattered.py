@@ -16,7 +16,7 @@ from examples.make_example import example_surface
 from surfcomp.core import bspline, corrected
 from surfcomp.core import scattered as sc
 from surfcomp.core import scattered_field as scf
-from surfcomp.core import scattered_fit as sfit
+from surfcomp.core.pspline import PSplineSolver, tensor_rows
 from surfcomp.core.scattered import ScatteredField, smooth
 from surfcomp.errors import InputError
 
@@ -71,15 +71,15 @@ def test_pspline_loo_equals_brute_force_refits():
     rng = np.random.default_rng(1)
     x = rng.random((150, 2)) * [30.0, 10.0]
     d = 0.01 * np.sin(x[:, 0] / 5) * np.cos(x[:, 1] / 4) + rng.normal(0, 0.002, 150)
-    solver = sfit._PSplineSolver(x, d, x.min(axis=0), x.max(axis=0))
+    solver = PSplineSolver(x, d, x.min(axis=0), x.max(axis=0))
     rho = 0.3
     resid, loo, _ = solver.solve(rho)
-    B = solver.B.toarray()
+    B = tensor_rows(solver.ku, solver.kv, solver.nu, solver.nv, x).toarray()
     for k in range(0, 150, 7):
         keep = np.arange(150) != k
-        c = np.linalg.solve(B[keep].T @ B[keep] + rho * solver._J, B[keep].T @ d[keep])
+        c = np.linalg.solve(B[keep].T @ B[keep] + rho * solver.J, B[keep].T @ d[keep])
         assert_allclose(loo[k], d[k] - B[k] @ c, atol=1e-12)
-    c = np.linalg.solve(B.T @ B + rho * solver._J, B.T @ d)
+    c = np.linalg.solve(B.T @ B + rho * solver.J, B.T @ d)
     assert_allclose(resid, d - B @ c, atol=1e-12)
 
 
