@@ -141,12 +141,16 @@ def _ders_chunk(surf, Pw, u, v, order):
     Nv, sv = basis_functions(surf.knots_v, pv, v, order)
     iu = su[:, None] - pu + np.arange(pu + 1)
     iv = sv[:, None] - pv + np.arange(pv + 1)
-    n, k_u, k_v = u.size, pu + 1, pv + 1
-    G = Pw[iu[:, :, None], iv[:, None, :]].reshape(n, k_u * k_v, -1)  # (n, (pu+1)(pv+1), dim)
-    # one contraction per derivative with the outer product of the two bases (faster
-    # than two chained einsums over these short axes)
-    A = {(k, kv): np.einsum("nk,nkc->nc",
-                            (Nu[k][:, :, None] * Nv[kv][:, None, :]).reshape(n, -1), G)
+    n = u.size
+    nv, dim = Pw.shape[1], Pw.shape[2]
+    # the (pu+1)(pv+1) poles of every point, gathered by flat index (several times faster
+    # than indexing the (nu, nv) net with two index arrays)
+    flat = (iu[:, :, None] * nv + iv[:, None, :]).reshape(n, -1)
+    G = np.take(Pw.reshape(-1, dim), flat, axis=0)             # (n, (pu+1)(pv+1), dim)
+    # one contraction per derivative with the outer product of the two bases, as a
+    # stack of (1 x k) (k x dim) products
+    A = {(k, kv): np.matmul((Nu[k][:, :, None] * Nv[kv][:, None, :]).reshape(n, 1, -1),
+                            G)[:, 0, :]
          for (k, kv) in _ORDER_KEYS[order]}
     if surf.weights is None:
         return {key: val[:, :3] for key, val in A.items()}
