@@ -11,14 +11,10 @@ another part of the face comes close) all parts of the face within reach, seed
 further Newton runs; the best result wins. Everything is vectorised over points,
 chunked and run in threads.
 
-Evaluation inside the Newton loop uses a per-span power-basis table of the
-surface (Taylor coefficients of each polynomial piece, from the basis
-functions' derivatives at the span starts) evaluated by Horner's scheme on
-structure-of-arrays data; it is tested against :func:`bspline.derivatives`.
+Evaluation and the Newton iterations are in :mod:`surfcomp.core.projection_newton`.
 """
 
 import itertools
-import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -29,12 +25,8 @@ from scipy.spatial import cKDTree
 from ..errors import GeometryError, InputError
 from . import bspline
 from .progress import report
+from .projection_newton import GenericEval, Newton, SpanTable, dot
 
-#: Newton stops when a full (second-order) step moves the foot point less than
-#: this (mm): the error left after applying it is O(step^2 / R) ~ 1e-13 mm
-STEP_TOL = 1e-6
-#: the same for other steps and near curvature centres (linear convergence)
-STEP_TOL_SLOW = 1e-10
 #: Newton iterations per point in the first, chunked pass (the rest is batched)
 FIRST_PASS_ITER = 8
 #: points per vectorised Newton chunk (keeps temporaries in cache)
@@ -83,308 +75,6 @@ class Projection:
         return self.u.shape[0]
 
 
-# --------------------------------------------------------------------------- power-basis table
-
-class _SpanTable:
-    """Taylor coefficients of every polynomial piece of the (homogeneous) surface.
-
-    For the span pair (i, j) with local coordinates ``s = (u - a_i) / h_i``,
-    ``t = (v - b_j) / k_j`` in [0, 1]: ``A(s, t) = sum_ab C[i, j, a, b] s^a t^b``
-    with ``C = h^a k^b / (a! b!) d^a/du^a d^b/dv^b A(a_i, b_j)``.
-    """
-
-    def __init__(self, surf):
-        self.surf = surf
-        pu, pv = surf.degree_u, surf.degree_v
-        nu, nv = surf.shape
-        self.pu, self.pv = pu, pv
-        self.rational = surf.weights is not None
-        Pw = bspline._homogeneous(surf) if self.rational else surf.poles
-        self.dim = dim = Pw.shape[2]
-        self.bu = self._breaks(surf.knots_u, pu, nu)
-        self.bv = self._breaks(surf.knots_v, pv, nv)
-        self.hu, self.hv = np.diff(self.bu), np.diff(self.bv)
-        Ku, Kv = self.hu.size, self.hv.size
-        flat = np.ascontiguousarray(Pw.transpose(1, 0, 2)).reshape(nv, nu * dim)
-        # coefficient table laid out (Ku, Kv, b, a, c)
-        C = np.empty((Ku, Kv, pv + 1, pu + 1, dim))
-        for b in range(pv + 1):
-            Bv = bspline.basis_matrix(surf.knots_v, pv, nv, self.bv[:-1], b)
-            Tv = (Bv @ flat).reshape(Kv, nu, dim).transpose(1, 0, 2).reshape(nu, Kv * dim)
-            fv = (self.hv ** b / math.factorial(b))[None, :, None]
-            for a in range(pu + 1):
-                Bu = bspline.basis_matrix(surf.knots_u, pu, nu, self.bu[:-1], a)
-                fu = (self.hu ** a / math.factorial(a))[:, None, None]
-                C[:, :, b, a, :] = (Bu @ Tv).reshape(Ku, Kv, dim) * fu * fv
-        self.Kv = Kv
-        self.row = (pv + 1) * (pu + 1) * dim
-        # transposed: one column per span pair, gathered with table[:, keys]
-        self._table = np.ascontiguousarray(C.reshape(Ku * Kv, self.row).T)
-
-    @staticmethod
-    def _breaks(knots, p, n):
-        lo, hi = knots[p], knots[n]
-        k = np.unique(knots[(knots >= lo) & (knots <= hi)])
-        return k
-
-    @staticmethod
-    def size(surf):
-        Ku = np.unique(surf.knots_u).size
-        Kv = np.unique(surf.knots_v).size
-        dim = 4 if surf.weights is not None else 3
-        return Ku * Kv * (surf.degree_u + 1) * (surf.degree_v + 1) * dim
-
-    def locate(self, u, v):
-        iu = np.clip(np.searchsorted(self.bu, u, side="right") - 1, 0, self.hu.size - 1)
-        iv = np.clip(np.searchsorted(self.bv, v, side="right") - 1, 0, self.hv.size - 1)
-        hu, hv = self.hu[iu], self.hv[iv]
-        return iu * self.Kv + iv, (u - self.bu[iu]) / hu, (v - self.bv[iv]) / hv, hu, hv
-
-    def evaluate(self, u, v, order):
-        """SoA derivatives: list of (3, n) arrays in bspline._ORDER_KEYS[order] order."""
-        key, s, t, hu, hv = self.locate(u, v)
-        n = u.size
-        pu, pv, dim = self.pu, self.pv, self.dim
-        G = self._table[:, key].reshape(pv + 1, (pu + 1) * dim, n)
-        W = _horner(G, t, order)  # W[kv]: d^kv/dt^kv, (A*C, n)
-        keys = bspline._ORDER_KEYS[order]
-        A = {}
-        inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
-        for kv in range(order + 1):
-            Ws = W[kv].reshape(pu + 1, dim, n)
-            D = _horner(Ws, s, order - kv)
-            for k in range(order - kv + 1):
-                if (k, kv) in keys:
-                    val = D[k]
-                    if k:
-                        val = val * inv_hu ** k
-                    if kv:
-                        val = val * inv_hv ** kv
-                    A[(k, kv)] = val
-        if not self.rational:
-            return [A[key_] for key_ in keys]
-        return _quotient_soa(A, order)
-
-
-def _horner(G, x, order):
-    """Value and derivatives up to ``order`` (<= 2) of ``sum_b G[b] x^b`` (leading axis b).
-
-    ``G`` has shape (deg + 1, m, n), ``x`` shape (n,); returns a list of (m, n)
-    arrays: the value, first and second derivative w.r.t. x.
-    """
-    deg = G.shape[0] - 1
-    p = G[deg].copy()
-    d1 = np.zeros_like(p) if order >= 1 else None
-    d2 = np.zeros_like(p) if order >= 2 else None
-    for b in range(deg - 1, -1, -1):
-        if d2 is not None:
-            d2 *= x
-            d2 += d1
-        if d1 is not None:
-            d1 *= x
-            d1 += p
-        p *= x
-        p += G[b]
-    out = [p]
-    if order >= 1:
-        out.append(d1)
-    if order >= 2:
-        out.append(2.0 * d2)
-    return out
-
-
-def _quotient_soa(A, order):
-    """Rational quotient rule (NURBS book eq. 4.20) on (4, n) homogeneous arrays."""
-    w = A[(0, 0)][3]
-    S = A[(0, 0)][:3] / w
-    out = [S]
-    if order >= 1:
-        wu, wv = A[(1, 0)][3], A[(0, 1)][3]
-        Su = (A[(1, 0)][:3] - wu * S) / w
-        Sv = (A[(0, 1)][:3] - wv * S) / w
-        out += [Su, Sv]
-    if order >= 2:
-        out.append((A[(2, 0)][:3] - 2.0 * wu * Su - A[(2, 0)][3] * S) / w)
-        out.append((A[(1, 1)][:3] - wu * Sv - wv * Su - A[(1, 1)][3] * S) / w)
-        out.append((A[(0, 2)][:3] - 2.0 * wv * Sv - A[(0, 2)][3] * S) / w)
-    return out
-
-
-class _GenericEval:
-    """Fallback evaluator for surfaces too large for a span table."""
-
-    def __init__(self, surf):
-        self.surf = surf
-
-    def evaluate(self, u, v, order):
-        return [d.T.copy() for d in bspline.derivatives(self.surf, u, v, order)]
-
-
-# --------------------------------------------------------------------------- Newton machinery
-
-def _dot(a, b):
-    """Row-wise dot product of SoA arrays (3, n) -> (n,)."""
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-class _Newton:
-    """Safeguarded, bound-constrained Newton iterations for many points at once.
-
-    Minimises ``f(u, v) = |S(u, v) - P|^2 / 2`` over the work area: full
-    Newton steps where the Hessian of f is positive definite, shifted-Hessian
-    (or Gauss-Newton) steps elsewhere, variables at a bound with the gradient
-    pointing outwards
-    held fixed (projected Newton), steps limited to half the work area, and
-    halved back towards the last accepted point when f grew.
-    """
-
-    def __init__(self, evaluator, u_range, v_range, maxiter=60, max_halvings=40):
-        self.ev = evaluator
-        self.u0, self.u1 = u_range
-        self.v0, self.v1 = v_range
-        self.maxiter = maxiter
-        self.max_halvings = max_halvings
-
-    def step(self, u, v, r, Su, Sv, Suu, Suv, Svv):
-        """Projected Newton step (du, dv) and whether it was a fast (Newton) one."""
-        gu, gv = _dot(r, Su), _dot(r, Sv)
-        a, b, c = _dot(Su, Su), _dot(Su, Sv), _dot(Sv, Sv)
-        Huu, Huv, Hvv = a + _dot(r, Suu), b + _dot(r, Suv), c + _dot(r, Svv)
-        det = Huu * Hvv - Huv * Huv
-        gn_det = a * c - b * b
-        pd = (Huu > 0) & (Hvv > 0) & (det > 1e-10 * gn_det)
-        fix_u = ((u <= self.u0) & (gu > 0)) | ((u >= self.u1) & (gu < 0))
-        fix_v = ((v <= self.v0) & (gv > 0)) | ((v >= self.v1) & (gv < 0))
-        # where the Hessian is not positive definite: the Hessian shifted by
-        # sigma I (sigma = 1.5 |lambda_min|, so its smallest eigenvalue becomes
-        # |lambda_min| / 2, plus a little Gauss-Newton scale); with one variable
-        # held at a bound only its own curvature matters (else Gauss-Newton)
-        mu = 1e-9 * (a + c)
-        h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
-        h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
-        if pd.all():
-            H_uu, H_uv, H_vv, det2 = Huu, Huv, Hvv, det
-        else:
-            lam_min = 0.5 * (Huu + Hvv) - np.sqrt(0.25 * (Huu - Hvv) ** 2 + Huv * Huv)
-            sigma = np.where(pd, 0.0, 1.5 * np.abs(np.minimum(lam_min, 0.0)) + 1e-3 * (a + c))
-            H_uu, H_uv, H_vv = Huu + sigma, Huv, Hvv + sigma
-            det2 = H_uu * H_vv - H_uv * H_uv
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            du = np.where(fix_v, -gu / h_u, (H_uv * gv - H_vv * gu) / det2)
-            dv = np.where(fix_u, -gv / h_v, (H_uv * gu - H_uu * gv) / det2)
-        du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
-        dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
-        # trust region: at most half the work area per step
-        lim = np.maximum(np.abs(du) * (2.0 / (self.u1 - self.u0)),
-                         np.abs(dv) * (2.0 / (self.v1 - self.v0)))
-        scale = 1.0 / np.maximum(lim, 1.0)
-        un = np.minimum(np.maximum(u + du * scale, self.u0), self.u1)
-        vn = np.minimum(np.maximum(v + dv * scale, self.v0), self.v1)
-        # fast = a true Newton step away from a curvature centre (quadratic convergence)
-        fast = np.where(fix_u | fix_v,
-                        np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a),
-                        pd & (det > 0.5 * gn_det))
-        return un - u, vn - v, fast
-
-    def run(self, P, u, v, seed_derivs=None, maxiter=None):
-        """Iterate all points from (u, v).
-
-        Parameters
-        ----------
-        P : ndarray, shape (3, n)
-        u, v : ndarray, shape (n,)
-        seed_derivs : list of 6 (3, n) arrays, optional
-            S, Su, Sv, Suu, Suv, Svv at (u, v) when already known (samples).
-        maxiter : int, optional
-
-        Returns
-        -------
-        u, v : ndarray, shape (n,)
-        D : list of 6 (3, n) arrays
-            Derivatives at the result (S, Su, Sv by Taylor expansion over the
-            last small step).
-        converged : ndarray of bool
-        """
-        n = u.size
-        U, V = np.empty(n), np.empty(n)
-        OUT = [np.empty((3, n)) for _ in range(6)]
-        CONV = np.zeros(n, dtype=bool)
-        idx = np.arange(n)
-        Pa, ua, va = P, u.copy(), v.copy()
-        uprev, vprev = ua.copy(), va.copy()
-        fprev = np.full(n, np.inf)
-        dul, dvl = np.zeros(n), np.zeros(n)
-        halv = np.zeros(n)
-        mvl = np.full(n, np.inf)
-        best = None
-        for it in range((maxiter or self.maxiter) + 1):
-            if idx.size == 0:
-                break
-            if it == 0 and seed_derivs is not None:
-                D = seed_derivs
-            else:
-                D = self.ev.evaluate(ua, va, 2)
-            r = D[0] - Pa
-            f = _dot(r, r)
-            worse = f > fprev * (1.0 + 1e-12) + 1e-24
-            acc = ~worse
-            anyworse = bool(worse.any())
-            if anyworse:  # rejected points keep their last accepted values
-                D = [np.where(worse, b_, d_) for b_, d_ in zip(best, D)]
-                r = D[0] - Pa
-                f = np.where(worse, fprev, f)
-                uprev = np.where(acc, ua, uprev)
-                vprev = np.where(acc, va, vprev)
-            else:
-                uprev, vprev = ua, va
-            best, fprev = D, f
-            du, dv, fast = self.step(uprev, vprev, r, *D[1:])
-            mv = D[1] * du + D[2] * dv
-            mvn = np.sqrt(_dot(mv, mv))
-            done = acc & (mvn <= np.where(fast, STEP_TOL, STEP_TOL_SLOW))
-            mvl = np.where(acc, mvn, mvl)
-            if anyworse:
-                # no decrease possible: the last accepted point is the answer; a
-                # minimum when the failed step was already at rounding level
-                gave = worse & ((halv >= self.max_halvings) | (mvl <= STEP_TOL_SLOW))
-                dul = np.where(acc, du, 0.5 * dul)
-                dvl = np.where(acc, dv, 0.5 * dvl)
-                halv = np.where(acc, 0.0, halv + 1.0)
-            else:
-                gave = None
-                dul, dvl = du, dv
-                halv = np.zeros_like(halv) if it == 0 else halv * 0.0
-            ua = uprev + dul
-            va = vprev + dvl
-            finished = done if gave is None else (done | gave)
-            if finished.any():
-                fin = np.flatnonzero(finished)
-                gi = idx[fin]
-                dn = done[fin]
-                dud, dvd = np.where(dn, du[fin], 0.0), np.where(dn, dv[fin], 0.0)
-                S, Su, Sv, Suu, Suv, Svv = [d_[:, fin] for d_ in D]
-                # Taylor expansion over the last small step (no re-evaluation)
-                OUT[0][:, gi] = S + Su * dud + Sv * dvd + 0.5 * (Suu * dud * dud
-                                                                 + 2.0 * Suv * dud * dvd
-                                                                 + Svv * dvd * dvd)
-                OUT[1][:, gi] = Su + Suu * dud + Suv * dvd
-                OUT[2][:, gi] = Sv + Suv * dud + Svv * dvd
-                OUT[3][:, gi], OUT[4][:, gi], OUT[5][:, gi] = Suu, Suv, Svv
-                U[gi] = uprev[fin] + dud
-                V[gi] = vprev[fin] + dvd
-                CONV[gi] = dn | (mvl[fin] <= 1e-8)
-                keep = ~finished
-                idx, Pa, ua, va = idx[keep], Pa[:, keep], ua[keep], va[keep]
-                uprev, vprev, fprev = uprev[keep], vprev[keep], fprev[keep]
-                dul, dvl, halv, mvl = dul[keep], dvl[keep], halv[keep], mvl[keep]
-                best = [b_[:, keep] for b_ in best]
-        if idx.size:  # iteration limit: keep the last accepted point, not converged
-            U[idx], V[idx] = uprev, vprev
-            for o_, b_ in zip(OUT, best):
-                o_[:, idx] = b_
-        return U, V, OUT, CONV
-
-
 # --------------------------------------------------------------------------- projector
 
 def _sample_params(breaks, per_span, lo, hi):
@@ -399,11 +89,11 @@ def _max_curvature(D):
     """Largest principal curvature magnitude (1/mm) at SoA derivative samples; NaN if degenerate."""
     S, Su, Sv, Suu, Suv, Svv = D
     n = np.cross(Su.T, Sv.T).T
-    nn = np.sqrt(_dot(n, n))
+    nn = np.sqrt(dot(n, n))
     with np.errstate(divide="ignore", invalid="ignore"):
         n = n / nn
-        E, F, G = _dot(Su, Su), _dot(Su, Sv), _dot(Sv, Sv)
-        L, M, N = _dot(n, Suu), _dot(n, Suv), _dot(n, Svv)
+        E, F, G = dot(Su, Su), dot(Su, Sv), dot(Sv, Sv)
+        L, M, N = dot(n, Suu), dot(n, Suv), dot(n, Svv)
         den = E * G - F * F
         K = (L * N - M * M) / den
         H = (E * N - 2.0 * F * M + G * L) / (2.0 * den)
@@ -430,13 +120,13 @@ class Projector:
     def __init__(self, surf, samples_per_span=None, workers=None):
         self.surf = surf
         self.workers = max(1, int(workers or os.cpu_count() or 1))
-        if _SpanTable.size(surf) <= MAX_TABLE_VALUES:
-            self.ev = _SpanTable(surf)
+        if SpanTable.size(surf) <= MAX_TABLE_VALUES:
+            self.ev = SpanTable(surf)
             bu, bv = self.ev.bu, self.ev.bv
         else:
-            self.ev = _GenericEval(surf)
-            bu = _SpanTable._breaks(surf.knots_u, surf.degree_u, surf.shape[0])
-            bv = _SpanTable._breaks(surf.knots_v, surf.degree_v, surf.shape[1])
+            self.ev = GenericEval(surf)
+            bu = SpanTable._breaks(surf.knots_u, surf.degree_u, surf.shape[0])
+            bv = SpanTable._breaks(surf.knots_v, surf.degree_v, surf.shape[1])
         (u0, u1), (v0, v1) = surf.u_range, surf.v_range
         bu = np.unique(np.r_[u0, bu[(bu > u0) & (bu < u1)], u1])
         bv = np.unique(np.r_[v0, bv[(bv > v0) & (bv < v1)], v1])
@@ -469,7 +159,7 @@ class Projector:
         self.safe_distance = 0.5 / kmax.max() if kmax.size and kmax.max() > 0 else np.inf
         self.tree_ids = np.flatnonzero(regular)  # tree index -> sample index
         self.tree = cKDTree(grid.reshape(-1, 3)[self.tree_ids])
-        self.newton = _Newton(self.ev, surf.u_range, surf.v_range)
+        self.newton = Newton(self.ev, surf.u_range, surf.v_range)
 
     def _sample_grid(self, bu, bv, mu, mv):
         """Sample parameters equally spaced in arc length (roughly square cells in mm).
@@ -577,7 +267,7 @@ class Projector:
         # a local minimum closer than the reach of the face is the global one;
         # the others get checked with more seeds
         r = D[0] - P.T
-        check = np.flatnonzero(~(_dot(r, r) < self.safe_distance ** 2))
+        check = np.flatnonzero(~(dot(r, r) < self.safe_distance ** 2))
         if check.size:
             sus, owner, seeds = self._suspicious(P[check], u[check], v[check],
                                                  [d[:, check] for d in D])
@@ -604,8 +294,8 @@ class Projector:
         """Indices of points whose local minimum may not be the global one."""
         S, Su, Sv, Suu, Suv, Svv = D
         r = S - P.T
-        a, b, c = _dot(Su, Su), _dot(Su, Sv), _dot(Sv, Sv)
-        Huu, Huv, Hvv = a + _dot(r, Suu), b + _dot(r, Suv), c + _dot(r, Svv)
+        a, b, c = dot(Su, Su), dot(Su, Sv), dot(Sv, Sv)
+        Huu, Huv, Hvv = a + dot(r, Suu), b + dot(r, Suv), c + dot(r, Svv)
         # near a curvature centre the distance Hessian degenerates
         flat = (Huu * Hvv - Huv * Huv) < 0.5 * (a * c - b * b)
         # a sample close enough to hold a better minimum (|X - P| < d + eps) that is
@@ -623,7 +313,7 @@ class Projector:
                                   + c[:, None] * dv_ * dv_, 0.0))
         X = self.samples[0][:, nb]  # (3, n, k)
         xf = np.sqrt(np.sum((X - S[:, :, None]) ** 2, axis=0))
-        d = np.sqrt(_dot(r, r))[:, None]
+        d = np.sqrt(dot(r, r))[:, None]
         reach = dist < d + self.eps
         far = path > 3.0 * xf + 2.0 * self.eps
         sus = np.flatnonzero(flat | np.any(reach & far, axis=1))
@@ -656,7 +346,7 @@ class Projector:
         u2, v2, D2, conv2 = self._newton_from_samples(P[owner], seeds)
         ro = D[0][:, owner] - P[owner].T
         rn = D2[0] - P[owner].T
-        f_old, f_new = _dot(ro, ro), _dot(rn, rn)
+        f_old, f_new = dot(ro, ro), dot(rn, rn)
         order = np.argsort(f_new, kind="stable")  # best candidate per point first
         first = order[np.unique(owner[order], return_index=True)[1]]
         better = first[f_new[first] < f_old[first] * (1 - 1e-12) - 1e-24]
@@ -675,7 +365,7 @@ class Projector:
         Sp = sd[0] + sd[1] * du + sd[2] * dv + 0.5 * (sd[3] * du * du + 2.0 * sd[4] * du * dv
                                                        + sd[5] * dv * dv)
         rp = Sp - Pk
-        return su + du, sv + dv, np.sqrt(_dot(rp, rp))
+        return su + du, sv + dv, np.sqrt(dot(rp, rp))
 
     def _reseed(self, P, sus, u, v, D, conv, max_seeds=12, per_point=400, chunk=256):
         """Newton from all parts of the face within reach of a better minimum; keep the best.
@@ -689,7 +379,7 @@ class Projector:
         for start in range(0, sus.size, chunk):
             pts = sus[start:start + chunk]
             r = D[0][:, pts] - P[pts].T
-            d = np.sqrt(_dot(r, r))
+            d = np.sqrt(dot(r, r))
             balls = self.tree.query_ball_point(P[pts], d + self.eps, workers=1)
             lens = np.fromiter((len(b) for b in balls), dtype=np.intp, count=len(balls))
             if lens.sum() == 0:
