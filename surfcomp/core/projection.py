@@ -1,21 +1,27 @@
 """Orthogonal projection of points onto a B-spline face (no FreeCAD).
 
 Method: a dense sample grid of the face (:func:`bspline.evaluate_grid` with
-second derivatives) in a ``scipy.spatial.cKDTree`` gives seeds; safeguarded
-Newton iterations on ``(S - P) . Su = 0``, ``(S - P) . Sv = 0`` (second-order
-Hessian, shifted to positive definite where it is not, step halving, bound
-constraints on the work area) refine them. Points farther from the face than
-half its smallest radius of curvature are checked: samples within reach whose
-one-step prediction lands elsewhere, and (near curvature centres or where
-another part of the face comes close) all parts of the face within reach, seed
-further Newton runs; the best result wins. Everything is vectorised over points,
-chunked and run in threads.
+second derivatives) in a ``scipy.spatial.cKDTree`` gives seeds (one query per
+voxel of points); two plain Newton steps on ``(S - P) . Su = 0``,
+``(S - P) . Sv = 0`` from each seed's stored derivatives finish almost every
+point, the rest run safeguarded Newton iterations (second-order Hessian, shifted to
+positive definite where it is not, step halving, bound constraints on the work
+area). A local minimum is the global one when it is closer than half the face's
+smallest radius of curvature, or when the region certificate of its part of the
+face covers it (:mod:`surfcomp.core.projection_regions`: curvature towards the
+point and clearance to other parts of the face, per tile of the sample grid,
+decided once per face). Only the other points are checked one by one: samples
+within reach whose one-step prediction lands elsewhere, and (near curvature
+centres or where another part of the face comes close) all parts of the face
+within reach, seed further Newton runs; the best result wins. Everything is
+vectorised over points, chunked and run in threads.
 
 Evaluation and the Newton iterations are in :mod:`surfcomp.core.projection_newton`.
 """
 
 import itertools
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -26,15 +32,17 @@ from ..errors import GeometryError, InputError
 from . import bspline
 from .progress import report
 from .projection_newton import GenericEval, Newton, SpanTable, dot
+from .projection_regions import Regions, principal_curvatures
 
-#: Newton iterations per point in the first, chunked pass (the rest is batched)
-FIRST_PASS_ITER = 8
 #: points per vectorised Newton chunk (keeps temporaries in cache)
-CHUNK = 8192
+CHUNK = 16384
 #: upper bound on the number of seed samples
 MAX_SAMPLES = 250_000
 #: the power-basis table is used when it has at most this many values
 MAX_TABLE_VALUES = 20_000_000
+#: feet up to this far from the face (mm) are certified per region of the face
+#: (:mod:`surfcomp.core.projection_regions`); farther ones are checked point by point
+CERTIFY_DISTANCE = 1.0
 
 
 @dataclass(frozen=True)
@@ -85,21 +93,6 @@ def _sample_params(breaks, per_span, lo, hi):
     return np.unique(np.r_[lo, t, hi])
 
 
-def _max_curvature(D):
-    """Largest principal curvature magnitude (1/mm) at SoA derivative samples; NaN if degenerate."""
-    S, Su, Sv, Suu, Suv, Svv = D
-    n = np.cross(Su.T, Sv.T).T
-    nn = np.sqrt(dot(n, n))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        n = n / nn
-        E, F, G = dot(Su, Su), dot(Su, Sv), dot(Sv, Sv)
-        L, M, N = dot(n, Suu), dot(n, Suv), dot(n, Svv)
-        den = E * G - F * F
-        K = (L * N - M * M) / den
-        H = (E * N - 2.0 * F * M + G * L) / (2.0 * den)
-        return np.abs(H) + np.sqrt(np.maximum(H * H - K, 0.0))
-
-
 class Projector:
     """Reusable projection engine for one face (samples, KD-tree, span table).
 
@@ -115,9 +108,13 @@ class Projector:
     workers : int, optional
         Threads for the Newton chunks and the KD-tree queries; default: the
         number of CPUs.
+    min_samples : int, optional
+        Refine the grid until it has about this many samples (at most
+        ``MAX_SAMPLES``): closer seeds save Newton iterations when many points
+        are projected (:func:`project` asks for one sample per 16 points).
     """
 
-    def __init__(self, surf, samples_per_span=None, workers=None):
+    def __init__(self, surf, samples_per_span=None, workers=None, min_samples=0):
         self.surf = surf
         self.workers = max(1, int(workers or os.cpu_count() or 1))
         if SpanTable.size(surf) <= MAX_TABLE_VALUES:
@@ -132,9 +129,12 @@ class Projector:
         bv = np.unique(np.r_[v0, bv[(bv > v0) & (bv < v1)], v1])
         mu = samples_per_span or 3 * (surf.degree_u + 1)
         mv = samples_per_span or 3 * (surf.degree_v + 1)
-        self.us, self.vs = self._sample_grid(bu, bv, mu, mv)
+        self.us, self.vs = self._sample_grid(bu, bv, mu, mv, min(int(min_samples), MAX_SAMPLES))
         D = bspline.evaluate_grid(surf, self.us, self.vs, order=2)
-        self.samples = [d.reshape(-1, 3).T.copy() for d in D]  # SoA (3, M)
+        # S, Su, Sv, Suu, Suv, Svv: one row per sample (seeds are gathered row by row)
+        # and SoA (3, M) arrays
+        self._rows = np.concatenate([d.reshape(-1, 3) for d in D], axis=1)
+        self.samples = [d.reshape(-1, 3).T.copy() for d in D]
         grid = D[0]
         # covering radius: half the longest cell diagonal (plus margin)
         d1 = np.linalg.norm(grid[1:, 1:] - grid[:-1, :-1], axis=2)
@@ -144,7 +144,7 @@ class Projector:
         edges = np.r_[np.linalg.norm(np.diff(grid, axis=0), axis=2).ravel(),
                       np.linalg.norm(np.diff(grid, axis=1), axis=2).ravel()]
         edges = edges[edges > 0]
-        self.voxel = 0.5 * float(np.median(edges)) if edges.size else 1.0
+        self.voxel = float(np.median(edges)) if edges.size else 1.0
         # degenerate samples (collapsed edges, poles) are no seeds: Newton cannot
         # leave them (zero gradient) and all their parameters give one point
         scale_u, scale_v = bspline._derivative_scales(surf)
@@ -154,14 +154,28 @@ class Projector:
             raise GeometryError("the face is degenerate everywhere (Su x Sv = 0)")
         # points closer than this to the face have a unique closest point
         # (half the smallest radius of curvature seen at the samples)
-        kmax = _max_curvature(self.samples)[regular]
+        self._curvatures = principal_curvatures(self.samples)
+        k1, k2 = self._curvatures
+        kmax = np.maximum(np.abs(k1), np.abs(k2))[regular]
         kmax = kmax[np.isfinite(kmax)]
         self.safe_distance = 0.5 / kmax.max() if kmax.size and kmax.max() > 0 else np.inf
         self.tree_ids = np.flatnonzero(regular)  # tree index -> sample index
         self.tree = cKDTree(grid.reshape(-1, 3)[self.tree_ids])
         self.newton = Newton(self.ev, surf.u_range, surf.v_range)
+        self._regular = regular
+        self._regions = None
+        self._regions_lock = threading.Lock()
 
-    def _sample_grid(self, bu, bv, mu, mv):
+    def regions(self):
+        """The face's region certificate (:class:`~surfcomp.core.projection_regions.Regions`),
+        built on first use."""
+        with self._regions_lock:
+            if self._regions is None:
+                self._regions = Regions(self.us, self.vs, self.samples, self._curvatures,
+                                        self._regular, self.eps, 2.0 * CERTIFY_DISTANCE)
+            return self._regions
+
+    def _sample_grid(self, bu, bv, mu, mv, min_samples=0):
         """Sample parameters equally spaced in arc length (roughly square cells in mm).
 
         The spacing is the finer of ``length / (spans * m)`` along u and v (the
@@ -182,6 +196,8 @@ class Projector:
         if lu <= 0 or lv <= 0:
             raise GeometryError("the face has zero extent along u or v")
         h = min(lu / max(1, (bu.size - 1) * mu), lv / max(1, (bv.size - 1) * mv))
+        if min_samples > 0:
+            h = min(h, np.sqrt(lu * lv / min_samples))
         h = max(h, np.sqrt(lu * lv / MAX_SAMPLES))
         nu_s = int(min(np.ceil(lu / h), MAX_SAMPLES // 2)) + 1
         nv_s = int(min(np.ceil(lv / h), MAX_SAMPLES // 2)) + 1
@@ -202,8 +218,9 @@ class Projector:
                    normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
                    outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
         good = np.flatnonzero(np.all(np.isfinite(P), axis=1))
-        # blocks are independent (disjoint result rows): one thread each
-        block = CHUNK * 8
+        # blocks are independent (disjoint result rows): one thread each; two per thread
+        # at most (each ends with a tail of iterations on its few slow points)
+        block = max(CHUNK * 8, -(-good.size // (2 * self.workers)))
         blocks = [good[s_:s_ + block] for s_ in range(0, good.size, block)]
         job = lambda idx: self._project_block(P[idx], idx, res, max_distance)  # noqa: E731
         if self.workers == 1 or len(blocks) == 1:
@@ -251,34 +268,64 @@ class Projector:
         P, idx, seeds = P[near], idx[near], seeds[near]
         if P.shape[0] == 0:
             return
-        parts = [self._newton_from_samples(P[c], seeds[c], FIRST_PASS_ITER)
-                 for c in (slice(s_, s_ + CHUNK) for s_ in range(0, P.shape[0], CHUNK))]
-        u = np.concatenate([r[0] for r in parts])
-        v = np.concatenate([r[1] for r in parts])
-        D = [np.concatenate([r[2][i] for r in parts], axis=1) for i in range(6)]
-        conv = np.concatenate([r[3] for r in parts])
-        # the few slow points of all chunks continue together (no per-chunk tail)
+        Pt = np.ascontiguousarray(P.T)
+        n = P.shape[0]
+        u, v = np.empty(n), np.empty(n)
+        D = [np.empty((3, n)) for _ in range(6)]
+        conv = np.zeros(n, dtype=bool)
+        for a in range(0, n, CHUNK):
+            c = slice(a, a + CHUNK)
+            iu, iv = np.divmod(seeds[c], self.vs.size)
+            uc, vc, Dc, conv[c] = self.newton.quick(Pt[:, c], self.us[iu], self.vs[iv],
+                                                    self._sample_derivs(seeds[c]))
+            u[c], v[c] = uc, vc
+            for dst, src in zip(D, Dc):
+                dst[:, c] = src
+        # the few points that need the safeguards start again from their seeds, all
+        # chunks together
         slow = np.flatnonzero(~conv)
         if slow.size:
-            u2, v2, D2, c2 = self.newton.run(np.ascontiguousarray(P[slow].T), u[slow], v[slow])
+            u2, v2, D2, c2 = self._newton_from_samples(P[slow], seeds[slow])
             u[slow], v[slow], conv[slow] = u2, v2, c2
             for a, b in zip(D, D2):
                 a[:, slow] = b
-        # a local minimum closer than the reach of the face is the global one;
-        # the others get checked with more seeds
+        # a local minimum closer than the reach of the face is the global one, and so
+        # is one that the region certificate covers; the others get checked with more
+        # seeds
         r = D[0] - P.T
         check = np.flatnonzero(~(dot(r, r) < self.safe_distance ** 2))
         if check.size:
+            check = check[~self._certified(u[check], v[check], r[:, check],
+                                           [d[:, check] for d in D[1:3]], conv[check])]
+        if check.size:
             sus, owner, seeds = self._suspicious(P[check], u[check], v[check],
-                                                 [d[:, check] for d in D])
+                                                 [d[:, check] for d in D],
+                                                 *self._nearest(P[check]))
             self._best_of(P, check[owner], seeds, u, v, D, conv)
             if sus.size:
                 self._reseed(P, check[sus], u, v, D, conv)
         self._finish(P, idx, u, v, D, conv, res, max_distance)
 
+    def _certified(self, u, v, r, tangents, conv):
+        """Interior converged feet that the region certificate proves global."""
+        (u0, u1), (v0, v1) = self.surf.u_range, self.surf.v_range
+        inside = conv & (u > u0) & (u < u1) & (v > v0) & (v < v1)
+        if not inside.any() or self.safe_distance >= CERTIFY_DISTANCE:
+            return np.zeros(u.size, dtype=bool)
+        n = np.cross(tangents[0].T, tangents[1].T).T
+        d = np.copysign(np.sqrt(dot(r, r)), -dot(r, n))   # r = S - P, d along Su x Sv
+        out = np.zeros(u.size, dtype=bool)
+        out[inside] = self.regions().certified(u[inside], v[inside], d[inside])
+        return out
+
+    def _sample_derivs(self, seeds):
+        """S, Su, Sv, Suu, Suv, Svv at samples: six (3, n) arrays."""
+        g = np.take(self._rows, seeds, axis=0).T.copy()
+        return [g[3 * k:3 * k + 3] for k in range(6)]
+
     def _newton_from_samples(self, P, seeds, maxiter=None):
         Pt = np.ascontiguousarray(P.T)
-        sd = [s_[:, seeds] for s_ in self.samples]
+        sd = self._sample_derivs(seeds)
         iu, iv = np.divmod(seeds, self.vs.size)
         return self.newton.run(Pt, self.us[iu], self.vs[iv], sd, maxiter=maxiter)
 
@@ -290,8 +337,15 @@ class Projector:
             out.append(np.where(np.abs(t - ts[i - 1]) <= np.abs(ts[i] - t), i - 1, i))
         return out[0], out[1]
 
-    def _suspicious(self, P, u, v, D, k=12):
-        """Indices of points whose local minimum may not be the global one."""
+    def _nearest(self, P, k=12):
+        """The ``k`` nearest samples of each point: distances and sample numbers (n, k)."""
+        dist, nb = self.tree.query(P, k=min(k, self.tree.n), workers=1)
+        return dist.reshape(P.shape[0], -1), self.tree_ids[nb.reshape(P.shape[0], -1)]
+
+    def _suspicious(self, P, u, v, D, dist, nb):
+        """Points whose local minimum may not be the global one (indices) and the seeds
+        (owner, sample) of their neighbouring basins, from the nearest samples
+        ``dist``, ``nb`` (n, k) of each point (``inf`` distance: no sample)."""
         S, Su, Sv, Suu, Suv, Svv = D
         r = S - P.T
         a, b, c = dot(Su, Su), dot(Su, Sv), dot(Sv, Sv)
@@ -302,9 +356,6 @@ class Projector:
         # far from the foot along the face (length of the parameter offset in the
         # foot's first fundamental form > 3 |X - F| + 2 eps) although close in
         # space: another part of the face comes close (a second basin)
-        dist, nb = self.tree.query(P, k=min(k, self.tree.n), workers=1)
-        nb = self.tree_ids[nb.reshape(P.shape[0], -1)]
-        dist = dist.reshape(P.shape[0], -1)
         ki, kj = np.divmod(nb, self.vs.size)
         i0, j0 = self._grid_index(u, v)
         i0, j0 = i0[:, None], j0[:, None]
@@ -358,7 +409,7 @@ class Projector:
     def _predict(self, owner, seeds, P):
         """One Newton step on the stored sample derivatives: landing (u, v) and distance."""
         Pk = P[owner].T
-        sd = [s_[:, seeds] for s_ in self.samples]
+        sd = self._sample_derivs(seeds)
         ki, kj = np.divmod(seeds, self.vs.size)
         su, sv = self.us[ki], self.vs[kj]
         du, dv, _ = self.newton.step(su, sv, sd[0] - Pk, *sd[1:])
@@ -367,15 +418,13 @@ class Projector:
         rp = Sp - Pk
         return su + du, sv + dv, np.sqrt(dot(rp, rp))
 
-    def _reseed(self, P, sus, u, v, D, conv, max_seeds=12, per_point=400, chunk=256):
+    def _reseed(self, P, sus, u, v, D, conv, per_point=400, chunk=256):
         """Newton from all parts of the face within reach of a better minimum; keep the best.
 
-        Candidates are the samples within ``d + eps`` of the point (thinned on the
-        grid to about ``per_point``); one Newton step on each sample's stored
-        derivatives predicts its landing point; landings away from the current
-        foot (other grid cells) that promise a distance below ``d + eps / 2`` are
-        deduplicated by cell and the ``max_seeds`` best run the full Newton.
+        Candidates are the samples within ``d + eps`` of the point (a KD-tree ball
+        query per point), thinned and pursued by :meth:`_pursue`.
         """
+        seeds = []
         for start in range(0, sus.size, chunk):
             pts = sus[start:start + chunk]
             r = D[0][:, pts] - P[pts].T
@@ -387,27 +436,43 @@ class Projector:
             cand = self.tree_ids[np.fromiter(itertools.chain.from_iterable(balls), dtype=np.intp,
                                              count=int(lens.sum()))]
             local = np.repeat(np.arange(pts.size), lens)
-            # thin crowded balls on the grid: keep every s-th row and column
-            stride = np.maximum(1, np.ceil(np.sqrt(lens / per_point))).astype(np.intp)[local]
-            ki, kj = np.divmod(cand, self.vs.size)
-            keep = (ki % stride == 0) & (kj % stride == 0)
-            local, cand = local[keep], cand[keep]
-            owner = pts[local]
-            lu, lv, dp = self._predict(owner, cand, P)
-            li, lj = self._grid_index(lu, lv)
-            fi, fj = self._grid_index(u[owner], v[owner])
-            ok = ((li != fi) | (lj != fj)) & (dp < d[local] + 0.5 * self.eps)
-            owner, cand, dp, li, lj = owner[ok], cand[ok], dp[ok], li[ok], lj[ok]
-            # best candidate per (point, landing cell), then the max_seeds best per point
-            order = np.lexsort((dp, lj, li, owner))
-            owner, cand, dp, li, lj = owner[order], cand[order], dp[order], li[order], lj[order]
-            first = np.r_[True, (np.diff(owner) != 0) | (np.diff(li) != 0) | (np.diff(lj) != 0)]
-            owner, cand, dp = owner[first], cand[first], dp[first]
-            order = np.lexsort((dp, owner))
-            owner, cand = owner[order], cand[order]
-            rank = np.arange(owner.size) - np.searchsorted(owner, owner)
-            sel = rank < max_seeds
-            self._best_of(P, owner[sel], cand[sel], u, v, D, conv)
+            seeds.append(self._pursue(P, pts, local, cand, lens, d, u, v, per_point))
+        if seeds:
+            self._best_of(P, np.concatenate([o for o, _ in seeds]),
+                          np.concatenate([c for _, c in seeds]), u, v, D, conv)
+
+    def _pursue(self, P, pts, local, cand, lens, d, u, v, per_point, max_seeds=12):
+        """Seeds for Newton among the candidate samples ``cand`` of points ``pts[local]``.
+
+        Crowded candidate sets are thinned on the grid to about ``per_point``; one
+        Newton step on each sample's stored derivatives predicts its landing point;
+        landings away from the current foot (other grid cells) that promise a
+        distance below ``d + eps / 2`` are deduplicated by cell and the
+        ``max_seeds`` best are returned as (owner, sample) for :meth:`_best_of`.
+        """
+        # thin crowded balls on the grid: keep every s-th row and column
+        stride = np.maximum(1, np.ceil(np.sqrt(lens / per_point))).astype(np.intp)[local]
+        ki, kj = np.divmod(cand, self.vs.size)
+        keep = (ki % stride == 0) & (kj % stride == 0)
+        local, cand = local[keep], cand[keep]
+        owner = pts[local]
+        lu, lv, dp = self._predict(owner, cand, P)
+        li, lj = self._grid_index(lu, lv)
+        fi, fj = self._grid_index(u[owner], v[owner])
+        ok = ((li != fi) | (lj != fj)) & (dp < d[local] + 0.5 * self.eps)
+        owner, cand, dp, li, lj = owner[ok], cand[ok], dp[ok], li[ok], lj[ok]
+        if owner.size == 0:
+            return owner, cand
+        # best candidate per (point, landing cell), then the max_seeds best per point
+        order = np.lexsort((dp, lj, li, owner))
+        owner, cand, dp, li, lj = owner[order], cand[order], dp[order], li[order], lj[order]
+        first = np.r_[True, (np.diff(owner) != 0) | (np.diff(li) != 0) | (np.diff(lj) != 0)]
+        owner, cand, dp = owner[first], cand[first], dp[first]
+        order = np.lexsort((dp, owner))
+        owner, cand = owner[order], cand[order]
+        rank = np.arange(owner.size) - np.searchsorted(owner, owner)
+        sel = rank < max_seeds
+        return owner[sel], cand[sel]
 
     def _finish(self, P, idx, u, v, D, conv, res, max_distance):
         S, Su, Sv = D[0].T, D[1].T, D[2].T
@@ -463,4 +528,6 @@ def project(surf, points, max_distance=None, progress=None, workers=None):
     For repeated projections onto the same face build a :class:`Projector`
     once and call its ``project`` method.
     """
-    return Projector(surf, workers=workers).project(points, max_distance, progress)
+    n = len(points)
+    return Projector(surf, workers=workers, min_samples=n // 16).project(points, max_distance,
+                                                                         progress)

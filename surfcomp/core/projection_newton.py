@@ -224,6 +224,52 @@ class Newton:
                         pd & (det > 0.5 * gn_det))
         return un - u, vn - v, fast
 
+    def quick(self, P, u, v, seed_derivs, evaluations=2, extra=1):
+        """Plain Newton steps from samples: the common case without the safeguards.
+
+        From ``seed_derivs`` (S, Su, Sv, Suu, Suv, Svv at (u, v)), ``evaluations``
+        steps each followed by an evaluation, then one more step taken by Taylor
+        expansion; ``done`` marks the points where every step decreased the distance
+        and the last one was a full Newton step shorter than ``STEP_TOL``: there the
+        result is what :meth:`run` reaches (one iteration further at most). Points
+        still on their way get ``extra`` more evaluations (one at a time, on them
+        alone); the others must go through :meth:`run`, their entries are
+        meaningless.
+
+        Returns
+        -------
+        u, v : ndarray, shape (n,)
+        D : list of 6 (3, n) arrays
+        done : ndarray of bool
+        """
+        D = seed_derivs
+        r = D[0] - P
+        f = dot(r, r)
+        ok = np.ones(u.size, dtype=bool)
+        for _ in range(evaluations):
+            du, dv, _ = self.step(u, v, r, *D[1:])
+            u, v = u + du, v + dv
+            D = self.ev.evaluate(u, v, 2)
+            r = D[0] - P
+            fn = dot(r, r)
+            ok &= ~(fn > f * (1.0 + 1e-12) + 1e-24)
+            f = fn
+        du, dv, fast = self.step(u, v, r, *D[1:])
+        S, Su, Sv, Suu, Suv, Svv = D
+        mv = Su * du + Sv * dv
+        done = ok & fast & (dot(mv, mv) <= STEP_TOL * STEP_TOL)
+        on = np.flatnonzero(ok & ~done) if extra else ()
+        out = [S + mv + 0.5 * (Suu * du * du + 2.0 * Suv * du * dv + Svv * dv * dv),
+               Su + Suu * du + Suv * dv, Sv + Suv * du + Svv * dv, Suu, Suv, Svv]
+        un, vn = u + du, v + dv
+        if len(on):
+            u2, v2, D2, done2 = self.quick(P[:, on], u[on], v[on], [d_[:, on] for d_ in D], 1,
+                                           extra - 1)
+            un[on], vn[on], done[on] = u2, v2, done2
+            for o_, d_ in zip(out, D2):
+                o_[:, on] = d_
+        return un, vn, out, done
+
     def run(self, P, u, v, seed_derivs=None, maxiter=None):
         """Iterate all points from (u, v).
 
