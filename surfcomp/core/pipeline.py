@@ -12,7 +12,6 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
-from . import bspline
 from .corrected import DEFAULT_REFINE, construct
 from .deviations import deviation_components, statistics
 from .field import GridField
@@ -20,7 +19,7 @@ from .filters import make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
 from .methods import compute_correction
 from .progress import report, sub
-from .projection import project
+from .projection import project, tangent_lengths
 from .scattered import ScatteredField, smooth
 
 #: a given normal more than this many degrees off the face normal is reported
@@ -108,6 +107,52 @@ def _err(ms, k, message):
     return MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]))
 
 
+def _given_normals(ms, n_face, options, warnings):
+    """The normals of the measurement file checked against the face's outward normals
+    ``n_face`` (N, 3), or ``n_face`` when the file has none."""
+    if ms.normal is None:
+        return n_face
+    given = np.asarray(ms.normal, dtype=float)
+    if options.flip_normals:
+        given = -given
+    cosang = np.einsum("ij,ij->i", given, n_face)
+    opposite = np.nonzero(cosang < 0)[0]
+    if opposite.size:
+        k = opposite[0]
+        raise _err(ms, k, "the given normal points to the other side of the face than the "
+                   "face's outward normal (%d point(s)); use --flip-normals if the file's "
+                   "normals point into the material" % opposite.size)
+    ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
+    off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
+    for k in off[:10]:
+        warnings.append("%s:%d: the given normal is %.1f degrees off the face normal (more "
+                        "than %g)" % (ms.source, ms.lines[k], ang[k], NORMAL_WARNING_DEG))
+    if off.size > 10:
+        warnings.append("%s: %d more normals are more than %g degrees off the face normal"
+                        % (ms.source, off.size - 10, NORMAL_WARNING_DEG))
+    return given
+
+
+def _layout(ms, u, v, options, warnings):
+    """The points' grid (row/col columns or found from (u, v)), or a scattered layout."""
+    if options.layout not in LAYOUTS:
+        raise InputError("unknown layout %r (expected one of %s)"
+                         % (options.layout, ", ".join(LAYOUTS)))
+    if options.layout == "scattered":
+        return Scattered(np.arange(u.size), "scattered (as asked)")
+    if ms.row is not None and ms.col is not None:
+        return grid_from_indices(ms.row, ms.col, u, v, ms.lines, ms.source)
+    try:
+        return grid_from_uv(u, v, ms.lines, ms.source)
+    except GridError as exc:
+        if options.layout == "grid":
+            raise
+        warnings.append("%s; the points are used as a scattered layout (the determined "
+                        "component comes from a smoothing fit instead of the mask "
+                        "filter; --layout grid refuses such files)" % exc)
+        return Scattered(np.arange(u.size), "scattered (not a complete grid)")
+
+
 def prepare(surface, outward, ms, options=None, progress=None):
     """Locate the measured points on the nominal face and compute their deviations.
 
@@ -167,29 +212,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
         raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
                    "(%d point(s) do; expected points on the face)"
                    % (tuple(base[k]) + (outside.size,)))
-    n_face = proj.normal * outward
-    if ms.normal is not None:
-        given = np.asarray(ms.normal, dtype=float)
-        if options.flip_normals:
-            given = -given
-        cosang = np.einsum("ij,ij->i", given, n_face)
-        opposite = np.nonzero(cosang < 0)[0]
-        if opposite.size:
-            k = opposite[0]
-            raise _err(ms, k, "the given normal points to the other side of the face than the "
-                       "face's outward normal (%d point(s)); use --flip-normals if the file's "
-                       "normals point into the material" % opposite.size)
-        ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
-        off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
-        for k in off[:10]:
-            warnings.append("%s:%d: the given normal is %.1f degrees off the face normal (more "
-                            "than %g)" % (ms.source, ms.lines[k], ang[k], NORMAL_WARNING_DEG))
-        if off.size > 10:
-            warnings.append("%s: %d more normals are more than %g degrees off the face normal"
-                            % (ms.source, off.size - 10, NORMAL_WARNING_DEG))
-        normal = given
-    else:
-        normal = n_face
+    normal = _given_normals(ms, proj.normal * outward, options, warnings)
     if ms.deviation is not None:
         d = np.asarray(ms.deviation, dtype=float) * (-1.0 if options.flip_normals else 1.0)
     elif ms.nominal is not None and ms.measured is not None:
@@ -198,23 +221,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
         d = dist
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
-    if options.layout not in LAYOUTS:
-        raise InputError("unknown layout %r (expected one of %s)"
-                         % (options.layout, ", ".join(LAYOUTS)))
-    if options.layout == "scattered":
-        grid = Scattered(np.arange(proj.u.size), "scattered (as asked)")
-    elif ms.row is not None and ms.col is not None:
-        grid = grid_from_indices(ms.row, ms.col, proj.u, proj.v, ms.lines, ms.source)
-    else:
-        try:
-            grid = grid_from_uv(proj.u, proj.v, ms.lines, ms.source)
-        except GridError as exc:
-            if options.layout == "grid":
-                raise
-            grid = Scattered(np.arange(proj.u.size), "scattered (not a complete grid)")
-            warnings.append("%s; the points are used as a scattered layout (the determined "
-                            "component comes from a smoothing fit instead of the mask "
-                            "filter; --layout grid refuses such files)" % exc)
+    grid = _layout(ms, proj.u, proj.v, options, warnings)
     report(progress, 1.0, "%s layout" % ("scattered" if isinstance(grid, Scattered)
                                          else "%d x %d grid" % grid.shape))
     return Prepared(u=proj.u, v=proj.v, nominal=np.asarray(nominal, dtype=float), normal=normal,
@@ -346,9 +353,8 @@ def build_surface(result, surface, outward, delta, progress=None):
 def parameter_scale(surface, prepared):
     """Median length per unit parameter (mm) along u and along v at the measured points,
     so that fits over (u, v) are isotropic on the face."""
-    _, Su, Sv = bspline.derivatives(surface, prepared.u, prepared.v, order=1)
-    return (float(np.median(np.linalg.norm(Su, axis=-1))) or 1.0,
-            float(np.median(np.linalg.norm(Sv, axis=-1))) or 1.0)
+    lu, lv = tangent_lengths(surface, prepared.u, prepared.v)
+    return float(np.median(lu)) or 1.0, float(np.median(lv)) or 1.0
 
 
 def scattered_spacing(prepared, scale):

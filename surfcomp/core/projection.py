@@ -500,6 +500,25 @@ class Projector:
         res["converged"][idx] = conv[keep]
 
 
+def tangent_lengths(surf, u, v, chunk=CHUNK):
+    """``|Su|`` and ``|Sv|`` (mm per unit parameter) at face parameters ``u``, ``v`` (N,),
+    with the projector's span-table evaluator (several times faster than
+    :func:`bspline.derivatives` at many points).
+
+    Returns
+    -------
+    (ndarray, ndarray), shape (N,) each
+    """
+    u = np.asarray(u, dtype=float).ravel()
+    v = np.asarray(v, dtype=float).ravel()
+    ev = SpanTable(surf) if SpanTable.size(surf) <= MAX_TABLE_VALUES else GenericEval(surf)
+    lu, lv = np.empty(u.size), np.empty(u.size)
+    for a in range(0, u.size, chunk):
+        _, Su, Sv = ev.evaluate(u[a:a + chunk], v[a:a + chunk], 1)
+        lu[a:a + chunk], lv[a:a + chunk] = np.sqrt(dot(Su, Su)), np.sqrt(dot(Sv, Sv))
+    return lu, lv
+
+
 def project(surf, points, max_distance=None, progress=None, workers=None):
     """Closest points of a B-spline face to measured points (issue 5).
 
