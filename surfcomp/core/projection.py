@@ -148,6 +148,7 @@ class Projector:
         # degenerate samples (collapsed edges, poles) are no seeds: Newton cannot
         # leave them (zero gradient) and all their parameters give one point
         scale_u, scale_v = bspline._derivative_scales(surf)
+        self._scale_u, self._scale_v = scale_u, scale_v
         Su, Sv = self.samples[1].T, self.samples[2].T
         regular = ~bspline._degenerate(np.cross(Su, Sv), Su, Sv, scale_u, scale_v, rel=1e-6)
         if not regular.any():
@@ -475,26 +476,34 @@ class Projector:
         return owner[sel], cand[sel]
 
     def _finish(self, P, idx, u, v, D, conv, res, max_distance):
-        S, Su, Sv = D[0].T, D[1].T, D[2].T
-        n = bspline._unit_normals(self.surf, u, v, Su, Sv)
-        r = P - S
-        d = np.einsum("ij,ij->i", r, n)
+        S, Su, Sv = D[0], D[1], D[2]                       # SoA (3, n)
+        n = np.cross(Su, Sv, axis=0)
+        nn = np.sqrt(dot(n, n))
+        # degenerate normals (collapsed edges, poles) as bspline.normals has them
+        bad = ((nn <= 1e-10 * self._scale_u * self._scale_v)
+               | (nn <= 1e-10 * np.sqrt(dot(Su, Su) * dot(Sv, Sv))))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n = n / nn
+        if bad.any():
+            n[:, bad] = bspline._unit_normals(self.surf, u[bad], v[bad], Su[:, bad].T,
+                                              Sv[:, bad].T).T
+        r = P.T - S
+        d = dot(r, n)
         # outside: at a bound with a tangential residual (> 1e-8 mm) pointing out of
         # the work area, i.e. the unconstrained foot lies beyond that bound
-        rt = r - d[:, None] * n
-        big = np.einsum("ij,ij->i", rt, rt) > 1e-16
-        tu = np.einsum("ij,ij->i", rt, Su)
-        tv = np.einsum("ij,ij->i", rt, Sv)
+        rt = r - d * n
+        big = dot(rt, rt) > 1e-16
+        tu, tv = dot(rt, Su), dot(rt, Sv)
         (u0, u1), (v0, v1) = self.surf.u_range, self.surf.v_range
         out = big & (((u <= u0) & (tu < 0)) | ((u >= u1) & (tu > 0)) |
                      ((v <= v0) & (tv < 0)) | ((v >= v1) & (tv > 0)))
-        d = np.where(out, np.copysign(np.linalg.norm(r, axis=1), d), d)
+        d = np.where(out, np.copysign(np.sqrt(dot(r, r)), d), d)
         keep = np.ones(u.size, dtype=bool)
         if max_distance is not None:
             keep = np.abs(d) <= float(max_distance)
         idx = idx[keep]
         res["u"][idx], res["v"][idx] = u[keep], v[keep]
-        res["foot"][idx], res["normal"][idx] = S[keep], n[keep]
+        res["foot"][idx], res["normal"][idx] = S[:, keep].T, n[:, keep].T
         res["distance"][idx] = d[keep]
         res["outside"][idx] = out[keep]
         res["converged"][idx] = conv[keep]
