@@ -118,11 +118,12 @@ def inspect_case(meas, command="inspect", out_dir=None):
 
 
 def freecad_inspection(X):
-    """Seconds of FreeCAD's ``Inspection::Feature`` recompute for points X against the
-    example face (as bench_projection.time_freecad), in a fresh process."""
+    """Wall and CPU seconds of FreeCAD's ``Inspection::Feature`` recompute for points X
+    against the example face (bench_projection.time_freecad), in a fresh process."""
     path = os.path.join(tempfile.mkdtemp(prefix="surfcomp-bench-"), "fc.npy")
     np.save(path, X)
-    return _child(["freecad", path])["seconds"]
+    out = _child(["freecad", path])
+    return out["seconds"], out["cpu"]
 
 
 def projection_case(n, offset, workers=None):
@@ -149,8 +150,8 @@ def _run_child(kind, *args):
 
         from examples.make_example import example_surface
 
-        seconds, _ = time_freecad(example_surface(), np.load(args[0]))
-        out = {"seconds": seconds}
+        seconds, _, cpu = time_freecad(example_surface(), np.load(args[0]))
+        out = {"seconds": seconds, "cpu": cpu}
     elif kind == "project":
         n, offset, workers = int(args[0]), float(args[1]), int(args[2]) or None
         _, surf = blade_face()
@@ -170,19 +171,20 @@ def _run_child(kind, *args):
         from surfcomp.core.projection import project
 
         X = blade_points(surf, n, offset, seed=seed)
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         for p in X.tolist():
             face.Surface.parameter(FreeCAD.Vector(*p))
-        t_param = (time.perf_counter() - t) / n
+        t_param, c_param = (time.perf_counter() - t) / n, (time.process_time() - c) / n
         dist, feet = [], []
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         for p in X.tolist():
             d, pairs, _ = face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))
             dist.append(d)
             feet.append(tuple(pairs[0][0]))
-        t_dist = (time.perf_counter() - t) / n
+        t_dist, c_dist = (time.perf_counter() - t) / n, (time.process_time() - c) / n
         r = project(surf, X)
-        out = {"parameter_s": t_param, "dist_s": t_dist,
+        out = {"parameter_s": t_param, "dist_s": t_dist, "parameter_cpu": c_param,
+               "dist_cpu": c_dist,
                "max_dd_um": float(np.max(np.abs(np.abs(r.distance) - np.array(dist)))) * 1e3,
                "max_foot_um": float(np.max(np.linalg.norm(r.foot - np.array(feet), axis=1)))
                * 1e3}
@@ -224,22 +226,25 @@ def main(argv=None):
 def _inspect_table(sizes, folder, args):
     _line("\ninspect end to end, N points scattered over the example face, vs FreeCAD "
           "Inspection::Feature on the same points")
-    _line("%9s %9s %9s %9s %11s %9s %8s" % ("points", "ours s", "cpu s", "peak MB",
-                                             "FreeCAD s", "ratio", "pts/s"))
+    _line("%9s %8s %8s %8s %10s %10s %8s %8s %8s" % (
+        "points", "ours s", "cpu s", "peak MB", "FreeCAD s", "FC cpu s", "ratio", "cpu ratio",
+        "pts/s"))
     fc_n = [int(x) for x in args.fc_points.split(",")]
     times = {}
     for n in sizes:
         X = scattered_points(n)
         meas = write_xyz(X, os.path.join(folder, "scattered_%d.xyz" % n))
         ours = inspect_case(meas)
-        t_fc = [freecad_inspection(X[:k]) for k in fc_n]
-        slope = (t_fc[1] - t_fc[0]) / (fc_n[1] - fc_n[0])
-        fc = t_fc[1] + slope * (n - fc_n[1])
+        fc_runs = [freecad_inspection(X[:k]) for k in fc_n]
+        # FreeCAD's wall and CPU time for n points: the line through the two subsets
+        fc = [f[1] + (f[1] - f[0]) / (fc_n[1] - fc_n[0]) * (n - fc_n[1])
+              for f in zip(*fc_runs)]
         times[n] = ours["wall"]
-        _line("%9d %9.2f %9.2f %9.0f %11.0f %8.0fx %8.0f   (FreeCAD: %.2f s for %d, %.2f s for "
-              "%d points, extrapolated)" % (n, ours["wall"], ours["cpu"], ours["peak_mb"], fc,
-                                            fc / ours["wall"], n / ours["wall"], t_fc[0],
-                                            fc_n[0], t_fc[1], fc_n[1]))
+        _line("%9d %8.2f %8.2f %8.0f %10.0f %10.0f %7.0fx %7.0fx %8.0f   (FreeCAD: %.2f s for "
+              "%d, %.2f s for %d points, extrapolated)" % (
+                  n, ours["wall"], ours["cpu"], ours["peak_mb"], fc[0], fc[1],
+                  fc[0] / ours["wall"], fc[1] / ours["cpu"], n / ours["wall"], fc_runs[0][0],
+                  fc_n[0], fc_runs[1][0], fc_n[1]))
         if args.compensate:
             comp = inspect_case(meas, "compensate", folder)
             times[("compensate", n)] = comp["wall"]
@@ -257,9 +262,9 @@ def _inspect_table(sizes, folder, args):
 def _projection_table(sizes, offsets, args):
     _line("\nprojection onto the BladeX upper face (526 x 13 poles, degree 3 x 2), set-up "
           "included, vs OCCT on %d of the points" % args.occt_points)
-    _line("%7s %9s %8s %8s %9s %8s %11s %11s %9s %9s" % (
-        "offset", "points", "ours s", "cpu s", "pts/s", "peak MB", "parameter", "distToShape",
-        "|dd| um", "foot um"))
+    _line("%7s %9s %7s %7s %8s %10s %8s %10s %10s %8s %8s" % (
+        "offset", "points", "ours s", "cpu s", "pts/s", "pts/cpu-s", "peak MB", "parameter",
+        "distToShape", "|dd| um", "foot um"))
     for off in offsets:
         occt = occt_projection(args.occt_points, off)
         walls = {}
@@ -267,12 +272,14 @@ def _projection_table(sizes, offsets, args):
             ours = projection_case(n, off)
             walls[n] = ours["wall"]
             rate = n / ours["wall"]
-            _line("%7.2f %9d %8.2f %8.2f %9.0f %8.0f %10.0fx %10.0fx %9.5f %9.5f" % (
-                off, n, ours["wall"], ours["cpu"], rate, ours["peak_mb"],
+            _line("%7.2f %9d %7.2f %7.2f %8.0f %10.0f %8.0f %9.0fx %9.0fx %8.5f %8.5f" % (
+                off, n, ours["wall"], ours["cpu"], rate, n / ours["cpu"], ours["peak_mb"],
                 rate * occt["parameter_s"], rate * occt["dist_s"], occt["max_dd_um"],
                 occt["max_foot_um"]))
-        _line("%7s OCCT: Surface.parameter %.0f pts/s, Face.distToShape %.0f pts/s"
-              % ("", 1 / occt["parameter_s"], 1 / occt["dist_s"]))
+        _line("%7s OCCT on %d points: Surface.parameter %.0f pts/s (%.0f per CPU s), "
+              "Face.distToShape %.0f pts/s (%.0f per CPU s)"
+              % ("", args.occt_points, 1 / occt["parameter_s"], 1 / occt["parameter_cpu"],
+                 1 / occt["dist_s"], 1 / occt["dist_cpu"]))
         if len(sizes) > 1:
             a, b = sizes[0], sizes[-1]
             _line("%7s growth t(%d) / t(%d) = %.2f" % ("", b, a, walls[b] / walls[a]))
