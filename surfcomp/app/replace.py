@@ -19,6 +19,7 @@ import json
 
 from ..errors import GeometryError, InputError
 from . import features
+from .undo import UndoStep
 
 #: properties never rebound: group membership and the compensation's own inputs
 SKIP_PROPERTIES = ("Group", "ExpressionEngine", "InList", "OutList")
@@ -220,16 +221,8 @@ class _Undo:
 
 def _run(doc, name, work):
     undo = _Undo(doc)
-    doc.openTransaction(name)
-    try:
-        result = work(undo)
-    except BaseException:
-        undo.rollback()
-        doc.abortTransaction()
-        undo.rollback()     # the abort may have replayed older values: ours win
-        raise
-    doc.commitTransaction()
-    return result
+    with UndoStep(doc, name, rollback=undo.rollback):
+        return work(undo)
 
 
 def _check_computed(comp):

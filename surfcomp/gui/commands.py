@@ -16,6 +16,7 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features
+from ..app.undo import UndoStep
 from ..errors import ComputationError, InputError, SurfcompError
 from . import dialogs, prefs
 
@@ -96,17 +97,11 @@ class Command:
     def macro(label, lines, modules=()):
         """Run ``lines`` with ``Gui.doCommand`` (so they are recorded in macros) inside one
         transaction of the active document; abort it on any error and re-raise."""
-        doc = FreeCAD.ActiveDocument
         for mod in modules:
             FreeCADGui.addModule(mod)
-        doc.openTransaction(label)
-        try:
+        with UndoStep(FreeCAD.ActiveDocument, label):
             for line in lines:
                 FreeCADGui.doCommand(line)
-        except BaseException:
-            doc.abortTransaction()
-            raise
-        doc.commitTransaction()
 
     @staticmethod
     def new_objects(before):
@@ -138,8 +133,7 @@ def create_compensation(label, display="Map", quantity="deviation"):
              # the map lies on the nominal face: hide what would cover it
              "_doc.getObject(%r).ViewObject.Visibility = False" % nom.Name,
              "_doc.getObject(%r).ViewObject.Visibility = False" % meas.Name]
-    doc.openTransaction(label)
-    try:
+    with UndoStep(doc, label, rollback=doc.recompute):
         FreeCADGui.addModule("surfcomp.app.features")
         FreeCADGui.addModule("surfcomp.gui.viewproviders")
         for line in lines:
@@ -148,11 +142,6 @@ def create_compensation(label, display="Map", quantity="deviation"):
         if "Invalid" in comp.State or "Error" in comp.State or comp.Shape.isNull():
             raise _state_error(comp)
         comp.ViewObject.DisplayMode = display
-    except BaseException:
-        doc.abortTransaction()
-        doc.recompute()
-        raise
-    doc.commitTransaction()
     return comp
 
 
@@ -325,46 +314,43 @@ class BuildFace(Command):
             "App.ActiveDocument.recompute()"])
 
 
-class ReplaceInDocument(Command):
+class _ReplaceCommand(Command):
+    """Replace in document / Restore nominal: one command, two directions."""
+
+    #: ``surfcomp.app.replace`` function to call, and whether it needs a replacing compensation
+    ACTION = "replace"
+    WHILE_REPLACING = False
+
+    def active(self):
+        from ..app import replace
+
+        comp = selected_compensation()
+        return comp is not None and replace.is_replacing(comp) == self.WHILE_REPLACING
+
+    def run(self):
+        # surfcomp.app.replace opens and commits its own transaction
+        comp = selected_compensation()
+        FreeCADGui.addModule("surfcomp.app.replace")
+        FreeCADGui.doCommand("surfcomp.app.replace.%s(App.ActiveDocument, "
+                             "App.ActiveDocument.getObject(%r))" % (self.ACTION, comp.Name))
+        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+
+
+class ReplaceInDocument(_ReplaceCommand):
     ID = "SurfComp_ReplaceInDocument"
     MENU = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Replace in document")
     TIP = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument",
                             "Let the users of the nominal (Path jobs, links) use the corrected "
                             "face instead; Restore puts the nominal back")
 
-    def active(self):
-        from ..app import replace
 
-        comp = selected_compensation()
-        return comp is not None and not replace.is_replacing(comp)
-
-    def run(self):
-        # surfcomp.app.replace opens and commits its own transaction
-        comp = selected_compensation()
-        FreeCADGui.addModule("surfcomp.app.replace")
-        FreeCADGui.doCommand("surfcomp.app.replace.replace(App.ActiveDocument, "
-                             "App.ActiveDocument.getObject(%r))" % comp.Name)
-        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
-
-
-class RestoreNominal(Command):
+class RestoreNominal(_ReplaceCommand):
     ID = "SurfComp_RestoreNominal"
     MENU = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Restore nominal")
     TIP = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal",
                             "Undo Replace in document: the users of the nominal use it again")
-
-    def active(self):
-        from ..app import replace
-
-        comp = selected_compensation()
-        return comp is not None and replace.is_replacing(comp)
-
-    def run(self):
-        comp = selected_compensation()
-        FreeCADGui.addModule("surfcomp.app.replace")
-        FreeCADGui.doCommand("surfcomp.app.replace.restore(App.ActiveDocument, "
-                             "App.ActiveDocument.getObject(%r))" % comp.Name)
-        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+    ACTION = "restore"
+    WHILE_REPLACING = True
 
 
 class Report(Command):

@@ -12,6 +12,7 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from ..app import reports
+from ..app.undo import UndoStep
 from ..core.deviations import Statistics, format_table
 from ..core.filters import EDGE_MODES
 from ..errors import SurfcompError
@@ -168,7 +169,7 @@ class FilterPanel:
         self.weights.editingFinished.connect(self.timer.start)
         self.edge.currentIndexChanged.connect(self.timer.start)
         self.show.currentIndexChanged.connect(self.show_map)
-        self.doc.openTransaction(translate("SurfComp", "Filter %s") % obj.Label)
+        self.step = UndoStep(self.doc, translate("SurfComp", "Filter %s") % obj.Label).open()
         vobj = obj.ViewObject
         if vobj is not None and "Map" in vobj.PropertiesList:
             vobj.DisplayMode = "Map"
@@ -223,13 +224,13 @@ class FilterPanel:
             FreeCADGui.doCommand(line)
         if not self._show_state():
             return False
-        self.doc.commitTransaction()
+        self.step.commit()
         self._close()
         return True
 
     def reject(self):
         self.timer.stop()
-        self.doc.abortTransaction()
+        self.step.abort()
         self._close()
         vobj = self.obj.ViewObject
         if vobj is not None and vobj.Proxy is not None and hasattr(vobj.Proxy, "redraw"):

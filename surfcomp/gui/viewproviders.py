@@ -13,6 +13,7 @@ The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
 import FreeCAD
 import numpy as np
 from PySide import QtCore
+from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features, reports
@@ -39,25 +40,47 @@ RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "NominalPoints",
 _G = "Colour map"
 # (type, name, tooltip, default)
 MAP_PROPERTIES = (
-    ("App::PropertyEnumeration", "Map", "Quantity drawn in the Map display mode",
+    ("App::PropertyEnumeration", "Map",
+     QT_TRANSLATE_NOOP("App::Property", "Quantity drawn in the Map display mode"),
      list(QUANTITIES)),
-    ("App::PropertyEnumeration", "Scheme", "Colour scheme", list(colormap.SCHEMES)),
+    ("App::PropertyEnumeration", "Scheme",
+     QT_TRANSLATE_NOOP("App::Property", "Colour scheme"),
+     list(colormap.SCHEMES)),
     ("App::PropertyBool", "AutoRange",
-     "Symmetric range from the largest absolute value (off: RangeMin .. RangeMax)", True),
-    ("App::PropertyDistance", "RangeMin", "Lower end of the colour range (AutoRange off)",
+     QT_TRANSLATE_NOOP("App::Property", "Symmetric range from the largest absolute value (off: "
+                                        "RangeMin .. RangeMax)"),
+     True),
+    ("App::PropertyDistance", "RangeMin",
+     QT_TRANSLATE_NOOP("App::Property", "Lower end of the colour range (AutoRange off)"),
      -0.05),
-    ("App::PropertyDistance", "RangeMax", "Upper end of the colour range (AutoRange off)",
+    ("App::PropertyDistance", "RangeMax",
+     QT_TRANSLATE_NOOP("App::Property", "Upper end of the colour range (AutoRange off)"),
      0.05),
     ("App::PropertyBool", "ToleranceBand",
-     "Tolerance band mode: in tolerance one colour, below and above their own", False),
-    ("App::PropertyDistance", "ToleranceLower", "Lower limit of the tolerance band", -0.01),
-    ("App::PropertyDistance", "ToleranceUpper", "Upper limit of the tolerance band", 0.01),
-    ("App::PropertyEnumeration", "LegendUnit", "Unit of the legend and labels", ["mm", "um"]),
-    ("App::PropertyBool", "ShowPoints", "Draw the measured points as coloured markers", True),
-    ("App::PropertyBool", "ShowLabels", "Label the largest positive and negative value",
+     QT_TRANSLATE_NOOP("App::Property", "Tolerance band mode: in tolerance one colour, below and "
+                                        "above their own"),
+     False),
+    ("App::PropertyDistance", "ToleranceLower",
+     QT_TRANSLATE_NOOP("App::Property", "Lower limit of the tolerance band"),
+     -0.01),
+    ("App::PropertyDistance", "ToleranceUpper",
+     QT_TRANSLATE_NOOP("App::Property", "Upper limit of the tolerance band"),
+     0.01),
+    ("App::PropertyEnumeration", "LegendUnit",
+     QT_TRANSLATE_NOOP("App::Property", "Unit of the legend and labels"),
+     ["mm", "um"]),
+    ("App::PropertyBool", "ShowPoints",
+     QT_TRANSLATE_NOOP("App::Property", "Draw the measured points as coloured markers"),
      True),
-    ("App::PropertyBool", "ShowLegend", "Draw the colour bar legend", True),
-    ("App::PropertyInteger", "MapVersion", "Property set version of this view", VERSION),
+    ("App::PropertyBool", "ShowLabels",
+     QT_TRANSLATE_NOOP("App::Property", "Label the largest positive and negative value"),
+     True),
+    ("App::PropertyBool", "ShowLegend",
+     QT_TRANSLATE_NOOP("App::Property", "Draw the colour bar legend"),
+     True),
+    ("App::PropertyInteger", "MapVersion",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this view"),
+     VERSION),
 )
 
 
