@@ -370,13 +370,3 @@ def test_base_of_another_face_is_refused(doc):
         features.make_compensation(doc, a, "Face2", m, output="shell")
     with pytest.raises(InputError, match="is not a surfcomp measurement"):
         features.make_compensation(doc, a, "Face2", c1)
-
-
-def test_app_modules_do_not_import_gui():
-    import re
-
-    from surfcomp.app import docjob, pathjob, replace
-    for mod in (features, replace, pathjob, docjob):
-        src = open(mod.__file__, encoding="utf-8").read()
-        imports = re.findall(r"^\s*(?:import|from)\s+([\w.]+)", src, re.M)
-        assert not [m for m in imports if m.split(".")[0] in ("FreeCADGui", "PySide", "PySide2")]
