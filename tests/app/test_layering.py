@@ -1,8 +1,10 @@
 """The layers import only downwards (STYLE: gui -> app -> io -> core; cli over io, core, app).
 
 For each layer a subprocess imports every module of the layer (sub-packages included) while
-an import hook refuses the layers above it and the libraries it must not use; relative
-imports go through the same hook, so ``from ..app import x`` in core fails the check. The
+an import hook refuses, to surfcomp's own modules, the layers above it and the libraries it
+must not use (FreeCAD's modules may import what they like: 1.x's Path imports PySide);
+relative imports go through the same hook, so ``from ..app import x`` in core fails the
+check. The
 FreeCAD-free layers run with FreeCAD off the path; app and cli run with FreeCAD importable
 but the GUI (FreeCADGui, Qt, coin) refused, so every document object recomputes headless.
 """
@@ -38,8 +40,20 @@ if FREECAD == "1":
 else:
     sys.path = [p for p in sys.path if 'freecad' not in p.lower()]
 
+def importer():
+    # the module whose code asked for this import (importlib's frames skipped)
+    f = sys._getframe(2)
+    while f is not None and f.f_globals.get('__name__', '').startswith(
+            ('importlib', '_frozen_importlib')):
+        f = f.f_back
+    return f.f_globals.get('__name__', '') if f is not None else ''
+
 class Block:
     def find_spec(self, name, path=None, target=None):
+        # surfcomp's own imports only: FreeCAD's modules may use Qt themselves
+        # (1.x's Path package imports PySide)
+        if not (importer().startswith('surfcomp') or name.startswith('surfcomp')):
+            return None
         for b in BLOCKED:
             if name == b or name.startswith(b + '.'):
                 raise ImportError('layering: %s must not import %s' % (LAYER, name))
