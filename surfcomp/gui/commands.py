@@ -190,16 +190,18 @@ class ImportMeasurements(Command):
 
     def run(self):
         from ..io.readers import read_any
-        from .panels import PreviewDialog
+        from .preview import PreviewDialog
 
         path = dialogs.ask_open_file(translate("SurfComp", "Measurement file"),
                                      MEASUREMENT_FILTER)
         if not path:
             return
-        units = prefs.file_units()
-        ms = read_any(path, units=units)
-        if not dialogs.run_dialog(PreviewDialog(ms)):
+        ms = read_any(path, units=prefs.file_units())
+        dlg = PreviewDialog(ms, reader=lambda units: read_any(path, units=units))
+        # a file with implausible deviations never reaches the document
+        if not dialogs.run_dialog(dlg) or not dlg.accepted_ok():
             return
+        units = dlg.units()
         self.macro(translate("SurfComp", "Import measurements"), [
             "_meas = surfcomp.app.features.make_measurement(App.ActiveDocument, %r, units=%r)"
             % (path, units),

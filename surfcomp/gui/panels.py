@@ -1,8 +1,8 @@
-"""Task panels and dialogs of the workbench: measurement preview, filter panel, report.
+"""Task panels and dialogs of the workbench: filter panel, report (the import preview is
+in :mod:`surfcomp.gui.preview`).
 
-No numerics: the preview shows what :func:`surfcomp.io.readers.read_any` found, the
-filter panel edits the compensation's properties and recomputes it, the report shows
-the statistics the compensation stored.
+No numerics: the filter panel edits the compensation's properties and recomputes it, the
+report shows the statistics the compensation stored.
 """
 
 import json
@@ -24,47 +24,6 @@ translate = FreeCAD.Qt.translate
 REPORT_COLUMNS = (("deviation", "Deviation"), ("determined", "Determined"),
                   ("random", "Random"), ("increment", "Increment"),
                   ("correction", "Correction"))
-
-
-def preview_text(ms):
-    """What the import preview says about a measurement set (plain text)."""
-    lines = [translate("SurfComp", "File: %s") % ms.source,
-             translate("SurfComp", "Points: %d") % len(ms),
-             translate("SurfComp", "Columns: %s") % ms.kind(),
-             translate("SurfComp", "Units of the file: %s (stored in mm)") % ms.units]
-    if ms.columns:
-        lines.append(translate("SurfComp", "Detected columns: %s") % ", ".join(
-            "%s=%s" % (k, v) for k, v in ms.columns.items()))
-    if ms.ignored_columns:
-        lines.append(translate("SurfComp", "Ignored columns: %s") % ", ".join(ms.ignored_columns))
-    if ms.row is not None and ms.col is not None:
-        lines.append(translate("SurfComp", "Grid: %d x %d (from row/col indices)")
-                     % (int(ms.row.max()) + 1, int(ms.col.max()) + 1))
-    else:
-        lines.append(translate("SurfComp", "Grid: detected on the face when the map is made"))
-    if ms.warnings:
-        lines.append(translate("SurfComp", "Problems found (%d):") % len(ms.warnings))
-        lines += ["  " + w for w in ms.warnings[:50]]
-    else:
-        lines.append(translate("SurfComp", "Problems found: none"))
-    return "\n".join(lines)
-
-
-class PreviewDialog(QtGui.QDialog):
-    """Shows what a measurement file holds before anything is added to the document."""
-
-    def __init__(self, ms, parent=None):
-        super().__init__(parent or FreeCADGui.getMainWindow())
-        self.setWindowTitle(translate("SurfComp", "Import measurements: preview"))
-        lay = QtGui.QVBoxLayout(self)
-        self.text = QtGui.QPlainTextEdit(preview_text(ms))
-        self.text.setReadOnly(True)
-        self.text.setMinimumSize(560, 260)
-        lay.addWidget(self.text)
-        box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
-        box.accepted.connect(self.accept)
-        box.rejected.connect(self.reject)
-        lay.addWidget(box)
 
 
 def statistics_columns(obj):
