@@ -178,7 +178,7 @@ class PointLocator:
         from .features import measurement_set
 
         self.obj = obj
-        nodes = np.asarray(obj.NominalPoints, dtype=float).reshape(-1, 3)
+        nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
         dev = np.asarray(obj.Deviation, dtype=float)
         self.keep = np.flatnonzero(np.isfinite(dev))
         self.nodes = nodes

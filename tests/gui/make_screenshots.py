@@ -43,13 +43,13 @@ view.viewIsometric()
 view.fitAll()
 Gui.updateGui()
 vobj = comp.ViewObject
-vobj.LegendUnit = "um"
+vobj.Unit = "um"
 view.saveImage(os.path.join(outdir, "deviation_map.png"), 1000, 650, "White")
-vobj.ToleranceBand = True
-vobj.ToleranceLower = -0.01
-vobj.ToleranceUpper = 0.01
+vobj.TolBand = True
+vobj.TolLow = -0.01
+vobj.TolHigh = 0.01
 view.saveImage(os.path.join(outdir, "tolerance_band.png"), 1000, 650, "White")
-vobj.ToleranceBand = False
+vobj.TolBand = False
 Gui.Selection.addSelection(doc.Name, comp.Name)
 Gui.runCommand("SurfComp_Filter")
 panels.FilterPanel.instance.show.setCurrentIndex(1)
