@@ -11,6 +11,7 @@ the hover or the click. The values come from :class:`surfcomp.app.reports.PointL
 import FreeCAD
 import FreeCADGui
 from pivy import coin
+from PySide import QtCore
 
 from ..core import colormap
 from ..errors import SurfcompError
@@ -33,10 +34,11 @@ def install(view=None):
     view = view or fcgui.active_view()
     if view is None or not hasattr(view, "addEventCallbackPivy") or _known(view):
         return view
-    cbs = [(coin.SoLocation2Event.getClassTypeId(), _on_move),
-           (coin.SoMouseButtonEvent.getClassTypeId(), _on_click)]
-    for typ, cb in cbs:
-        view.addEventCallbackPivy(typ, cb)
+    cbs = []
+    for typ, cb in ((coin.SoLocation2Event.getClassTypeId(), _on_move),
+                    (coin.SoMouseButtonEvent.getClassTypeId(), _on_click)):
+        # removal needs what the add returned (FreeCAD wraps the function)
+        cbs.append((typ, view.addEventCallbackPivy(typ, cb) or cb))
     _VIEWS.append((view, cbs))
     return view
 
@@ -110,11 +112,17 @@ def click(view, position):
         return False
     obj = proxy.vobj.Object
     proxy.toggle_flag(info["node"])
-    FreeCADGui.Selection.clearSelection()
-    FreeCADGui.Selection.addSelection(obj.Document.Name, obj.Name)
+    # FreeCAD's selection node may see the click after this callback (it would select a mesh
+    # element, or the tool path in front): select the whole map once the event is done
+    QtCore.QTimer.singleShot(0, lambda: _select(obj.Document.Name, obj.Name))
     LAST.clear()
     LAST.update(info, text=describe(info, proxy.vobj.Unit, obj.Label), clicked=True)
     return True
+
+
+def _select(doc_name, name):
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(doc_name, name)
 
 
 def _view_of(_event_cb):

@@ -101,11 +101,14 @@ def shot(view, name):
 
 
 def gl_widget():
-    """The 3D view's OpenGL widget (where the mouse events go)."""
+    """The active 3D view's OpenGL viewport (where the mouse events go): the visible GL
+    widget of the view's size."""
+    size = list(Gui.ActiveDocument.ActiveView.getSize())
     found = [w for w in mw.findChildren(QtGui.QWidget)
              if w.metaObject().className() in ("QOpenGLWidget", "QtGLWidget", "QGLWidget")
              and w.isVisible()]
-    return found[0] if found else None
+    same = [w for w in found if [w.width(), w.height()] == size]
+    return (same or found or [None])[0]
 
 
 def mouse(kind, xy, button=None):
@@ -113,8 +116,9 @@ def mouse(kind, xy, button=None):
     getPointOnScreen gives them)."""
     w = gl_widget()
     view = Gui.ActiveDocument.ActiveView
-    H = view.getSize()[1]
-    pos = QtCore.QPointF(xy[0], H - 1 - xy[1])
+    W, H = view.getSize()
+    ratio = float(W) / w.width()        # the view counts device pixels
+    pos = QtCore.QPointF((xy[0] + 0.5) / ratio, (H - 1 - xy[1] + 0.5) / ratio)
     glob = QtCore.QPointF(w.mapToGlobal(pos.toPoint()))
     types = {"move": QtCore.QEvent.MouseMove, "press": QtCore.QEvent.MouseButtonPress,
              "release": QtCore.QEvent.MouseButtonRelease}
