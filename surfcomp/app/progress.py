@@ -58,7 +58,7 @@ def recompute_with_progress(doc, title):
     order = list(getattr(doc, "TopologicalSortedObjects", doc.Objects))
     todo, names = [], set()
     for o in order:
-        if "Touched" in o.State or o.mustExecute() or any(x.Name in names for x in o.OutList):
+        if "Touched" in o.State or any(x.Name in names for x in o.OutList):
             todo.append(o)
             names.add(o.Name)
     done = []
