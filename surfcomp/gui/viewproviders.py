@@ -198,8 +198,27 @@ def arrange_legends(doc, changed=None):
     return out
 
 
-def map_data(obj, quantity, samples=None):
-    """Mesh and values of a computed compensation's map (no drawing).
+def map_mesh(obj, samples=None):
+    """``(points, triangles, u, v)``: the map's mesh of the nominal face (see
+    :func:`surfcomp.core.colormap.uv_grid_mesh`), in the nominal object's own coordinates."""
+    nominal, _placement = features.nominal_of(obj)
+    n, m = int(obj.GridRows), int(obj.GridCols)
+    samples = samples or colormap.mesh_resolution((n, m))
+    return colormap.uv_grid_mesh(nominal.surface, samples)
+
+
+def mesh_key(obj):
+    """What the mesh depends on: the nominal face's shape and the grid's shape."""
+    nom = obj.Nominal
+    shape = getattr(nom, "Shape", None)
+    code = shape.hashCode() if shape is not None and hasattr(shape, "hashCode") else id(shape)
+    return (getattr(nom, "Name", None), obj.FaceName, int(obj.GridRows), int(obj.GridCols),
+            code)
+
+
+def map_data(obj, quantity, samples=None, mesh=None):
+    """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
+    :func:`map_mesh` returns it (made when not given).
 
     Returns
     -------
@@ -208,10 +227,7 @@ def map_data(obj, quantity, samples=None):
         ``markers`` (K, 3) measured nodes and ``marker_values`` (K,), mm, in the
         nominal object's own coordinates.
     """
-    nominal, _placement = features.nominal_of(obj)
-    n, m = int(obj.GridRows), int(obj.GridCols)
-    samples = samples or colormap.mesh_resolution((n, m))
-    pts, tri, u, v = colormap.uv_grid_mesh(nominal.surface, samples)
+    pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
     values = reports.deviation_field(obj, quantity)(u, v)
     nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
     dev = np.asarray(obj.Deviation, dtype=float)
@@ -316,7 +332,10 @@ class ViewProviderCompensation:
             return
         try:
             if q not in self._data:
-                self._data[q] = map_data(obj, q)
+                key = mesh_key(obj)     # the mesh outlives result changes (filter preview)
+                if getattr(self, "_mesh", (None,))[0] != key:
+                    self._mesh = (key, map_mesh(obj))
+                self._data[q] = map_data(obj, q, mesh=self._mesh[1])
         except SurfcompError as exc:
             self.scene.clear()
             FreeCAD.Console.PrintWarning("%s: no map: %s\n" % (obj.Label, exc))

@@ -234,8 +234,14 @@ def test_deviation_field_passes_through_the_nodes(doc):
     for q, prop in (("deviation", "Deviation"), ("random", "Random"), ("correction", "Correction")):
         np.testing.assert_allclose(reports.deviation_field(c, q)(U, V),
                                    np.reshape(getattr(c, prop), (45, 45)), atol=1e-12)
-    np.testing.assert_allclose(reports.deviation_field(c, "residual")(U, V),
-                               np.reshape(c.Random, (45, 45)), atol=1e-12)  # filtered method
+    # predicted residual d_f - stock - increment: zero for the filtered method ...
+    np.testing.assert_allclose(reports.deviation_field(c, "residual")(U, V), 0.0, atol=1e-12)
+    # ... and -random for the mirror method (it copies the random scatter into the face)
+    c.Method, c.Stock = "mirror", 0.05
+    doc.recompute()
+    np.testing.assert_allclose(reports.quantity_values(c, "residual"),
+                               -np.reshape(c.Random, (45, 45)), atol=1e-12)
+    assert np.nanmax(np.abs(reports.quantity_values(c, "residual"))) > 1e-4
     with pytest.raises(InputError, match="unknown quantity 'colour'"):
         reports.deviation_field(c, "colour")
 
