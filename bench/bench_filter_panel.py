@@ -72,12 +72,11 @@ for what, value in changes:
     else:
         panel.edge.setCurrentIndex(value)
     panel.timer.stop()
-    t0 = time.perf_counter()
-    r0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     ok = panel.update()
-    total = time.perf_counter() - t0
+    total, cpu = time.perf_counter() - t0, time.process_time() - c0
     Gui.updateGui()
-    rows.append([what, str(value), total, ok])
+    rows.append([what, str(value), total, ok, cpu])
 RESULTS["rows"] = rows
 RESULTS["redraw"] = parts["redraw"]
 RESULTS["debounce"] = panels.FilterPanel.DEBOUNCE
@@ -101,11 +100,14 @@ def main():
         raise SystemExit(1)
     print("filter panel on the 45 x 45 example grid (seconds, after the %d ms debounce)"
           % res["debounce"])
-    for what, value, total, ok in res["rows"]:
-        print("  %-8s %-22s update %.3f%s" % (what, value or "(none)", total,
-                                              "" if ok else "  (refused)"))
+    for what, value, total, ok, cpu in res["rows"]:
+        print("  %-8s %-22s update %.3f (CPU %.3f)%s" % (what, value or "(none)", total, cpu,
+                                                         "" if ok else "  (refused)"))
     totals = sorted(r[2] for r in res["rows"])
-    print("update: median %.3f, max %.3f" % (totals[len(totals) // 2], totals[-1]))
+    cpus = sorted(r[4] for r in res["rows"])
+    print("update: median %.3f, max %.3f; CPU time median %.3f, max %.3f (the machine's load "
+          "average: %.1f)" % (totals[len(totals) // 2], totals[-1], cpus[len(cpus) // 2],
+                              cpus[-1], os.getloadavg()[0]))
     red = sorted(res["redraw"])
     print("of which redraw (mesh field, colours, coin): median %.3f, max %.3f"
           % (red[len(red) // 2], red[-1]))

@@ -180,7 +180,7 @@ class MapScene:
 
     # -- data --------------------------------------------------------------------------
     def set_data(self, points, triangles, values, marker_points=None, marker_values=None,
-                 title=""):
+                 title="", restyle=True):
         """New geometry and values.
 
         Parameters
@@ -194,6 +194,8 @@ class MapScene:
             Measured points drawn as markers, coloured by ``marker_values`` (K,).
         title : str
             Legend title (e.g. ``'Deviation'``).
+        restyle : bool
+            Recolour with the current style now (False: the caller sets a style next).
         """
         points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
         tri = np.asarray(triangles, dtype=np.int32).reshape(-1, 3)
@@ -216,7 +218,8 @@ class MapScene:
             self._marker_points = self._marker_values = None
             self.marker_coords.point.setNum(0)
         self._title = title
-        self.set_style(self._style)
+        if restyle:
+            self.set_style(self._style)
 
     def clear(self):
         """Show nothing (no data)."""

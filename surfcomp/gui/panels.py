@@ -231,8 +231,8 @@ class FilterPanel:
         self.doc.recompute()
         ok = self._show_state()
         proxy = getattr(self.obj.ViewObject, "Proxy", None)
-        if ok and hasattr(proxy, "redraw"):
-            proxy.redraw()
+        if ok and getattr(proxy, "_dirty", False):
+            proxy.redraw()      # not yet drawn while the recompute processed events
         self._show_figures()
         return ok
 

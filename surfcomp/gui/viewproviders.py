@@ -342,7 +342,7 @@ class ViewProviderCompensation:
             return
         d = self._data[q]
         self.scene.set_data(d["points"], d["triangles"], d["values"], d["markers"],
-                            d["marker_values"], title=TITLES[q])
+                            d["marker_values"], title=TITLES[q], restyle=False)
         self.restyle()
         self.draw_flags()
         from . import readout
@@ -363,7 +363,8 @@ class ViewProviderCompensation:
         """Recolour from the view properties (no new geometry, no recompute)."""
         vobj = self.vobj
         if arrange and vobj.Object.Document is not None:
-            self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None)))
+            if self.scene.range is None:    # first drawing: arrange_legends needs a range
+                self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None)))
             arrange_legends(vobj.Object.Document, changed=vobj.Object)
         self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
                                       self.shared_range()))
