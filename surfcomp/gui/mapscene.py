@@ -394,5 +394,8 @@ def _flag(point, text):
     style.pointSize = 9
     for node in (col, style, c3, coin.SoPointSet()):
         sep.addChild(node)
-    sep.addChild(_text(point, "  " + text, size=14))
+    label = _text(point, "", size=14)
+    # on the line below the point: the min/max label may sit on the point's own line
+    label.getChild(3).string.setValues(0, 2, ["", "  " + text])
+    sep.addChild(label)
     return sep

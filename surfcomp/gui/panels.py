@@ -147,6 +147,7 @@ class FilterPanel:
         self.status = QtGui.QLabel("")
         self.status.setWordWrap(True)
         self.figures = QtGui.QLabel("")
+        self.figures.setWordWrap(True)
         self.figures.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
         lay.addRow(translate("SurfComp", "Mask size"), self.mask)
         lay.addRow(translate("SurfComp", "Mask kind"), self.kind)
@@ -244,9 +245,9 @@ class FilterPanel:
             return
         um = 1000.0
         self.figures.setText(translate(
-            "SurfComp", "RMS  deviation %.2f µm, determined %.2f µm, random %.2f µm\n"
+            "SurfComp", "RMS  deviation %.2f µm, determined %.2f µm, random %.2f µm.\n"
                         "Predicted residual %.2f µm RMS; next part %.2f µm RMS "
-                        "(residual + a new random scatter)")
+                        "(residual + a new random scatter).")
             % (fig["deviation"] * um, fig["determined"] * um, fig["random"] * um,
                fig["residual"] * um, fig["next_part"] * um))
 
