@@ -56,7 +56,10 @@ from .shapes import corrected_shape
 QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 #: version of the property sets; onDocumentRestored upgrades older objects
-VERSION = 1
+#: (2: short names that fit the property view, see RENAMED)
+VERSION = 2
+#: compensation properties renamed in version 2: old name -> new name
+RENAMED = {"FlipNormals": "Flip", "EdgeTolerance": "EdgeTol", "NominalPoints": "Nodes"}
 
 MEASUREMENT_TYPE = "SurfComp_Measurement"
 COMPENSATION_TYPE = "SurfComp_Compensation"
@@ -190,7 +193,7 @@ COMPENSATION_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
                                         "face"),
      1.0, 0),
-    ("App::PropertyBool", "FlipNormals", _IN,
+    ("App::PropertyBool", "Flip", _IN,
      QT_TRANSLATE_NOOP("App::Property", "The file's normals point into the material: flip them and"
                                         " the deviations' sign"),
      False, 0),
@@ -241,7 +244,7 @@ COMPENSATION_PROPERTIES = (
     ("App::PropertyFloatList", "V", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Face parameter v of every grid node (row-major)"),
      None, _RO),
-    ("App::PropertyFloatList", "NominalPoints", _RES,
+    ("App::PropertyFloatList", "Nodes", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Nominal point of every node, flat x y z (mm)"),
      None, _RO),
     ("App::PropertyFloatList", "Normals", _RES,
@@ -277,7 +280,7 @@ COMPENSATION_PROPERTIES = (
     ("App::PropertyInteger", "Round", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Iteration round (1 without a Base)"),
      1, _RO),
-    ("App::PropertyLength", "EdgeTolerance", _RES,
+    ("App::PropertyLength", "EdgeTol", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Largest edge tolerance of the output solid (covers the "
                                         "face border's shift)"),
      0.0, _RO),
@@ -467,6 +470,7 @@ class CompensationFeature(_Proxy):
 
     Type = COMPENSATION_TYPE
     PROPERTIES = COMPENSATION_PROPERTIES
+    RENAMED = RENAMED
 
     def execute(self, obj):
         result = _compute(obj)
@@ -485,10 +489,35 @@ def options_of(obj):
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
-                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.FlipNormals),
+                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
                    refine=int(obj.Refine), layout=obj.Layout,
                    smoothing=(float(obj.Smoothing.Value) or None),
                    tip_radius=float(obj.TipRadius.Value))
+
+
+#: compensation property -> core option of the filter (the task panel's fields)
+FILTER_OPTIONS = {"MaskSize": "mask_size", "Weights": "weights", "MaskKind": "mask_kind",
+                  "Edge": "edge"}
+
+
+def check_filter(obj, **values):
+    """Check filter values (``MaskSize=``, ``Weights=``, ``MaskKind=``, ``Edge=``) with the
+    core's option domains before they are set, so a panel can show the message instead
+    of a failed recompute. Returns the mask's size (custom weights set it).
+
+    Raises
+    ------
+    InputError
+        The message of :meth:`surfcomp.core.pipeline.Options.validate`.
+    """
+    kw = {}
+    for name, value in values.items():
+        if name == "Weights":
+            value = value.strip() or None
+        kw[FILTER_OPTIONS[name]] = value
+    options = _dc_replace(options_of(obj), **kw)
+    options.validate()
+    return int(options.mask().shape[0])
 
 
 def chain(obj):
@@ -590,7 +619,7 @@ def _compute(obj):
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
     if preview:
-        return _Result(comp, nominal, increment, None, obj.EdgeTolerance.Value, len(links))
+        return _Result(comp, nominal, increment, None, obj.EdgeTol.Value, len(links))
     shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     shape.Placement = placement
     return _Result(comp, nominal, increment, shape, tol, len(links))
@@ -623,7 +652,7 @@ def _write_results(obj, r):
     obj.FieldScale = list(comp.scale) if p.scattered else []
     obj.U = _flat(g.take(p.u))
     obj.V = _flat(g.take(p.v))
-    obj.NominalPoints = _flat(g.take(p.nominal))
+    obj.Nodes = _flat(g.take(p.nominal))
     obj.Normals = _flat(g.take(p.normal))
     c = comp.correction
     obj.Deviation = _flat(c.deviation)
@@ -637,7 +666,7 @@ def _write_results(obj, r):
         obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
     obj.Warnings = [str(w) for w in p.warnings]
     obj.Round = r.round
-    obj.EdgeTolerance = float(r.edge_tolerance)
+    obj.EdgeTol = float(r.edge_tolerance)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,

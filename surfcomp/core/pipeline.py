@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
-from . import bspline
+from . import bspline, plausibility
 from .corrected import DEFAULT_REFINE, construct
 from .deviations import deviation_components, statistics
 from .field import GridField
@@ -201,6 +201,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
     else:
         d = dist
     _check_deviations(ms, d, options)
+    _check_units(surface, d, warnings, ms.source)
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
     grid = _arrange(ms, proj, options, warnings)
@@ -287,6 +288,17 @@ def _check_deviations(ms, d, options):
                                     options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
                                     bad.size, hint))
+
+
+def _check_units(surface, d, warnings, source):
+    """Warn when every deviation is far beyond the face's size tolerance (see
+    :mod:`surfcomp.core.plausibility`): plausible against max-offset, but not for a part."""
+    us = np.linspace(surface.u_range[0], surface.u_range[1], 9)
+    vs = np.linspace(surface.v_range[0], surface.v_range[1], 9)
+    size = plausibility.largest_dimension(bspline.evaluate_grid(surface, us, vs))
+    message = plausibility.units_warning(d, size)
+    if message:
+        warnings.append("%s: %s" % (source, message))
 
 
 #: fewest points of a scattered layout (its smoothing fit needs them off one line)

@@ -123,7 +123,7 @@ def test_compensation_matches_the_pipeline(doc):
     g = prep.grid
     assert (c.GridRows, c.GridCols) == g.shape == (45, 45)
     np.testing.assert_allclose(np.reshape(c.U, g.shape), g.take(prep.u), atol=0)
-    np.testing.assert_allclose(np.reshape(c.NominalPoints, g.shape + (3,)), g.take(prep.nominal),
+    np.testing.assert_allclose(np.reshape(c.Nodes, g.shape + (3,)), g.take(prep.nominal),
                                atol=0)
     for prop, name in (("Deviation", "deviation"), ("Determined", "determined"),
                        ("Random", "random"), ("Correction", "delta")):
@@ -234,8 +234,14 @@ def test_deviation_field_passes_through_the_nodes(doc):
     for q, prop in (("deviation", "Deviation"), ("random", "Random"), ("correction", "Correction")):
         np.testing.assert_allclose(reports.deviation_field(c, q)(U, V),
                                    np.reshape(getattr(c, prop), (45, 45)), atol=1e-12)
-    np.testing.assert_allclose(reports.deviation_field(c, "residual")(U, V),
-                               np.reshape(c.Random, (45, 45)), atol=1e-12)  # filtered method
+    # predicted residual d_f - stock - increment: zero for the filtered method ...
+    np.testing.assert_allclose(reports.deviation_field(c, "residual")(U, V), 0.0, atol=1e-12)
+    # ... and -random for the mirror method (it copies the random scatter into the face)
+    c.Method, c.Stock = "mirror", 0.05
+    doc.recompute()
+    np.testing.assert_allclose(reports.quantity_values(c, "residual"),
+                               -np.reshape(c.Random, (45, 45)), atol=1e-12)
+    assert np.nanmax(np.abs(reports.quantity_values(c, "residual"))) > 1e-4
     with pytest.raises(InputError, match="unknown quantity 'colour'"):
         reports.deviation_field(c, "colour")
 
@@ -273,12 +279,12 @@ def test_solid_output_replaces_the_face_in_the_block(doc):
     dA = np.linalg.norm(np.cross(Su, Sv), axis=1) * (u1 - u0) * (v1 - v0) / k ** 2
     layer = np.sum(reports.deviation_field(c, "correction")(uu.ravel(), vv.ravel()) * dA)
     assert dA.sum() == pytest.approx(solid.Faces[1].Area, rel=1e-4)
-    # (to 15 %: the border moved off the side faces by up to EdgeTolerance, and OCCT's
+    # (to 15 %: the border moved off the side faces by up to EdgeTol, and OCCT's
     # volume of the tolerant rim differs from the layer's by ~ perimeter x shift x height)
     assert solid.Volume - out.Volume == pytest.approx(layer, rel=0.15)
     assert out.Shells[0].isClosed() and len(out.Shells) == 1
-    assert 1e-6 < c.EdgeTolerance.Value < 0.05          # covers the border's shift
-    assert c_face.EdgeTolerance.Value < 1e-5
+    assert 1e-6 < c.EdgeTol.Value < 0.05          # covers the border's shift
+    assert c_face.EdgeTol.Value < 1e-5
 
 
 def test_face_output_of_a_solid_is_the_face(doc):
