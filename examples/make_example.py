@@ -20,30 +20,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
 from surfcomp.app import fcenv  # noqa: E402
+from surfcomp.core.presets import werner_surface  # noqa: E402
 
 SEED = 20221
 GRID = 45
 
 
-#: heights (mm) of the 7 x 7 poles on a regular 45 mm x-y grid
-HEIGHTS = np.array([[0.0, 1.5, 3.0, 3.5, 3.0, 2.0, 1.0],
-                    [1.0, 3.0, 5.5, 6.0, 5.0, 3.5, 2.0],
-                    [2.0, 4.5, 8.0, 9.0, 7.5, 5.0, 3.0],
-                    [2.5, 5.0, 8.5, 10.0, 8.0, 5.5, 3.5],
-                    [2.0, 4.0, 7.0, 8.0, 7.0, 5.0, 3.0],
-                    [1.0, 2.5, 4.5, 5.5, 4.5, 3.5, 2.0],
-                    [0.0, 1.0, 2.5, 3.0, 2.5, 1.5, 1.0]])
-
-
 def example_surface():
     """The example face as a core :class:`surfcomp.core.bspline.Surface` (no FreeCAD):
-    7 x 7 poles, bicubic, interior knots 0.25, 0.5, 0.75."""
-    from surfcomp.core import bspline
-
-    x = np.linspace(0.0, 45.0, 7)
-    P = np.stack([*np.meshgrid(x, x, indexing="ij"), HEIGHTS], axis=-1)
-    k = np.array([0, 0, 0, 0, 0.25, 0.5, 0.75, 1, 1, 1, 1.0])
-    return bspline.Surface(P, k, k, 3, 3)
+    7 x 7 poles, bicubic, interior knots 0.25, 0.5, 0.75; built by
+    :func:`surfcomp.core.presets.werner_surface` (the ``werner2022`` preset's surface)."""
+    return werner_surface()
 
 
 def nominal_surface():

@@ -3,8 +3,9 @@
 # Debian testing/sid (FreeCAD 1.1); run as root. Idempotent: a second run skips what is
 # installed. Used by the README's two commands, by .ci/run and inside the version matrix.
 #
-# OpenCamLib (for CAM's 3D Surface operation) comes from Debian where Debian packages it
-# (python3-opencamlib, Debian 13 and later) and from PyPI only where it does not (Debian 12).
+# OpenCamLib (for CAM's 3D Surface operation) and the linter ruff come from Debian where
+# Debian packages them (python3-opencamlib from 13, ruff in sid) and from PyPI only where it
+# does not.
 set -euo pipefail
 
 APT_PACKAGES=(
@@ -13,7 +14,11 @@ APT_PACKAGES=(
   xvfb xauth             # GUI tests under xvfb-run
   chromium               # headless screenshot of the HTML report in tests
   git                    # the Addon Manager test clones the checkout
+  python3-hypothesis     # property-based tests (tests/fuzz)
+  linuxcnc-uspace        # rs274, LinuxCNC's own G-code interpreter, reads our G-code in tests
 )
+#: the linter, the same version everywhere (Debian's where the archive has ruff, else PyPI)
+RUFF_VERSION=0.16.10
 
 installed() {
   dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"
@@ -40,12 +45,20 @@ if [ ${#missing[@]} -gt 0 ] || ! compgen -G "/var/lib/apt/lists/*_Packages*" >/d
   apt-get update -qq
 fi
 
-opencamlib_from=pypi
+# python3-opencamlib and ruff from Debian where the archive has them, else from PyPI
+pypi=()
 if installed python3-opencamlib || [ -n "$(candidate python3-opencamlib)" ]; then
-  opencamlib_from=debian
   installed python3-opencamlib || missing+=(python3-opencamlib)
-else
-  installed python3-pip || missing+=(python3-pip)
+elif ! /usr/bin/python3 -c "import opencamlib.ocl" 2>/dev/null; then
+  pypi+=("opencamlib>=2023.1")
+fi
+if installed ruff || [ -n "$(candidate ruff)" ]; then
+  installed ruff || missing+=(ruff)
+elif [ "$(ruff --version 2>/dev/null)" != "ruff $RUFF_VERSION" ]; then
+  pypi+=("ruff==$RUFF_VERSION")
+fi
+if [ ${#pypi[@]} -gt 0 ] && ! installed python3-pip; then
+  missing+=(python3-pip)
 fi
 
 if [ ${#missing[@]} -gt 0 ]; then
@@ -54,15 +67,14 @@ else
   echo "surfcomp setup: Debian packages already installed"
 fi
 
-if [ "$opencamlib_from" = pypi ]; then
-  if /usr/bin/python3 -c "import opencamlib.ocl" 2>/dev/null; then
-    echo "surfcomp setup: OpenCamLib already installed (PyPI)"
-  else
-    # Debian 12 has no python3-opencamlib: the PyPI wheel is the only source there
-    echo "surfcomp setup: installing from PyPI: opencamlib (Debian has no python3-opencamlib here)"
-    /usr/bin/python3 -m pip install --quiet --break-system-packages --root-user-action=ignore \
-      "opencamlib>=2023.1"
-  fi
+if [ ${#pypi[@]} -gt 0 ]; then
+  # only what this Debian release does not package (Debian 12: opencamlib and ruff;
+  # Debian 13: ruff); --break-system-packages because pip may not write there otherwise
+  echo "surfcomp setup: installing from PyPI (not packaged by this Debian): ${pypi[*]}"
+  /usr/bin/python3 -m pip install --quiet --break-system-packages --root-user-action=ignore \
+    "${pypi[@]}"
+else
+  echo "surfcomp setup: nothing needed from PyPI"
 fi
 
 # Link this checkout into FreeCAD's user Mod folder, as the Addon Manager would clone it:
@@ -84,3 +96,4 @@ fi
 
 # What was found: the versions every result depends on
 /usr/bin/python3 "$repo/tools/versions.py" --prefix "surfcomp setup: found "
+echo "surfcomp setup: found $(ruff --version)"

@@ -4,28 +4,30 @@ let Path regenerate, save a new document and (optionally) post the G-code.
     python3 -m surfcomp compensate DOC.FCStd MEAS.csv --object O --face F --replace \\
         --save OUT.FCStd [--gcode OUT.ngc --post linuxcnc]
 
-Safety rules (issue 3):
+Safety rules:
 
 - Path and OpenCamLib are set up *before* the document is opened
-  (:func:`surfcomp.app.cam.setup_workbench`): an object whose module cannot be
-  imported at open time loses its proxy silently, and a document saved like that can never
-  recompute that object again. Such documents are refused (nothing is written).
-- The input document is never overwritten unless ``overwrite_input=True``.
+  (:func:`surfcomp.app.cam.setup_workbench`), and the document is opened through
+  :func:`surfcomp.app.documents.open_document` (Document.xml checked, only trusted proxy
+  modules imported): an object whose module cannot be imported at open time loses its
+  proxy, and a document saved like that can never recompute that object again. Such
+  documents are refused (nothing is written).
+- The outputs are checked against the inputs and each other before the document is
+  opened; the input document is never overwritten unless ``overwrite_input=True``.
 - All outputs (document, G-code) are written together or not at all (temporary files
   renamed at the end); after any failure nothing is written.
 """
 
 import json
 import os
-import xml.etree.ElementTree as ET
-import zipfile
 from dataclasses import dataclass, field
 
 from ..core.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
-from ..io.atomic import Transaction
-from . import cam
+from ..io.atomic import Transaction, check_outputs
+from . import cam, features, pathjob
+from .documents import open_document, restore_failures
 
 
 @dataclass
@@ -46,74 +48,6 @@ class DocumentJobResult:
     warnings: list = field(default_factory=list)
 
 
-def _xml_objects(path):
-    """Names and type ids of the objects listed in an FCStd's Document.xml."""
-    try:
-        with zipfile.ZipFile(path) as z:
-            root = ET.fromstring(z.read("Document.xml"))
-    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as exc:
-        raise InputError("not a FreeCAD document (%s)" % exc, file=path) from exc
-    objs = root.find("Objects")
-    return [(o.get("name"), o.get("type")) for o in (objs if objs is not None else [])
-            if o.tag == "Object"]
-
-
-def preload_proxy_modules(path):
-    """Import the modules of the Python proxies stored in an FCStd before opening it.
-
-    Opened from a plain ``python3``, FreeCAD restores a proxy only when its module is
-    already imported (Path's ``PathScripts.PathJob`` is not, and the Job would lose its
-    proxy silently). On FreeCAD 1.x the CAM modules a 0.20 document names are aliased to
-    their 1.x homes first (:func:`surfcomp.app.cam.alias_legacy_modules`). Returns
-    ``{module: error text}`` for the modules that cannot be imported (their objects will be
-    reported by :func:`restore_failures`).
-    """
-    import importlib
-
-    try:
-        with zipfile.ZipFile(path) as z:
-            root = ET.fromstring(z.read("Document.xml"))
-    except (OSError, KeyError, zipfile.BadZipFile, ET.ParseError) as exc:
-        raise InputError("not a FreeCAD document (%s)" % exc, file=path) from exc
-    names = sorted({el.get("module") for el in root.iter("Python") if el.get("module")})
-    cam.alias_legacy_modules(names)
-    failed = {}
-    for name in names:
-        try:
-            importlib.import_module(name)
-        except Exception as exc:  # any import-time error means the proxy cannot restore
-            failed[name] = "%s: %s" % (type(exc).__name__, exc)
-    return failed
-
-
-def restore_failures(doc, path=None):
-    """Objects of an opened document that did not restore completely.
-
-    - Python features (``...::FeaturePython``) whose proxy is None: the proxy's module
-      could not be imported at open time (e.g. Path's 3D Surface without ``ocl``, or a
-      workbench that is not installed);
-    - objects listed in the file (``path``) that are missing from the document (a type
-      this FreeCAD does not know).
-
-    Returns
-    -------
-    list of str
-        One description per problem (empty when everything restored).
-    """
-    problems = []
-    for o in doc.Objects:
-        if "Python" in o.TypeId and "Proxy" in o.PropertiesList and o.Proxy is None:
-            problems.append("%s (%s, label %r): its Python proxy was not restored (a module it "
-                            "needs could not be imported)" % (o.Name, o.TypeId, o.Label))
-    if path:
-        have = {o.Name for o in doc.Objects}
-        for name, typ in _xml_objects(path):
-            if name not in have:
-                problems.append("%s (%s): missing after opening (unknown object type?)"
-                                % (name, typ))
-    return problems
-
-
 def _find_object(doc, name, source):
     obj = doc.getObject(name) or next((o for o in doc.Objects if o.Label == name), None)
     if obj is None:
@@ -127,20 +61,11 @@ def _find_object(doc, name, source):
 
 
 def _jobs_using(doc, comp):
-    from . import pathjob
-
     jobs = []
     for job in pathjob.jobs_of(doc):
         if any(comp in list(getattr(c, "Objects", []) or []) or c is comp for c in job.Model.Group):
             jobs.append(job)
     return jobs
-
-
-def _same_file(a, b):
-    a, b = os.path.abspath(a), os.path.abspath(b)
-    if a == b:
-        return True
-    return os.path.exists(a) and os.path.exists(b) and os.path.samefile(a, b)
 
 
 def run_document_job(document, measurements, object_name, face=None, save=None, replace=True,
@@ -196,62 +121,28 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
     ComputationError
         An object is invalid after the recompute; nothing is written.
     """
-    options = options or Options()
-    if not os.path.isfile(document):
-        raise InputError("document not found (expected a FreeCAD .FCStd file)", file=document)
-    if not document.lower().endswith(".fcstd"):
-        raise InputError("expected a FreeCAD document (.FCStd)", file=document)
-    if (replace or gcode) and not save:
-        raise InputError("--replace and --gcode need --save OUT.FCStd (the input document is "
-                         "not overwritten)")
-    if save and not save.lower().endswith(".fcstd"):
-        raise InputError("the saved document must end in .FCStd", file=save)
-    for out in (save, gcode):
-        if out and _same_file(out, measurements):
-            raise InputError("an output would overwrite the measurement file", file=out)
-    if save and _same_file(save, document) and not overwrite_input:
-        raise InputError("refusing to overwrite the input document (save to another file, or "
-                         "ask for it explicitly)", file=save)
-    if gcode and save and _same_file(gcode, save):
-        raise InputError("the G-code and the document cannot be the same file", file=gcode)
-
+    options = (options or Options()).validate()
+    _check_paths(document, measurements, save, gcode, replace, overwrite_input)
     report(progress, 0.0, "setting up Path and OpenCamLib")
     cam.setup_workbench()
     import FreeCAD
 
-    from . import features, pathjob
     from . import replace as replace_mod
 
     report(progress, 0.05, "opening %s" % os.path.basename(document))
-    unimportable = preload_proxy_modules(document)
     before = set(FreeCAD.listDocuments())
+    doc, refused, info = open_document(document)
     try:
-        doc = FreeCAD.openDocument(os.path.abspath(document), True)
-    except (OSError, RuntimeError, ValueError) as exc:
-        raise InputError("cannot open the FreeCAD document: %s" % exc, file=document) from exc
-    try:
-        problems = restore_failures(doc, document)
+        problems = restore_failures(doc, info=info)
         if problems:
-            why = "".join("; module %s cannot be imported (%s)" % item
-                          for item in sorted(unimportable.items()))
+            why = "".join("; module %s %s" % item for item in sorted(refused.items()))
             raise InputError("%d object(s) did not restore, so the document cannot be updated "
                              "safely (saving would lose them): %s%s"
                              % (len(problems), "; ".join(problems), why), file=document)
         nominal = _find_object(doc, object_name, document)
-        if output is None:
-            output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
         report(progress, 0.1, "reading the measurements")
-        meas = features.make_measurement(doc, measurements, units=units, fmt=fmt,
-                                         sample=sample)
-        comp = features.make_compensation(
-            doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
-            weights=options.weights if isinstance(options.weights, str) else "",
-            edge=options.edge, stock=options.stock or 0.0, output=output)
-        comp.MaskKind = options.mask_kind
-        comp.Sigma = float(options.sigma or 0.0)
-        comp.MaxOffset = float(options.max_offset)
-        comp.FlipNormals = bool(options.flip_normals)
-        comp.Refine = int(options.refine)
+        comp, meas = _add_compensation(doc, nominal, face, measurements, units, fmt, sample,
+                                       options, output)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
         # computed once outside the recompute so bad input raises with file and line
         features.compensation_result(comp)
@@ -262,48 +153,97 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
             report(progress, 0.3, "replacing the nominal")
             result.replaced = replace_mod.replace(doc, comp)
         report(progress, 0.35, "recomputing the document (Path regenerates the tool paths)")
-        doc.recompute()
-        bad = [o for o in doc.Objects
-               if "Invalid" in o.State or "Error" in o.State]
-        if bad:
-            raise ComputationError("after the recompute %d object(s) are invalid: %s"
-                                   % (len(bad), ", ".join("%s (%s)" % (o.Label, o.Name)
-                                                          for o in bad)))
+        _recompute(doc)
         jobs = _jobs_using(doc, comp)
         result.jobs = [j.Name for j in jobs]
         result.operations = [op.Name for j in jobs for op in pathjob.operations_of(j)]
         text = None
         if gcode:
-            if job_name:
-                jobs = [j for j in jobs if job_name in (j.Name, j.Label)]
-            if len(jobs) != 1:
-                raise InputError("%s Path jobs use the compensation (%s): choose one with the "
-                                 "job name" % (len(jobs) or "no",
-                                               ", ".join(j.Label for j in jobs) or "none"))
-            report(progress, 0.9, "post-processing %s with %s" % (jobs[0].Label, post))
-            text = pathjob.post_process(jobs[0], post, post_args)
+            job = _one_job(jobs, job_name)
+            report(progress, 0.9, "post-processing %s with %s" % (job.Label, post))
+            text = pathjob.post_process(job, post, post_args)
         result.statistics = json.loads(comp.Statistics)
         result.checks = json.loads(comp.Checks)
         result.warnings = list(comp.Warnings)
         report(progress, 0.95, "saving")
-        with Transaction() as tx:
-            if save:
-                tmp = tx.stage(save)
-                os.unlink(tmp)           # FreeCAD writes the file itself
-                # saveCopy keeps the document's file name; the label follows the new file
-                doc.Label = os.path.splitext(os.path.basename(save))[0]
-                doc.saveCopy(tmp)
-                result.saved = os.path.abspath(save)
-            if text is not None:
-                tx.stage_text(gcode, text)
-                result.gcode = os.path.abspath(gcode)
-                result.gcode_lines = text.count("\n")
-            tx.commit()
+        _write(doc, result, save, gcode, text, _declared(document, measurements, save, gcode,
+                                                         overwrite_input))
         report(progress, 1.0, "done")
         return result
     finally:
         if doc.Name not in before and doc.Name in FreeCAD.listDocuments():
             FreeCAD.closeDocument(doc.Name)
+
+
+def _declared(document, measurements, save, gcode, overwrite_input):
+    """(outputs, inputs) for :class:`surfcomp.io.atomic.Transaction`."""
+    inputs = [("MEASUREMENTS", measurements)]
+    if not overwrite_input:
+        inputs.append(("document (--overwrite-input allows it)", document))
+    return [("--save", save), ("--gcode", gcode)], inputs
+
+
+def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
+    if not os.path.isfile(document):
+        raise InputError("document not found (expected a FreeCAD .FCStd file)", file=document)
+    if not document.lower().endswith(".fcstd"):
+        raise InputError("expected a FreeCAD document (.FCStd)", file=document)
+    if (replace or gcode) and not save:
+        raise InputError("--replace and --gcode need --save OUT.FCStd (the input document is "
+                         "not overwritten)")
+    if save and not save.lower().endswith(".fcstd"):
+        raise InputError("the saved document must end in .FCStd", file=save)
+    check_outputs(*_declared(document, measurements, save, gcode, overwrite_input))
+
+
+def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output):
+    if output is None:
+        output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
+    meas = features.make_measurement(doc, measurements, units=units, fmt=fmt, sample=sample)
+    comp = features.make_compensation(
+        doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
+        weights=options.weights if isinstance(options.weights, str) else "",
+        edge=options.edge, stock=options.stock or 0.0, output=output)
+    comp.MaskKind = options.mask_kind
+    comp.Sigma = float(options.sigma or 0.0)
+    comp.MaxOffset = float(options.max_offset)
+    comp.Flip = bool(options.flip_normals)
+    comp.Refine = int(options.refine)
+    return comp, meas
+
+
+def _recompute(doc):
+    doc.recompute()
+    bad = [o for o in doc.Objects if "Invalid" in o.State or "Error" in o.State]
+    if bad:
+        raise ComputationError("after the recompute %d object(s) are invalid: %s"
+                               % (len(bad), ", ".join("%s (%s)" % (o.Label, o.Name)
+                                                      for o in bad)))
+
+
+def _one_job(jobs, job_name):
+    if job_name:
+        jobs = [j for j in jobs if job_name in (j.Name, j.Label)]
+    if len(jobs) != 1:
+        raise InputError("%s Path jobs use the compensation (%s): choose one with the job name"
+                         % (len(jobs) or "no", ", ".join(j.Label for j in jobs) or "none"))
+    return jobs[0]
+
+
+def _write(doc, result, save, gcode, text, declared):
+    with Transaction(*declared) as tx:
+        if save:
+            tmp = tx.stage(save)
+            os.unlink(tmp)           # FreeCAD writes the file itself
+            # saveCopy keeps the document's file name; the label follows the new file
+            doc.Label = os.path.splitext(os.path.basename(save))[0]
+            doc.saveCopy(tmp)
+            result.saved = os.path.abspath(save)
+        if text is not None:
+            tx.stage_text(gcode, text)
+            result.gcode = os.path.abspath(gcode)
+            result.gcode_lines = text.count("\n")
+        tx.commit()
 
 
 def summary_lines(result):
@@ -322,4 +262,4 @@ def summary_lines(result):
     return lines
 
 
-__all__ = ["run_document_job", "DocumentJobResult", "restore_failures", "summary_lines"]
+__all__ = ["run_document_job", "DocumentJobResult", "summary_lines"]

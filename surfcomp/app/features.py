@@ -38,33 +38,34 @@ import FreeCAD
 import numpy as np
 
 from ..core.deviations import statistics
-from ..core.field import GridField
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
 from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare
 from ..core.progress import sub
-from ..core.scattered import ScatteredField
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
 from .progress import freecad_progress
 from .proxies import Proxy
 from .proxies import migrate as _migrate
+from .reports import deviation_field
+from .shapes import corrected_shape
+
+#: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
+#: context when it shows them)
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 #: version of the property sets; onDocumentRestored upgrades older objects
-VERSION = 1
+#: (2: short names that fit the property view, see RENAMED)
+VERSION = 2
+#: compensation properties renamed in version 2: old name -> new name
+RENAMED = {"FlipNormals": "Flip", "EdgeTolerance": "EdgeTol", "NominalPoints": "Nodes"}
 
 MEASUREMENT_TYPE = "SurfComp_Measurement"
 COMPENSATION_TYPE = "SurfComp_Compensation"
 
 OUTPUTS = ("face", "solid")
 MASK_KINDS = ("box", "gaussian")
-#: quantities of :func:`deviation_field`
-QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
-
-#: a solid whose face was replaced gets its edges' tolerance raised to cover the shift of
-#: the face border inside the neighbouring faces (mm): refuse larger shifts
-MAX_EDGE_TOLERANCE = 1.0
 
 _RO = 1      # editor mode: read-only
 _HIDDEN = 2  # editor mode: hidden
@@ -73,130 +74,222 @@ _HIDDEN = 2  # editor mode: hidden
 _MEAS = "Measurement"
 MEASUREMENT_PROPERTIES = (
     ("App::PropertyString", "SourceName", _MEAS,
-     "File the measurements were read from (information only: the data is stored below)",
+     QT_TRANSLATE_NOOP("App::Property", "File the measurements were read from (information only: "
+                                        "the data is stored below)"),
      "", _RO),
-    ("App::PropertyString", "SourceSha256", _MEAS, "SHA-256 of the source file's bytes", "",
-     _RO),
+    ("App::PropertyString", "SourceSha256", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "SHA-256 of the source file's bytes"),
+     "", _RO),
     ("App::PropertyString", "Units", _MEAS,
-     "Units of the source file's length columns (the stored values are in mm)", "mm", _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Units of the source file's length columns (the stored "
+                                        "values are in mm)"),
+     "mm", _RO),
     ("App::PropertyString", "Kind", _MEAS,
-     "Columns the file had: nominal+normal+deviation, nominal+measured, ...", "", _RO),
-    ("App::PropertyInteger", "PointCount", _MEAS, "Number of measured points", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Columns the file had: nominal+normal+deviation, "
+                                        "nominal+measured, ..."),
+     "", _RO),
+    ("App::PropertyInteger", "PointCount", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Number of measured points"),
+     0, _RO),
     ("App::PropertyIntegerList", "GridShape", _MEAS,
-     "Rows and columns of the grid when the file gives row/col indices (else empty)", None,
-     _RO),
-    ("App::PropertyFloatList", "NominalX", _MEAS, "Nominal points, x (mm)", None, _RO),
-    ("App::PropertyFloatList", "NominalY", _MEAS, "Nominal points, y (mm)", None, _RO),
-    ("App::PropertyFloatList", "NominalZ", _MEAS, "Nominal points, z (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredX", _MEAS, "Measured points, x (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredY", _MEAS, "Measured points, y (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredZ", _MEAS, "Measured points, z (mm)", None, _RO),
-    ("App::PropertyFloatList", "NormalI", _MEAS, "Normals, x component", None, _RO),
-    ("App::PropertyFloatList", "NormalJ", _MEAS, "Normals, y component", None, _RO),
-    ("App::PropertyFloatList", "NormalK", _MEAS, "Normals, z component", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Rows and columns of the grid when the file gives row/col "
+                                        "indices (else empty)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalX", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, x (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalY", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, y (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalZ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredX", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, x (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredY", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, y (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredZ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalI", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, x component"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalJ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, y component"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalK", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, z component"),
+     None, _RO),
     ("App::PropertyFloatList", "Deviation", _MEAS,
-     "Deviation along the normal (mm, positive = material left)", None, _RO),
-    ("App::PropertyIntegerList", "Row", _MEAS, "Grid row of every point (when given)", None,
-     _RO),
-    ("App::PropertyIntegerList", "Col", _MEAS, "Grid column of every point (when given)",
+     QT_TRANSLATE_NOOP("App::Property", "Deviation along the normal (mm, positive = material "
+                                        "left)"),
      None, _RO),
-    ("App::PropertyIntegerList", "Lines", _MEAS, "Line of every point in the source file",
+    ("App::PropertyIntegerList", "Row", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Grid row of every point (when given)"),
      None, _RO),
-    ("App::PropertyStringList", "Ids", _MEAS, "Point names (when given)", None, _RO),
+    ("App::PropertyIntegerList", "Col", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Grid column of every point (when given)"),
+     None, _RO),
+    ("App::PropertyIntegerList", "Lines", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Line of every point in the source file"),
+     None, _RO),
+    ("App::PropertyStringList", "Ids", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Point names (when given)"),
+     None, _RO),
     ("App::PropertyString", "Columns", _MEAS,
-     "Role -> column name as written in the file (JSON)", "{}", _RO),
-    ("App::PropertyStringList", "ReadWarnings", _MEAS, "Warnings of the file reader", None,
-     _RO),
-    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     QT_TRANSLATE_NOOP("App::Property", "Role -> column name as written in the file (JSON)"),
+     "{}", _RO),
+    ("App::PropertyStringList", "ReadWarnings", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Warnings of the file reader"),
+     None, _RO),
+    ("App::PropertyInteger", "Version", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
 _IN, _RES = "Compensation", "Result"
 COMPENSATION_PROPERTIES = (
-    ("App::PropertyLink", "Nominal", _IN, "Object holding the nominal face", None, 0),
-    ("App::PropertyString", "FaceName", _IN, "The nominal face (FaceN of Nominal)", "Face1",
-     0),
-    ("App::PropertyLink", "Measurement", _IN, "Measurement object (SurfComp_Measurement)",
+    ("App::PropertyLink", "Nominal", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Object holding the nominal face"),
+     None, 0),
+    ("App::PropertyString", "FaceName", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "The nominal face (FaceN of Nominal)"),
+     "Face1", 0),
+    ("App::PropertyLink", "Measurement", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Measurement object (SurfComp_Measurement)"),
      None, 0),
     ("App::PropertyLink", "Base", _IN,
-     "Previous compensation (iterations): this measurement is of the part machined from its "
-     "corrected face; corrections accumulate", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Previous compensation (iterations): this measurement is "
+                                        "of the part machined from its corrected face; corrections"
+                                        " accumulate"),
+     None, 0),
     ("App::PropertyEnumeration", "Method", _IN,
-     "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs Stock), offset", list(METHODS), 0),
-    ("App::PropertyInteger", "MaskSize", _IN, "Odd size of the filter mask", 5, 0),
+     QT_TRANSLATE_NOOP("App::Property", "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs "
+                                        "Stock), offset"),
+     list(METHODS), 0),
+    ("App::PropertyInteger", "MaskSize", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Odd size of the filter mask"),
+     5, 0),
     ("App::PropertyString", "Weights", _IN,
-     "Custom mask weights, rows separated by ';' (empty: MaskKind and MaskSize)", "", 0),
-    ("App::PropertyEnumeration", "MaskKind", _IN, "Mask shape without custom weights",
+     QT_TRANSLATE_NOOP("App::Property", "Custom mask weights, rows separated by ';' (empty: "
+                                        "MaskKind and MaskSize)"),
+     "", 0),
+    ("App::PropertyEnumeration", "MaskKind", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Mask shape without custom weights"),
      list(MASK_KINDS), 0),
     ("App::PropertyFloat", "Sigma", _IN,
-     "Gaussian sigma in grid steps (0: MaskSize / 4)", 0.0, 0),
-    ("App::PropertyEnumeration", "Edge", _IN, "Edge handling of the filter", list(EDGE_MODES),
-     0),
+     QT_TRANSLATE_NOOP("App::Property", "Gaussian sigma in grid steps (0: MaskSize / 4)"),
+     0.0, 0),
+    ("App::PropertyEnumeration", "Edge", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Edge handling of the filter"),
+     list(EDGE_MODES), 0),
     ("App::PropertyLength", "Stock", _IN,
-     "Semi-finishing allowance of the mirror method (mm; DH = Stock / 2)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
+                                        "Stock / 2)"),
+     0.0, 0),
     ("App::PropertyLength", "MaxOffset", _IN,
-     "Largest accepted distance of a measured point from the face", 1.0, 0),
-    ("App::PropertyBool", "FlipNormals", _IN,
-     "The file's normals point into the material: flip them and the deviations' sign",
+     QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
+                                        "face"),
+     1.0, 0),
+    ("App::PropertyBool", "Flip", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "The file's normals point into the material: flip them and"
+                                        " the deviations' sign"),
      False, 0),
     ("App::PropertyInteger", "Refine", _IN,
-     "Knot spans of the corrected surface per measurement grid step", 4, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
+                                        "step"),
+     4, 0),
     ("App::PropertyEnumeration", "Output", _IN,
-     "face: the corrected face; solid: the nominal's shape with the face replaced",
+     QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
+                                        " the face replaced"),
      list(OUTPUTS), 0),
     ("App::PropertyEnumeration", "Layout", _IN,
-     "auto: a complete grid if the points form one, else scattered; grid: refuse others",
+     QT_TRANSLATE_NOOP("App::Property", "auto: a complete grid if the points form one, else "
+                                        "scattered; grid: refuse others"),
      list(LAYOUTS), 0),
     ("App::PropertyLength", "Smoothing", _IN,
-     "Scattered points: smoothing length of the fit that replaces the mask filter "
-     "(0: chosen by generalized cross-validation)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Scattered points: smoothing length of the fit that "
+                                        "replaces the mask filter (0: chosen by generalized "
+                                        "cross-validation)"),
+     0.0, 0),
     ("App::PropertyLength", "TipRadius", _IN,
-     "Stylus ball radius when the measured points are tip centres (probe logs)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Stylus ball radius when the measured points are tip "
+                                        "centres (probe logs)"),
+     0.0, 0),
     ("App::PropertyBool", "Preview", _IN,
-     "Filter preview (task panel): compute deviations and components only and keep the "
-     "last corrected shape; the panel clears it when it closes", False, _HIDDEN),
+     QT_TRANSLATE_NOOP("App::Property", "Filter preview (task panel): compute deviations and "
+                                        "components only and keep the last corrected shape; the "
+                                        "panel clears it when it closes"),
+     False, _HIDDEN),
     ("App::PropertyInteger", "GridRows", _RES,
-     "Rows of the measurement grid (scattered layouts: the number of points)", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Rows of the measurement grid (scattered layouts: the "
+                                        "number of points)"),
+     0, _RO),
     ("App::PropertyInteger", "GridCols", _RES,
-     "Columns of the measurement grid (scattered layouts: 1)", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Columns of the measurement grid (scattered layouts: 1)"),
+     0, _RO),
     ("App::PropertyBool", "Scattered", _RES,
-     "The points are a scattered layout (not a grid): fields are built over the points",
+     QT_TRANSLATE_NOOP("App::Property", "The points are a scattered layout (not a grid): fields "
+                                        "are built over the points"),
      False, _RO),
     ("App::PropertyFloatList", "FieldScale", _RES,
-     "Scattered layouts: mm per unit parameter along u and v used by the fits", None, _RO),
-    ("App::PropertyFloatList", "U", _RES, "Face parameter u of every grid node (row-major)",
+     QT_TRANSLATE_NOOP("App::Property", "Scattered layouts: mm per unit parameter along u and v "
+                                        "used by the fits"),
      None, _RO),
-    ("App::PropertyFloatList", "V", _RES, "Face parameter v of every grid node (row-major)",
+    ("App::PropertyFloatList", "U", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Face parameter u of every grid node (row-major)"),
      None, _RO),
-    ("App::PropertyFloatList", "NominalPoints", _RES,
-     "Nominal point of every node, flat x y z (mm)", None, _RO),
-    ("App::PropertyFloatList", "Normals", _RES, "Outward normal of every node, flat", None,
-     _RO),
+    ("App::PropertyFloatList", "V", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Face parameter v of every grid node (row-major)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Nodes", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal point of every node, flat x y z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Normals", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Outward normal of every node, flat"),
+     None, _RO),
     ("App::PropertyFloatList", "Deviation", _RES,
-     "Deviation from the nominal at every node (mm, NaN = not measured)", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Deviation from the nominal at every node (mm, NaN = not "
+                                        "measured)"),
+     None, _RO),
     ("App::PropertyFloatList", "Determined", _RES,
-     "Filtered (determined) component of the deviation (mm)", None, _RO),
-    ("App::PropertyFloatList", "Random", _RES, "Random component: deviation - determined (mm)",
+     QT_TRANSLATE_NOOP("App::Property", "Filtered (determined) component of the deviation (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Random", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Random component: deviation - determined (mm)"),
      None, _RO),
     ("App::PropertyFloatList", "Increment", _RES,
-     "Correction of this round (mm); equals Correction without a Base", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Correction of this round (mm); equals Correction without "
+                                        "a Base"),
+     None, _RO),
     ("App::PropertyFloatList", "Correction", _RES,
-     "Total correction realised by the corrected face (mm, accumulated over the Base chain)",
+     QT_TRANSLATE_NOOP("App::Property", "Total correction realised by the corrected face (mm, "
+                                        "accumulated over the Base chain)"),
      None, _RO),
     ("App::PropertyString", "Statistics", _RES,
-     "name -> statistics (mm) as JSON", "{}", _RO),
-    ("App::PropertyString", "Checks", _RES, "Check figures of the corrected face (JSON)", "{}",
-     _RO),
-    ("App::PropertyStringList", "Warnings", _RES, "What the computation warned about", None,
-     _RO),
-    ("App::PropertyInteger", "Round", _RES, "Iteration round (1 without a Base)", 1, _RO),
-    ("App::PropertyLength", "EdgeTolerance", _RES,
-     "Largest edge tolerance of the output solid (covers the face border's shift)", 0.0,
-     _RO),
+     QT_TRANSLATE_NOOP("App::Property", "name -> statistics (mm) as JSON"),
+     "{}", _RO),
+    ("App::PropertyString", "Checks", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Check figures of the corrected face (JSON)"),
+     "{}", _RO),
+    ("App::PropertyStringList", "Warnings", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "What the computation warned about"),
+     None, _RO),
+    ("App::PropertyInteger", "Round", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Iteration round (1 without a Base)"),
+     1, _RO),
+    ("App::PropertyLength", "EdgeTol", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Largest edge tolerance of the output solid (covers the "
+                                        "face border's shift)"),
+     0.0, _RO),
     ("App::PropertyString", "ReplacedLinks", "Replace",
-     "Links rebound by surfcomp.app.replace.replace (JSON; restore() reverts them)", "",
-     _HIDDEN),
-    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     QT_TRANSLATE_NOOP("App::Property", "Links rebound by surfcomp.app.replace.replace (JSON; "
+                                        "restore() reverts them)"),
+     "", _HIDDEN),
+    ("App::PropertyInteger", "Version", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
@@ -377,6 +470,7 @@ class CompensationFeature(_Proxy):
 
     Type = COMPENSATION_TYPE
     PROPERTIES = COMPENSATION_PROPERTIES
+    RENAMED = RENAMED
 
     def execute(self, obj):
         result = _compute(obj)
@@ -395,10 +489,35 @@ def options_of(obj):
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
-                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.FlipNormals),
+                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
                    refine=int(obj.Refine), layout=obj.Layout,
                    smoothing=(float(obj.Smoothing.Value) or None),
                    tip_radius=float(obj.TipRadius.Value))
+
+
+#: compensation property -> core option of the filter (the task panel's fields)
+FILTER_OPTIONS = {"MaskSize": "mask_size", "Weights": "weights", "MaskKind": "mask_kind",
+                  "Edge": "edge"}
+
+
+def check_filter(obj, **values):
+    """Check filter values (``MaskSize=``, ``Weights=``, ``MaskKind=``, ``Edge=``) with the
+    core's option domains before they are set, so a panel can show the message instead
+    of a failed recompute. Returns the mask's size (custom weights set it).
+
+    Raises
+    ------
+    InputError
+        The message of :meth:`surfcomp.core.pipeline.Options.validate`.
+    """
+    kw = {}
+    for name, value in values.items():
+        if name == "Weights":
+            value = value.strip() or None
+        kw[FILTER_OPTIONS[name]] = value
+    options = _dc_replace(options_of(obj), **kw)
+    options.validate()
+    return int(options.mask().shape[0])
 
 
 def chain(obj):
@@ -500,7 +619,7 @@ def _compute(obj):
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
     if preview:
-        return _Result(comp, nominal, increment, None, obj.EdgeTolerance.Value, len(links))
+        return _Result(comp, nominal, increment, None, obj.EdgeTol.Value, len(links))
     shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     shape.Placement = placement
     return _Result(comp, nominal, increment, shape, tol, len(links))
@@ -519,89 +638,6 @@ def _build(nominal, prepared, comp, total, build=True, progress=None):
     return build_surface(comp, nominal.surface, nominal.outward, total, progress=progress)
 
 
-def rebuild_face(face, bs):
-    """The face ``face`` with its surface replaced by ``bs`` (same parametrisation).
-
-    The boundary is rebuilt from the face's own 2D curves (pcurves) on the new surface,
-    so trimmed faces and holes keep their place in parameter space; edges come in the
-    order of ``face.Edges``.
-    """
-    import Part
-
-    outer = face.OuterWire
-    wires = [outer] + [w for w in face.Wires if not w.isSame(outer)]
-    new_wires = []
-    for w in wires:
-        edges = []
-        for e in w.Edges:
-            c2d, a, b = face.curveOnSurface(e)[:3]
-            edges.append(c2d.toShape(bs, a, b))
-        new_wires.append(Part.Wire(edges))
-    out = Part.Face(bs, new_wires[0])
-    if len(new_wires) > 1:
-        out = out.cutHoles(new_wires[1:]) or out
-    if face.Orientation == "Reversed":
-        out.reverse()
-    if not out.isValid():
-        out.fix(1e-7, 1e-7, 1e-4)
-    if not out.isValid() or len(out.Edges) != len(face.Edges):
-        raise GeometryError("cannot rebuild %s on the corrected surface (%d edges instead of "
-                            "%d)" % ("the face", len(out.Edges), len(face.Edges)))
-    return out
-
-
-def corrected_shape(nominal, corrected, output="face", label="compensation"):
-    """The output shape of a compensation: ``(shape, max_edge_tolerance)``.
-
-    Parameters
-    ----------
-    nominal : surfcomp.app.nominal.Nominal
-        ``nominal.face`` is the face in ``nominal.shape``.
-    corrected : surfcomp.core.bspline.Surface
-    output : {'face', 'solid'}
-        ``solid``: ``nominal.shape`` with the face (and its edges and vertices) replaced;
-        the neighbouring faces keep their surfaces, their shared edges get the tolerance
-        that covers the shift of the border (reported, at most
-        :data:`MAX_EDGE_TOLERANCE`). Same number and order of faces.
-    """
-    from .convert import surface_to_part
-
-    bs = surface_to_part(corrected)
-    old = nominal.face
-    new = rebuild_face(old, bs)
-    if output == "face":
-        return new, max(e.Tolerance for e in new.Edges)
-    shape = nominal.shape
-    idx = int(nominal.face_name[4:]) - 1
-    old = shape.Faces[idx]
-    new = rebuild_face(old, bs)
-    pairs = [(old, new)]
-    for a, b in zip(old.Edges, new.Edges):
-        pairs.append((a, b))
-    for a, b in zip(old.Vertexes, new.Vertexes):
-        pairs.append((a, b))
-    out = shape.replaceShape(pairs)
-    out.fix(1e-7, 1e-7, MAX_EDGE_TOLERANCE)
-    problems = []
-    if not out.isValid():
-        problems.append("not valid")
-    if len(out.Faces) != len(shape.Faces):
-        problems.append("%d faces instead of %d" % (len(out.Faces), len(shape.Faces)))
-    if len(out.Solids) != len(shape.Solids):
-        problems.append("%d solids instead of %d" % (len(out.Solids), len(shape.Solids)))
-    if not problems:
-        for k, (a, b) in enumerate(zip(shape.Faces, out.Faces)):
-            if k != idx and a.Surface.TypeId != b.Surface.TypeId:
-                problems.append("Face%d changed its type" % (k + 1))
-                break
-        if out.Faces[idx].Surface.TypeId != "Part::GeomBSplineSurface":
-            problems.append("%s is not the corrected surface" % nominal.face_name)
-    if problems:
-        raise GeometryError("%s: cannot replace %s in the nominal's shape (%s); use Output = "
-                            "face" % (label, nominal.face_name, ", ".join(problems)))
-    return out, max(e.Tolerance for e in out.Edges)
-
-
 def _flat(a):
     return np.asarray(a, dtype=float).ravel().tolist()
 
@@ -616,7 +652,7 @@ def _write_results(obj, r):
     obj.FieldScale = list(comp.scale) if p.scattered else []
     obj.U = _flat(g.take(p.u))
     obj.V = _flat(g.take(p.v))
-    obj.NominalPoints = _flat(g.take(p.nominal))
+    obj.Nodes = _flat(g.take(p.nominal))
     obj.Normals = _flat(g.take(p.normal))
     c = comp.correction
     obj.Deviation = _flat(c.deviation)
@@ -630,7 +666,7 @@ def _write_results(obj, r):
         obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
     obj.Warnings = [str(w) for w in p.warnings]
     obj.Round = r.round
-    obj.EdgeTolerance = float(r.edge_tolerance)
+    obj.EdgeTol = float(r.edge_tolerance)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
@@ -685,60 +721,6 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     return _created(obj)
 
 
-def _grid(obj, name):
-    a = np.asarray(getattr(obj, name), dtype=float)
-    n, m = obj.GridRows, obj.GridCols
-    if n * m == 0 or a.size != n * m:
-        raise InputError("%s has no computed %s (recompute it first)" % (obj.Label, name))
-    return a.reshape(n, m)
-
-
-def _fill_gaps(values):
-    """Unmeasured nodes (NaN) take the value of the nearest measured node."""
-    bad = ~np.isfinite(values)
-    if not bad.any():
-        return values
-    if bad.all():
-        raise InputError("no measured node to build a field from")
-    from scipy import ndimage
-
-    idx = ndimage.distance_transform_edt(bad, return_distances=False, return_indices=True)
-    return values[tuple(idx)]
-
-
-def deviation_field(obj, quantity):
-    """A C1 field ``f(u, v)`` of a compensation's node values over the face's parameters.
-
-    Parameters
-    ----------
-    obj : ``SurfComp_Compensation`` (computed)
-    quantity : str
-        ``deviation``, ``determined``, ``random``, ``correction`` (total, accumulated),
-        ``increment`` (this round's correction) or ``residual``
-        (``deviation - increment``: what this round leaves uncorrected).
-
-    Returns
-    -------
-    surfcomp.core.field.GridField
-        Callable on arrays of u, v (face parameters); values in mm. Unmeasured nodes
-        take the value of their nearest measured node.
-    """
-    names = {"deviation": "Deviation", "determined": "Determined", "random": "Random",
-             "correction": "Correction", "increment": "Increment"}
-    if quantity == "residual":
-        values = _grid(obj, "Deviation") - _grid(obj, "Increment")
-    elif quantity in names:
-        values = _grid(obj, names[quantity])
-    else:
-        raise InputError("unknown quantity %r (expected one of %s)"
-                         % (quantity, ", ".join(QUANTITIES)))
-    if obj.Scattered:
-        surf = nominal_of(obj)[0].surface
-        return ScatteredField(_grid(obj, "U").ravel(), _grid(obj, "V").ravel(), values.ravel(),
-                              scale=tuple(obj.FieldScale), box=(surf.u_range, surf.v_range))
-    return GridField(_grid(obj, "U"), _grid(obj, "V"), _fill_gaps(values))
-
-
 def compensation_result(obj):
     """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
     recomputed from its properties and links (nothing is cached on the proxy).
@@ -749,51 +731,8 @@ def compensation_result(obj):
     return _compute(obj).comp
 
 
-def report_of(obj):
-    """The JSON report (schema ``surfcomp-report/1``, as the CLI writes it) of a
-    compensation object, recomputed from its properties and links."""
-    from ..io import report as report_io
-
-    comp = compensation_result(obj)
-    nominal = nominal_of(obj)[0]
-    m = obj.Measurement
-    inputs = {
-        "nominal": {"path": obj.Document.FileName or obj.Document.Name,
-                    "object": obj.Nominal.Label, "face": obj.FaceName,
-                    "poles": list(nominal.surface.shape),
-                    "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
-                    "rational": nominal.surface.weights is not None},
-        "measurements": {"path": m.SourceName, "sha256": m.SourceSha256, "units": m.Units,
-                         "points": int(m.PointCount), "object": m.Label},
-    }
-    return report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
-
-
-def write_html_report(obj, path):
-    """Write the self-contained HTML report of a compensation object (atomically)."""
-    from ..io.html_report import write_html_report as write
-
-    return write(path, report_of(obj))
-
-
-def corrected_surface(obj):
-    """The corrected surface of a computed compensation object as a core
-    :class:`~surfcomp.core.bspline.Surface` (from its Shape, in document coordinates:
-    the feature's Placement applied)."""
-    from .convert import surface_from_part
-
-    shape = obj.Shape
-    if obj.Output == "solid":
-        face = shape.Faces[int(obj.FaceName[4:]) - 1]
-    else:
-        face = shape.Faces[0]
-    u0, u1, v0, v1 = face.ParameterRange
-    return surface_from_part(face.Surface, (u0, u1), (v0, v1))
-
-
 __all__ = ["VERSION", "MEASUREMENT_TYPE", "COMPENSATION_TYPE", "MeasurementFeature",
            "CompensationFeature", "make_measurement", "make_measurement_from_set",
            "set_measurement_data", "measurement_set", "make_compensation",
-           "compensation_result", "deviation_field", "options_of", "chain", "migrate",
-           "is_compensation", "is_measurement", "corrected_shape", "rebuild_face",
-           "nominal_of", "corrected_surface"]
+           "compensation_result", "options_of", "chain", "migrate", "is_compensation",
+           "is_measurement", "nominal_of"]

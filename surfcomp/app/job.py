@@ -14,7 +14,7 @@ from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import sub
 from ..errors import InputError
 from ..io import report as report_io
-from ..io.atomic import Transaction
+from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.html_report import render_html
 from ..io.readers import read_any
@@ -62,15 +62,36 @@ class Job:
         return cls(**kw)
 
 
+#: the outputs of a job: (attribute of :class:`Job`, command-line option)
+OUTPUT_OPTIONS = (("output", "-o"), ("report", "--report"), ("points", "--points"),
+                  ("curves", "--curves"), ("html", "--html"))
+
+
+def declared_outputs(job):
+    """``(option, path)`` of every output the job writes."""
+    return [(option, getattr(job, attr)) for attr, option in OUTPUT_OPTIONS
+            if getattr(job, attr)]
+
+
+def declared_inputs(job):
+    return [("NOMINAL", job.nominal), ("MEASUREMENTS", job.measurements)]
+
+
 def run_job(job, progress=None):
-    """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs."""
+    """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs.
+
+    The outputs are checked against the inputs and each other before anything is read, and
+    written together at the end (:class:`surfcomp.io.atomic.Transaction`).
+    """
+    outputs, inputs = declared_outputs(job), declared_inputs(job)
+    check_outputs(outputs, inputs)
+    job.options.validate()
+    for attr in ("output", "curves"):
+        if getattr(job, attr):
+            cad_format(getattr(job, attr), dict(OUTPUT_OPTIONS)[attr])
     fcenv.import_freecad()
     from .nominal import load_nominal
 
-    for out in (job.output, job.report, job.points, job.curves, job.html):
-        if out and os.path.abspath(out) in (os.path.abspath(job.nominal),
-                                            os.path.abspath(job.measurements)):
-            raise InputError("an output would overwrite an input file", file=out)
     nominal = load_nominal(job.nominal, job.face, job.object)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
@@ -78,49 +99,55 @@ def run_job(job, progress=None):
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
                       progress=sub(progress, 0.3, 0.95))
-    inputs = {
-        "nominal": {"path": os.path.abspath(job.nominal), "sha256": sha256_file(job.nominal),
-                    "face": nominal.face_name, "object": nominal.object_name,
-                    "surface": nominal.converted or "BSplineSurface",
-                    "poles": list(nominal.surface.shape),
-                    "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
-                    "rational": nominal.surface.weights is not None,
-                    "u_range": list(nominal.surface.u_range),
-                    "v_range": list(nominal.surface.v_range)},
-        "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
-                         "units": ms.units, "kind": ms.kind(), "points": len(ms),
-                         "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
-    }
-    outputs = {k: os.path.abspath(getattr(job, k)) for k in ("output", "report", "points", "curves",
-                                                               "html")
-               if getattr(job, k)}
-    rep = report_io.build_report(job.command, inputs, comp, prepared.warnings, outputs,
+    rep = report_io.build_report(job.command, _inputs_record(job, nominal, ms), comp,
+                                 prepared.warnings,
+                                 {attr: os.path.abspath(getattr(job, attr))
+                                  for attr, _opt in OUTPUT_OPTIONS if getattr(job, attr)},
                                  points=bool(job.report or job.html))
-    with Transaction() as tx:
-        if build and job.output:
-            write_face(tx.stage(job.output), corrected_face(comp, nominal))
-        if job.points:
-            tx.stage_text(job.points, corrected_points_csv(comp))
-        if build and job.curves:
-            write_face(tx.stage(job.curves), curve_net(comp))
-        if job.report:
-            tx.stage_text(job.report, report_io.dumps(rep))
-        if job.html:
-            tx.stage_text(job.html, render_html(rep))
+    # everything is computed before the first file is staged
+    shapes = {}
+    if build and job.output:
+        shapes["output"] = corrected_face(comp, nominal)
+    if build and job.curves:
+        shapes["curves"] = curve_net(comp)
+    texts = {}
+    if job.points:
+        texts["points"] = corrected_points_csv(comp)
+    if job.report:
+        texts["report"] = report_io.dumps(rep)
+    if job.html:
+        texts["html"] = render_html(rep)
+    with Transaction(outputs, inputs) as tx:
+        for attr, shape in shapes.items():
+            tx.write(getattr(job, attr), lambda tmp, shape=shape: write_face(tmp, shape))
+        for attr, text in texts.items():
+            tx.stage_text(getattr(job, attr), text)
         tx.commit()
     return comp, rep
 
 
+def _inputs_record(job, nominal, ms):
+    surface = nominal.surface
+    return {
+        "nominal": {"path": os.path.abspath(job.nominal), "sha256": sha256_file(job.nominal),
+                    "face": nominal.face_name, "object": nominal.object_name,
+                    "surface": nominal.converted or "BSplineSurface",
+                    "poles": list(surface.shape),
+                    "degree": [surface.degree_u, surface.degree_v],
+                    "rational": surface.weights is not None,
+                    "u_range": list(surface.u_range), "v_range": list(surface.v_range)},
+        "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
+                         "units": ms.units, "kind": ms.kind(), "points": len(ms),
+                         "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
+    }
+
+
 def corrected_face(comp, nominal):
-    """The corrected ``Part.Face`` with the nominal face's orientation."""
-    import Part
+    """The corrected face: the nominal face's boundary (trim, holes) on the corrected
+    surface, with the nominal's orientation (:func:`surfcomp.app.shapes.corrected_shape`)."""
+    from .shapes import corrected_shape
 
-    from .convert import surface_to_part
-
-    face = Part.Face(surface_to_part(comp.corrected))
-    if nominal.outward < 0:
-        face.reverse()
-    return face
+    return corrected_shape(nominal, comp.corrected, "face", nominal.face_name)[0]
 
 
 def curve_net(comp):
@@ -141,18 +168,31 @@ def curve_net(comp):
     return Part.Compound(edges)
 
 
+#: CAD output formats by file extension
+CAD_FORMATS = {".step": "step", ".stp": "step", ".iges": "iges", ".igs": "iges",
+               ".brep": "brep", ".brp": "brep"}
+
+
+def cad_format(path, option="output"):
+    """The CAD format of an output file from its extension (checked before any work)."""
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in CAD_FORMATS:
+        raise InputError("%s: unsupported file type %r (expected .step, .iges or .brep)"
+                         % (option, ext), file=path)
+    return CAD_FORMATS[ext]
+
+
 def write_face(path, shape):
     """Write a shape as STEP, IGES or BREP, chosen by the file extension of ``path``."""
-    ext = os.path.splitext(path)[1].lower()
-    if ext in (".step", ".stp"):
+    fmt = cad_format(path)
+    if fmt == "step":
         shape.exportStep(path)
-    elif ext in (".iges", ".igs"):
+    elif fmt == "iges":
         shape.exportIges(path)
-    elif ext in (".brep", ".brp"):
-        shape.exportBrep(path)
     else:
-        raise InputError("unsupported output type %r (expected .step, .iges or .brep)" % ext,
-                         file=path)
+        shape.exportBrep(path)
+    if not os.path.getsize(path):
+        raise InputError("OpenCASCADE wrote an empty file", file=path)
 
 
 def corrected_points_csv(comp):

@@ -8,7 +8,9 @@ from dataclasses import dataclass
 
 from ..errors import GeometryError
 from . import fcenv
+from .cadread import read_cad
 from .convert import surface_from_part
+from .documents import open_document
 
 CAD_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
 
@@ -51,9 +53,6 @@ def read_shape(path, object_name=None):
     that has B-spline faces is taken.
     """
     fcenv.import_freecad()
-    import FreeCAD
-    import Part
-
     if not os.path.isfile(path):
         raise GeometryError("nominal file not found (expected a STEP, IGES, BREP or FCStd file)",
                             file=path)
@@ -65,24 +64,14 @@ def read_shape(path, object_name=None):
                             ".brep/.brp or .FCStd)" % ext, file=path)
     if object_name:
         raise GeometryError("--object applies to FCStd documents only", file=path)
-    try:
-        shape = Part.read(path)
-    except (Part.OCCError, RuntimeError, ValueError) as exc:
-        raise GeometryError("cannot read the CAD file: %s" % exc, file=path) from exc
-    if shape.isNull() or not shape.Faces:
-        raise GeometryError("the file contains no faces", file=path)
-    del FreeCAD
-    return shape, None
+    return read_cad(path), None
 
 
 def _shape_from_document(path, object_name):
     import FreeCAD
 
     before = set(FreeCAD.listDocuments())
-    try:
-        doc = FreeCAD.openDocument(path, True)
-    except (OSError, RuntimeError, ValueError) as exc:
-        raise GeometryError("cannot open the FreeCAD document: %s" % exc, file=path) from exc
+    doc = open_document(path)[0]
     try:
         if object_name:
             obj = doc.getObject(object_name) or next(

@@ -19,6 +19,7 @@ import json
 
 from ..errors import GeometryError, InputError
 from . import features
+from .undo import UndoStep
 
 #: properties never rebound: group membership and the compensation's own inputs
 SKIP_PROPERTIES = ("Group", "ExpressionEngine", "InList", "OutList")
@@ -66,14 +67,6 @@ def _decode(doc, kind, data):
     return [(obj(n), tuple(subs)) for n, subs in data]
 
 
-def _get(o, prop):
-    return getattr(o, prop)
-
-
-def _set(o, prop, value):
-    setattr(o, prop, value)
-
-
 def _map_subs(subs, mapping, where, label):
     if mapping is None:
         return list(subs)
@@ -102,6 +95,29 @@ def _sub_mapping(comp):
     return {comp.FaceName: "Face1"}
 
 
+def _rebound(value, kind, names, comp, mapping, where):
+    """``value`` of a link property with the targets (``names``) replaced by ``comp``, or
+    None when it links none of them."""
+    def subs_of(old):
+        return _map_subs(old, mapping, where, comp.Label)
+
+    if kind == "link":
+        return comp if value is not None and value.Name in names else None
+    if kind == "list":
+        if not any(x.Name in names for x in value):
+            return None
+        return [comp if x.Name in names else x for x in value]
+    if kind == "sub":
+        if not value or value[0].Name not in names:
+            return None
+        return (comp, subs_of(list(value[1])))
+    pairs = [(x, list(subs) if isinstance(subs, (list, tuple)) else [subs]) for x, subs in value]
+    if not any(x.Name in names for x, _subs in pairs):
+        return None
+    return [(comp, tuple(subs_of(subs))) if x.Name in names else (x, tuple(subs))
+            for x, subs in pairs]
+
+
 def plan(doc, comp):
     """What :func:`replace` would change: a list of ``(object, property, kind, old, new)``.
 
@@ -110,8 +126,7 @@ def plan(doc, comp):
     GeometryError
         A sub-element link to a face that the compensation's output does not have.
     """
-    targets = _targets(comp)
-    names = {t.Name for t in targets}
+    names = {t.Name for t in _targets(comp)}
     mapping = _sub_mapping(comp)
     clones = set()
     changes = []
@@ -119,38 +134,16 @@ def plan(doc, comp):
         if o is comp or features.is_compensation(o) or features.is_measurement(o):
             continue
         for prop in o.PropertiesList:
-            if prop in SKIP_PROPERTIES:
-                continue
-            kind = _kind(o.getTypeIdOfProperty(prop))
+            kind = None if prop in SKIP_PROPERTIES else _kind(o.getTypeIdOfProperty(prop))
             if kind is None:
                 continue
-            old = _get(o, prop)
-            where = "%s.%s" % (o.Label, prop)
-            if kind == "link":
-                if old is not None and old.Name in names:
-                    changes.append((o, prop, kind, old, comp))
-            elif kind == "list":
-                if any(x.Name in names for x in old):
-                    changes.append((o, prop, kind, old,
-                                    [comp if x.Name in names else x for x in old]))
-                    if o.isDerivedFrom("Part::Feature") and len(old) == 1:
-                        clones.add(o.Name)      # a clone of the nominal (Draft, Path model)
-            elif kind == "sub":
-                if old and old[0].Name in names:
-                    changes.append((o, prop, kind, old,
-                                    (comp, _map_subs(list(old[1]), mapping, where, comp.Label))))
-            else:
-                new = []
-                hit = False
-                for x, subs in old:
-                    subs = list(subs) if isinstance(subs, (list, tuple)) else [subs]
-                    if x.Name in names:
-                        hit = True
-                        new.append((comp, tuple(_map_subs(subs, mapping, where, comp.Label))))
-                    else:
-                        new.append((x, tuple(subs)))
-                if hit:
-                    changes.append((o, prop, kind, old, new))
+            old = getattr(o, prop)
+            new = _rebound(old, kind, names, comp, mapping, "%s.%s" % (o.Label, prop))
+            if new is None:
+                continue
+            changes.append((o, prop, kind, old, new))
+            if kind == "list" and o.isDerivedFrom("Part::Feature") and len(old) == 1:
+                clones.add(o.Name)      # a clone of the nominal (Draft, Path model)
     if mapping is not None and clones:
         # a clone of the nominal (Path's model, Draft) gets the face output's single face,
         # so links to the clone's FaceN would point elsewhere
@@ -228,16 +221,8 @@ class _Undo:
 
 def _run(doc, name, work):
     undo = _Undo(doc)
-    doc.openTransaction(name)
-    try:
-        result = work(undo)
-    except BaseException:
-        undo.rollback()
-        doc.abortTransaction()
-        undo.rollback()     # the abort may have replayed older values: ours win
-        raise
-    doc.commitTransaction()
-    return result
+    with UndoStep(doc, name, rollback=undo.rollback):
+        return work(undo)
 
 
 def _check_computed(comp):
@@ -276,12 +261,22 @@ def replace(doc, comp):
 
     def work(undo):
         changes = plan(doc, comp)
-        record = {"links": [], "visibility": {}}
+        if not changes:
+            raise InputError("nothing in the document uses %s (no Path job, clone or other "
+                             "feature links it): there is nothing to replace; export the "
+                             "corrected face with Build corrected face instead"
+                             % nominal.Label)
+        record = {"links": [], "visibility": {}, "labels": {}}
         for o, prop, kind, old, new in changes:
             record["links"].append({"object": o.Name, "property": prop, "kind": kind,
                                     "old": _encode(kind, old)})
             undo.set(o, prop, new)
         _relink_elements(undo, changes)
+        for o in _clones(changes):
+            # a clone named after the nominal (Path's "Model-nominal") is named after comp
+            if nominal.Label in o.Label:
+                record["labels"][o.Name] = o.Label
+                undo.set(o, "Label", o.Label.replace(nominal.Label, comp.Label))
         for o, vis in ((nominal, False), (comp, True)):
             if "Visibility" in o.PropertiesList:
                 record["visibility"][o.Name] = bool(o.Visibility)
@@ -329,10 +324,52 @@ def restore(doc, comp):
             o = doc.getObject(name)
             if o is not None and "Visibility" in o.PropertiesList:
                 undo.set(o, "Visibility", bool(vis))
+        for name, label in record.get("labels", {}).items():
+            o = doc.getObject(name)
+            if o is not None:
+                undo.set(o, "Label", label)
         undo.set(comp, "ReplacedLinks", "")
         return done
 
     return _run(doc, "Restore %s" % getattr(comp.Nominal, "Label", "nominal"), work)
+
+
+def _clones(changes):
+    """The Part features among the changed objects that copy one source (clones, Path's
+    model clone)."""
+    seen = []
+    for o, _prop, kind, _old, new in changes:
+        if kind in ("link", "list") and o.isDerivedFrom("Part::Feature") and o not in seen \
+                and (kind == "link" or len(new) == 1):
+            seen.append(o)
+    return seen
+
+
+def summary(doc, comp):
+    """What :func:`replace` changed, from its record on ``comp``: ``objects`` (labels of
+    the objects whose links were rebound), ``links`` (number of link properties),
+    ``jobs`` (labels of the Path jobs that use a rebound object), ``renamed``
+    (``(old label, new label)``)."""
+    try:
+        record = json.loads(comp.ReplacedLinks or "{}")
+    except ValueError:
+        record = {}
+    names = []
+    for item in record.get("links", []):
+        if item["object"] not in names:
+            names.append(item["object"])
+    objs = [doc.getObject(n) for n in names if doc.getObject(n) is not None]
+    from .pathjob import jobs_of
+
+    jobs = []
+    for job in jobs_of(doc):
+        used = {o.Name for o in job.OutListRecursive} | {job.Name}
+        if used & set(names):
+            jobs.append(job.Label)
+    renamed = [(old, doc.getObject(n).Label) for n, old in record.get("labels", {}).items()
+               if doc.getObject(n) is not None]
+    return {"objects": [o.Label for o in objs], "links": len(record.get("links", [])),
+            "jobs": jobs, "renamed": renamed}
 
 
 def is_replacing(comp):
@@ -340,4 +377,4 @@ def is_replacing(comp):
     return bool(getattr(comp, "ReplacedLinks", ""))
 
 
-__all__ = ["replace", "restore", "plan", "is_replacing"]
+__all__ = ["replace", "restore", "plan", "is_replacing", "summary"]

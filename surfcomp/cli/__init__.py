@@ -2,12 +2,16 @@
 
 Each subcommand lives in its own module of this package with two functions,
 ``add_parser(subparsers)`` and ``run(args) -> int``. Exit codes: 0 ok, 2 bad input
-(stderr says why, nothing written), 1 internal error, 130 interrupted.
+(stderr says why, nothing written), 1 internal error, 130 interrupted (Ctrl-C), 143
+terminated (SIGTERM), 129 hung up (SIGHUP). An interrupted command removes its temporary
+files and writes nothing.
 """
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 import traceback
 
 from .. import __version__
@@ -35,18 +39,42 @@ class ArgumentError(SurfcompError):
     exit_code = 2
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP: unwinds like Ctrl-C (temporary files removed, nothing written)."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.exit_code = 128 + signum
+
+
+def _terminate(signum, _frame):
+    raise Terminated(signum)
+
+
+def _handle_signals():
+    if threading.current_thread() is not threading.main_thread():
+        return
+    for name in ("SIGTERM", "SIGHUP"):
+        sig = getattr(signal, name, None)
+        if sig is not None and signal.getsignal(sig) is not signal.SIG_IGN:
+            signal.signal(sig, _terminate)
+
+
 def main(argv=None):
     """Run the command line; return the process exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    _handle_signals()
     try:
         return int(args.run(args) or 0)
     except SurfcompError as exc:
         print("surfcomp: error: %s" % exc, file=sys.stderr)
         return exc.exit_code
-    except KeyboardInterrupt:
-        print("surfcomp: interrupted; nothing was written", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        print("surfcomp: %s; nothing was written"
+              % ("interrupted" if not isinstance(exc, Terminated) else
+                 "terminated by signal %d" % (exc.exit_code - 128)), file=sys.stderr)
+        return getattr(exc, "exit_code", 130)
     except Exception:  # an internal error: show the traceback, exit 1
         traceback.print_exc()
         print("surfcomp: internal error (please report it with the traceback above)",

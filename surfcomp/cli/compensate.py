@@ -64,6 +64,9 @@ def run_document(args):
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
                          "'compensate' without them for the files" % other[0])
+    from ..app import fcenv
+
+    fcenv.import_freecad()
     from ..app.docjob import run_document_job, summary_lines
 
     res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,

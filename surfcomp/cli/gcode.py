@@ -13,10 +13,11 @@ import numpy as np
 
 from .. import __version__
 from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors, volumetric_map
-from ..errors import InputError
-from ..io.atomic import Transaction
+from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH, check_segments
+from ..errors import GCodeError, InputError
+from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
-from ..io.gcode import compensate_gcode, read_gcode
+from ..io.gcode import compensate_gcode, parse_gcode, read_gcode
 from ..io.hashing import sha256_file
 
 SCHEMA = "surfcomp-gcode-report/1"
@@ -37,13 +38,18 @@ def add_parser(subparsers):
                    help="compensated program (written atomically)")
     p.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
                    help="longest piece of a split G1 move or of an arc turned into G1 "
-                        "segments (default 2 mm)")
+                        "segments (default 2 mm; at least %g mm, and at most %d segments "
+                        "in all)" % (MIN_SEGMENT_LENGTH, MAX_SEGMENTS))
     p.add_argument("--model", choices=MODEL_CHOICES, default="auto",
                    help="degree of every error function, or auto: quadratic where the "
                         "F-test of the quadratic term is significant at 5%% (default auto)")
     p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
     p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
                    help="units of error-file columns without a unit suffix (default mm)")
+    p.add_argument("--max-error", type=float, default=1.0, metavar="MM",
+                   help="largest plausible machine error: a larger value in the error file, "
+                        "or a larger predicted error at a programmed point, is refused as a "
+                        "likely unit mistake (default 1 mm)")
     p.add_argument("--reference", metavar="X,Y,Z", default="0,0,0",
                    help="where the other slides stood while one slide was measured "
                         "(error-file coordinates, mm; default 0,0,0)")
@@ -55,9 +61,10 @@ def add_parser(subparsers):
                         "default unknown: an axis is not written before the program sets it")
     p.add_argument("--tolerance", type=float, default=1e-4, metavar="MM",
                    help="split a long G1 move only where the compensated path leaves its "
-                        "chord by more than this (default 0.0001 mm)")
+                        "chord by more than this (default 0.0001 mm; > 0)")
     p.add_argument("--arc-tolerance", type=float, default=1e-3, metavar="MM",
-                   help="largest chord-to-arc deviation of converted arcs (default 0.001 mm)")
+                   help="largest chord-to-arc deviation of converted arcs (default 0.001 mm; "
+                        "> 0)")
     p.add_argument("--decimals", type=int, metavar="N",
                    help="least decimals of rewritten numbers (default 4 in mm, 5 in inch)")
     p.set_defaults(run=run)
@@ -75,8 +82,12 @@ def _triple(text, option):
     return np.array(vals)
 
 
-def _positive(value, option):
-    if not (value > 0 and np.isfinite(value)):
+def _positive(value, option, minimum=None):
+    """``value`` when it is finite and > 0 (and >= ``minimum``); NaN is refused."""
+    if minimum is not None and not (np.isfinite(value) and value >= minimum):
+        raise InputError("%s %r: expected a positive length of at least %g mm"
+                         % (option, value, minimum))
+    if not (np.isfinite(value) and value > 0):
         raise InputError("%s %r: expected a positive length in mm" % (option, value))
     return value
 
@@ -97,27 +108,39 @@ def _outside_travel(model, points):
     return int((dist > 1e-9).sum()), float(dist.max())
 
 
+def _declared(args):
+    """(outputs, inputs) of the command, checked before any work and at the commit."""
+    return ([("-o", args.output), ("--report", args.report)],
+            [("IN.ngc", args.program), ("--axis-errors", args.axis_errors)])
+
+
 def run(args):
-    seg = _positive(args.segment_length, "--segment-length")
-    tol = args.tolerance
-    if not (tol >= 0 and np.isfinite(tol)):
-        raise InputError("--tolerance %r: expected a length >= 0 in mm" % tol)
+    check_outputs(*_declared(args))
+    seg = _positive(args.segment_length, "--segment-length", MIN_SEGMENT_LENGTH)
+    tol = _positive(args.tolerance, "--tolerance")
     arc_tol = _positive(args.arc_tolerance, "--arc-tolerance")
+    max_error = _positive(args.max_error, "--max-error")
     if args.decimals is not None and not 0 <= args.decimals <= 9:
         raise InputError("--decimals %d: expected 0 to 9" % args.decimals)
     reference = _triple(args.reference, "--reference")
     offset = None if args.work_offset is None else _triple(args.work_offset, "--work-offset")
     start = None if args.start is None else _triple(args.start, "--start")
 
-    table = read_axis_errors(args.axis_errors, units=args.units)
+    table = read_axis_errors(args.axis_errors, units=args.units, max_error=max_error)
     model = fit_axis_errors(table.data, model=args.model, reference=reference,
                             source=args.axis_errors)
     prog_model = model if offset is None else model.in_program_coordinates(offset)
     data = read_gcode(args.program)
+    parsed = parse_gcode(data, source=args.program, start=start)
+    if parsed[0].is_empty():
+        raise GCodeError("the program is empty (no G-code words, only blank lines, comments "
+                         "or % lines; expected G0/G1/G2/G3 moves)", file=args.program)
+    check_segments(parsed[0], seg, arc_tol, names=("--segment-length", "--arc-tolerance"),
+                   source=args.program)
     res = compensate_gcode(data, prog_model, segment_length=seg, tolerance=tol,
                            arc_tolerance=arc_tol, decimals=args.decimals, start=start,
-                           source=args.program)
-    pred = res.predicted(prog_model)
+                           source=args.program, parsed=parsed, max_error=max_error)
+    pred = dict(res.predicted(prog_model), max_correction_mm=res.max_correction())
     vmap = volumetric_map(model)
     ends = res.program.end[res.program.known.all(axis=1)]
     n_out, d_out = _outside_travel(prog_model, ends)
@@ -133,10 +156,8 @@ def run(args):
                         % _um(spread.max()))
 
     outputs = {"program": os.path.abspath(args.output)}
-    with Transaction() as tr:
-        tmp = tr.stage(args.output)
-        with open(tmp, "wb") as fh:
-            fh.write(res.data)
+    with Transaction(*_declared(args)) as tr:
+        tr.stage_bytes(args.output, res.output)
         if args.report:
             outputs["report"] = os.path.abspath(args.report)
             rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,
@@ -170,8 +191,9 @@ def print_summary(args, table, model, res, pred, vmap, warnings, out=None):
     print("Program:      %s (%d lines, %d moves)" % (args.program, st["lines_in"], st["moves"]),
           file=out)
     print("Output:       %d lines changed, %d added; %d G1 moves split, %d arcs turned into G1 "
-          "segments" % (st["lines_changed"], st["lines_added"], st["moves_split"],
-                        st["arcs_converted"]), file=out)
+          "segments; largest correction %.3f um" % (st["lines_changed"], st["lines_added"],
+                                                    st["moves_split"], st["arcs_converted"],
+                                                    _um(pred["max_correction_mm"])), file=out)
     b, a = pred["before"], pred["after"]
     print("Predicted positional error at the program's %d points (model, |E|):" % b["n"],
           file=out)
@@ -208,7 +230,8 @@ def build_report(args, table, model, prog_model, res, pred, vmap, warnings, outp
                             "rows": table.rows(), "units_without_suffix": args.units},
         },
         "options": {"model": args.model, "segment_length_mm": seg, "tolerance_mm": tol,
-                    "arc_tolerance_mm": arc_tol, "decimals": args.decimals,
+                    "arc_tolerance_mm": arc_tol, "max_error_mm": args.max_error,
+                    "decimals": args.decimals,
                     "reference_mm": reference.tolist(),
                     "work_offset_mm": None if offset is None else offset.tolist(),
                     "start_mm": None if start is None else start.tolist()},

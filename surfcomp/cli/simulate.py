@@ -1,27 +1,42 @@
 """``python3 -m surfcomp simulate``: virtual machining loop before cutting metal.
 
-For every method and replica: machine the nominal with the machining-error model,
-measure it on the grid, compensate, machine the corrected face with the same model
+For every method and replica: machine a part (a semi-finishing and a finishing pass)
+from the nominal with the machining-process model, measure it on the grid (the mirror
+method: its own semi-finished part), compensate, machine a part from the corrected face
 and measure it against the nominal at the grid nodes and between them. Prints the
-papers' table (max negative, max positive, mean, std, ISO 1101 profile; mean and
-range over the replicas) and the per-replica standard deviations (mirror paper Tab. 2).
+papers' table (max negative, max positive, mean, std, ISO 1101 profile; mean and range
+over the replicas) and the per-replica standard deviations (mirror paper Tab. 2).
 
-Machining-error model (``surfcomp.core.simulate``; lengths in mm, defaults in brackets),
-error ``e`` along the outward normal, positive = material left::
+``--preset NAME`` runs a case that imitates a paper (``surfcomp.core.presets``:
+werner2022, mirror2019-s1, -s2, -s3) on its own surface, so NOMINAL may be left out,
+and prints the paper's table beside the simulated one. Given a NOMINAL too, the preset's
+process runs on that face instead; options given explicitly override the preset's.
+
+Machining-process model (``surfcomp.core.process_model``; lengths in mm, defaults in
+brackets), error ``e`` of a pass along the outward normal, positive = material left::
 
     e = offset + slope_gain * s + abs_slope_gain * |s|
-        + tilt_f * xi + tilt_c * eta + bow_f * xi^2 + bow_c * eta^2
-        + waviness * sin(2 pi p_f / wavelength) + E_axis . n + random
+        + tilt_f * xi + tilt_c * eta + bow_f * xi^2 + bow_c * eta^2 + E_axis . n
+        + a * (k_0 + k_s * s + k_a * |s|)
+        + waviness * sin(2 pi p_f / wavelength) + random
+
+``a`` the depth the pass removes: ``semi_engagement`` for the semi-finishing pass
+(programmed ``stock`` outside the CAM surface), ``stock + e_semi`` for the finishing
+pass.
 
 --offset MM             constant error (tool radius / wear) [0]
 --slope-gain MM         per unit slope along the feed, s = dz/dfeed (signed) [0.06]
 --abs-slope-gain MM     per unit |slope| (deflection grows with steepness) [0.03]
 --tilt F,C              linear error at the work-area border along / across the feed [0,0.02]
 --bow F,C               quadratic error at the border along / across the feed [-0.02,0.02]
+--deflection K0,KS,KA   deflection per mm of engagement, and its growth with s and |s| [0,0,0]
+--stock MM              allowance the semi-finishing pass leaves; the mirror method's
+                        stock (DH = stock / 2) [0.3]
+--semi-engagement MM    depth the semi-finishing pass removes [the stock]
 --waviness MM           amplitude of a periodic error along the feed [0]
 --wavelength MM         its wavelength [10]
 --feed X,Y,Z            feed direction [1,0,0]; --tool-axis X,Y,Z [0,0,1]
---sigma MM              random machining error, standard deviation [0.0015]
+--sigma MM              random machining error of every pass, standard deviation [0.0015]
 --correlation-length MM random part correlated as exp(-(r/L)^2); 0 = independent [0]
 --probe-sigma MM        measurement noise of every probed point [0.0005]
 --axis-errors ERR.csv   machine-axis errors (Dobariya 2015 model fitted from the per-axis
@@ -38,46 +53,78 @@ from dataclasses import fields
 
 import numpy as np
 
+from ..core import presets as presets_
 from ..core import simulate as sim
 from ..core.filters import EDGE_MODES
 from ..core.progress import sub
 from ..errors import InputError
-from ..io.atomic import Transaction
+from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from .common import ProgressLine
 
 _DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
+#: model options: (option name, metavar, help, values per option, may be negative)
+_MODEL_OPTIONS = (
+    ("offset", "MM", "constant error (tool radius/wear)", 1, True),
+    ("slope-gain", "MM", "error per unit slope along the feed (signed)", 1, True),
+    ("abs-slope-gain", "MM", "error per unit |slope| along the feed", 1, True),
+    ("tilt", "F,C", "linear error at the work-area border along,across the feed", 2, True),
+    ("bow", "F,C", "quadratic error at the border along,across the feed", 2, True),
+    ("deflection", "K0,KS,KA", "deflection per mm of engagement: constant, per unit slope, "
+                               "per unit |slope| (mm/mm)", 3, True),
+    ("waviness", "MM", "amplitude of a periodic error along the feed", 1, True),
+    ("wavelength", "MM", "wavelength of the waviness", 1, False),
+    ("feed", "X,Y,Z", "feed direction", 3, True),
+    ("tool-axis", "X,Y,Z", "tool axis", 3, True),
+    ("sigma", "MM", "random machining error of every pass, standard deviation", 1, False),
+    ("correlation-length", "MM", "correlation length of the random part (0: independent)", 1,
+     False),
+    ("probe-sigma", "MM", "measurement noise, standard deviation", 1, False),
+    ("semi-engagement", "MM", "depth the semi-finishing pass removes", 1, False),
+)
+_LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4, "between": 2}
 
 
 def _fmt(v):
+    if v is None:
+        return "the stock"
     return ",".join("%g" % x for x in v) if isinstance(v, tuple) else "%g" % v
 
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
         "simulate", help="virtual machining: predict what each compensation method achieves",
-        description="Virtual machining loop (Werner 2022, mirror paper): machine the nominal with "
-                    "a machining-error model, measure, compensate with each method, machine the "
-                    "corrected face, measure again; statistics per method over replicas.",
+        description="Virtual machining loop (Werner 2022, mirror paper 2019): machine parts with "
+                    "a machining-process model (semi-finishing and finishing pass), measure, "
+                    "compensate with each method, machine the corrected face, measure again; "
+                    "statistics per method over replicas. --preset imitates a paper and prints "
+                    "its table beside the simulated one.",
         epilog="Model: e = offset + slope_gain*s + abs_slope_gain*|s| + tilt_f*xi + tilt_c*eta "
-               "+ bow_f*xi^2 + bow_c*eta^2 + waviness*sin(2 pi p_f/wavelength) + E_axis.n "
-               "+ random (s = slope along the feed, xi/eta = position over the half extent "
-               "along/across the feed). See README 'Virtual machining'.")
-    p.add_argument("nominal", metavar="NOMINAL",
-                   help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)")
+               "+ bow_f*xi^2 + bow_c*eta^2 + E_axis.n + a*(k_0 + k_s*s + k_a*|s|) "
+               "+ waviness*sin(2 pi p_f/wavelength) + random (s = slope along the feed, xi/eta "
+               "= position over the half extent along/across the feed, a = depth the pass "
+               "removes: semi-engagement, then stock + the semi-finishing error). Presets: %s. "
+               "See README 'Virtual machining'." % ", ".join(presets_.PRESETS))
+    p.add_argument("nominal", metavar="NOMINAL", nargs="?",
+                   help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd); "
+                        "optional with --preset (the preset's own surface)")
     p.add_argument("--face", metavar="FaceN",
                    help="the nominal face (default: the only B-spline face)")
     p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
+    p.add_argument("--preset", metavar="NAME",
+                   help="a case imitating a paper: %s (its surface, model, grid and the "
+                        "paper's table)" % ", ".join(presets_.PRESETS))
     g = p.add_argument_group("loop")
-    g.add_argument("--grid", default="45x45", metavar="NxM",
-                   help="measurement grid, uniform in the face parameters (default 45x45, "
-                        "Werner 2022)")
+    g.add_argument("--grid", default=None, metavar="NxM",
+                   help="measurement grid, uniform in the face parameters, at most %d x %d "
+                        "(default 45x45, Werner 2022, or the preset's)"
+                        % (sim.MAX_GRID, sim.MAX_GRID))
     g.add_argument("--margin", type=float, default=0.02, metavar="FRACTION",
                    help="parameter range left free at each border (default 0.02)")
-    g.add_argument("--between", type=int, default=2, metavar="K",
+    g.add_argument("--between", type=int, default=None, metavar="K",
                    help="the corrected parts are measured on a grid K times denser (grid nodes "
-                        "and points between them; default 2)")
-    g.add_argument("--replicas", type=int, default=4, metavar="N",
+                        "and points between them; default 2, or the preset's)")
+    g.add_argument("--replicas", type=int, default=None, metavar="N",
                    help="parts machined per method (default 4, as the mirror paper)")
     g.add_argument("--methods", default="none,offset,raw,filtered,mirror", metavar="LIST",
                    help="comma-separated methods: none, offset, raw, filtered, mirror "
@@ -87,28 +134,17 @@ def add_parser(subparsers):
     g.add_argument("--mask-kind", choices=("box", "gaussian"), default="box",
                    help="mask shape (default box)")
     g.add_argument("--edge", choices=EDGE_MODES, default="renormalize", help="filter edge handling")
-    g.add_argument("--stock", type=float, default=0.3, metavar="MM",
-                   help="semi-finishing allowance of the mirror method (default 0.3 mm)")
+    g.add_argument("--stock", type=float, default=None, metavar="MM",
+                   help="allowance the semi-finishing pass leaves, and the mirror method's stock "
+                        "(default 0.3 mm, or the preset's)")
     g.add_argument("--refine", type=int, default=4, metavar="K",
                    help="knot spans of the corrected surface per grid step (default 4)")
     g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
-    m = p.add_argument_group("machining-error model (mm)")
-    for name, metavar, text in (
-            ("offset", "MM", "constant error (tool radius/wear)"),
-            ("slope-gain", "MM", "error per unit slope along the feed (signed)"),
-            ("abs-slope-gain", "MM", "error per unit |slope| along the feed"),
-            ("tilt", "F,C", "linear error at the work-area border along,across the feed"),
-            ("bow", "F,C", "quadratic error at the border along,across the feed"),
-            ("waviness", "MM", "amplitude of a periodic error along the feed"),
-            ("wavelength", "MM", "wavelength of the waviness"),
-            ("feed", "X,Y,Z", "feed direction"),
-            ("tool-axis", "X,Y,Z", "tool axis"),
-            ("sigma", "MM", "random machining error, standard deviation"),
-            ("correlation-length", "MM", "correlation length of the random part (0: independent)"),
-            ("probe-sigma", "MM", "measurement noise, standard deviation")):
+    m = p.add_argument_group("machining-process model (mm)")
+    for name, metavar, text, _, _ in _MODEL_OPTIONS:
         key = name.replace("-", "_")
         m.add_argument("--" + name, dest=key, metavar=metavar, default=None,
-                       help="%s (default %s)" % (text, _fmt(_DEFAULTS[key])))
+                       help="%s (default %s, or the preset's)" % (text, _fmt(_DEFAULTS[key])))
     m.add_argument("--axis-errors", metavar="ERR.csv",
                    help="per-axis error measurements (as for the gcode command); the fitted "
                         "Dobariya 2015 model adds its error along the normal")
@@ -120,7 +156,8 @@ def add_parser(subparsers):
     o.add_argument("--json", metavar="OUT.json", help="write every replica's statistics (JSON)")
     o.add_argument("--html", metavar="OUT.html",
                    help="write the HTML report of the first replica's compensation with the "
-                        "--report-method, and the before/after table")
+                        "--report-method, the before/after table, the paper's table beside the "
+                        "simulated one (--preset) and the simulated parts' maps")
     o.add_argument("--report-method", metavar="LABEL",
                    help="method of the HTML report (default filtered, else the first compensation)")
     o.add_argument("--quiet", action="store_true", help="print no progress lines")
@@ -128,7 +165,7 @@ def add_parser(subparsers):
     return p
 
 
-def _numbers(text, count, option):
+def _numbers(text, count, option, negative=True):
     parts = str(text).replace(";", ",").split(",")
     try:
         vals = [float(t) for t in parts]
@@ -136,11 +173,14 @@ def _numbers(text, count, option):
         vals = []
     if len(vals) != count or not all(np.isfinite(vals)):
         raise InputError("%s %r: expected %d comma-separated numbers" % (option, text, count))
+    if not negative and any(v < 0 for v in vals):
+        raise InputError("%s %r: %s must be >= 0 mm" % (option, text,
+                                                         option.lstrip("-").replace("-", " ")))
     return tuple(vals)
 
 
 def parse_grid(text):
-    """``'45x45'`` -> (45, 45)."""
+    """``'45x45'`` -> (45, 45); at least 3 x 3, at most ``MAX_GRID`` per direction."""
     parts = str(text).lower().replace("*", "x").split("x")
     try:
         n, m = (int(t) for t in parts)
@@ -148,21 +188,36 @@ def parse_grid(text):
         raise InputError("--grid %r: expected NxM, e.g. 45x45" % (text,)) from None
     if n < 3 or m < 3:
         raise InputError("--grid %r: expected at least 3x3 points" % (text,))
+    if n > sim.MAX_GRID or m > sim.MAX_GRID:
+        raise InputError("--grid %r: expected at most %dx%d points"
+                         % (text, sim.MAX_GRID, sim.MAX_GRID))
     return n, m
 
 
-def model_from_args(args):
-    """The :class:`MachiningModel` of the command-line options (defaults: the dataclass')."""
-    kw = {}
-    for key in ("offset", "slope_gain", "abs_slope_gain", "waviness", "wavelength", "sigma",
-                "correlation_length", "probe_sigma"):
+def check_loop_options(args):
+    """Refuse non-finite or out-of-range loop options, naming the option (exit 2)."""
+    if not (np.isfinite(args.margin) and 0 <= args.margin < 0.5):
+        raise InputError("--margin %r: expected a fraction >= 0 and < 0.5" % (args.margin,))
+    if args.stock is not None and not (np.isfinite(args.stock) and args.stock >= 0):
+        raise InputError("--stock %r: expected a finite allowance >= 0 mm" % (args.stock,))
+    for name, low in (("between", 1), ("replicas", 1), ("refine", 1), ("seed", 0)):
+        val = getattr(args, name)
+        if val is not None and val < low:
+            raise InputError("--%s %d: expected a whole number >= %d" % (name, val, low))
+
+
+def model_from_args(args, preset=None):
+    """The :class:`MachiningModel` of the command-line options: explicit options, else the
+    preset's values, else the dataclass' defaults."""
+    kw = dict(preset.model) if preset is not None else {}
+    for name, _, _, count, negative in _MODEL_OPTIONS:
+        key = name.replace("-", "_")
         val = getattr(args, key)
         if val is not None:
-            kw[key] = _numbers(val, 1, "--" + key.replace("_", "-"))[0]
-    for key, count in (("tilt", 2), ("bow", 2), ("feed", 3), ("tool_axis", 3)):
-        val = getattr(args, key)
-        if val is not None:
-            kw[key] = _numbers(val, count, "--" + key.replace("_", "-"))
+            vals = _numbers(val, count, "--" + name, negative)
+            kw[key] = vals[0] if count == 1 else vals
+    if args.stock is not None:
+        kw["stock"] = float(args.stock)
     if args.axis_errors:
         from ..core.axis_errors import fit_axis_errors
         from ..io.axis_csv import read_axis_errors
@@ -174,58 +229,92 @@ def model_from_args(args):
     return sim.MachiningModel(**kw)
 
 
-def run(args):
-    from ..app.nominal import load_nominal
+def _report_label(args, specs):
+    if not args.html:
+        return None
+    comp_labels = [s.label for s in specs if s.method != "none"]
+    if not comp_labels:
+        raise InputError("--html needs a compensating method in --methods (the report "
+                         "shows a compensation)")
+    if args.report_method is None:
+        return next((x for x in comp_labels if x.startswith("filtered")), comp_labels[0])
+    if args.report_method not in comp_labels:
+        raise InputError("--report-method %r: expected one of %s"
+                         % (args.report_method, ", ".join(comp_labels)))
+    return args.report_method
 
-    grid = parse_grid(args.grid)
-    if args.replicas < 1:
-        raise InputError("--replicas %d: expected at least 1" % args.replicas)
+
+def _nominal(args, preset):
+    """(surface, outward, inputs['nominal'], printed name) of the file or the preset."""
+    if args.nominal is None:
+        surface, outward = preset.surface()
+        info = {"preset": preset.name, "surface": "BSplineSurface",
+                "built_by": "surfcomp.core.presets (%s)" % preset.imitates}
+        name = "preset %s surface (%s)" % (preset.name, preset.imitates)
+    else:
+        from ..app.nominal import load_nominal
+
+        nominal = load_nominal(args.nominal, args.face, args.object)
+        surface, outward = nominal.surface, nominal.outward
+        info = {"path": os.path.abspath(args.nominal), "sha256": sha256_file(args.nominal),
+                "face": nominal.face_name, "object": nominal.object_name,
+                "surface": nominal.converted or "BSplineSurface"}
+        name = "%s (%s" % (args.nominal, nominal.face_name)
+    info.update(poles=list(surface.shape), degree=[surface.degree_u, surface.degree_v],
+                rational=surface.weights is not None, u_range=list(surface.u_range),
+                v_range=list(surface.v_range))
+    return surface, outward, info, "%s, %d x %d poles%s" % (
+        name, surface.shape[0], surface.shape[1], ")" if args.nominal else "")
+
+
+def run(args):
+    preset = presets_.get_preset(args.preset) if args.preset else None
+    if args.nominal is None and preset is None:
+        raise InputError("give NOMINAL (a face file) or --preset NAME (one of %s)"
+                         % ", ".join(presets_.PRESETS))
+    check_loop_options(args)
+    grid = (parse_grid(args.grid) if args.grid is not None
+            else (preset.grid if preset else _LOOP_DEFAULTS["grid"]))
+    replicas = args.replicas or (preset.replicas if preset else _LOOP_DEFAULTS["replicas"])
+    between = args.between or (preset.between if preset else _LOOP_DEFAULTS["between"])
     try:
         masks = [int(x) for x in args.mask.split(",")]
     except ValueError:
         raise InputError("--mask %r: expected odd whole numbers, e.g. 5 or 3,5,7"
                          % args.mask) from None
     methods = [x.strip() for x in args.methods.split(",") if x.strip()]
-    specs = sim.method_specs(methods, masks, args.stock, args.mask_kind, args.edge, args.refine)
-    labels = [s.label for s in specs]
-    report_label = args.report_method
-    if args.html:
-        comp_labels = [s.label for s in specs if s.method != "none"]
-        if not comp_labels:
-            raise InputError("--html needs a compensating method in --methods (the report "
-                             "shows a compensation)")
-        if report_label is None:
-            report_label = next((x for x in comp_labels if x.startswith("filtered")),
-                                comp_labels[0])
-        elif report_label not in comp_labels:
-            raise InputError("--report-method %r: expected one of %s"
-                             % (report_label, ", ".join(comp_labels)))
-    model = model_from_args(args)
-    for out in (args.json, args.html):
-        if out and os.path.abspath(out) == os.path.abspath(args.nominal):
-            raise InputError("an output would overwrite the nominal", file=out)
+    specs = sim.method_specs(methods, masks, None, args.mask_kind, args.edge, args.refine)
+    report_label = _report_label(args, specs)
+    model = model_from_args(args, preset)
+    check_outputs(*_declared(args))
     progress = ProgressLine(args.quiet)
-    nominal = load_nominal(args.nominal, args.face, args.object)
-    res = sim.simulate(nominal.surface, nominal.outward, model, grid=grid, specs=specs,
-                       replicas=args.replicas, seed=args.seed, margin=args.margin,
-                       between=args.between, keep=bool(args.html), progress=sub(progress, 0, 0.95))
-    inputs = {"nominal": {"path": os.path.abspath(args.nominal),
-                          "sha256": sha256_file(args.nominal),
-                          "face": nominal.face_name, "object": nominal.object_name,
-                          "surface": nominal.converted or "BSplineSurface",
-                          "poles": list(nominal.surface.shape),
-                          "degree": [nominal.surface.degree_u, nominal.surface.degree_v],
-                          "rational": nominal.surface.weights is not None,
-                          "u_range": list(nominal.surface.u_range),
-                          "v_range": list(nominal.surface.v_range)}}
+    surface, outward, info, name = _nominal(args, preset)
+    res = sim.simulate(surface, outward, model, grid=grid, specs=specs, replicas=replicas,
+                       seed=args.seed, margin=args.margin, between=between,
+                       keep=bool(args.html), progress=sub(progress, 0, 0.95))
+    res.preset = preset
+    inputs = {"nominal": info}
     data = res.as_dict()
+    if preset is not None and args.nominal is not None:
+        data["preset"]["surface_replaced_by"] = info["path"]
     data = dict({"command": "simulate", "inputs": inputs}, **data)
-    with Transaction() as tx:
+    _write(args, res, data, inputs, report_label)
+    _print(args, res, grid, name, preset)
+    return 0
+
+
+def _declared(args):
+    """(outputs, inputs) of the command, checked before any work and at the commit."""
+    return [("--json", args.json), ("--html", args.html)], [("NOMINAL", args.nominal)]
+
+
+def _write(args, res, data, inputs, report_label):
+    with Transaction(*_declared(args)) as tx:
         if args.json:
             tx.stage_text(args.json, json.dumps(data, indent=1, allow_nan=False) + "\n")
         if args.html:
             from ..io import report as report_io
-            from ..io.html_report import render_html
+            from ..io.html_report import render_html, simulation_maps
 
             comp = res.compensations[report_label]
             meas = {"path": "<simulated: replica 1, %s>" % report_label,
@@ -236,22 +325,29 @@ def run(args):
             rep = report_io.build_report("simulate", dict(inputs, measurements=meas), comp,
                                          comp.prepared.warnings,
                                          {"html": os.path.abspath(args.html)})
-            tx.stage_text(args.html, render_html(rep, data))
+            tx.stage_text(args.html, render_html(rep, dict(data, maps=simulation_maps(res))))
         tx.commit()
-    print("Nominal:   %s (%s, %d x %d poles)"
-          % (args.nominal, nominal.face_name, *nominal.surface.shape))
+
+
+def _print(args, res, grid, name, preset):
+    print("Nominal:   %s" % name)
+    if preset is not None:
+        print("Preset:    %s (%s)%s" % (preset.name, preset.imitates,
+                                        "; surface replaced by NOMINAL" if args.nominal else ""))
     print("Grid:      %d x %d measured, %d x %d evaluated (nodes and between); "
           "%d replica(s), seed %d"
           % (grid + res.eval_shape + (res.replicas, res.seed)))
-    print("Methods:   %s" % ", ".join(labels))
+    print("Methods:   %s" % ", ".join(res.labels))
     print("")
     print(res.table())
     print("")
     print(res.replica_table("std"))
+    if preset is not None:
+        print("")
+        print(res.side_table())
     for out in (args.json, args.html):
         if out:
             print("wrote %s" % out)
-    return 0
 
 
 def _array_sha256(a):

@@ -53,10 +53,10 @@ import numpy as np
 from scipy import stats
 
 from ..errors import ComputationError, InputError
+from .axes import AXES, as_points, axis_index
+from .machine import SimulatedMachine  # noqa: F401 (its home before core/machine.py)
 from .progress import report
 
-#: the three axes, in order
-AXES = ("x", "y", "z")
 #: fit choices of :func:`fit_axis_errors`
 MODEL_CHOICES = ("linear", "quadratic", "auto")
 #: significance level of the F-test of ``model='auto'``
@@ -67,18 +67,15 @@ EXACT_RMS = 1e-9
 COMPENSATE_TOL = 1e-10
 
 
-def _axis_index(name):
-    key = str(name).strip().lower()
-    if key not in AXES:
-        raise ValueError("axis must be one of x, y, z (got %r)" % (name,))
-    return AXES.index(key)
-
-
-def _points(points):
-    p = np.asarray(points, dtype=float)
-    if p.shape[-1:] != (3,):
-        raise ValueError("points must have shape (..., 3), got %s" % (p.shape,))
-    return p
+def _finite_points(values, message, points=None):
+    """Raise InputError when a row of ``values`` (n, 3) is not finite; ``message`` gets
+    the count and the first such row of ``points`` (default ``values``)."""
+    ok = np.isfinite(values).all(axis=1)
+    if ok.all():
+        return
+    bad = np.flatnonzero(~ok)
+    at = (values if points is None else points)[bad[0]]
+    raise InputError(message % ((bad.size,) + tuple(at)))
 
 
 @dataclass
@@ -178,11 +175,11 @@ class AxisErrorModel:
         self.offset_spread = (np.zeros(3) if offset_spread is None
                               else np.array(offset_spread, dtype=float).reshape(3))
         if self.slope.shape != (3, 3) or self.curvature.shape != (3, 3):
-            raise ValueError("slope and curvature must be 3 x 3")
+            raise InputError("slope and curvature must be 3 x 3")
         for name, arr in (("slope", self.slope), ("curvature", self.curvature),
                           ("reference", self.reference), ("offset", self.offset)):
             if not np.all(np.isfinite(arr)):
-                raise ValueError("%s of the axis error model has non-finite values" % name)
+                raise InputError("%s of the axis error model has non-finite values" % name)
 
     # ----------------------------------------------------------------- construction
     @classmethod
@@ -214,26 +211,26 @@ class AxisErrorModel:
         slope = np.zeros((3, 3))
         curv = np.zeros((3, 3))
         for ax, s in (scale or {}).items():
-            a = _axis_index(ax)
+            a = axis_index(ax)
             slope[a, a] += float(s)
         for ax, (c1, c2) in (positional or {}).items():
-            a = _axis_index(ax)
+            a = axis_index(ax)
             slope[a, a] += float(c1)
             curv[a, a] += float(c2)
         for key, (c1, c2) in (straightness or {}).items():
             k = key.replace(" ", "").lower()
             if len(k) != 4 or k[1] != "(" or k[3] != ")" or k[0] == k[2]:
-                raise ValueError("straightness keys are 'i(a)' with i != a, e.g. 'y(x)' "
+                raise InputError("straightness keys are 'i(a)' with i != a, e.g. 'y(x)' "
                                  "(got %r)" % key)
-            i, a = _axis_index(k[0]), _axis_index(k[2])
+            i, a = axis_index(k[0]), axis_index(k[2])
             slope[a, i] += float(c1)
             curv[a, i] += float(c2)
         for key, alpha in (squareness or {}).items():
             k = key.strip().lower()
             if len(k) != 2 or k[0] == k[1]:
-                raise ValueError("squareness keys are two different axes, e.g. 'xy' (got %r)"
+                raise InputError("squareness keys are two different axes, e.g. 'xy' (got %r)"
                                  % key)
-            a, i = _axis_index(k[0]), _axis_index(k[1])
+            a, i = axis_index(k[0]), axis_index(k[1])
             slope[a, i] += float(alpha)
         return cls(slope, curv, reference=reference, offset=offset)
 
@@ -291,7 +288,7 @@ class AxisErrorModel:
         ndarray (n,)
             ``slope[a, i] t + curvature[a, i] t^2`` with ``t = position - r_a`` (mm).
         """
-        i, a = _axis_index(component), _axis_index(axis)
+        i, a = axis_index(component), axis_index(axis)
         t = np.asarray(positions, dtype=float) - self.reference[a]
         return self.slope[a, i] * t + self.curvature[a, i] * t * t
 
@@ -308,20 +305,20 @@ class AxisErrorModel:
         ndarray (..., 3)
             ``E_i = e0_i + sum_a (slope[a, i] t_a + curvature[a, i] t_a^2)`` (mm).
         """
-        p = _points(points)
+        p = as_points(points)
         t = p - self.reference
         return self.offset + t @ self.slope + (t * t) @ self.curvature
 
     def jacobian(self, points):
         """``dE_i/dX_a`` at the points: array (..., 3, 3) indexed ``[..., i, a]``."""
-        p = _points(points)
+        p = as_points(points)
         t = p - self.reference
         d = self.slope[None, :, :] + 2.0 * t.reshape(-1, 3)[:, :, None] * self.curvature
         return np.swapaxes(d, 1, 2).reshape(p.shape[:-1] + (3, 3))
 
     def actual(self, points):
         """Where the tool lands for commanded points: ``X + E(X)`` (mm)."""
-        p = _points(points)
+        p = as_points(points)
         return p + self.error(p)
 
     def compensate(self, points, tol=COMPENSATE_TOL, max_iter=30):
@@ -347,14 +344,24 @@ class AxisErrorModel:
         ComputationError
             When Newton's method does not converge (an error model whose slopes reach
             -1, i.e. a slide that does not move).
+        InputError
+            Non-finite points, or points so far outside the measured travel that the
+            model's polynomials overflow there.
         """
-        p = _points(points)
+        p = as_points(points)
         flat = p.reshape(-1, 3)
+        _finite_points(flat, "cannot compensate %d non-finite point(s) (the first: %.6g, "
+                             "%.6g, %.6g)")
         if self.is_zero() or flat.shape[0] == 0:
             return p.copy()
-        xc = flat - self.error(flat)
+        with np.errstate(over="ignore", invalid="ignore"):
+            xc = flat - self.error(flat)
         for _ in range(max_iter):
-            r = xc + self.error(xc) - flat
+            with np.errstate(over="ignore", invalid="ignore"):
+                r = xc + self.error(xc) - flat
+            _finite_points(r, "the axis error model has no finite compensation for %d "
+                           "point(s) (the first at %.6g, %.6g, %.6g mm): they lie too far "
+                           "outside the measured travel for its polynomials", flat)
             bad = np.abs(r).max(axis=1) > tol
             if not bad.any():
                 return xc.reshape(p.shape)
@@ -501,8 +508,9 @@ def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_
         pos = np.asarray(pos, dtype=float).reshape(-1)
         err = np.asarray(err, dtype=float).reshape(-1, 3)
         if err.shape[0] != pos.size:
-            raise ValueError("axis %s: %d positions but %d error rows" % (ax, pos.size,
-                                                                           err.shape[0]))
+            raise InputError("axis %s: %d positions but %d error rows" % (ax, pos.size,
+                                                                           err.shape[0]),
+                             file=source)
         if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(err))):
             raise InputError("axis %s: non-finite measured values" % ax.upper(), file=source)
         n_distinct = np.unique(pos).size
@@ -620,77 +628,6 @@ def volumetric_map(model, envelope=None, shape=(11, 11, 11)):
     return VolumetricMap(axes, err, mag, st)
 
 
-# ----------------------------------------------------------------- simulated machine
-class SimulatedMachine:
-    """A 3-axis machine with known geometric errors, for validation.
-
-    The tool lands at ``X + E_true(X)`` with ``E_true`` composed as in eq. 14 from a
-    polynomial :class:`AxisErrorModel` plus optional non-polynomial per-slide terms (e.g.
-    a periodic ball-screw error) that a linear/quadratic fit cannot represent.
-
-    Parameters
-    ----------
-    model : AxisErrorModel
-        The polynomial part (its reference is the machine's reference point).
-    extra : dict, optional
-        ``{'x': f}`` with ``f(t) -> (n, 3)``: additional error (mm) of slide ``x`` at travel
-        ``t = X_x - r_x``; should be 0 at ``t = 0`` so that the measurement at the
-        reference stays ``e0``.
-    """
-
-    def __init__(self, model, extra=None):
-        self.model = model
-        self.extra = {k.lower(): f for k, f in (extra or {}).items()}
-        for k in self.extra:
-            _axis_index(k)
-
-    def error(self, points):
-        """True tool-position error at commanded points (mm), shape (..., 3)."""
-        p = _points(points)
-        e = self.model.error(p)
-        for ax, f in self.extra.items():
-            a = _axis_index(ax)
-            t = (p[..., a] - self.model.reference[a]).reshape(-1)
-            e = e + np.asarray(f(t), dtype=float).reshape(p.shape)
-        return e
-
-    def actual(self, points):
-        """Where the tool lands for commanded points (mm)."""
-        p = _points(points)
-        return p + self.error(p)
-
-    def measure(self, positions, noise=0.0, seed=0):
-        """Simulate the per-axis measurement (one slide moves, the others at the reference).
-
-        Parameters
-        ----------
-        positions : mapping
-            ``{'x': positions (n,)}`` (mm).
-        noise : float
-            Standard deviation (mm) of Gaussian measurement noise per reading.
-        seed : int
-            Seed of ``numpy.random.default_rng``.
-
-        Returns
-        -------
-        dict
-            ``{'x': (positions (n,), errors (n, 3))}``, the input of :func:`fit_axis_errors`.
-        """
-        rng = np.random.default_rng(seed)
-        out = {}
-        for ax in AXES:
-            if ax not in positions and ax.upper() not in positions:
-                continue
-            p = np.asarray(positions.get(ax, positions.get(ax.upper())), dtype=float)
-            pts = np.repeat(self.model.reference[None, :], p.size, axis=0)
-            pts[:, _axis_index(ax)] = p
-            e = self.error(pts)
-            if noise:
-                e = e + rng.normal(0.0, noise, e.shape)
-            out[ax] = (p.copy(), e)
-        return out
-
-
 def error_stats(vectors):
     """``max``, ``mean``, ``rms`` of ``|v|`` and largest ``|v_i|`` per axis (mm)."""
     v = np.asarray(vectors, dtype=float).reshape(-1, 3)
@@ -722,7 +659,7 @@ def validate(model, machine, points, progress=None):
         ``X'``): :func:`error_stats` of ``actual - X``; ``reduction`` = 1 - after RMS /
         before RMS.
     """
-    p = _points(points).reshape(-1, 3)
+    p = as_points(points).reshape(-1, 3)
     report(progress, 0.0, "compensating %d points" % p.shape[0])
     before = machine.actual(p) - p
     after = machine.actual(model.compensate(p)) - p

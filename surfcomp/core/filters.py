@@ -22,6 +22,10 @@ from ..errors import InputError
 #: edge handling choices: 'renormalize' (default, see module docstring),
 #: 'reflect' (mirror the grid at its border), 'nearest' (repeat the border nodes)
 EDGE_MODES = ("renormalize", "reflect", "nearest")
+#: Werner 2022's mask: 5 x 5 box (the default everywhere)
+WERNER_MASK_SIZE = 5
+#: the largest mask accepted (a window of 201 x 201 grid steps)
+MAX_MASK_SIZE = 201
 
 
 def box_mask(size):
@@ -34,8 +38,9 @@ def gaussian_mask(size, sigma=None):
     """A ``size`` x ``size`` Gaussian mask, ``sigma`` in grid steps (default ``size / 4``)."""
     _check_size(size)
     sigma = float(size) / 4.0 if sigma is None else float(sigma)
-    if not sigma > 0:
-        raise InputError("Gaussian sigma must be > 0 grid steps, got %g" % sigma)
+    if not 0 < sigma <= MAX_MASK_SIZE:
+        raise InputError("Gaussian sigma must be > 0 and at most %d grid steps, got %g"
+                         % (MAX_MASK_SIZE, sigma))
     r = size // 2
     x = np.arange(-r, r + 1, dtype=float)
     g = np.exp(-0.5 * (x / sigma) ** 2)
@@ -68,9 +73,14 @@ def parse_weights(text):
     return mask
 
 
+def _whole(x):
+    return isinstance(x, (int, np.integer)) or (isinstance(x, float) and x.is_integer())
+
+
 def _check_size(size):
-    if int(size) != size or size < 1 or size % 2 == 0:
-        raise InputError("mask size must be an odd whole number (3, 5, 7, ...), got %r" % (size,))
+    if not _whole(size) or not 1 <= size <= MAX_MASK_SIZE or size % 2 == 0:
+        raise InputError("mask size must be an odd whole number from 1 to %d (3, 5, 7, ...), "
+                         "got %r" % (MAX_MASK_SIZE, size))
 
 
 def check_mask(mask):
@@ -87,7 +97,7 @@ def check_mask(mask):
     return mask
 
 
-def make_mask(size=5, weights=None, kind="box", sigma=None):
+def make_mask(size=WERNER_MASK_SIZE, weights=None, kind="box", sigma=None):
     """Build the filter mask from user options (box by default, 5x5 as in Werner 2022).
 
     Parameters
@@ -135,10 +145,10 @@ def mask_filter(d, mask, edge="renormalize"):
         (possible only with negative weights), naming the node.
     """
     mask = check_mask(mask)
+    d = np.asarray(d, dtype=float)
     if edge not in EDGE_MODES:
         raise InputError("unknown edge handling %r (expected one of %s)"
                          % (edge, ", ".join(EDGE_MODES)))
-    d = np.asarray(d, dtype=float)
     valid = np.isfinite(d)
     values = np.where(valid, d, 0.0)
     mode = "constant" if edge == "renormalize" else ("mirror" if edge == "reflect" else "nearest")

@@ -12,12 +12,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
+from . import bspline, plausibility
 from .corrected import DEFAULT_REFINE, construct
 from .deviations import deviation_components, statistics
 from .field import GridField
-from .filters import make_mask
+from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
-from .methods import compute_correction
+from .methods import METHODS, compute_correction
 from .progress import report, sub
 from .projection import project, tangent_lengths
 from .scattered import ScatteredField, smooth
@@ -49,7 +50,7 @@ class Options:
     """
 
     method: str = "filtered"
-    mask_size: int = 5
+    mask_size: int = WERNER_MASK_SIZE
     weights: object = None
     mask_kind: str = "box"
     sigma: float = None
@@ -64,6 +65,55 @@ class Options:
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
+
+    def validate(self):
+        """Refuse values outside their domain (NaN included), naming the option.
+
+        Every route (command line, document objects, simulation) checks its options here
+        before it reads a file. Returns ``self``.
+
+        Raises
+        ------
+        InputError
+            ``--option value: expected ...`` (the document property in parentheses).
+        """
+        for name, (option, prop, lo, hi, optional, what) in _DOMAINS.items():
+            value = getattr(self, name)
+            if value is None and optional:
+                continue
+            try:
+                ok = lo <= float(value) <= hi           # False for NaN
+            except (TypeError, ValueError):
+                ok = False
+            if ok and name in ("mask_size", "refine"):
+                ok = float(value).is_integer()
+            if not ok:
+                raise InputError("%s %r: expected %s from %g to %g (%s in the document)"
+                                 % (option, value, what, lo, hi, prop))
+        for name, choices, option in (("method", METHODS, "--method"),
+                                      ("mask_kind", ("box", "gaussian"), "--mask-kind"),
+                                      ("edge", EDGE_MODES, "--edge"),
+                                      ("layout", LAYOUTS, "--layout")):
+            if getattr(self, name) not in choices:
+                raise InputError("%s %r: expected one of %s"
+                                 % (option, getattr(self, name), ", ".join(choices)))
+        if self.method == "mirror" and self.stock is None:
+            raise InputError("--method mirror needs --stock (the semi-finishing allowance in "
+                             "mm; DH = stock / 2)")
+        self.mask()                                      # odd size, custom weights
+        return self
+
+
+#: option domains: field -> (option, document property, low, high, may be None, what)
+_DOMAINS = {
+    "mask_size": ("--mask", "MaskSize", 1, MAX_MASK_SIZE, False, "an odd whole number"),
+    "sigma": ("--sigma", "Sigma", 1e-3, MAX_MASK_SIZE, True, "grid steps"),
+    "stock": ("--stock", "Stock", 0.0, 10.0, True, "a length in mm"),
+    "max_offset": ("--max-offset", "MaxOffset", 1e-4, 100.0, False, "a length in mm"),
+    "refine": ("--refine", "Refine", 1, 16, False, "a whole number of spans per grid step"),
+    "tip_radius": ("--tip-radius", "TipRadius", 0.0, 50.0, False, "a length in mm"),
+    "smoothing": ("--smoothing", "Smoothing", 1e-3, 1e4, True, "a length in mm"),
+}
 
 
 @dataclass
@@ -107,52 +157,6 @@ def _err(ms, k, message):
     return MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]))
 
 
-def _given_normals(ms, n_face, options, warnings):
-    """The normals of the measurement file checked against the face's outward normals
-    ``n_face`` (N, 3), or ``n_face`` when the file has none."""
-    if ms.normal is None:
-        return n_face
-    given = np.asarray(ms.normal, dtype=float)
-    if options.flip_normals:
-        given = -given
-    cosang = np.einsum("ij,ij->i", given, n_face)
-    opposite = np.nonzero(cosang < 0)[0]
-    if opposite.size:
-        k = opposite[0]
-        raise _err(ms, k, "the given normal points to the other side of the face than the "
-                   "face's outward normal (%d point(s)); use --flip-normals if the file's "
-                   "normals point into the material" % opposite.size)
-    ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
-    off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
-    for k in off[:10]:
-        warnings.append("%s:%d: the given normal is %.1f degrees off the face normal (more "
-                        "than %g)" % (ms.source, ms.lines[k], ang[k], NORMAL_WARNING_DEG))
-    if off.size > 10:
-        warnings.append("%s: %d more normals are more than %g degrees off the face normal"
-                        % (ms.source, off.size - 10, NORMAL_WARNING_DEG))
-    return given
-
-
-def _layout(ms, u, v, options, warnings):
-    """The points' grid (row/col columns or found from (u, v)), or a scattered layout."""
-    if options.layout not in LAYOUTS:
-        raise InputError("unknown layout %r (expected one of %s)"
-                         % (options.layout, ", ".join(LAYOUTS)))
-    if options.layout == "scattered":
-        return Scattered(np.arange(u.size), "scattered (as asked)")
-    if ms.row is not None and ms.col is not None:
-        return grid_from_indices(ms.row, ms.col, u, v, ms.lines, ms.source)
-    try:
-        return grid_from_uv(u, v, ms.lines, ms.source)
-    except GridError as exc:
-        if options.layout == "grid":
-            raise
-        warnings.append("%s; the points are used as a scattered layout (the determined "
-                        "component comes from a smoothing fit instead of the mask "
-                        "filter; --layout grid refuses such files)" % exc)
-        return Scattered(np.arange(u.size), "scattered (not a complete grid)")
-
-
 def prepare(surface, outward, ms, options=None, progress=None):
     """Locate the measured points on the nominal face and compute their deviations.
 
@@ -177,55 +181,154 @@ def prepare(surface, outward, ms, options=None, progress=None):
     GridError
         The points do not form a complete grid.
     """
-    options = options or Options()
+    options = (options or Options()).validate()
     warnings = list(getattr(ms, "warnings", []) or [])
     base = ms.nominal if ms.nominal is not None else ms.measured
     if base is None:
         raise InputError("the measurement set has neither nominal nor measured points",
                          file=ms.source)
-    tip = float(options.tip_radius or 0.0)
-    if tip < 0:
-        raise InputError("the tip radius must be >= 0 mm, got %g" % tip, file=ms.source)
-    if tip and ms.deviation is not None:
-        raise InputError("--tip-radius applies to measured points (tip centres); this file "
-                         "gives deviations, which the CMM has already compensated", file=ms.source)
-    if tip and ms.measured is None:
-        raise InputError("--tip-radius needs measured points (tip centres) in the file",
-                         file=ms.source)
-    if getattr(ms, "tip_centres", False) and not tip:
-        warnings.append("%s: the points are stylus tip centres (probe log); without "
-                        "--tip-radius every deviation is off by the tip radius" % ms.source)
+    tip = _tip_radius(ms, options, warnings)
     report(progress, 0.0, "locating %d points on the face" % len(base))
     proj = project(surface, base, progress=sub(progress, 0.0, 0.8))
     # a tip centre lies one tip radius outside its contact point (along the normal)
     dist = proj.distance * outward - (tip if ms.nominal is None else 0.0)
-    far = np.nonzero(np.abs(dist) > options.max_offset)[0]
-    if far.size:
-        k = far[np.argmax(np.abs(dist[far]))]
-        what = "nominal point" if ms.nominal is not None else "measured point"
-        raise _err(ms, k, "%s (%.4f, %.4f, %.4f) is %.4f mm from the face (expected at most "
-                   "--max-offset %g mm; %d point(s) are farther: wrong face, units or alignment?)"
-                   % ((what,) + tuple(base[k]) + (abs(dist[k]), options.max_offset, far.size)))
-    outside = np.nonzero(proj.outside)[0]
-    if outside.size:
-        k = outside[0]
-        raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
-                   "(%d point(s) do; expected points on the face)"
-                   % (tuple(base[k]) + (outside.size,)))
-    normal = _given_normals(ms, proj.normal * outward, options, warnings)
+    _check_on_face(ms, base, proj, dist, options)
+    normal = _normals(ms, proj.normal * outward, options, warnings)
     if ms.deviation is not None:
         d = np.asarray(ms.deviation, dtype=float) * (-1.0 if options.flip_normals else 1.0)
     elif ms.nominal is not None and ms.measured is not None:
         d = np.einsum("ij,ij->i", ms.measured - ms.nominal, normal) - tip
     else:
         d = dist
+    _check_deviations(ms, d, options)
+    _check_units(surface, d, warnings, ms.source)
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
-    grid = _layout(ms, proj.u, proj.v, options, warnings)
+    grid = _arrange(ms, proj, options, warnings)
     report(progress, 1.0, "%s layout" % ("scattered" if isinstance(grid, Scattered)
                                          else "%d x %d grid" % grid.shape))
     return Prepared(u=proj.u, v=proj.v, nominal=np.asarray(nominal, dtype=float), normal=normal,
                     deviation=d, grid=grid, lines=ms.lines, source=ms.source, warnings=warnings)
+
+
+def _tip_radius(ms, options, warnings):
+    tip = float(options.tip_radius or 0.0)
+    if tip and ms.deviation is not None:
+        raise InputError("--tip-radius applies to measured points (tip centres); this file "
+                         "gives deviations, which the CMM has already compensated",
+                         file=ms.source)
+    if tip and ms.measured is None:
+        raise InputError("--tip-radius needs measured points (tip centres) in the file",
+                         file=ms.source)
+    if getattr(ms, "tip_centres", False) and not tip:
+        warnings.append("%s: the points are stylus tip centres (probe log); without "
+                        "--tip-radius every deviation is off by the tip radius" % ms.source)
+    return tip
+
+
+def _check_on_face(ms, base, proj, dist, options):
+    """Every point within ``max_offset`` of the face (NaN is not) and inside its border."""
+    far = np.nonzero(~(np.abs(dist) <= options.max_offset))[0]
+    if far.size:
+        size = np.where(np.isfinite(dist[far]), np.abs(dist[far]), np.inf)
+        k = far[np.argmax(size)]
+        what = "nominal point" if ms.nominal is not None else "measured point"
+        raise _err(ms, k, "%s (%.4f, %.4f, %.4f) is %.4f mm from the face (expected at most "
+                   "--max-offset %g mm; %d point(s) are farther: wrong face, units or "
+                   "alignment?)" % ((what,) + tuple(base[k]) + (abs(dist[k]), options.max_offset,
+                                                                far.size)))
+    outside = np.nonzero(proj.outside)[0]
+    if outside.size:
+        k = outside[0]
+        raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
+                   "(%d point(s) do; expected points on the face)"
+                   % (tuple(base[k]) + (outside.size,)))
+
+
+def _normals(ms, n_face, options, warnings):
+    """The normals the deviations are measured along: the file's (checked against the
+    face's outward normal) or the face's."""
+    if ms.normal is None:
+        return n_face
+    given = np.asarray(ms.normal, dtype=float)
+    if options.flip_normals:
+        given = -given
+    cosang = np.einsum("ij,ij->i", given, n_face)
+    opposite = np.nonzero(cosang < 0)[0]
+    if opposite.size:
+        raise _err(ms, opposite[0], "the given normal points to the other side of the face "
+                   "than the face's outward normal (%d point(s)); use --flip-normals if the "
+                   "file's normals point into the material" % opposite.size)
+    ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
+    off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
+    for k in off[:10]:
+        warnings.append("%s:%d: the given normal is %.1f degrees off the face normal (more "
+                        "than %g)" % (ms.source, ms.lines[k], ang[k], NORMAL_WARNING_DEG))
+    if off.size > 10:
+        warnings.append("%s: %d more normals are more than %g degrees off the face normal"
+                        % (ms.source, off.size - 10, NORMAL_WARNING_DEG))
+    return given
+
+
+def _check_deviations(ms, d, options):
+    """Every deviation finite and at most ``max_offset`` (the mirror method's measurement
+    carries the stock on top): a larger one is a unit or file mistake, not a machining
+    error, and would move the corrected face by as much."""
+    allowed = options.max_offset + (options.stock or 0.0 if options.method == "mirror" else 0.0)
+    bad = np.nonzero(~(np.abs(d) <= allowed))[0]
+    if not bad.size:
+        return
+    size = np.where(np.isfinite(d[bad]), np.abs(d[bad]), np.inf)
+    k = bad[np.argmax(size)]
+    hint = ("are the deviations in um? Give the unit (--units um, or a column name like "
+            "'dev [um]')" if np.isfinite(d[k]) and np.abs(d[k]) < 1e5 * allowed
+            else "is this the right file?")
+    raise _err(ms, k, "deviation %s mm (expected at most --max-offset %g mm%s; %d point(s) "
+               "exceed it): %s" % ("%.4f" % d[k] if np.isfinite(d[k]) else d[k],
+                                    options.max_offset,
+                                    " + stock" if options.method == "mirror" else "",
+                                    bad.size, hint))
+
+
+def _check_units(surface, d, warnings, source):
+    """Warn when every deviation is far beyond the face's size tolerance (see
+    :mod:`surfcomp.core.plausibility`): plausible against max-offset, but not for a part."""
+    us = np.linspace(surface.u_range[0], surface.u_range[1], 9)
+    vs = np.linspace(surface.v_range[0], surface.v_range[1], 9)
+    size = plausibility.largest_dimension(bspline.evaluate_grid(surface, us, vs))
+    message = plausibility.units_warning(d, size)
+    if message:
+        warnings.append("%s: %s" % (source, message))
+
+
+#: fewest points of a scattered layout (its smoothing fit needs them off one line)
+MIN_SCATTERED = 4
+
+
+def _arrange(ms, proj, options, warnings):
+    """The points' grid (from row/col columns or the (u, v) pattern) or a scattered layout."""
+    grid = _grid_or_scattered(ms, proj, options, warnings)
+    if isinstance(grid, Scattered) and proj.u.size < MIN_SCATTERED:
+        raise InputError("%d measured point(s): too few to compensate (expected a grid of at "
+                         "least 2 x 2 points or at least %d scattered points)"
+                         % (proj.u.size, MIN_SCATTERED), file=ms.source)
+    return grid
+
+
+def _grid_or_scattered(ms, proj, options, warnings):
+    if options.layout == "scattered":
+        return Scattered(np.arange(proj.u.size), "scattered (as asked)")
+    if ms.row is not None and ms.col is not None:
+        return grid_from_indices(ms.row, ms.col, proj.u, proj.v, ms.lines, ms.source)
+    try:
+        return grid_from_uv(proj.u, proj.v, ms.lines, ms.source)
+    except GridError as exc:
+        if options.layout == "grid":
+            raise
+        warnings.append("%s; the points are used as a scattered layout (the determined "
+                        "component comes from a smoothing fit instead of the mask filter; "
+                        "--layout grid refuses such files)" % exc)
+        return Scattered(np.arange(proj.u.size), "scattered (not a complete grid)")
 
 
 @dataclass
@@ -285,7 +388,7 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     -------
     Compensation
     """
-    options = options or Options()
+    options = (options or Options()).validate()
     g = prepared.grid
     d = g.take(prepared.deviation)
     scale = parameter_scale(surface, prepared)

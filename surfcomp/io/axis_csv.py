@@ -34,10 +34,14 @@ Common rules
 - Unit suffixes as in :mod:`surfcomp.io.units`: ``position[mm]``, ``ex[um]``, ``EXX_um``,
   ``X(in)``. Columns without a suffix are in ``units`` (default mm). Values are returned in
   mm.
+- Every value must be finite; with ``max_error`` an error larger than it (mm, after the
+  unit conversion) is refused, since it is most likely a unit mistake (micrometres read as
+  millimetres).
 - Every problem raises :class:`surfcomp.errors.MeasurementFileError` naming
   ``file:line[:column]``, what is wrong and what was expected.
 """
 
+import math
 import os
 import re
 from dataclasses import dataclass, field
@@ -46,6 +50,7 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .atomic import write_text
+from .files import read_bytes
 from .units import split_unit_suffix, unit_factor
 
 AXES = ("x", "y", "z")
@@ -120,16 +125,33 @@ def _split_name(name):
     return base, unit
 
 
-def _number(text, path, line, col, what):
+def _number(text, path, line, col, what, factor=1.0):
+    """The value of a field in mm (``factor`` mm per unit of its column); finite."""
     s = text.strip()
     if not _NUMBER.match(s):
         raise MeasurementFileError("%s: %r is not a number (expected e.g. 12.5 or -0.003; "
                                    "decimal point, no thousands separators)" % (what, text),
                                    file=path, line=line, column=col)
-    return float(s)
+    v = float(s) * factor
+    if not math.isfinite(v):
+        raise MeasurementFileError("%s: %r is out of range (expected a finite number)"
+                                   % (what, text), file=path, line=line, column=col)
+    return v
 
 
-def read_axis_errors(path, units="mm", text=None):
+def _error(text, path, line, col, what, factor, max_error):
+    """An error value in mm, refused when larger than ``max_error`` (mm; None: no limit)."""
+    v = _number(text, path, line, col, what, factor)
+    if max_error is not None and not abs(v) <= max_error:
+        raise MeasurementFileError("%s: error %r = %.6g mm is larger than --max-error %g mm "
+                                   "(expected the error of a machine axis: check the units; "
+                                   "a column in um needs a suffix such as %s[um], or --units "
+                                   "um)" % (what, text.strip(), v, max_error, what),
+                                   file=path, line=line, column=col)
+    return v
+
+
+def read_axis_errors(path, units="mm", text=None, max_error=None):
     """Read a per-axis error file (either layout).
 
     Parameters
@@ -140,6 +162,8 @@ def read_axis_errors(path, units="mm", text=None):
         Unit of columns without a suffix (``mm``, ``um``, ``in``).
     text : str, optional
         The file's content (then ``path`` is only a name).
+    max_error : float, optional
+        Largest accepted error value (mm); default no limit.
 
     Returns
     -------
@@ -151,12 +175,9 @@ def read_axis_errors(path, units="mm", text=None):
         Unreadable file, unknown header, bad value, or no data rows.
     """
     if text is None:
+        raw = read_bytes(path, "the axis error file")
         try:
-            with open(path, encoding="utf-8-sig", newline="") as fh:
-                text = fh.read()
-        except OSError as exc:
-            raise MeasurementFileError("cannot read the axis error file: %s" % exc.strerror,
-                                       file=path) from exc
+            text = raw.decode("utf-8-sig")
         except UnicodeDecodeError as exc:
             raise MeasurementFileError("not UTF-8 text (byte %d)" % exc.start, file=path) from exc
     lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
@@ -167,15 +188,15 @@ def read_axis_errors(path, units="mm", text=None):
     sep = _separator(lines[first])
     names = [_split_name(f)[0].lower() for f in _split(lines[first], sep)]
     if "axis" in names:
-        return _read_long(path, lines, first, units)
+        return _read_long(path, lines, first, units, max_error)
     if names and names[0] in AXES:
-        return _read_tables(path, lines, first, units)
+        return _read_tables(path, lines, first, units, max_error)
     raise MeasurementFileError("unknown header %r (expected 'axis,position,ex,ey,ez' or "
                                "per-axis tables starting 'X EXX EYX EZX')"
                                % lines[first].strip(), file=path, line=first + 1)
 
 
-def _read_long(path, lines, first, units):
+def _read_long(path, lines, first, units, max_error=None):
     lineno = first + 1
     sep = _separator(lines[first])
     header = _split(lines[first], sep)
@@ -215,15 +236,17 @@ def _read_long(path, lines, first, units):
         if ax not in AXES:
             raise MeasurementFileError("axis %r (expected X, Y or Z)" % fields[role["axis"]],
                                        file=path, line=k + 1, column=role["axis"] + 1)
-        vals = [_number(fields[role[c]], path, k + 1, role[c] + 1, c) * factor[c]
-                for c in ("position", "ex", "ey", "ez")]
+        vals = [_number(fields[role["position"]], path, k + 1, role["position"] + 1,
+                        "position", factor["position"])]
+        vals += [_error(fields[role[c]], path, k + 1, role[c] + 1, c, factor[c], max_error)
+                 for c in ("ex", "ey", "ez")]
         rows[ax][0].append(vals[0])
         rows[ax][1].append(vals[1:])
         rows[ax][2].append(k + 1)
     return _finish(path, rows, "long", lines)
 
 
-def _read_tables(path, lines, first, units):
+def _read_tables(path, lines, first, units, max_error=None):
     rows = {a: ([], [], []) for a in AXES}
     cur = None  # (axis, sep, ncols, pos_factor, [(component, factor, col)])
     for k in range(first, len(lines)):
@@ -244,11 +267,11 @@ def _read_tables(path, lines, first, units):
         if len(fields) != ncols:
             raise MeasurementFileError("%d fields, expected %d like the table header"
                                        % (len(fields), ncols), file=path, line=k + 1)
-        pos = _number(fields[0], path, k + 1, 1, ax.upper()) * pfac
+        pos = _number(fields[0], path, k + 1, 1, ax.upper(), pfac)
         err = [0.0, 0.0, 0.0]
         for comp, fac, col in comps:
-            err[comp] = _number(fields[col], path, k + 1, col + 1,
-                                "E%s%s" % (AXES[comp].upper(), ax.upper())) * fac
+            err[comp] = _error(fields[col], path, k + 1, col + 1,
+                               "E%s%s" % (AXES[comp].upper(), ax.upper()), fac, max_error)
         rows[ax][0].append(pos)
         rows[ax][1].append(err)
         rows[ax][2].append(k + 1)

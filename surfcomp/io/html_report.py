@@ -13,12 +13,21 @@ no external resources. Sections carry stable ids for tools and tests:
 ``histograms``  distributions of raw deviation, random component, predicted residual
 ``statistics``  the papers' table (Werner 2022 Tab. 1 and 3) for every quantity
 ``checks``      the corrected face's check figures (or why there are none)
-``simulation``  the before/after table over replicas (only with a simulation result)
+``simulation``  the before/after table over replicas (only with a simulation result); with
+                a preset the paper's table beside the simulated one (``id="side-by-side"``),
+                what the model contains and leaves out, and the simulated parts' maps
+                (``id="simulated-maps"``, :func:`simulation_maps`)
 ``warnings``    messages of the run
 
-The predicted residual is what is left if the machine repeats the measured error
-exactly: ``d - s - delta`` (``s`` the stock for the mirror method, else 0): zero for
-raw, the random component for filtered, ``d - mean(d)`` for offset.
+The predicted residual is what the correction leaves of the repeatable (determined)
+error when the next part is cut: ``d_f - s - delta`` (``s`` the stock for the mirror
+method, else 0); the next part's new random scatter comes on top. It is defined for every
+method: zero for filtered, ``-(d - d_f)`` for raw and mirror (they copy this part's random
+scatter into the face), ``d_f - mean(d)`` for offset. The statistics add the expected RMS of
+the next part, ``sqrt(rms(residual)^2 + rms(random)^2)``.
+
+Maps use the colour scheme of :mod:`surfcomp.core.colormap` (the GUI's, default rainbow)
+and, when given, the GUI map's range, values beyond it in the out-of-range colours.
 """
 
 import base64
@@ -27,7 +36,11 @@ import io
 
 import numpy as np
 
+from ..core import colormap
 from .atomic import write_text
+
+#: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
+DEFAULT_STYLE = {"scheme": colormap.DEFAULT_SCHEME, "range": None}
 
 #: section ids in document order
 SECTIONS = ("inputs", "method", "maps", "histograms", "statistics", "checks", "simulation",
@@ -108,7 +121,7 @@ def grid_arrays(report):
     out["x"], out["y"] = put(nominal[:, 0]), put(nominal[:, 1])
     for key in ("deviation", "determined", "random", "correction"):
         out[key] = put(pts[key])
-    out["residual"] = out["deviation"] - predicted_stock(report) - out["correction"]
+    out["residual"] = out["determined"] - predicted_stock(report) - out["correction"]
     return out
 
 
@@ -118,13 +131,32 @@ def predicted_stock(report):
     return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
 
 
-def _map(x, y, values_um, title, symmetric=True):
-    fig = _figure()
-    ax = fig.add_subplot()
+def _cmap(scheme):
+    from matplotlib.colors import LinearSegmentedColormap
+
+    cmap = LinearSegmentedColormap.from_list(scheme, colormap.scheme(scheme))
+    cmap.set_under(colormap.OUT_OF_RANGE_COLORS["below"])
+    cmap.set_over(colormap.OUT_OF_RANGE_COLORS["above"])
+    cmap.set_bad(colormap.NAN_COLOR)
+    return cmap
+
+
+def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None, style=None):
+    if ax is None:
+        fig = _figure()
+        ax = fig.add_subplot()
+    style = style or DEFAULT_STYLE
     finite = values_um[np.isfinite(values_um)]
     lim = float(np.max(np.abs(finite))) if finite.size else 1.0
     lim = lim or 1.0
-    kw = dict(vmin=-lim, vmax=lim, cmap="RdBu_r") if symmetric else dict(cmap="viridis")
+    extend = "neither"
+    if style.get("range") is not None:
+        lo, hi = (1e3 * float(r) for r in style["range"])
+        extend = "both"
+    else:
+        lo, hi = -lim, lim
+    kw = dict(vmin=lo, vmax=hi, cmap=_cmap(style["scheme"])) if symmetric \
+        else dict(cmap="viridis")
     if x.ndim == 1:  # scattered points: Delaunay triangles of the nominal x, y
         mesh = ax.tripcolor(x, y, values_um, shading="gouraud", **kw)
         ax.plot(x, y, ".", color="k", markersize=1.5)
@@ -140,7 +172,7 @@ def _map(x, y, values_um, title, symmetric=True):
         mesh = ax.imshow(values_um.T, origin="lower", **kw)
         ax.set_xlabel("grid row")
         ax.set_ylabel("grid column")
-    cb = fig.colorbar(mesh, ax=ax, shrink=0.85)
+    cb = fig.colorbar(mesh, ax=ax, shrink=0.85, extend=extend if symmetric else "neither")
     cb.set_label("µm (along the outward normal)")
     ax.set_title(title, fontsize=11)
     return fig
@@ -221,18 +253,27 @@ def _section_method(report):
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
 
 
-def _section_maps(arrays):
+def _section_maps(arrays, style=None):
     figs = []
     for key, title in (("deviation", "Raw deviation d"),
                        ("determined", "Determined (filtered) d_f"),
                        ("random", "Random d - d_f"), ("correction", "Correction applied delta"),
                        ("residual", "Predicted residual")):
-        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]"),
-                         "map of " + key, title))
+        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]",
+                              style=style), "map of " + key, title))
     return ('<section id="maps"><h2>Maps</h2><p>Values along the outward normal in µm; '
-            'positive = material left. Predicted residual = d - stock - delta (what remains if '
-            'the machine repeats the measured error).</p><div class="figs">%s</div></section>'
-            % "".join(figs))
+            'positive = material left; correction positive = material removed (the face moves '
+            'inwards by it). Predicted residual = d_f - stock - delta: what the correction '
+            'leaves of the repeatable error; the next part\'s random scatter comes on top. '
+            'Colour scheme %s%s.</p><div class="figs">%s</div></section>'
+            % (_e((style or DEFAULT_STYLE)["scheme"]), _range_note(style), "".join(figs)))
+
+
+def _range_note(style):
+    if not style or style.get("range") is None:
+        return ", each map on its own symmetric range"
+    lo, hi = style["range"]
+    return ", range %.1f .. %.1f µm as in the GUI (beyond it: grey)" % (1e3 * lo, 1e3 * hi)
 
 
 def _section_histograms(arrays):
@@ -250,15 +291,22 @@ def _section_statistics(report, arrays):
                                     ("random", "Random"),
                                     ("correction", "Correction"))] if st else []
     res = arrays["residual"][np.isfinite(arrays["residual"])]
+    note = ""
     if res.size:
         std = float(np.std(res, ddof=1)) if res.size > 1 else 0.0
+        rms_res = float(np.sqrt(np.mean(res ** 2)))
         cols.append(("Predicted residual", {"count": res.size, "max_negative": res.min(),
                                             "max_positive": res.max(), "mean": res.mean(),
-                                            "std": std, "rms": float(np.sqrt(np.mean(res ** 2))),
+                                            "std": std, "rms": rms_res,
                                             "profile": 2 * np.abs(res).max()}))
+        rnd = arrays["random"][np.isfinite(arrays["random"])]
+        rms_rnd = float(np.sqrt(np.mean(rnd ** 2))) if rnd.size else 0.0
+        note = ("<p>Expected RMS of the next part (predicted residual plus a new random scatter "
+                'like this one): <span class="num">%.2f µm</span>.</p>'
+                % (1e3 * float(np.hypot(rms_res, rms_rnd))))
     return ('<section id="statistics"><h2>Statistics</h2><p>Werner 2022 Tab. 1 and 3 form; '
-            'standard deviation with ddof=%s.</p>%s</section>'
-            % (_e(report.get("statistics_ddof", 1)), _stat_table(cols)))
+            'standard deviation with ddof=%s.</p>%s%s</section>'
+            % (_e(report.get("statistics_ddof", 1)), _stat_table(cols), note))
 
 
 def _section_checks(report):
@@ -302,6 +350,117 @@ def _bar_chart(sim):
     return fig
 
 
+def simulation_maps(result):
+    """The first replica's simulated parts as maps for :func:`render_html` (``sim['maps']``).
+
+    Parameters
+    ----------
+    result : surfcomp.core.simulate.SimulationResult
+        Run with ``keep=True``.
+
+    Returns
+    -------
+    list of dict
+        ``{'key', 'title', 'x', 'y', 'values'}``: nominal x, y (mm) and deviations along the
+        outward normal (mm) of the first machined part, the mirror method's semi-finished
+        part (its measured deviation minus the stock, at the grid nodes) and every method's
+        corrected part (on the evaluation grid).
+    """
+    if result.points is None:
+        return []
+    P = np.asarray(result.points)
+    b = result.between
+    out = [{"key": "before", "title": "Machined from the nominal", "x": P[..., 0],
+            "y": P[..., 1], "values": result.maps["before"]["after"]}]
+    for spec in result.specs:
+        mp = result.maps.get(spec.label)
+        if mp is None:
+            continue
+        if spec.label in result.semi_error:
+            out.append({"key": "semi-finished", "title": "Semi-finished (minus the stock)",
+                        "x": P[::b, ::b, 0], "y": P[::b, ::b, 1],
+                        "values": np.asarray(mp["measured"]) - result.model.stock})
+        out.append({"key": spec.label, "title": "After %s" % spec.label, "x": P[..., 0],
+                    "y": P[..., 1], "values": mp["after"]})
+    return out
+
+
+def _side_by_side_html(side):
+    cols = (("mean", "mean"), ("std", "std"), ("max", "max"), ("min", "min"),
+            ("profile", "ISO 1101"))
+    head = "".join("<th>%s</th>" % h for _, h in cols)
+    rows = ["<tr><th rowspan=\"2\">Method (µm)</th><th colspan=\"5\">Paper</th>"
+            "<th colspan=\"5\">Simulated</th></tr><tr>%s%s</tr>" % (head, head)]
+    for r in side["rows"]:
+        cells = []
+        for part in (r["paper"], r["simulated"]):
+            for key, _ in cols:
+                v = None if part is None else part.get(key)
+                cells.append('<td class="num">%s</td>' % ("-" if v is None else "%.1f" % (v * 1e3)))
+        rows.append("<tr><th>%s</th>%s</tr>" % (_e(r["method"]), "".join(cells)))
+    gains = ["<tr><th>Gain 1 - after/before</th><th>std, paper</th><th>std, simulated</th>"
+             "<th>ISO 1101, paper</th><th>ISO 1101, simulated</th></tr>"]
+    for g in side["gains"]:
+        vals = [g[k][w] for k in ("std", "profile") for w in ("paper", "simulated")]
+        gains.append("<tr><th>%s (vs %s)</th>%s</tr>" % (
+            _e(g["method"]), _e(g["reference"]),
+            "".join('<td class="num">%s</td>' % ("-" if v is None else "%.0f %%" % (100 * v))
+                    for v in vals)))
+    return ('<div id="side-by-side"><h3>Paper vs simulated</h3><p>Paper: %s. Simulated: at the '
+            'measured points; mean and std pooled over the replicas, max, min and ISO 1101 '
+            'averaged over them.</p><table>%s</table><table>%s</table></div>'
+            % (_e(side["citation"]), "".join(rows), "".join(gains)))
+
+
+def _preset_html(sim):
+    preset, paper = sim.get("preset"), sim.get("paper") or {}
+    notes = list(paper.get("notes", [])) + list((preset or {}).get("notes", []))
+    summary = sim.get("model_summary") or {}
+    out = []
+    if preset:
+        out.append("<h3>Preset %s</h3><p>Imitates %s. Calibrated: %s.</p>"
+                   % (_e(preset["name"]), _e(preset["imitates"]), _e(preset["calibrated"])))
+    if sim.get("side_by_side"):
+        out.append(_side_by_side_html(sim["side_by_side"]))
+    if notes:
+        out.append("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(n) for n in notes))
+    if summary:
+        out.append("<h3>What the model contains and leaves out</h3><p>%s</p><p>Left out: %s</p>"
+                   % (_e(summary.get("contains", "")), _e(summary.get("leaves_out", ""))))
+    return "".join(out)
+
+
+def simulation_maps_figure(maps, columns=4, title=None):
+    """All :func:`simulation_maps` in one matplotlib Figure (``columns`` maps per row), e.g.
+    for the README; each map on its own symmetric scale in um."""
+    from matplotlib.figure import Figure
+
+    rows = -(-len(maps) // columns)
+    fig = Figure(figsize=(4.6 * columns, 3.7 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
+    for ax, m in zip(axes, maps):
+        v = np.asarray(m["values"]) * 1e3
+        _map(np.asarray(m["x"]), np.asarray(m["y"]), v,
+             "%s (std %.2f µm)" % (m["title"], np.std(v, ddof=1)), fig=fig, ax=ax)
+    for ax in axes[len(maps):]:
+        ax.set_axis_off()
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def _simulated_maps_html(maps):
+    if not maps:
+        return ""
+    figs = [_img(_map(np.asarray(m["x"]), np.asarray(m["y"]), np.asarray(m["values"]) * 1e3,
+                      "%s [µm]" % m["title"]), "simulated map of " + m["key"],
+                 "%s (std %.2f µm)" % (m["title"], np.std(np.asarray(m["values"]) * 1e3, ddof=1)))
+            for m in maps]
+    return ('<div id="simulated-maps"><h3>Simulated parts, replica 1</h3><p>Deviation from the '
+            'nominal along the outward normal, µm; each map on its own symmetric scale.</p>'
+            '<div class="figs">%s</div></div>' % "".join(figs))
+
+
 def _section_simulation(sim):
     if not sim:
         return ""
@@ -329,14 +488,16 @@ def _section_simulation(sim):
     return ('<section id="simulation"><h2>Simulated machining: before / after</h2>'
             '<p>%d replica(s), seed %s, measured on a %s grid and evaluated on %s points (grid '
             'nodes and between). Cells: mean over replicas (range max - min), µm; mirror paper '
-            'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div><h3>Model parameters</h3>%s</section>'
+            'Tab. 2-4 form.</p>%s%s<div class="figs">%s</div>%s%s<h3>Model parameters</h3>%s'
+            '</section>'
             % (sim.get("replicas", 0), _e(sim.get("seed")),
                _e("x".join(map(str, sim.get("grid", [])))),
                _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
-               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"), params))
+               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"),
+               _preset_html(sim), _simulated_maps_html(sim.get("maps")), params))
 
 
-def render_html(report, simulation=None):
+def render_html(report, simulation=None, style=None):
     """The report as one HTML document (str).
 
     Parameters
@@ -344,7 +505,11 @@ def render_html(report, simulation=None):
     report : dict
         From :func:`surfcomp.io.report.build_report` (schema ``surfcomp-report/1``).
     simulation : dict, optional
-        From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section).
+        From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section); a
+        ``'maps'`` entry (:func:`simulation_maps`) adds the simulated parts' maps.
+    style : dict, optional
+        ``scheme`` and ``range`` ((lo, hi) mm or None) of the maps (default
+        :data:`DEFAULT_STYLE`): the GUI passes its map's so both show the same colours.
     """
     arrays = grid_arrays(report)
     warn = report.get("warnings") or []
@@ -355,7 +520,7 @@ def render_html(report, simulation=None):
     parts = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
              "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
              "<h1>%s</h1>" % _e(title),
-             _section_inputs(report), _section_method(report), _section_maps(arrays),
+             _section_inputs(report), _section_method(report), _section_maps(arrays, style),
              _section_histograms(arrays), _section_statistics(report, arrays),
              _section_checks(report), _section_simulation(simulation),
              '<section id="warnings"><h2>Warnings</h2>%s</section>' % warn_html,
@@ -363,7 +528,7 @@ def render_html(report, simulation=None):
     return "\n".join(parts)
 
 
-def write_html_report(path, report, simulation=None):
+def write_html_report(path, report, simulation=None, style=None):
     """Write :func:`render_html` to ``path`` atomically (temporary file, then rename)."""
-    write_text(path, render_html(report, simulation))
+    write_text(path, render_html(report, simulation, style))
     return path

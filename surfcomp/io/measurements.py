@@ -90,6 +90,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError, MeasurementFileError
+from .files import read_bytes
 from .units import SUFFIX_BRACKET, UNIT_FACTORS, split_unit_suffix, unit_factor
 
 #: largest difference (mm) between a given deviation and (measured - nominal) . normal
@@ -286,13 +287,7 @@ def read_measurements(path, units="mm"):
         and what was expected in the message).
     """
     source = os.fspath(path)
-    try:
-        with open(source, "rb") as fh:
-            raw = fh.read()
-    except OSError as exc:
-        raise MeasurementFileError("cannot read the file: %s (expected a readable measurement "
-                                   "file)" % (exc.strerror or exc), file=source) from exc
-    return parse_measurements(raw, source=source, units=units)
+    return parse_measurements(read_bytes(source), source=source, units=units)
 
 
 def parse_measurements(text_or_bytes, source="<text>", units="mm"):

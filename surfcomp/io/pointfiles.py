@@ -41,6 +41,7 @@ import re
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
+from .files import read_bytes
 from .measurements import NORMAL_LENGTH_TOL, NORMAL_ZERO, MeasurementSet, decode_utf8
 from .units import split_unit_suffix, unit_factor
 
@@ -67,16 +68,6 @@ _UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
 
 # --------------------------------------------------------------------------- text input
-
-def _read_bytes(path):
-    """Return the bytes of ``path``; unreadable files raise MeasurementFileError."""
-    try:
-        with open(path, "rb") as fh:
-            return fh.read()
-    except OSError as exc:
-        raise MeasurementFileError("cannot read the file: %s" % (exc.strerror or exc),
-                                   file=str(path)) from exc
-
 
 def _split_lines(text):
     """Lines without their end-of-line characters; ``\\n``, ``\\r\\n`` and ``\\r`` end lines."""
@@ -306,12 +297,7 @@ def detect_format(path):
         If the file cannot be read or is empty.
     """
     with_path = str(path)
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-    except OSError as exc:
-        raise MeasurementFileError("cannot read the file: %s" % (exc.strerror or exc),
-                                   file=with_path) from exc
+    head = read_bytes(path, limit=1 << 16)
     text = head.decode("utf-8-sig", errors="replace")
     if not text.strip():
         raise MeasurementFileError("the file is empty; expected measured points",
@@ -397,7 +383,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     if sample is not None:
         raise InputError("sample=%r applies to QIF files only, this is a %s file" % (sample, fmt),
                          file=str(path))
-    data = _read_bytes(path)
+    data = read_bytes(path)
     warnings = []
     text = decode_utf8(data, str(path))
     if not text.strip():
@@ -413,6 +399,63 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     return MeasurementSet(nominal=None, deviation=None, row=None, col=None, ids=None,
                           source=source, sha256=hashlib.sha256(data).hexdigest(),
                           warnings=texts, tip_centres=is_tip_centre(fmt), **fields)
+
+
+def _plain_columns(path, rows, sep):
+    """Columns of a headerless XYZ file: x y z or x y z i j k by the field count."""
+    nf = len(_fields(rows[0][1], sep))
+    if nf not in (3, 6):
+        raise MeasurementFileError(
+            "wrong field count: %d fields, expected 3 (x y z) or 6 (x y z i j k); "
+            "add a header line naming the columns to read other layouts" % nf,
+            file=str(path), line=rows[0][0])
+    names = list("xyz" if nf == 3 else "xyzijk")
+    roles = {r: k for k, r in enumerate(names)}
+    columns = {r: "column %d" % (k + 1) for k, r in enumerate(names)}
+    return names, roles, columns, None
+
+
+def _header_columns(path, header, sep, warnings):
+    """Columns named by an XYZ file's header line (with unit suffixes)."""
+    hline, htext = header
+    hfields = _fields(htext, sep)
+    names, roles, columns, col_units, ignored = [], {}, {}, {}, []
+    for k, (name, col) in enumerate(hfields):
+        base, unit = split_unit_suffix(name)
+        role = _HEADER_ROLES.get(base.lower())
+        names.append(name)
+        if role is None:
+            ignored.append(name)
+            continue
+        if role in roles:
+            raise MeasurementFileError("column %r repeats %r; each of x y z i j k may "
+                                       "appear once" % (name, columns[role]),
+                                       file=str(path), line=hline, column=col)
+        roles[role] = k
+        columns[role] = name
+        if unit is not None and role in "xyz":
+            col_units[name] = unit
+    missing = [r for r in "xyz" if r not in roles]
+    if missing:
+        raise MeasurementFileError(
+            "line %d is not numeric, so it was read as a header, but it names no %s "
+            "column (found %s); expected a header such as 'x y z' or 'x y z i j k', or "
+            "numbers only" % (hline, ", ".join(missing),
+                              ", ".join(repr(f) for f, _ in hfields)),
+            file=str(path), line=hline, column=1)
+    dirs = [r for r in "ijk" if r in roles]
+    if dirs and len(dirs) != 3:
+        raise MeasurementFileError("the header names %s but not all of i, j, k"
+                                   % ", ".join(dirs), file=str(path), line=hline, column=1)
+    file_units = None
+    if col_units:
+        if len({unit_factor(u) for u in col_units.values()}) > 1:
+            raise MeasurementFileError("the x, y, z columns have different units: %s"
+                                       % ", ".join(col_units), file=str(path), line=hline)
+        file_units = next(iter(col_units.values()))
+    if ignored:
+        warnings.append((hline, "columns ignored (not x y z i j k): %s" % ", ".join(ignored)))
+    return names, roles, columns, file_units
 
 
 def _read_xyz(path, lines, units, warnings):
@@ -438,60 +481,12 @@ def _read_xyz(path, lines, units, warnings):
     decimal_comma = sep != "," and "," in "\n".join(rows.texts)
     sep_label = sep if sep is not None else ("\t" if "\t" in rows[0][1] else " ")
 
-    file_units = None
-    ignored = []
     if header is None:
-        nf = len(_fields(rows[0][1], sep))
-        if nf not in (3, 6):
-            raise MeasurementFileError(
-                "wrong field count: %d fields, expected 3 (x y z) or 6 (x y z i j k); "
-                "add a header line naming the columns to read other layouts" % nf,
-                file=str(path), line=rows[0][0])
-        names = list("xyz" if nf == 3 else "xyzijk")
-        roles = {r: k for k, r in enumerate(names)}
-        columns = {r: "column %d" % (k + 1) for k, r in enumerate(names)}
+        names, roles, columns, file_units = _plain_columns(path, rows, sep)
     else:
-        hline, htext = header
-        hfields = _fields(htext, sep)
-        names = []
-        roles = {}
-        columns = {}
-        col_units = {}
-        for k, (name, col) in enumerate(hfields):
-            base, unit = split_unit_suffix(name)
-            role = _HEADER_ROLES.get(base.lower())
-            names.append(name)
-            if role is None:
-                ignored.append(name)
-                continue
-            if role in roles:
-                raise MeasurementFileError("column %r repeats %r; each of x y z i j k may "
-                                           "appear once" % (name, columns[role]),
-                                           file=str(path), line=hline, column=col)
-            roles[role] = k
-            columns[role] = name
-            if unit is not None and role in "xyz":
-                col_units[name] = unit
-        missing = [r for r in "xyz" if r not in roles]
-        if missing:
-            raise MeasurementFileError(
-                "line %d is not numeric, so it was read as a header, but it names no %s "
-                "column (found %s); expected a header such as 'x y z' or 'x y z i j k', or "
-                "numbers only" % (hline, ", ".join(missing),
-                                  ", ".join(repr(f) for f, _ in hfields)),
-                file=str(path), line=hline, column=1)
-        dirs = [r for r in "ijk" if r in roles]
-        if dirs and len(dirs) != 3:
-            raise MeasurementFileError("the header names %s but not all of i, j, k"
-                                       % ", ".join(dirs), file=str(path), line=hline, column=1)
-        if col_units:
-            distinct = {unit_factor(u) for u in col_units.values()}
-            if len(distinct) > 1:
-                raise MeasurementFileError("the x, y, z columns have different units: %s"
-                                           % ", ".join(col_units), file=str(path), line=hline)
-            file_units = next(iter(col_units.values()))
-        if ignored:
-            warnings.append((hline, "columns ignored (not x y z i j k): %s" % ", ".join(ignored)))
+        names, roles, columns, file_units = _header_columns(path, header, sep, warnings)
+    used = set(roles.values())
+    ignored = [name for k, name in enumerate(names) if k not in used]
     ncols = len(names)
     expected = "%d (%s)" % (ncols, " ".join(names))
     usecols = sorted(roles.values())

@@ -62,6 +62,7 @@ from xml.parsers import expat
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
+from .files import read_bytes
 from .measurements import (
     DEV_CHECK_TOL,
     MAX_POINT_WARNINGS,
@@ -296,12 +297,7 @@ class _Units:
 # ------------------------------------------------------------------------------- samples
 
 def _read(path):
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read()
-    except OSError as exc:
-        raise MeasurementFileError("cannot read the file: %s" % (exc.strerror or exc),
-                                   file=str(path)) from exc
+    data = read_bytes(path)
     if not data.strip():
         raise MeasurementFileError("the file is empty; expected a QIF 3.0 XML document",
                                    file=str(path))
@@ -416,80 +412,114 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
     k = _choose(doc, blocks, samples, sample)
     mr = blocks[k]
 
+    pts = _surface_points(doc, mr, ufac)
+    nominal, measured, normal = (np.array(pts[key]) for key in ("nom", "act", "nrm"))
+    ids, lines = pts["ids"], pts["lines"]
+    computed = np.einsum("ij,ij->i", measured - nominal, normal)
+    deviation, from_file = _file_deviations(doc, mr, ufac, pts, computed, deviation_tol)
+
+    columns = {}
+    for r in ("x_nom", "y_nom", "z_nom"):
+        columns[r] = "PointFeatureNominal/Location"
+    for r in ("x_meas", "y_meas", "z_meas"):
+        columns[r] = "PointFeatureMeasurement/Location"
+    for r in "ijk":
+        columns[r] = "PointFeatureNominal/Normal"
+    if from_file.any():
+        columns["dev"] = "PointProfileCharacteristicMeasurement/Value"
+    columns["id"] = "PointFeatureItem/FeatureName"
+    return MeasurementSet(
+        nominal=nominal, measured=measured, normal=normal, deviation=deviation,
+        row=None, col=None, ids=ids, lines=np.array(lines, dtype=np.int64),
+        source=doc.source, sha256=hashlib.sha256(data).hexdigest(), units=ufac.name,
+        columns=columns, ignored_columns=[], warnings=doc.warnings, separator=" ",
+        decimal_comma=False)
+
+
+def _surface_point(doc, fm, items, nominals, ufac, skipped, no_normal):
+    """One measured feature: ``(nominal, actual, normal, name)`` of a surface point, or None
+    (counted in ``skipped`` / ``no_normal``)."""
+    fid = fm.get("id")
+    item_id, _ = doc.text(fm, "FeatureItemId", "the id of a feature item")
+    item = items.get(item_id)
+    if item is None:
+        raise doc.error("<%s id=%r> refers to FeatureItemId %s, which is no feature item "
+                        "of the file; expected an id under Features/FeatureItems"
+                        % (_local(fm.tag), fid, item_id), fm)
+    nominal_id, _ = doc.text(item, "FeatureNominalId", "the id of a feature nominal")
+    nominal = nominals.get(nominal_id)
+    if nominal is None:
+        raise doc.error("<%s id=%r> refers to FeatureNominalId %s, which is no feature "
+                        "nominal of the file; expected an id under Features/FeatureNominals"
+                        % (_local(item.tag), item.get("id"), nominal_id), item)
+    kind = _local(nominal.tag)
+    if kind != _SURFACE_POINT:
+        skipped[kind.replace("FeatureNominal", "")] += 1
+        return None
+    normal_el = doc.find(nominal, "q:Normal")
+    name_el = doc.find(item, "q:FeatureName")
+    name = name_el.text.strip() if name_el is not None and name_el.text else \
+        "feature item %s" % item_id
+    if normal_el is None:
+        no_normal.append(name)
+        return None
+    _, nloc = doc.text(nominal, "Location", "x y z")
+    _, aloc = doc.text(fm, "Location", "x y z")
+    n = doc.numbers(normal_el, 3, "the unit normal i j k")
+    length = float(np.linalg.norm(n))
+    if length < NORMAL_ZERO:
+        raise doc.error("the <Normal> of <PointFeatureNominal id=%r> is zero; expected a "
+                        "unit vector" % nominal_id, normal_el)
+    if abs(length - 1.0) > NORMAL_LENGTH_TOL:
+        doc.warn("the normal of %s has length %.6g; used normalised" % (name, length),
+                 normal_el)
+    return (doc.numbers(nloc, 3, "nominal x y z") * ufac.of(nloc),
+            doc.numbers(aloc, 3, "actual x y z") * ufac.of(aloc), n / length, name)
+
+
+def _surface_points(doc, mr, ufac):
+    """The surface points of one ``MeasurementResults``: lists ``nom``, ``act``, ``nrm``,
+    ``ids``, ``lines``, ``meas_ids``."""
     nominals = _by_id(doc, "q:Features/q:FeatureNominals")
     items = _by_id(doc, "q:Features/q:FeatureItems")
     mf = doc.find(mr, "q:MeasuredFeatures")
     if mf is None or len(mf) == 0:
         raise doc.error("MeasurementResults id %s holds no measured features; expected "
                         "<MeasuredFeatures> with surface points" % mr.get("id"), mr)
-
-    nom, act, nrm, ids, lines, meas_ids = [], [], [], [], [], []
+    pts = {key: [] for key in ("nom", "act", "nrm", "ids", "lines", "meas_ids")}
     skipped = collections.Counter()
     no_normal = []
     for fm in mf:
-        fid = fm.get("id")
-        item_id, _ = doc.text(fm, "FeatureItemId", "the id of a feature item")
-        item = items.get(item_id)
-        if item is None:
-            raise doc.error("<%s id=%r> refers to FeatureItemId %s, which is no feature item "
-                            "of the file; expected an id under Features/FeatureItems"
-                            % (_local(fm.tag), fid, item_id), fm)
-        nominal_id, _ = doc.text(item, "FeatureNominalId", "the id of a feature nominal")
-        nominal = nominals.get(nominal_id)
-        if nominal is None:
-            raise doc.error("<%s id=%r> refers to FeatureNominalId %s, which is no feature "
-                            "nominal of the file; expected an id under Features/FeatureNominals"
-                            % (_local(item.tag), item.get("id"), nominal_id), item)
-        kind = _local(nominal.tag)
-        if kind != _SURFACE_POINT:
-            skipped[kind.replace("FeatureNominal", "")] += 1
+        got = _surface_point(doc, fm, items, nominals, ufac, skipped, no_normal)
+        if got is None:
             continue
-        normal_el = doc.find(nominal, "q:Normal")
-        name_el = doc.find(item, "q:FeatureName")
-        name = name_el.text.strip() if name_el is not None and name_el.text else \
-            "feature item %s" % item_id
-        if normal_el is None:
-            no_normal.append(name)
-            continue
-        _, nloc = doc.text(nominal, "Location", "x y z")
-        _, aloc = doc.text(fm, "Location", "x y z")
-        nom.append(doc.numbers(nloc, 3, "nominal x y z") * ufac.of(nloc))
-        act.append(doc.numbers(aloc, 3, "actual x y z") * ufac.of(aloc))
-        n = doc.numbers(normal_el, 3, "the unit normal i j k")
-        length = float(np.linalg.norm(n))
-        if length < NORMAL_ZERO:
-            raise doc.error("the <Normal> of <PointFeatureNominal id=%r> is zero; expected a "
-                            "unit vector" % nominal_id, normal_el)
-        if abs(length - 1.0) > NORMAL_LENGTH_TOL:
-            doc.warn("the normal of %s has length %.6g; used normalised" % (name, length),
-                     normal_el)
-        nrm.append(n / length)
-        ids.append(name)
-        lines.append(doc.line(fm))
-        meas_ids.append(fid)
-
+        for key, value in zip(("nom", "act", "nrm", "ids"), got):
+            pts[key].append(value)
+        pts["lines"].append(doc.line(fm))
+        pts["meas_ids"].append(fm.get("id"))
+    skipped_text = ", ".join("%d %s" % (c, t) for t, c in sorted(skipped.items()))
     if skipped:
         doc.warn("%d measured feature(s) are not surface points and were skipped: %s"
-                 % (sum(skipped.values()),
-                    ", ".join("%d %s" % (c, t) for t, c in sorted(skipped.items()))), mr)
+                 % (sum(skipped.values()), skipped_text), mr)
     if no_normal:
         doc.warn("%d point feature(s) have no nominal <Normal> and were skipped: %s"
                  % (len(no_normal), ", ".join(no_normal)), mr)
-    if not nom:
+    if not pts["nom"]:
         raise doc.error("MeasurementResults id %s holds no surface points (point features "
                         "with a nominal normal); skipped: %s"
-                        % (mr.get("id"), ", ".join("%d %s" % (c, t) for t, c in
-                                                   sorted(skipped.items())) or "none"), mr)
+                        % (mr.get("id"), skipped_text or "none"), mr)
+    return pts
 
-    nominal = np.array(nom)
-    measured = np.array(act)
-    normal = np.array(nrm)
-    computed = np.einsum("ij,ij->i", measured - nominal, normal)
+
+def _file_deviations(doc, mr, ufac, pts, computed, deviation_tol):
+    """The file's point-profile values where given (else ``computed``), checked against
+    ``computed``; returns ``(deviation, from_file)``."""
+    ids, lines = pts["ids"], pts["lines"]
     values = _profile_values(doc, mr, ufac)
     deviation = computed.copy()
     from_file = np.zeros(len(ids), dtype=bool)
     several = []
-    for p, fid in enumerate(meas_ids):
+    for p, fid in enumerate(pts["meas_ids"]):
         vals = values.get(fid)
         if vals:
             deviation[p] = vals[0][0]
@@ -517,23 +547,7 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
     if bad.size > MAX_POINT_WARNINGS:
         doc.warn("%d more deviations differ from (actual - nominal) . normal by more than %g um"
                  % (bad.size - MAX_POINT_WARNINGS, deviation_tol * 1e3))
-
-    columns = {}
-    for r in ("x_nom", "y_nom", "z_nom"):
-        columns[r] = "PointFeatureNominal/Location"
-    for r in ("x_meas", "y_meas", "z_meas"):
-        columns[r] = "PointFeatureMeasurement/Location"
-    for r in "ijk":
-        columns[r] = "PointFeatureNominal/Normal"
-    if from_file.any():
-        columns["dev"] = "PointProfileCharacteristicMeasurement/Value"
-    columns["id"] = "PointFeatureItem/FeatureName"
-    return MeasurementSet(
-        nominal=nominal, measured=measured, normal=normal, deviation=deviation,
-        row=None, col=None, ids=ids, lines=np.array(lines, dtype=np.int64),
-        source=doc.source, sha256=hashlib.sha256(data).hexdigest(), units=ufac.name,
-        columns=columns, ignored_columns=[], warnings=doc.warnings, separator=" ",
-        decimal_comma=False)
+    return deviation, from_file
 
 
 def _by_id(doc, path):

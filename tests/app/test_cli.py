@@ -230,7 +230,7 @@ def test_html_report_written_with_the_other_outputs(tmp_path):
     assert "wrote %s" % (tmp_path / "r.html") in out.stdout
     # an input path among the outputs is refused before anything is written
     bad = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "--html", EXAMPLE_CSV, "--quiet")
-    assert bad.returncode == 2 and "overwrite an input" in bad.stderr
+    assert bad.returncode == 2 and "--html would overwrite the input MEASUREMENTS" in bad.stderr
 
 
 def test_probe_log_tip_radius_compensation(tmp_path):
@@ -324,8 +324,11 @@ sys.exit(main(sys.argv[1:]))
 """
 
 
-def test_interrupt_leaves_no_outputs(tmp_path):
-    """Ctrl-C while the corrected surface is being built: exit 130, nothing written."""
+@pytest.mark.parametrize("signame, code", [("SIGINT", 130), ("SIGTERM", 143),
+                                            ("SIGHUP", 129)])
+def test_interrupt_leaves_no_outputs(tmp_path, signame, code):
+    """Ctrl-C, SIGTERM or SIGHUP while the corrected surface is being built: exit 130, 143
+    or 129, nothing written (no temporary file either)."""
     import signal
 
     nom = load_nominal(EXAMPLE_STEP)
@@ -338,9 +341,10 @@ def test_interrupt_leaves_no_outputs(tmp_path):
     for line in proc.stderr:
         seen.append(line)
         if line.strip() == "HELD":
-            proc.send_signal(signal.SIGINT)
+            proc.send_signal(getattr(signal, signame))
             break
     rest = proc.stderr.read()
-    assert proc.wait(timeout=300) == 130, "".join(seen) + rest
-    assert "interrupted; nothing was written" in rest
+    assert proc.wait(timeout=300) == code, "".join(seen) + rest
+    assert ("interrupted" if code == 130 else "terminated by signal") in rest
+    assert "; nothing was written" in rest
     assert sorted(os.listdir(tmp_path)) == ["m.csv"]

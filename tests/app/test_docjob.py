@@ -8,7 +8,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import cam, docjob, features, pathjob
+from surfcomp.app import cam, docjob, documents, features, pathjob
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.pipeline import Options
 from surfcomp.errors import InputError, MeasurementFileError
@@ -64,7 +64,7 @@ def test_update_a_shop_document(shop, tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["out.FCStd", "out.ngc"]     # no temporary files
     doc = FreeCAD.openDocument(out)
     try:
-        assert docjob.restore_failures(doc, out) == []
+        assert documents.restore_failures(doc, out) == []
         comp = doc.getObject(res.compensation)
         assert features.is_compensation(comp) and comp.Output == "solid"
         assert comp.Measurement.SourceName == "meas.csv" and comp.Measurement.PointCount == 225
@@ -105,7 +105,8 @@ def pathjob_gcode_of(path):
 
 def test_never_overwrites_the_input(shop, tmp_path):
     digest = sha(shop["doc"])
-    with pytest.raises(InputError, match="refusing to overwrite the input document"):
+    with pytest.raises(InputError,
+                       match=r"--save would overwrite the input document \(--overwrite-input"):
         docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
                                 save=shop["doc"])
     with pytest.raises(InputError, match="need --save"):

@@ -10,7 +10,7 @@ import numpy as np
 import Part
 import pytest
 
-from surfcomp.app import features
+from surfcomp.app import features, reports
 from surfcomp.app.job import corrected_face
 from surfcomp.app.nominal import load_nominal, nominal_from_face
 from surfcomp.core.corrected import realised_correction
@@ -123,7 +123,7 @@ def test_compensation_matches_the_pipeline(doc):
     g = prep.grid
     assert (c.GridRows, c.GridCols) == g.shape == (45, 45)
     np.testing.assert_allclose(np.reshape(c.U, g.shape), g.take(prep.u), atol=0)
-    np.testing.assert_allclose(np.reshape(c.NominalPoints, g.shape + (3,)), g.take(prep.nominal),
+    np.testing.assert_allclose(np.reshape(c.Nodes, g.shape + (3,)), g.take(prep.nominal),
                                atol=0)
     for prop, name in (("Deviation", "deviation"), ("Determined", "determined"),
                        ("Random", "random"), ("Correction", "delta")):
@@ -138,7 +138,7 @@ def test_compensation_matches_the_pipeline(doc):
     assert c.Round == 1
     # the realised correction of the document's face at the nodes is the Correction
     U, V = np.reshape(c.U, g.shape), np.reshape(c.V, g.shape)
-    real = realised_correction(nominal.surface, features.corrected_surface(c), U.ravel(),
+    real = realised_correction(nominal.surface, reports.corrected_surface(c), U.ravel(),
                                V.ravel(), nominal.outward, guess=np.asarray(c.Correction))
     np.testing.assert_allclose(real, c.Correction, atol=2e-5)
 
@@ -232,12 +232,18 @@ def test_deviation_field_passes_through_the_nodes(doc):
     doc.recompute()
     U, V = np.reshape(c.U, (45, 45)), np.reshape(c.V, (45, 45))
     for q, prop in (("deviation", "Deviation"), ("random", "Random"), ("correction", "Correction")):
-        np.testing.assert_allclose(features.deviation_field(c, q)(U, V),
+        np.testing.assert_allclose(reports.deviation_field(c, q)(U, V),
                                    np.reshape(getattr(c, prop), (45, 45)), atol=1e-12)
-    np.testing.assert_allclose(features.deviation_field(c, "residual")(U, V),
-                               np.reshape(c.Random, (45, 45)), atol=1e-12)  # filtered method
+    # predicted residual d_f - stock - increment: zero for the filtered method ...
+    np.testing.assert_allclose(reports.deviation_field(c, "residual")(U, V), 0.0, atol=1e-12)
+    # ... and -random for the mirror method (it copies the random scatter into the face)
+    c.Method, c.Stock = "mirror", 0.05
+    doc.recompute()
+    np.testing.assert_allclose(reports.quantity_values(c, "residual"),
+                               -np.reshape(c.Random, (45, 45)), atol=1e-12)
+    assert np.nanmax(np.abs(reports.quantity_values(c, "residual"))) > 1e-4
     with pytest.raises(InputError, match="unknown quantity 'colour'"):
-        features.deviation_field(c, "colour")
+        reports.deviation_field(c, "colour")
 
 
 def test_solid_output_replaces_the_face_in_the_block(doc):
@@ -271,14 +277,14 @@ def test_solid_output_replaces_the_face_in_the_block(doc):
     uu, vv = np.meshgrid(us, vs, indexing="ij")
     _, Su, Sv = bspline.derivatives(nominal.surface, uu.ravel(), vv.ravel(), order=1)
     dA = np.linalg.norm(np.cross(Su, Sv), axis=1) * (u1 - u0) * (v1 - v0) / k ** 2
-    layer = np.sum(features.deviation_field(c, "correction")(uu.ravel(), vv.ravel()) * dA)
+    layer = np.sum(reports.deviation_field(c, "correction")(uu.ravel(), vv.ravel()) * dA)
     assert dA.sum() == pytest.approx(solid.Faces[1].Area, rel=1e-4)
-    # (to 15 %: the border moved off the side faces by up to EdgeTolerance, and OCCT's
+    # (to 15 %: the border moved off the side faces by up to EdgeTol, and OCCT's
     # volume of the tolerant rim differs from the layer's by ~ perimeter x shift x height)
     assert solid.Volume - out.Volume == pytest.approx(layer, rel=0.15)
     assert out.Shells[0].isClosed() and len(out.Shells) == 1
-    assert 1e-6 < c.EdgeTolerance.Value < 0.05          # covers the border's shift
-    assert c_face.EdgeTolerance.Value < 1e-5
+    assert 1e-6 < c.EdgeTol.Value < 0.05          # covers the border's shift
+    assert c_face.EdgeTol.Value < 1e-5
 
 
 def test_face_output_of_a_solid_is_the_face(doc):
@@ -294,7 +300,7 @@ def test_face_output_of_a_solid_is_the_face(doc):
     assert c.Shape.ShapeType == "Face" and len(c.Shape.Edges) == 4
     # zero deviations give the nominal back
     np.testing.assert_allclose(c.Correction, 0.0, atol=0)
-    s = features.corrected_surface(c)
+    s = reports.corrected_surface(c)
     u = np.linspace(0.1, 0.9, 5)
     from surfcomp.core import bspline
     np.testing.assert_allclose(bspline.evaluate(s, u, u), bspline.evaluate(nominal.surface, u, u),
@@ -318,7 +324,7 @@ def test_three_round_iteration_against_the_nominal(doc, tmp_path):
     rms, inner, comps = [], [], []
     for k in range(3):
         given = (np.zeros(U.shape) if prev is None else
-                 realised_correction(nominal.surface, features.corrected_surface(prev), U.ravel(),
+                 realised_correction(nominal.surface, reports.corrected_surface(prev), U.ravel(),
                                      V.ravel(), nominal.outward).reshape(U.shape))
         d = e - given + rng.normal(0, 5e-4, U.shape)    # machined = CAM surface + e
         path = tmp_path / ("round%d.csv" % (k + 1))
@@ -350,7 +356,7 @@ def test_three_round_iteration_against_the_nominal(doc, tmp_path):
     np.testing.assert_allclose(total, e, atol=4e-3)                 # corners: edge bias
     np.testing.assert_allclose(total[3:-3, 3:-3], e[3:-3, 3:-3], atol=1.5e-3)
     # and the last face realises it
-    real = realised_correction(nominal.surface, features.corrected_surface(comps[2]), U.ravel(),
+    real = realised_correction(nominal.surface, reports.corrected_surface(comps[2]), U.ravel(),
                                V.ravel(), nominal.outward)
     np.testing.assert_allclose(real, comps[2].Correction, atol=5e-5)
     assert features.chain(comps[2]) == [comps[2], comps[1], comps[0]]
@@ -370,13 +376,3 @@ def test_base_of_another_face_is_refused(doc):
         features.make_compensation(doc, a, "Face2", m, output="shell")
     with pytest.raises(InputError, match="is not a surfcomp measurement"):
         features.make_compensation(doc, a, "Face2", c1)
-
-
-def test_app_modules_do_not_import_gui():
-    import re
-
-    from surfcomp.app import docjob, pathjob, replace
-    for mod in (features, replace, pathjob, docjob):
-        src = open(mod.__file__, encoding="utf-8").read()
-        imports = re.findall(r"^\s*(?:import|from)\s+([\w.]+)", src, re.M)
-        assert not [m for m in imports if m.split(".")[0] in ("FreeCADGui", "PySide", "PySide2")]

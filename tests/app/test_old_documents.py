@@ -2,9 +2,9 @@
 
 ``tests/data/documents/shop-0.20.FCStd`` was made by ``make_shop_document.py`` with FreeCAD
 0.20.2 (Debian 12); ``shop-0.20.json`` holds what 0.20 computed. A fresh ``freecadcmd``
-opens a copy as the batch route does (:func:`surfcomp.app.docjob.preload_proxy_modules`,
-which on 1.x aliases the 0.20 CAM module names: FreeCAD 1.x itself restores none of the 0.20
-CAM proxies), recomputes everything and reports.
+opens a copy as the batch route does (:func:`surfcomp.app.documents.open_document`, which
+on 1.x aliases the 0.20 CAM module names: FreeCAD 1.x itself restores none of the 0.20 CAM
+proxies), recomputes everything and reports.
 """
 
 import json
@@ -23,25 +23,28 @@ DOCS = os.path.join(ROOT, "tests", "data", "documents")
 SCRIPT = r"""
 import json, os, sys
 sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
-from surfcomp.app import cam, docjob, pathjob
+from surfcomp.app import cam, documents, pathjob
 cam.setup_workbench()
 path = os.environ["SURFCOMP_DOC"]
-unimportable = docjob.preload_proxy_modules(path)
+doc, unimportable, info = documents.open_document(path)
 aliased = {name: sys.modules[name].__name__ for name in cam.LEGACY_MODULES
            if name in sys.modules and sys.modules[name].__name__ != name}
 import FreeCAD
-doc = FreeCAD.openDocument(path)
 
 def poles(shape, k):
     return [[list(p) for p in row] for row in shape.Faces[k].Surface.getPoles()]
 
 out = {"aliased": aliased, "unimportable": unimportable, "branches": cam.branches(),
-       "problems": docjob.restore_failures(doc, path),
+       "problems": documents.restore_failures(doc, info=info),
        "proxies": {o.Name: type(o.Proxy).__name__ for o in doc.Objects
                    if "Proxy" in o.PropertiesList},
        "versions": {n: doc.getObject(n).Version for n in ("Meas1", "Round1", "Round2",
                                                           "DressupAxisErrors")},
-       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")]}
+       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")],
+       "renamed": {n: {p: (len(getattr(doc.getObject(n), p)) if p == "Nodes" else True)
+                       for p in ("Flip", "EdgeTol", "Nodes", "FlipNormals", "EdgeTolerance",
+                                 "NominalPoints") if p in doc.getObject(n).PropertiesList}
+                   for n in ("Round1", "Round2")}}
 for o in doc.Objects:
     o.touch()
 doc.recompute()
@@ -101,7 +104,15 @@ def test_every_object_restores_with_its_proxy(reopened):
     else:
         assert r["aliased"] == {}
     # old objects are brought to the current property set
-    assert set(r["versions"].values()) == {features.VERSION}
+    from surfcomp.app import dressup_axis
+
+    versions = dict(r["versions"])
+    assert versions.pop("DressupAxisErrors") == dressup_axis.VERSION
+    assert set(versions.values()) == {features.VERSION}
+    # the properties renamed in version 2 keep their saved values under the new names
+    for name, props in r["renamed"].items():
+        assert set(props) == {"Flip", "EdgeTol", "Nodes"}, name
+        assert props["Nodes"] > 0, name
 
 
 def test_recomputes_to_what_0_20_computed(reopened):

@@ -19,7 +19,7 @@ import numpy as np
 import Part
 import pytest
 
-from surfcomp.app import cam, features, pathjob, replace
+from surfcomp.app import cam, features, pathjob, replace, reports
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.corrected import realised_correction
 from surfcomp.core.projection import project
@@ -126,7 +126,7 @@ def test_cutter_locations_move_by_t_over_nz(regenerated):
     doc, nom, comp, job, op, before, after = regenerated
     cl0, cl1 = before["cl"], after["cl"]
     nominal = nominal_from_face(nom.Shape.Faces[0])
-    corrected = features.corrected_surface(comp)
+    corrected = reports.corrected_surface(comp)
     out = nominal.outward
     # both tool paths lie on their surfaces' exact drop-cutter surfaces within the mesh
     # deflection (1 um)

@@ -16,7 +16,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import cam, docjob, features, pathjob, replace
+from surfcomp.app import cam, documents, features, pathjob, replace
 from surfcomp.app.nominal import nominal_from_face
 from tests.app.helpers import grid_on_face, write_cmm_csv
 from tests.app.test_features import add_part, block_solid, error_model
@@ -32,12 +32,12 @@ cam.setup_ocl()                   # before opening: the 3D Surface op imports oc
 import FreeCAD
 path = os.environ["SURFCOMP_DOC"]
 doc = FreeCAD.openDocument(path)
-from surfcomp.app import docjob, features, pathjob
+from surfcomp.app import documents, features, pathjob
 
 def poles(shape, k):
     return [[tuple(p) for p in row] for row in shape.Faces[k].Surface.getPoles()]
 
-out = {"gui": FreeCAD.GuiUp, "problems": docjob.restore_failures(doc, path),
+out = {"gui": FreeCAD.GuiUp, "problems": documents.restore_failures(doc, path),
        "types": {o.Name: getattr(o.Proxy, "Type", type(o.Proxy).__name__)
                  for o in doc.Objects if "Proxy" in o.PropertiesList},
        "module": features.__name__,
@@ -166,7 +166,7 @@ def test_old_documents_are_migrated(tmp_path):
     os.unlink(tmp_path / "m.csv")
     old = FreeCAD.openDocument(path)
     try:
-        assert docjob.restore_failures(old, path) == []
+        assert documents.restore_failures(old, path) == []
         c, m = old.getObject("Compensation"), old.getObject("Measurement")
         assert isinstance(c.Proxy, features.CompensationFeature)
         assert c.Version == features.VERSION and m.Version == features.VERSION

@@ -1,5 +1,5 @@
-"""``python3 -m surfcomp simulate`` on the bundled example: exit codes, JSON content, model
-options."""
+"""``python3 -m surfcomp simulate`` on the bundled example and the presets: exit codes, JSON
+content, model options, the papers' tables beside the simulated ones, refused options."""
 
 import hashlib
 import json
@@ -11,6 +11,9 @@ import numpy as np
 from numpy.testing import assert_allclose
 
 import surfcomp.cli
+from surfcomp.app.nominal import load_nominal
+from surfcomp.core import presets
+from surfcomp.core import simulate as sm
 from tests.app.helpers import EXAMPLE_STEP, ROOT
 
 #: until the command is listed in surfcomp.cli.COMMANDS the tests register it for the child
@@ -89,3 +92,79 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path):
     assert "--report-method 'none'" in _bad(tmp_path, "--report-method", "none")
     assert "sigma must be >= 0" in _bad(tmp_path, "--sigma", "-0.001")
     assert "Face9" in _bad(tmp_path, "--face", "Face9")
+
+
+def test_out_of_range_and_non_finite_options_name_the_option(tmp_path):
+    """Issue 12: every option value that is not finite, negative where it cannot be, or
+    beyond the limits is refused with exit 2 and a message naming the option."""
+    for args, text in (
+            (("--grid", "4001x45"), "--grid '4001x45': expected at most 4000x4000"),
+            (("--margin", "nan"), "--margin nan"), (("--margin", "0.5"), "--margin 0.5"),
+            (("--stock", "-0.1"), "--stock -0.1"), (("--stock", "inf"), "--stock inf"),
+            (("--seed", "-1"), "--seed -1"), (("--between", "0"), "--between 0"),
+            (("--replicas", "0"), "--replicas 0"), (("--refine", "0"), "--refine 0"),
+            (("--deflection", "0,nan,0"), "--deflection '0,nan,0'"),
+            (("--wavelength", "-10"), "--wavelength '-10'"),
+            (("--semi-engagement", "-0.2"), "--semi-engagement '-0.2'"),
+            (("--correlation-length", "inf"), "--correlation-length 'inf'"),
+            (("--offset", "nan"), "--offset 'nan'"),
+            (("--preset", "werner"), "unknown preset 'werner'")):
+        assert text in _bad(tmp_path, *args), args
+    out = run_cli("--quiet")  # neither a face nor a preset
+    assert out.returncode == 2 and "give NOMINAL" in out.stderr and "mirror2019-s1" in out.stderr
+
+
+def test_preset_prints_the_papers_table_beside_the_simulated_one(tmp_path):
+    """No NOMINAL: the preset's own surface (mirror paper Fig. 2), its 70 points, 4 replicas;
+    the paper's Tab. 3-4 figures in the rows of the simulated ones, JSON and HTML."""
+    out = subprocess.run([sys.executable, "-m", "surfcomp", "simulate", "--preset",
+                          "mirror2019-s1", "--json", str(tmp_path / "s.json"), "--html",
+                          str(tmp_path / "s.html"), "--report-method", "mirror", "--quiet"],
+                         cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    text = out.stdout.split("Paper vs simulated: preset mirror2019-s1")[1]
+    rows = {ln.split("|")[0].strip(): ln.split("|") for ln in text.splitlines() if "|" in ln}
+    assert rows["none"][1].split() == ["14.1", "6.2", "-", "-", "54.9"]
+    assert rows["offset"][1].split() == ["2.0", "6.1", "-", "-", "30.1"]
+    assert rows["semi-finished"][1].split() == ["15.1", "6.2", "-", "-", "57.6"]
+    assert rows["mirror"][1].split() == ["0.1", "2.4", "-", "-", "12.8"]
+    assert rows["raw"][1].split() == ["-"] * 5 and len(rows["raw"][2].split()) == 5
+    assert "mirror (vs semi-finished)" in text and "Preset:    mirror2019-s1" in out.stdout
+    d = json.loads((tmp_path / "s.json").read_text())
+    assert d["grid"] == [10, 7] and d["replicas"] == 4 and d["model"]["stock"] == 0.2
+    assert d["inputs"]["nominal"]["preset"] == "mirror2019-s1"
+    assert "path" not in d["inputs"]["nominal"] and d["inputs"]["nominal"]["degree"] == [2, 1]
+    assert {m["label"]: m for m in d["methods"]}["mirror"]["stock_mm"] == 0.2
+    side = {r["method"]: r for r in d["side_by_side"]["rows"]}
+    # calibrated to the paper's semi-finished parts (Tab. 3: 15.1 um, std 6.2 um)
+    assert_allclose([side["semi-finished"]["simulated"][k] for k in ("mean", "std")],
+                    [0.0151, 0.0062], rtol=0.1)
+    assert side["mirror"]["simulated"]["std"] < 0.5 * side["none"]["simulated"]["std"]
+    assert_allclose(d["side_by_side"]["gains"][1]["std"]["paper"], 1 - 2.4 / 6.2, atol=1e-12)
+    page = (tmp_path / "s.html").read_text()
+    assert 'id="side-by-side"' in page and "What the model contains and leaves out" in page
+    for key in ("before", "none", "offset", "raw", "filtered", "semi-finished", "mirror"):
+        assert 'alt="simulated map of %s"' % key in page, key
+    assert "<td class=\"num\">54.9</td>" in page
+
+
+def test_preset_on_a_nominal_file_is_the_same_process_on_that_face(tmp_path):
+    """The bundled example face is the werner2022 preset's surface: the preset run on the
+    STEP file gives the preset's own numbers (no random part: exactly)."""
+    out = run_cli(EXAMPLE_STEP, "--preset", "werner2022", "--grid", "9x9", "--replicas", "1",
+                  "--methods", "none,raw,mirror", "--sigma", "0", "--probe-sigma", "0",
+                  "--json", tmp_path / "s.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "surface replaced by NOMINAL" in out.stdout and "Paper vs simulated" in out.stdout
+    d = json.loads((tmp_path / "s.json").read_text())
+    assert d["model"]["deflection"] == [0.02, 0.2, 0.15] and d["model"]["sigma"] == 0.0
+    assert d["preset"]["surface_replaced_by"] == d["inputs"]["nominal"]["path"]
+    p = presets.get_preset("werner2022")
+    res = presets.run_preset(p, grid=(9, 9), replicas=1, model=p.machining_model(
+        sigma=0.0, probe_sigma=0.0), specs=sm.method_specs(["none", "raw", "mirror"]))
+    for m in d["methods"]:
+        got = m["replicas"][0]["all"]
+        assert_allclose([got["mean"], got["std"]],
+                        [res.values(m["label"], "mean")[0], res.values(m["label"], "std")[0]],
+                        atol=1e-8)
+    assert load_nominal(EXAMPLE_STEP).surface.shape == presets.werner_surface().shape

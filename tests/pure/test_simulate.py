@@ -1,17 +1,20 @@
-"""Virtual machining (surfcomp.core.simulate): model equations with hand-computed numbers,
-the random field's statistics, and the papers' orderings over replicas on a Werner-like case."""
+"""Virtual machining (surfcomp.core.simulate, process_model, sim_tables, presets): model
+equations with hand-computed numbers, the random field's statistics, the papers' orderings
+over replicas on a Werner-like case, and the presets that imitate the papers' tables."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
 from examples.make_example import example_surface
-from surfcomp.core import bspline
+from surfcomp.core import bspline, presets
+from surfcomp.core import sim_tables as tables
 from surfcomp.core import simulate as sm
 from surfcomp.core.axis_errors import AxisErrorModel
-from surfcomp.core.deviations import Statistics
+from surfcomp.core.deviations import Statistics, statistics
 from surfcomp.errors import InputError
 
 
@@ -232,7 +235,8 @@ def test_offset_fixes_the_mean_but_not_the_spread(werner_small_random):
     assert np.all(res.values("none", "mean") > 0.004)
     assert np.all(np.abs(res.values("offset", "mean")) < 0.0005)
     assert_allclose(res.values("offset", "std"), res.values("none", "std"), rtol=0.02)
-    # mirror and raw use the same measured error (the model has no depth-of-cut term)
+    # mirror and raw use the same measured error (the default model has no deflection term,
+    # so the semi-finishing pass leaves the finishing pass's error)
     assert_allclose(res.values("mirror", "std"), res.values("raw", "std"), rtol=0.1)
 
 
@@ -268,3 +272,252 @@ def test_filtered_beats_raw_only_when_the_random_part_matters():
     quiet = sm.simulate(surf, 1, sm.MachiningModel(sigma=0.0003), grid=(23, 23), replicas=4,
                         seed=5, specs=specs)
     assert np.all(quiet.values("raw", "std") < quiet.values("filtered", "std") - 0.0005)
+
+
+# ------------------------------------------------------------------ the process model
+def test_two_passes_with_deflection_by_hand_on_a_tilted_plane():
+    """Semi-finishing removes a_1 = 0.3 mm, finishing the stock 0.2 mm plus e_1; on a plane
+    of slope 0.2 along the feed g = 0.05 + 0.1 * 0.2 + 0.02 * 0.2 = 0.074."""
+    surf = plane(0.2)
+    model = sm.MachiningModel(offset=0.001, slope_gain=0.0, abs_slope_gain=0.0, tilt=(0, 0),
+                              bow=(0, 0), deflection=(0.05, 0.1, 0.02), stock=0.2,
+                              semi_engagement=0.3, sigma=0.0, probe_sigma=0.0)
+    assert model.deflects and model.semi_depth == 0.3
+    frame = model.frame(surf)
+    n = np.array([[-0.2, 0.0, 1.0]]) / np.sqrt(1.04)
+    assert_allclose(model.compliance(n), [0.074], atol=1e-15)
+    assert_allclose(model.deflection_error(n, 0.2), [0.0148], atol=1e-15)
+    us, vs = np.linspace(0.1, 0.9, 4), np.linspace(0.1, 0.9, 3)
+    e1 = 0.001 + 0.3 * 0.074                       # 0.0232 mm
+    e2 = 0.001 + 0.074 * (0.2 + e1)                # 0.0175168 mm
+    M, e = sm.machine(model, frame, surf, 1, us, vs, np.random.default_rng(0), offset=0.2,
+                      engagement=model.semi_depth, with_error=True)
+    assert_allclose(e, e1, atol=1e-15)
+    proj = sm.Projector(surf)
+    assert_allclose(sm.measure(proj, 1, M, None), 0.2 + e1, atol=1e-12)
+    M2 = sm.machine(model, frame, surf, 1, us, vs, np.random.default_rng(0), engagement=0.2 + e)
+    assert_allclose(sm.measure(proj, 1, M2, None), e2, atol=1e-12)
+    assert_allclose(e2, 0.0175168, atol=1e-15)
+    # no engagement given: the pass removes the stock
+    M3 = sm.machine(model, frame, surf, 1, us, vs, np.random.default_rng(0))
+    assert_allclose(sm.measure(proj, 1, M3, None), 0.001 + 0.074 * 0.2, atol=1e-12)
+    # the floor: this pass's scatter, the previous pass's through the engagement, the probe
+    noisy = replace(model, sigma=0.002, probe_sigma=0.0005)
+    assert_allclose(noisy.noise_floor(n), np.sqrt(4e-6 * (1 + 0.074 ** 2) + 2.5e-7), atol=1e-15)
+
+
+def test_bad_process_parameters_are_refused():
+    with pytest.raises(InputError, match="stock must be >= 0"):
+        sm.MachiningModel(stock=-0.1)
+    with pytest.raises(InputError, match="semi_engagement must be a finite depth"):
+        sm.MachiningModel(semi_engagement=float("nan"))
+    with pytest.raises(InputError, match="deflection takes 3 finite values"):
+        sm.MachiningModel(deflection=(0.0, float("inf"), 0.0))
+    with pytest.raises(InputError, match="deflection takes 3 finite values"):
+        sm.MachiningModel(deflection=(0.1, 0.2))
+    with pytest.raises(InputError, match="at most 4000 x 4000"):
+        sm.make_layout(plane(), (4001, 9))
+    with pytest.raises(InputError, match="seed must be a whole number >= 0"):
+        sm.simulate(plane(), 1, grid=(3, 3), replicas=1, seed=-1)
+
+
+def _noise_free(deflection, grid=(7, 5)):
+    """Surface one of the mirror paper, no random part: what every method leaves."""
+    model = presets.get_preset("mirror2019-s1").machining_model(
+        sigma=0.0, probe_sigma=0.0, deflection=deflection, slope_gain=0.01)
+    surf, out = presets.mirror_surface("s1"), 1
+    res = sm.simulate(surf, out, model, grid=grid, replicas=1, keep=True,
+                      specs=sm.method_specs(["none", "offset", "raw", "mirror"]))
+    lay = sm.make_layout(surf, grid)
+    S, nrm = sm.cam_grid(surf, out, lay.us[::2], lay.vs[::2])
+    s = model.slope(nrm.reshape(-1, 3)).reshape(S.shape[:-1])
+    return res, model, s
+
+
+def test_what_each_method_leaves_follows_from_the_model():
+    """Module docstring of process_model: with G = 0.01 s and g = k_0 + k_s s, e_1 = G + 0.2 g,
+    e_2 = (1 + g) e_1; mirror leaves g e_1, raw nothing, offset e_2 - mean(e_2)."""
+    res, model, s = _noise_free((0.07, 0.13, 0.0))
+    g = 0.07 + 0.13 * s
+    e1 = 0.01 * s + 0.2 * g
+    e2 = (1 + g) * e1
+    at = {lab: res.maps[lab]["after"][::2, ::2] for lab in res.labels}
+    assert_allclose(res.maps["none"]["after"][::2, ::2], e2, atol=2e-8)
+    assert_allclose(res.maps["mirror"]["measured"], 0.2 + e1, atol=2e-8)
+    # the corrected faces' normals differ from the nominal's by ~1e-3 rad: 0.05 um
+    assert_allclose(at["mirror"], g * e1, atol=5e-5)
+    assert np.mean(g * e1) > 0.001  # about 1.3 um: a residual the test can see
+    assert_allclose(at["raw"], 0.0, atol=5e-5)
+    assert_allclose(at["offset"], e2 - e2.mean(), atol=5e-5)
+    # without deflection both passes leave G: mirror and raw leave the same (nothing)
+    res0, _, _ = _noise_free((0.0, 0.0, 0.0))
+    assert_allclose(res0.maps["mirror"]["after"], res0.maps["raw"]["after"], atol=5e-5)
+    assert_allclose(res0.maps["mirror"]["after"], 0.0, atol=5e-5)
+
+
+# ------------------------------------------------------------------ tables
+def test_pooled_statistics_equal_those_of_the_concatenated_values():
+    rng = np.random.default_rng(4)
+    parts = [rng.normal(m, sd, n) for m, sd, n in ((0.001, 0.002, 40), (0.003, 0.001, 40),
+                                                     (-0.002, 0.004, 25))]
+    stats = [statistics(p) for p in parts]
+    allv = np.concatenate(parts)
+    assert_allclose(tables.pooled(stats), (allv.mean(), allv.std(ddof=1)), rtol=1e-12)
+    row = tables.side_values(stats)
+    assert_allclose([row["max"], row["min"], row["profile"]],
+                    [np.mean([p.max() for p in parts]), np.mean([p.min() for p in parts]),
+                     np.mean([2 * np.abs(p).max() for p in parts])], rtol=1e-12)
+
+
+def test_side_by_side_gains_and_text_by_hand():
+    paper = tables.PaperTable("a paper", (
+        tables.PaperRow("none", mean=0.010, std=0.004, profile=0.040),
+        tables.PaperRow("offset", mean=0.001, std=0.004, profile=0.030, reference="none"),
+        tables.PaperRow("mirror", mean=0.0, std=0.001, reference="none")))
+    sim_rows = {"none": ("none", {"mean": 0.012, "std": 0.005, "max": 0.02, "min": 0.004,
+                                  "profile": 0.04}),
+                "raw": ("raw", {"mean": 0.0, "std": 0.002, "max": 0.003, "min": -0.003,
+                                "profile": 0.008}),
+                "mirror": ("mirror", {"mean": 0.001, "std": 0.002, "max": 0.004, "min": -0.002,
+                                      "profile": 0.01})}
+    t = tables.side_by_side(sim_rows, paper)
+    assert [r["method"] for r in t["rows"]] == ["none", "offset", "raw", "mirror"]
+    assert t["rows"][1]["simulated"] is None and t["rows"][2]["paper"] is None
+    gains = {g["method"]: g for g in t["gains"]}
+    assert_allclose(gains["offset"]["profile"]["paper"], 0.25, atol=1e-15)
+    assert gains["offset"]["std"]["simulated"] is None
+    assert_allclose([gains["mirror"]["std"]["paper"], gains["mirror"]["std"]["simulated"]],
+                    [0.75, 0.6], atol=1e-15)
+    assert gains["mirror"]["profile"]["paper"] is None
+    assert_allclose(gains["mirror"]["profile"]["simulated"], 0.75, atol=1e-15)
+    text = tables.format_side_by_side(t, "title")
+    lines = {ln.split("|")[0].strip(): ln for ln in text.splitlines() if "|" in ln}
+    assert lines["none"].split("|")[1].split() == ["10.0", "4.0", "-", "-", "40.0"]
+    assert lines["raw"].split("|")[1].split() == ["-"] * 5
+    assert lines["mirror"].split("|")[2].split() == ["1.0", "2.0", "4.0", "-2.0", "10.0"]
+    assert "mirror (vs none)" in text and " 75 " in text
+
+
+def test_paper_tables_give_the_gains_the_papers_state():
+    """Mirror paper Sec. 3: std gains 61, 61, 32 %; ISO 1101 gains 45, 62, 56 % (offset) and
+    78, 84, 77 % (mirror); Tab. 4 itself gives 55 % for Surface three's offset."""
+    std_gain, iso_off, iso_mir = [], [], []
+    for k in ("s1", "s2", "s3"):
+        t = presets.get_preset("mirror2019-" + k).paper
+        r = {m: t.row(m) for m in ("none", "offset", "semi-finished", "mirror")}
+        std_gain.append(round(100 * (1 - r["mirror"].std / r["semi-finished"].std)))
+        iso_off.append(round(100 * (1 - r["offset"].profile / r["none"].profile)))
+        iso_mir.append(round(100 * (1 - r["mirror"].profile / r["semi-finished"].profile)))
+        assert round((r["none"].std - r["offset"].std) * 1e4) == 1  # 0.1 um every time
+    assert std_gain == [61, 61, 32] and iso_mir == [78, 84, 77] and iso_off == [45, 62, 55]
+    w = presets.get_preset("werner2022").paper
+    assert_allclose([w.row("none").std, w.row("raw").std, w.row("filtered").std],
+                    [0.0173, 0.0018, 0.0014], atol=0)
+
+
+# ------------------------------------------------------------------ presets
+def test_preset_surfaces_are_the_papers_shapes():
+    assert_allclose(presets.werner_surface().poles, werner_like().poles, atol=0)
+    t = np.linspace(0.0, 1.0, 5)
+    for k in ("s1", "s2", "s3"):
+        surf = presets.mirror_surface(k)
+        P = bspline.evaluate_grid(surf, t, t)
+        assert_allclose([np.ptp(P[..., 0]), np.ptp(P[..., 1])], [75.0, 63.0], atol=1e-12)
+        z = P[..., 2]
+        du2 = np.diff(z, 2, axis=0)  # second differences along u (x), per v
+        dv2 = np.diff(z, 2, axis=1)
+        # every parameter line a parabola or a straight line: constant second differences
+        assert_allclose(du2, np.broadcast_to(du2[:1, :], du2.shape), atol=1e-12)
+        assert_allclose(dv2, np.broadcast_to(dv2[:, :1], dv2.shape), atol=1e-12)
+        if k == "s1":   # identical u-quadratics, straight horizontal v-lines
+            assert_allclose(z, np.broadcast_to(z[:, :1], z.shape), atol=1e-12)
+            assert np.all(du2 < 0)
+        if k == "s2":   # straight u-lines; v-quadratics convex at u = 0, concave at u = 1
+            assert_allclose(du2, 0.0, atol=1e-12)
+            assert dv2[0, 0] < 0 < dv2[-1, 0]
+        if k == "s3":   # both families turn from convex to concave
+            assert du2[0, 0] < 0 < du2[0, -1] and dv2[0, 0] < 0 < dv2[-1, 0]
+    counts = [np.prod(presets.get_preset(n).grid) for n in presets.PRESETS]
+    assert counts == [45 * 45, 70, 49, 68]
+    with pytest.raises(InputError, match="unknown preset 'werner'"):
+        presets.get_preset("werner")
+
+
+@pytest.fixture(scope="module")
+def preset_runs():
+    return {}
+
+
+def _run(cache, name, **kw):
+    key = (name, tuple(sorted(kw.items())))
+    if key not in cache:
+        cache[key] = presets.run_preset(name, seed=0, **kw)
+    return cache[key]
+
+
+@pytest.mark.parametrize("name", ["mirror2019-s1", "mirror2019-s2", "mirror2019-s3"])
+def test_mirror_presets_reproduce_the_mirror_papers_findings(preset_runs, name):
+    """Mirror paper Tab. 3-4: mirror cuts the std (61, 61, 32 %), the tool-radius offset fixes
+    the mean (within 2 um) but not the std (0.1 um), and mirror gains more on ISO 1101.
+    Figures over the whole evaluation grid of the 4 replicas (the measured points and those
+    between them)."""
+    res = _run(preset_runs, name)
+    rows = {k: v[1] for k, v in res.side_rows("all").items()}
+    none, off, mir = rows["none"], rows["offset"], rows["mirror"]
+    assert 1 - mir["std"] / none["std"] >= 0.30, (mir["std"], none["std"])
+    assert abs(off["std"] / none["std"] - 1) <= 0.05, (off["std"], none["std"])
+    assert abs(off["mean"]) <= 0.002 and none["mean"] > 0.012
+    assert (1 - mir["profile"] / none["profile"]) > (1 - off["profile"] / none["profile"]) + 0.05
+    # the calibration: the semi-finished parts match the paper's (Tab. 3, mirror 'before')
+    semi = res.side_rows("grid")["semi-finished"][1]
+    paper = res.preset.paper.row("semi-finished")
+    assert_allclose(semi["mean"], paper.mean, atol=0.0005)
+    assert_allclose(semi["std"], paper.std, rtol=0.1)
+    # the deflection's echo: mirror leaves g e_1 (about 1.4 um), raw nothing systematic
+    assert mir["mean"] - rows["raw"]["mean"] > 0.0008
+
+
+def test_werner_preset_reproduces_werners_ordering(preset_runs):
+    """Werner 2022 Tab. 5: std 17.3 -> 1.8 (raw) -> 1.4 um (filtered, 5x5 box)."""
+    res = _run(preset_runs, "werner2022")
+    rows = {k: v[1] for k, v in res.side_rows("grid").items()}
+    assert_allclose([rows["none"]["mean"], rows["none"]["std"]], [0.0022, 0.0173], atol=0.001)
+    assert rows["filtered"]["std"] < rows["raw"]["std"] < rows["none"]["std"]
+    assert rows["filtered"]["std"] <= 1.15 * res.noise_floor, (rows["filtered"], res.noise_floor)
+    assert_allclose([rows["raw"]["std"], rows["filtered"]["std"]], [0.0018, 0.0014], atol=0.0003)
+    assert_allclose(res.noise_floor, np.sqrt(0.0012 ** 2 * (1 + 0.0041) + 0.0005 ** 2),
+                    rtol=0.002)
+
+
+def test_without_deflection_mirror_equals_raw_within_the_noise():
+    """The deflection term is what tells mirror from raw. The same error pattern made
+    independent of the cut (the deflection 0.2 (k_0 + k_s s) moved into the geometric
+    offset and slope gain) leaves mirror and raw equal within the scatter (std of a mean
+    over 4 x 247 points: about 0.06 um); with the deflection, mirror keeps about 1.3 um of
+    mean error (test above)."""
+    p = presets.get_preset("mirror2019-s1")
+    k0, ks, _ = p.model["deflection"]
+    model = p.machining_model(deflection=(0.0, 0.0, 0.0), offset=0.2 * k0, slope_gain=0.2 * ks)
+    res = presets.run_preset(p, model=model, seed=0)
+    rows = {k: v[1] for k, v in res.side_rows("all").items()}
+    mir, raw = rows["mirror"], rows["raw"]
+    assert rows["none"]["std"] > 0.005 and rows["none"]["mean"] > 0.013  # the same pattern
+    assert abs(mir["mean"] - raw["mean"]) < 0.0003, (mir["mean"], raw["mean"])
+    assert abs(mir["std"] / raw["std"] - 1) < 0.1, (mir["std"], raw["std"])
+
+
+def test_preset_result_holds_the_paper_and_the_side_by_side(preset_runs):
+    res = _run(preset_runs, "mirror2019-s2")
+    d = json.loads(json.dumps(res.as_dict(), allow_nan=False))
+    assert d["schema"] == "surfcomp-simulation/1" and d["grid"] == [7, 7]
+    assert d["preset"]["name"] == "mirror2019-s2" and d["model"]["stock"] == 0.2
+    assert d["paper"]["rows"][0] == dict(
+        method="none", mean=0.0172, std=0.0038, max=None, min=None, profile=0.0523,
+        source="Surface two; tool radius compensation, before (semi-finished)", reference=None)
+    rows = {r["method"]: r for r in d["side_by_side"]["rows"]}
+    assert list(rows) == ["none", "offset", "raw", "filtered", "semi-finished", "mirror"]
+    assert rows["raw"]["paper"] is None and rows["mirror"]["paper"]["std"] == 0.0015
+    assert rows["semi-finished"]["label"] == "semi-finished (mirror)"
+    assert len(d["methods"][4]["semi_finish"]["error_replicas"]) == 4
+    assert "Paper vs simulated: preset mirror2019-s2" in d["side_by_side"]["table"]
+    assert d["noise_floor_mm"] > 0.0013 and "leaves_out" in d["model_summary"]

@@ -1,0 +1,97 @@
+"""Read a user's STEP/IGES/BREP file in a child process, so a damaged file cannot take ours down.
+
+OpenCASCADE's STEP reader segfaults on some damaged files (a STEP with one entity line
+removed is enough). Read in this process, that ends the command (or the user's FreeCAD
+session, with its unsaved work) without a message. :func:`read_cad` runs the reader in a
+child ``python3`` that writes the shape as BREP (OCCT's own format, which it reads back
+robustly); a crash of the child becomes a clear :class:`~surfcomp.errors.GeometryError`.
+
+The child is this module run as a script::
+
+    python3 -m surfcomp.app.cadread IN.step OUT.brep
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+from ..errors import GeometryError
+
+#: seconds the reader may take (a large assembly takes minutes; a hang must end)
+TIMEOUT = float(os.environ.get("SURFCOMP_CAD_TIMEOUT", "900"))
+#: exit code of the child for a file OCCT refused without crashing
+_REFUSED = 3
+
+
+def _python():
+    """The interpreter for the child: this one when it is a Python (CLI, freecadcmd under
+    python3), else Debian's python3 (inside the FreeCAD GUI ``sys.executable`` is FreeCAD)."""
+    exe = sys.executable or ""
+    if os.path.basename(exe).startswith("python"):
+        return exe
+    return shutil.which("python3") or "/usr/bin/python3"
+
+
+def read_cad(path, label="NOMINAL"):
+    """The shape in the CAD file ``path``, read by OCCT in a child process.
+
+    Raises
+    ------
+    GeometryError
+        The reader crashed, refused the file, timed out, or the file has no faces.
+    """
+    import Part
+
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    with tempfile.TemporaryDirectory(prefix="surfcomp-read-") as tmp:
+        out = os.path.join(tmp, "shape.brep")
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+        try:
+            child = subprocess.run([_python(), "-m", "surfcomp.app.cadread",
+                                    os.path.abspath(path), out],
+                                   capture_output=True, text=True, timeout=TIMEOUT, env=env,
+                                   cwd=tmp)
+        except subprocess.TimeoutExpired:
+            raise GeometryError("could not read %s: OpenCASCADE took more than %d s (raise "
+                                "SURFCOMP_CAD_TIMEOUT for very large files)"
+                                % (label, TIMEOUT), file=path) from None
+        if child.returncode < 0 or child.returncode > 128:
+            raise GeometryError("could not read %s: the file is damaged (OpenCASCADE crashed "
+                                "while reading it)" % label, file=path)
+        if child.returncode == _REFUSED:
+            raise GeometryError(child.stderr.strip().splitlines()[-1], file=path)
+        if child.returncode != 0 or not os.path.isfile(out):
+            raise GeometryError("could not read %s: the reader failed (%s)"
+                                % (label, (child.stderr.strip().splitlines() or ["?"])[-1]),
+                                file=path)
+        shape = Part.Shape()
+        shape.read(out)
+    if shape.isNull() or not shape.Faces:
+        raise GeometryError("the file contains no faces", file=path)
+    return shape
+
+
+def _main(argv):
+    src, dst = argv
+    from . import fcenv
+
+    fcenv.import_freecad()
+    import Part
+
+    try:
+        shape = Part.read(src)
+    except (Part.OCCError, RuntimeError, ValueError) as exc:
+        print("cannot read the CAD file: %s" % exc, file=sys.stderr)
+        return _REFUSED
+    if shape.isNull() or not shape.Faces:
+        print("the file contains no faces", file=sys.stderr)
+        return _REFUSED
+    shape.exportBrep(dst)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_main(sys.argv[1:]))

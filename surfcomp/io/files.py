@@ -1,0 +1,27 @@
+"""Reading input files: the one place that turns an unreadable file into the project's error."""
+
+from ..errors import MeasurementFileError
+
+#: largest input file read (a 1M-point measurement file is about 100 MB)
+MAX_INPUT_BYTES = 4 * 1024 ** 3
+
+
+def read_bytes(path, what="the file", error=MeasurementFileError, limit=None):
+    """The bytes of ``path`` (at most ``limit`` of them when given).
+
+    Raises
+    ------
+    error (default MeasurementFileError)
+        The file cannot be read (missing, a folder, no permission) or is larger than
+        :data:`MAX_INPUT_BYTES`; the message names the file.
+    """
+    source = str(path)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_INPUT_BYTES + 1 if limit is None else limit)
+    except OSError as exc:
+        raise error("cannot read %s: %s" % (what, exc.strerror or exc), file=source) from exc
+    if limit is None and len(data) > MAX_INPUT_BYTES:
+        raise error("%s is larger than %d GB; expected a measurement or program file"
+                    % (what, MAX_INPUT_BYTES // 1024 ** 3), file=source)
+    return data

@@ -1,0 +1,220 @@
+"""What a compensation returns, and the bookkeeping both writers share.
+
+Both writers (G-code text, :mod:`.emitter`; Path command lists, :mod:`.commands`) return
+a :class:`CompensationResult` with the same fields, so the command line and the Path
+dressup read one shape: the output, statistics, warnings, and for every output move end
+point the programmed point and the command written.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...core.axis_errors import error_stats
+from ...errors import GCodeError
+
+#: the largest correction may exceed the largest model error at the programmed points by
+#: this fraction: ``|X' - X| = |E(X')|`` differs from ``|E(X)|`` by at most the model's
+#: slope times the correction, and no machine's errors change by 10 % of a millimetre
+#: per millimetre
+CORRECTION_SLACK = 0.1
+
+
+@dataclass
+class CompensationResult:
+    """A compensated program and what was done.
+
+    Attributes
+    ----------
+    output : bytes or list
+        The output program: G-code bytes (:class:`GCodeResult`) or a command list
+        (:class:`CommandsResult`).
+    stats : dict
+        ``lines_in``, ``lines_out``, ``lines_changed`` (input lines rewritten),
+        ``lines_added``, ``moves``, ``moves_split`` (G1 moves split), ``arcs_converted``,
+        ``points`` (output move end points); for command lists the ``lines_*`` count
+        commands.
+    nominal, emitted : ndarray (N, 3)
+        For every output move end point: the programmed point on the path (mm) and the
+        command written (mm, after rounding). Axes not yet known hold the assumed value.
+    known : ndarray (N,) bool
+        Every axis of the point had a known program position.
+    warnings : list of str
+    program : surfcomp.io.gcode.Program
+        The interpreted input.
+    line : ndarray (N,) int
+        1-based number of the input line (or command) each output point comes from.
+    """
+
+    output: object
+    stats: dict
+    nominal: np.ndarray
+    emitted: np.ndarray
+    known: np.ndarray
+    warnings: list
+    program: object = None
+    line: np.ndarray = None
+
+    def predicted(self, model):
+        """Predicted positional error at the output points (known ones), before/after.
+
+        ``before`` = ``|E(X)|`` for the programmed points; ``after`` = ``|X' + E(X') - X|``
+        for the commands written (rounding and chord effects included).
+        """
+        k = self.known
+        before = model.error(self.nominal[k])
+        after = model.actual(self.emitted[k]) - self.nominal[k]
+        return {"before": error_stats(before), "after": error_stats(after),
+                "points_unknown_axes": int((~k).sum())}
+
+    def corrections(self):
+        """``|emitted - nominal|`` (mm) at the points whose axes are all known, shape (n,)."""
+        return np.linalg.norm(self.emitted[self.known] - self.nominal[self.known], axis=1)
+
+    def max_correction(self):
+        """Largest distance (mm) by which a known point was moved (0 without points)."""
+        corr = self.corrections()
+        return float(corr.max()) if corr.size else 0.0
+
+    def check_bounds(self, model, resolution, source=None, max_error=None):
+        """Refuse an output that moves a point farther than the model can explain.
+
+        Every command written must be finite, and no point may be moved by more than
+        ``(1 + CORRECTION_SLACK)`` times the model's largest error at the program's
+        points plus the output rounding (all points, known axes or not). With
+        ``max_error``, the model's error at every programmed point must not exceed it
+        either (an extrapolation that far is a unit mistake or a program outside the
+        measured travel), which bounds every correction absolutely.
+
+        Parameters
+        ----------
+        model : surfcomp.core.axis_errors.AxisErrorModel
+            The model the output was compensated with.
+        resolution : float
+            Largest rounding (mm) of one point: half a unit of the last decimal written
+            on each axis, summed in quadrature.
+        source : str, optional
+            File name for messages.
+        max_error : float, optional
+            Largest plausible error (mm) of the machine.
+
+        Raises
+        ------
+        GCodeError
+            Naming the line of the first point out of bounds.
+        """
+        if self.nominal.shape[0] == 0:
+            return
+        corr = np.linalg.norm(self.emitted - self.nominal, axis=1)
+        error = np.linalg.norm(model.error(self.nominal), axis=1)
+        if max_error is not None:
+            self._check_error(error, max_error, source)
+        largest = float(error.max())
+        limit = (1.0 + CORRECTION_SLACK) * largest + resolution + 1e-9
+        over = np.flatnonzero(~(corr <= limit))      # NaN and infinity included
+        if over.size:
+            k = over[0]
+            raise GCodeError("the compensated command (%.6g, %.6g, %.6g) mm for the "
+                             "programmed point (%.6g, %.6g, %.6g) mm moves it by %.6g mm, "
+                             "more than the error model explains (its largest error at the "
+                             "program's points is %.6g mm; %d point(s) affected): nothing "
+                             "was written"
+                             % (tuple(self.emitted[k]) + tuple(self.nominal[k])
+                                + (corr[k], largest, over.size)),
+                             file=source, line=self._line_of(k))
+
+    def _line_of(self, k):
+        return None if self.line is None else int(self.line[k])
+
+    def _check_error(self, error, max_error, source):
+        """Refuse programmed points where the model's error exceeds ``max_error`` (mm)."""
+        over = np.flatnonzero(~(error <= max_error))
+        if over.size:
+            k = over[0]
+            raise GCodeError("the error model predicts an error of %.6g mm at the programmed "
+                             "point (%.6g, %.6g, %.6g) mm, more than --max-error %g mm (%d "
+                             "point(s)): check the units of the error file, or whether the "
+                             "program leaves the measured travel (the error functions are "
+                             "extrapolated there)"
+                             % ((error[k],) + tuple(self.nominal[k]) + (max_error, over.size)),
+                             file=source, line=self._line_of(k))
+
+
+class GCodeResult(CompensationResult):
+    """:class:`CompensationResult` of G-code text; ``output`` (also ``data``) is bytes."""
+
+    @property
+    def data(self):
+        return self.output
+
+
+class CommandsResult(CompensationResult):
+    """:class:`CompensationResult` of a command list.
+
+    ``output`` (also ``commands``) holds per output command either an ``int`` (index of an
+    input command kept unchanged) or a ``(name, parameters)`` pair.
+    """
+
+    @property
+    def commands(self):
+        return self.output
+
+
+class OutputState:
+    """What the machine holds after the output written so far, and the points written.
+
+    Parameters
+    ----------
+    start : sequence of 3 float or None
+        Known start position (program units), or None (nothing held yet).
+    """
+
+    def __init__(self, start=None):
+        #: value of each axis the machine holds (program units), None when not known
+        self.held = [None, None, None] if start is None else [float(v) for v in start]
+        self.nominal, self.emitted, self.known, self.line = [], [], [], []
+        self.changed = self.added = self.split = self.converted = 0
+
+    def forget(self, axes):
+        """The program moved these axes to positions it does not know (G53, G28, G30)."""
+        for a in axes:
+            self.held[a] = None
+
+    def hold_programmed(self, info):
+        """A line written as programmed: the machine holds its axis words' values."""
+        for a in range(3):
+            k = info.axis_words[a]
+            if k is not None:
+                v = info.words[k].value
+                self.held[a] = v if info.absolute else self.held[a] + v
+
+    def record(self, line, nominal, compensated, known, factor=1.0):
+        """One output move end point of input line ``line`` (1-based): programmed point
+        and compensated command (mm).
+
+        The command recorded is what the machine holds (the written value, ``factor`` mm
+        per program unit) on known axes, the compensated value on the others.
+        """
+        held = self.held
+        self.line.append(line)
+        self.nominal.append(nominal)
+        self.emitted.append([held[a] * factor if (known[a] and held[a] is not None)
+                             else compensated[a] for a in range(3)])
+        self.known.append(known[0] and known[1] and known[2])
+
+    def record_kept(self, line, point, known):
+        """The end point (mm) of a move of input line ``line`` written as programmed."""
+        self.line.append(line)
+        self.nominal.append(point)
+        self.emitted.append(point)
+        self.known.append(known[0] and known[1] and known[2])
+
+    def result(self, cls, output, lines_in, lines_out, prog):
+        """The :class:`CompensationResult` subclass ``cls`` of what was recorded."""
+        stats = {"lines_in": lines_in, "lines_out": lines_out, "lines_changed": self.changed,
+                 "lines_added": self.added, "moves": prog.n_moves, "moves_split": self.split,
+                 "arcs_converted": self.converted, "points": len(self.nominal)}
+        return cls(output, stats, np.array(self.nominal, dtype=float).reshape(-1, 3),
+                   np.array(self.emitted, dtype=float).reshape(-1, 3),
+                   np.array(self.known, dtype=bool), list(prog.warnings), prog,
+                   np.array(self.line, dtype=int))
