@@ -6,7 +6,10 @@
 - the status bar: the main window's, reached through Qt (``statusBar()``) where FreeCAD
   offers no call of its own;
 - modal dialogs: ``exec`` (Qt6) or ``exec_`` (Qt5);
-- the 3D view's widget size and mouse picking (``getObjectsInfo``, all versions since 0.19).
+- the 3D view's widget size and mouse picking (``getObjectsInfo``, all versions since 0.19);
+- Coin vectors from pivy: ``SbVec2s.getValue()`` gives a list with pivy 0.6.8/0.6.10 as
+  built for FreeCAD 0.20 and 1.0, but a bare ``short *`` with the pivy of FreeCAD 1.1
+  (Debian sid, newer SWIG); indexing works with all of them (``event_position``).
 """
 
 import FreeCAD
@@ -54,6 +57,14 @@ def legend_clearance(view=None):
         return 0, 0, height
     room = size + CUBE_MARGIN
     return (room, 0, height) if corner == TOP_RIGHT else (0, room, height)
+
+
+def event_position(event):
+    """``(x, y)``: the pixel of a Coin event (``SoEvent.getPosition()``, origin bottom left).
+
+    Indexed, not ``getValue()``: that returns an opaque pointer with some pivy builds."""
+    pos = event.getPosition()
+    return int(pos[0]), int(pos[1])
 
 
 def status_bar():

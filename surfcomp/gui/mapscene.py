@@ -168,11 +168,16 @@ class MapScene:
         # flags: labels the user placed at measured points (value and id)
         self.flags = coin.SoAnnotation()
 
-        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes
+        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes;
+        # not pickable: a hit on it is no point of the map (its coordinates are the legend
+        # camera's), so the readout would show, and a click flag, an unrelated point
         self.legend_switch = coin.SoSwitch()
         self.legend = coin.SoAnnotation()
         self.legend_switch.addChild(self.legend)
+        unpickable = coin.SoPickStyle()
+        unpickable.style = coin.SoPickStyle.UNPICKABLE
         skip = coin.SoType.fromName(coin.SbName("SoSkipBoundingGroup")).createInstance()
+        skip.addChild(unpickable)
         skip.addChild(self.legend_switch)
 
         for node in (self.surface, self.markers_switch, self.labels_switch, self.flags, skip):

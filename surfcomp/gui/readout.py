@@ -59,11 +59,16 @@ def map_under(view, position):
     bottom left, as Coin gives it), or ``(None, None)``."""
     from .viewproviders import ViewProviderCompensation
 
+    position = (int(position[0]), int(position[1]))
     try:
-        hits = view.getObjectsInfo(tuple(int(c) for c in position)) or []
-    except (RuntimeError, TypeError):
+        hits = view.getObjectsInfo(position) or []
+    except RuntimeError:
         return None, None
     doc = FreeCAD.ActiveDocument
+    # the surface first: a face is hit exactly under the cursor, the markers (GL points)
+    # within the pick radius, so at a coarse zoom (or a device pixel ratio of 2) the
+    # front-most hit is often a neighbouring point's marker
+    hits = sorted(hits, key=lambda h: not str(h.get("Component", "")).startswith("Face"))
     for hit in hits:
         obj = doc.getObject(hit.get("Object", "")) if doc is not None else None
         vobj = getattr(obj, "ViewObject", None)
@@ -132,7 +137,7 @@ def _view_of(_event_cb):
 def _on_move(event_cb):
     event = event_cb.getEvent()
     view = _view_of(event_cb)
-    if view is not None and hover(view, event.getPosition().getValue()):
+    if view is not None and hover(view, fcgui.event_position(event)):
         event_cb.setHandled()
 
 
@@ -143,8 +148,9 @@ def _on_click(event_cb):
     view = _view_of(event_cb)
     if view is None:
         return
+    position = fcgui.event_position(event)
     if event.getState() == coin.SoButtonEvent.DOWN:
-        if click(view, event.getPosition().getValue()):
+        if click(view, position):
             event_cb.setHandled()
-    elif map_under(view, event.getPosition().getValue())[0] is not None:
+    elif map_under(view, position)[0] is not None:
         event_cb.setHandled()       # the release too: no selection of what lies below

@@ -85,10 +85,22 @@ def view_top():
 
 
 def project(view, points):
+    """The pixels (origin bottom left, device pixels as ``getSize``) where ``points`` are
+    drawn. Coin's own projection, as rendering and picking do it: ``getPointOnScreen`` leaves
+    out the camera's widening of a view taller than wide (``ADJUST_CAMERA``), which the
+    Qt6 layouts give the 3D view beside the docks at a device pixel ratio of 2."""
+    from pivy import coin
+
+    region = view.getViewer().getSoRenderManager().getViewportRegion()
+    aspect = region.getViewportAspectRatio()
+    size = region.getViewportSizePixels()
+    volume = view.getCameraNode().getViewVolume(aspect)
+    if aspect < 1.0:
+        volume.scale(1.0 / aspect)
     out = []
     for p in points:
-        x, y = view.getPointOnScreen(FreeCAD.Vector(*map(float, p)))
-        out.append([int(x), int(y)])
+        s = volume.projectToScreen(coin.SbVec3f(*map(float, p)))
+        out.append([int(round(s[0] * size[0])), int(round(s[1] * size[1]))])
     return out
 
 
@@ -101,14 +113,17 @@ def shot(view, name):
 
 
 def gl_widget():
-    """The active 3D view's OpenGL viewport (where the mouse events go): the visible GL
-    widget of the view's size."""
-    size = list(Gui.ActiveDocument.ActiveView.getSize())
-    found = [w for w in mw.findChildren(QtGui.QWidget)
-             if w.metaObject().className() in ("QOpenGLWidget", "QtGLWidget", "QGLWidget")
-             and w.isVisible()]
-    same = [w for w in found if [w.width(), w.height()] == size]
-    return (same or found or [None])[0]
+    """The active 3D view's OpenGL viewport (where the mouse events go): the viewport of the
+    visible 3D viewer (a QGraphicsView) whose size in device pixels is the view's
+    (``getSize``). FreeCAD 1.1 also keeps a small visible GL widget on the main window, and
+    with a device pixel ratio other than 1 the sizes in device and in Qt pixels differ."""
+    W, H = Gui.ActiveDocument.ActiveView.getSize()
+    for v in mw.findChildren(QtGui.QGraphicsView):
+        w = v.viewport()
+        r = w.devicePixelRatioF()
+        if v.isVisible() and abs(w.width() * r - W) <= 1 and abs(w.height() * r - H) <= 1:
+            return w
+    raise RuntimeError("no 3D viewer of %d x %d device pixels" % (W, H))
 
 
 def mouse(kind, xy, button=None):
@@ -128,6 +143,14 @@ def mouse(kind, xy, button=None):
     ev = QtGui.QMouseEvent(types[kind], pos, glob, btn, btns, QtCore.Qt.NoModifier)
     QtGui.QApplication.sendEvent(w, ev)
     Gui.updateGui()
+
+
+def selection():
+    """``[[object name, [sub-element names]]]`` as the click made it: unresolved
+    (``resolve=0``, there since 0.19). Resolving (the default) checks the names against the
+    object's shape: FreeCAD 1.x drops those the shape lacks, such as a map mesh's
+    ``Vertex-1635``, which would make an element pick look like a whole-object one."""
+    return [[s.ObjectName, list(s.SubElementNames)] for s in Gui.Selection.getSelectionEx("", 0)]
 
 
 def legend_pixel(img, layout, fraction, dx=0.5):

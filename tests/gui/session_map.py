@@ -138,14 +138,12 @@ readout.uninstall_all()
 Gui.Selection.clearSelection()
 mouse("press", px)
 mouse("release", px)
-RESULTS["click_without_readout"] = [[s.ObjectName, list(s.SubElementNames)]
-                                    for s in Gui.Selection.getSelectionEx()]
+RESULTS["click_without_readout"] = selection()
 Gui.Selection.clearSelection()
 readout.install()
 mouse("press", px)
 mouse("release", px)
-RESULTS["click_over_path"] = {"selection": [[x.ObjectName, list(x.SubElementNames)]
-                                            for x in Gui.Selection.getSelectionEx()],
+RESULTS["click_over_path"] = {"selection": selection(),
                               "flags": list(vobj.Flags), "node": readout.LAST.get("node")}
 # click the same node again: the flag goes; once more: it stays
 mouse("press", px)
