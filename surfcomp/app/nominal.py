@@ -186,18 +186,22 @@ def nominal_from_face(face, source="<document>", face_name="Face1", object_name=
 
 
 #: boundary points per edge for integrals over trimmed faces and the inside test
-EDGE_POINTS = 1000
+EDGE_POINTS = 400
 #: a measured point farther than this (mm) outside the trimmed face is reported
 OUTSIDE_TOLERANCE = 1e-3
 
 
 def boundary_polylines(face, points=EDGE_POINTS):
-    """The face's edges as polylines in (u, v) (pcurves sampled at ``points`` parameters):
-    together they bound the face (outer wire and holes; a seam edge's two pcurves)."""
+    """The face's edges as polylines in (u, v) (pcurves sampled at ``points`` parameters),
+    each in its direction in the face's wire: together they bound the face (outer wire and
+    holes, which run the other way round; a seam edge's two pcurves)."""
     out = []
     for e in (e for w in face.Wires for e in w.childShapes()):
         c2d, a, b = face.curveOnSurface(e)[:3]
-        pts = [c2d.value(float(t)) for t in np.linspace(a, b, points)]
+        ts = np.linspace(a, b, points)
+        if e.Orientation == "Reversed":
+            ts = ts[::-1]
+        pts = [c2d.value(float(t)) for t in ts]
         out.append(np.array([(p.x, p.y) for p in pts], dtype=float))
     return out
 

@@ -228,8 +228,9 @@ def _check_replaced(shape, out, index, label):
                 break
         if out.Faces[index].Surface.TypeId != "Part::GeomBSplineSurface":
             problems.append("Face%d is not the corrected surface" % (index + 1))
+        # the edges the correction moves by at most PRECISION keep their own tolerance
         tol = _tolerance(out.Faces[index])
-        allowed = max(PRECISION, _tolerance(shape.Faces[index]))
+        allowed = PRECISION + _tolerance(shape.Faces[index])
         if tol > allowed:
             problems.append("edge tolerance %.3g mm (more than %g mm)" % (tol, allowed))
     if problems:
@@ -239,11 +240,10 @@ def _check_replaced(shape, out, index, label):
 
 
 def has_neighbours(shape, face):
-    """True when ``face`` sits in a shell or solid of ``shape`` (not a lone face)."""
-    if shape is None:
-        return False
-    return any(s.ShapeType in ("Solid", "Shell") and any(f.isSame(face) for f in s.Faces)
-               for s in shape.Solids + shape.Shells)
+    """True when ``face`` sits in a shell (or solid) of ``shape`` with other faces, not a
+    lone face (a STEP file of one face reads back as a shell of that face)."""
+    return len(shape.Faces) > 1 and any(any(f.isSame(face) for f in s.Faces)
+                                        for s in shape.Shells)
 
 
 def corrected_shape(nominal, corrected, output="face", label="compensation"):
@@ -257,17 +257,18 @@ def corrected_shape(nominal, corrected, output="face", label="compensation"):
     output : {'face', 'solid'}
         ``face``: the nominal face's boundary on the corrected surface. ``solid``:
         ``nominal.shape`` with the face replaced and its neighbours re-trimmed
-        (:func:`replace_face`): same number and order of faces; a lone face gives the face.
+        (:func:`replace_face`): same number and order of faces; a lone face (in no shell or
+        solid) gives the face.
     """
-    bs = surface_to_part(corrected)
-    integral = correction_volume(nominal, corrected)
-    if output == "face" or nominal.shape is None:
-        new = rebuild_face(nominal.bspline_face, bs)
-        return Output(new, "face", _tolerance(new), integral)
-    shape = nominal.shape
-    idx = int(nominal.face_name[4:]) - 1
     from .nominal import to_bspline_face
 
+    bs = surface_to_part(corrected)
+    integral = correction_volume(nominal, corrected)
+    shape = nominal.shape
+    idx = int(nominal.face_name[4:]) - 1
+    if output == "face" or shape is None or not has_neighbours(shape, shape.Faces[idx]):
+        new = rebuild_face(nominal.bspline_face, bs)
+        return Output(new, "face", _tolerance(new), integral)
     pface = to_bspline_face(shape.Faces[idx])[0]
     out, plan = replace_face(shape, idx, pface, bs, label)
     change = None
