@@ -20,6 +20,9 @@ from ..core import bspline
 from ..core.trimmed import correction_integral, domain_integral, knots_of
 from .nominal import boundary_polylines
 
+#: knots per direction above which the volume change's panels ignore them
+_MAX_KNOTS = 400
+
 
 def correction_volume(nominal, corrected):
     """The integral of the correction over the (trimmed) nominal face (mm^3, positive =
@@ -74,12 +77,15 @@ def volume_change(nominal, corrected, new_face, plan):
     bb = nominal.bspline_face.BoundBox
     centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
     knots = knots_of(nominal.surface, corrected)
+    panels = 16
+    if max(len(k) for k in knots) > _MAX_KNOTS:      # very fine corrections: a fixed grid
+        knots, panels = knots_of(nominal.surface), 256
     # one scan grid with panels broken at both surfaces' knots: the quadrature errors of
     # the two fluxes cancel to far below the change
     change = (domain_integral(_flux_density(corrected, nominal.outward, centre), new_lines,
-                              box=box, knots=knots)
+                              box=box, knots=knots, panels=panels)
               - domain_integral(_flux_density(nominal.surface, nominal.outward, centre),
-                                old_lines, box=box, knots=knots))
+                                old_lines, box=box, knots=knots, panels=panels))
     for p in plan.edges:
         if p.samples is not None:
             change += _strip_flux(p, centre)

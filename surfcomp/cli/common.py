@@ -183,9 +183,10 @@ def output_lines(shape):
     if not shape:
         return []
     if shape["kind"] == "face":
-        return ["Output:       the corrected face alone (largest edge tolerance %.2g mm); the "
-                "correction integrates to %.4f mm^3 over it"
-                % (shape["max_edge_tolerance_mm"], shape["correction_integral_mm3"])]
+        return ["Output:       the corrected face alone (largest edge tolerance %.2g mm)"
+                % shape["max_edge_tolerance_mm"],
+                "  the correction integrates to %.4f mm^3 over it (positive = material removed)"
+                % shape["correction_integral_mm3"]]
     lines = ["Output:       the nominal's shape with the face replaced (%d faces, %d solids; "
              "re-trimmed neighbours: %s; largest edge tolerance of the face %.2g mm)"
              % (shape["faces"], shape["solids"], ", ".join(shape["retrimmed_faces"]) or "none",
