@@ -30,7 +30,9 @@ class Nominal:
         The same face (geometry, boundary, orientation) as a B-spline face: ``face`` itself,
         or its ``toNurbs`` form; its pcurves are in the parametrisation of ``surface``.
     surface : surfcomp.core.bspline.Surface
-        Core arrays of ``bspline_face.Surface``; ``u_range``/``v_range`` = the face's UV bounds.
+        Core arrays of ``bspline_face.Surface`` made non-periodic and cut to the face's UV
+        bounds (:func:`work_surface`, same parametrisation); ``u_range``/``v_range`` = those
+        bounds.
     outward : int
         +1 when the face's outward normal is Su x Sv, -1 when the face is reversed.
     source, face_name, object_name : str
