@@ -213,7 +213,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     comp.MaskKind = options.mask_kind
     comp.Sigma = float(options.sigma or 0.0)
     comp.MaxOffset = float(options.max_offset)
-    comp.FlipNormals = bool(options.flip_normals)
+    comp.Flip = bool(options.flip_normals)
     comp.Refine = int(options.refine)
     return comp, meas
 

@@ -15,7 +15,7 @@ from .. import __version__
 from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors, volumetric_map
 from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH, check_segments
 from ..errors import GCodeError, InputError
-from ..io.atomic import Transaction
+from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
 from ..io.gcode import compensate_gcode, parse_gcode, read_gcode
 from ..io.hashing import sha256_file
@@ -108,7 +108,14 @@ def _outside_travel(model, points):
     return int((dist > 1e-9).sum()), float(dist.max())
 
 
+def _declared(args):
+    """(outputs, inputs) of the command, checked before any work and at the commit."""
+    return ([("-o", args.output), ("--report", args.report)],
+            [("IN.ngc", args.program), ("--axis-errors", args.axis_errors)])
+
+
 def run(args):
+    check_outputs(*_declared(args))
     seg = _positive(args.segment_length, "--segment-length", MIN_SEGMENT_LENGTH)
     tol = _positive(args.tolerance, "--tolerance")
     arc_tol = _positive(args.arc_tolerance, "--arc-tolerance")
@@ -149,10 +156,8 @@ def run(args):
                         % _um(spread.max()))
 
     outputs = {"program": os.path.abspath(args.output)}
-    with Transaction() as tr:
-        tmp = tr.stage(args.output)
-        with open(tmp, "wb") as fh:
-            fh.write(res.output)
+    with Transaction(*_declared(args)) as tr:
+        tr.stage_bytes(args.output, res.output)
         if args.report:
             outputs["report"] = os.path.abspath(args.report)
             rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,

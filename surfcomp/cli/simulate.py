@@ -58,7 +58,7 @@ from ..core import simulate as sim
 from ..core.filters import EDGE_MODES
 from ..core.progress import sub
 from ..errors import InputError
-from ..io.atomic import Transaction
+from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from .common import ProgressLine
 
@@ -286,9 +286,7 @@ def run(args):
     specs = sim.method_specs(methods, masks, None, args.mask_kind, args.edge, args.refine)
     report_label = _report_label(args, specs)
     model = model_from_args(args, preset)
-    for out in (args.json, args.html):
-        if out and args.nominal and os.path.abspath(out) == os.path.abspath(args.nominal):
-            raise InputError("an output would overwrite the nominal", file=out)
+    check_outputs(*_declared(args))
     progress = ProgressLine(args.quiet)
     surface, outward, info, name = _nominal(args, preset)
     res = sim.simulate(surface, outward, model, grid=grid, specs=specs, replicas=replicas,
@@ -305,8 +303,13 @@ def run(args):
     return 0
 
 
+def _declared(args):
+    """(outputs, inputs) of the command, checked before any work and at the commit."""
+    return [("--json", args.json), ("--html", args.html)], [("NOMINAL", args.nominal)]
+
+
 def _write(args, res, data, inputs, report_label):
-    with Transaction() as tx:
+    with Transaction(*_declared(args)) as tx:
         if args.json:
             tx.stage_text(args.json, json.dumps(data, indent=1, allow_nan=False) + "\n")
         if args.html:

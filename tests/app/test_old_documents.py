@@ -40,7 +40,11 @@ out = {"aliased": aliased, "unimportable": unimportable, "branches": cam.branche
                    if "Proxy" in o.PropertiesList},
        "versions": {n: doc.getObject(n).Version for n in ("Meas1", "Round1", "Round2",
                                                           "DressupAxisErrors")},
-       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")]}
+       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")],
+       "renamed": {n: {p: (len(getattr(doc.getObject(n), p)) if p == "Nodes" else True)
+                       for p in ("Flip", "EdgeTol", "Nodes", "FlipNormals", "EdgeTolerance",
+                                 "NominalPoints") if p in doc.getObject(n).PropertiesList}
+                   for n in ("Round1", "Round2")}}
 for o in doc.Objects:
     o.touch()
 doc.recompute()
@@ -103,7 +107,15 @@ def test_every_object_restores_with_its_proxy(reopened):
     else:
         assert r["aliased"] == {}
     # old objects are brought to the current property set
-    assert set(r["versions"].values()) == {features.VERSION}
+    from surfcomp.app import dressup_axis
+
+    versions = dict(r["versions"])
+    assert versions.pop("DressupAxisErrors") == dressup_axis.VERSION
+    assert set(versions.values()) == {features.VERSION}
+    # the properties renamed in version 2 keep their saved values under the new names
+    for name, props in r["renamed"].items():
+        assert set(props) == {"Flip", "EdgeTol", "Nodes"}, name
+        assert props["Nodes"] > 0, name
 
 
 def test_recomputes_to_what_0_20_computed(reopened):

@@ -411,7 +411,7 @@ def test_face_of_a_solid_in_the_document(circle_solid):
                                        method="raw", output="solid")
         doc.recompute()
         assert c.State == ["Up-to-date"], c.State
-        assert c.EdgeTolerance.Value <= 1e-4
+        assert c.EdgeTol.Value <= 1e-4
         assert json.loads(c.Checks)["max_error_at_points_mm"] <= 0.1 * UM
         _check_replaced_solid(case, c.Shape, c.VolumeChange, c.CorrectionVolume)
         if "cli" in case:          # the same construction as the command line's
