@@ -45,6 +45,7 @@ from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
+from .nominal import trim_warning
 from .progress import freecad_progress
 from .proxies import Proxy
 from .proxies import migrate as _migrate
@@ -56,7 +57,8 @@ from .shapes import corrected_shape
 QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 #: version of the property sets; onDocumentRestored upgrades older objects
-#: (2: short names that fit the property view, see RENAMED)
+#: (properties added since, such as VolumeChange, come from the property tables;
+#: 2: short names that fit the property view, see RENAMED)
 VERSION = 2
 #: compensation properties renamed in version 2: old name -> new name
 RENAMED = {"FlipNormals": "Flip", "EdgeTolerance": "EdgeTol", "NominalPoints": "Nodes"}
@@ -203,7 +205,8 @@ COMPENSATION_PROPERTIES = (
      4, 0),
     ("App::PropertyEnumeration", "Output", _IN,
      QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
-                                        " the face replaced"),
+                                        " the face replaced and its neighbours re-trimmed to meet"
+                                        " it"),
      list(OUTPUTS), 0),
     ("App::PropertyEnumeration", "Layout", _IN,
      QT_TRANSLATE_NOOP("App::Property", "auto: a complete grid if the points form one, else "
@@ -281,8 +284,17 @@ COMPENSATION_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Iteration round (1 without a Base)"),
      1, _RO),
     ("App::PropertyLength", "EdgeTol", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Largest edge tolerance of the output solid (covers the "
-                                        "face border's shift)"),
+     QT_TRANSLATE_NOOP("App::Property", "Largest tolerance of the corrected face's edges and "
+                                        "vertices"),
+     0.0, _RO),
+    ("App::PropertyFloat", "VolumeChange", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Output solid: its volume minus the nominal's (mm^3; 0 for"
+                                        " a face)"),
+     0.0, _RO),
+    ("App::PropertyFloat", "CorrectionVolume", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Integral of the correction over the face (mm^3, positive"
+                                        " = material removed): the volume change should be minus"
+                                        " this"),
      0.0, _RO),
     ("App::PropertyString", "ReplacedLinks", "Replace",
      QT_TRANSLATE_NOOP("App::Property", "Links rebound by surfcomp.app.replace.replace (JSON; "
@@ -549,14 +561,15 @@ def chain(obj):
 
 
 class _Result:
-    """What ``_compute`` returns: the core compensation plus the app-side products."""
+    """What ``_compute`` returns: the core compensation plus the app-side products
+    (``output``: a :class:`surfcomp.app.shapes.Output`, None for a preview)."""
 
-    def __init__(self, comp, nominal, increment, shape, edge_tol, round_):
+    def __init__(self, comp, nominal, increment, output, round_):
         self.comp = comp
         self.nominal = nominal
         self.increment = increment
-        self.shape = shape
-        self.edge_tolerance = edge_tol
+        self.output = output
+        self.shape = None if output is None else output.shape
         self.round = round_
 
 
@@ -610,6 +623,9 @@ def _compute(obj):
     with freecad_progress("%s: compensating" % obj.Label) as progress:
         prepared = prepare(nominal.surface, nominal.outward, ms, options,
                            progress=sub(progress, 0.0, 0.3))
+        warning = trim_warning(nominal, prepared)
+        if warning:
+            prepared.warnings.append(warning)
         comp = compensate(nominal.surface, nominal.outward, prepared, options,
                           build=base is None and not preview, progress=sub(progress, 0.3, 1.0))
         increment = comp.correction.delta
@@ -619,10 +635,11 @@ def _compute(obj):
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
     if preview:
-        return _Result(comp, nominal, increment, None, obj.EdgeTol.Value, len(links))
-    shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
-    shape.Placement = placement
-    return _Result(comp, nominal, increment, shape, tol, len(links))
+        return _Result(comp, nominal, increment, None, len(links))
+    output = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
+    output.shape.Placement = placement
+    comp.prepared.warnings.extend(output.warnings(obj.Label))
+    return _Result(comp, nominal, increment, output, len(links))
 
 
 def _build(nominal, prepared, comp, total, build=True, progress=None):
@@ -666,7 +683,10 @@ def _write_results(obj, r):
         obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
     obj.Warnings = [str(w) for w in p.warnings]
     obj.Round = r.round
-    obj.EdgeTol = float(r.edge_tolerance)
+    if r.output is not None:                  # a preview keeps the shape's figures
+        obj.EdgeTol = float(r.output.edge_tolerance)
+        obj.VolumeChange = float(r.output.volume_change or 0.0)
+        obj.CorrectionVolume = float(r.output.correction_volume)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
