@@ -86,7 +86,7 @@ comp.ViewObject.RangeMax = 0.02
 view.redraw()
 FreeCADGui.updateGui()
 RESULTS["restyle_s"] = time.perf_counter() - t0
-for name, prop in (("no_points", "ShowPoints"),):
+for name, prop in (("no_points", "Points"),):
     setattr(comp.ViewObject, prop, False)
     t0 = time.perf_counter()
     view.redraw()

@@ -104,8 +104,11 @@ build_root() {
 
 configure_root() {
   local suite=$1 root=$2
-  mkdir -p "$root/etc/ssl/certs" "$root/etc/apt/apt.conf.d"
+  mkdir -p "$root/etc/ssl/certs" "$root/etc/apt/apt.conf.d" "$root/usr/local/share/ca-certificates"
   cp /etc/ssl/certs/ca-certificates.crt "$root/etc/ssl/certs/ca-certificates.crt"
+  # the root's ca-certificates package rebuilds that bundle when it is installed or updated;
+  # a local certificate file keeps this machine's authorities in the rebuilt one (pip needs them)
+  cp /etc/ssl/certs/ca-certificates.crt "$root/usr/local/share/ca-certificates/surfcomp-host.crt"
   [ -f /etc/pip.conf ] && cp /etc/pip.conf "$root/etc/pip.conf"
   [ -f /etc/resolv.conf ] && cp -L /etc/resolv.conf "$root/etc/resolv.conf"
   echo "deb $mirror $suite main" >"$root/etc/apt/sources.list"

@@ -46,6 +46,9 @@ class DocumentJobResult:
     statistics: dict = field(default_factory=dict)
     checks: dict = field(default_factory=dict)
     warnings: list = field(default_factory=list)
+    output: str = "face"                               # the feature's Output
+    volume_change: float = 0.0                         # mm^3 (solid output)
+    correction_volume: float = 0.0                     # mm^3, integral of the correction
 
 
 def _find_object(doc, name, source):
@@ -165,6 +168,9 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         result.statistics = json.loads(comp.Statistics)
         result.checks = json.loads(comp.Checks)
         result.warnings = list(comp.Warnings)
+        result.output = comp.Output
+        result.volume_change = float(comp.VolumeChange)
+        result.correction_volume = float(comp.CorrectionVolume)
         report(progress, 0.95, "saving")
         _write(doc, result, save, gcode, text, _declared(document, measurements, save, gcode,
                                                          overwrite_input))
@@ -207,7 +213,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     comp.MaskKind = options.mask_kind
     comp.Sigma = float(options.sigma or 0.0)
     comp.MaxOffset = float(options.max_offset)
-    comp.FlipNormals = bool(options.flip_normals)
+    comp.Flip = bool(options.flip_normals)
     comp.Refine = int(options.refine)
     return comp, meas
 
@@ -250,6 +256,10 @@ def summary_lines(result):
     """Short human-readable lines about a :class:`DocumentJobResult` (for the CLI)."""
     lines = ["compensation %s (measurement %s) added to the document"
              % (result.compensation, result.measurement)]
+    if result.output == "solid":
+        lines.append("output: the nominal's shape with the face replaced; volume change %.4f "
+                     "mm^3, the correction integrates to %.4f mm^3"
+                     % (result.volume_change, -result.correction_volume))
     if result.replaced:
         lines.append("replaced the nominal in: %s"
                      % ", ".join("%s.%s" % pair for pair in result.replaced))

@@ -32,6 +32,10 @@ from ..io.gcode import compensate_commands
 from . import cam
 from .proxies import Proxy
 
+#: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
+#: context when it shows them)
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
+
 #: version of the document object's property set; onDocumentRestored upgrades older ones
 VERSION = 1
 
@@ -41,45 +45,73 @@ _GROUP_RESULT = "Result"
 
 #: (type, name, group, tooltip, default, editor mode) of every property
 PROPERTIES = (
-    ("App::PropertyLink", "Base", "Base", "The base path to modify", None, 0),
+    ("App::PropertyLink", "Base", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "The base path to modify"),
+     None, 0),
     ("App::PropertyStringList", "MeasuredAxis", _GROUP_DATA,
-     "Moving slide (X, Y or Z) of every measured row", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Moving slide (X, Y or Z) of every measured row"),
+     None, 0),
     ("App::PropertyFloatList", "MeasuredPosition", _GROUP_DATA,
-     "Position of the moving slide of every row (mm)", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Position of the moving slide of every row (mm)"),
+     None, 0),
     ("App::PropertyFloatList", "MeasuredErrorX", _GROUP_DATA,
-     "Tool-position error along X of every row (mm, actual - commanded)", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Tool-position error along X of every row (mm, actual - "
+                                        "commanded)"),
+     None, 0),
     ("App::PropertyFloatList", "MeasuredErrorY", _GROUP_DATA,
-     "Tool-position error along Y of every row (mm, actual - commanded)", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Tool-position error along Y of every row (mm, actual - "
+                                        "commanded)"),
+     None, 0),
     ("App::PropertyFloatList", "MeasuredErrorZ", _GROUP_DATA,
-     "Tool-position error along Z of every row (mm, actual - commanded)", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Tool-position error along Z of every row (mm, actual - "
+                                        "commanded)"),
+     None, 0),
     ("App::PropertyString", "SourceFile", _GROUP_DATA,
-     "File the measurements were read from (information only: the data is stored above)",
+     QT_TRANSLATE_NOOP("App::Property", "File the measurements were read from (information only: "
+                                        "the data is stored above)"),
      "", 1),
     ("App::PropertyEnumeration", "Model", _GROUP_DATA,
-     "Degree of the error functions: auto (F-test per function), linear or quadratic",
+     QT_TRANSLATE_NOOP("App::Property", "Degree of the error functions: auto (F-test per "
+                                        "function), linear or quadratic"),
      ["auto"] + [m for m in MODEL_CHOICES if m != "auto"], 0),
     ("App::PropertyVector", "Reference", _GROUP_DATA,
-     "Where the other slides stood while one slide was measured (measurement coordinates)",
+     QT_TRANSLATE_NOOP("App::Property", "Where the other slides stood while one slide was measured"
+                                        " (measurement coordinates)"),
      None, 0),
     ("App::PropertyVector", "WorkOffset", _GROUP_DATA,
-     "Measurement (machine) coordinates of the path's zero", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Measurement (machine) coordinates of the path's zero"),
+     None, 0),
     ("App::PropertyLength", "SegmentLength", _GROUP_COMP,
-     "Longest piece of a split G1 move or of an arc turned into G1 segments", 2.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Longest piece of a split G1 move or of an arc turned into"
+                                        " G1 segments"),
+     2.0, 0),
     ("App::PropertyLength", "Tolerance", _GROUP_COMP,
-     "Split a long G1 move only where the compensated path leaves its chord by more", 1e-4, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Split a long G1 move only where the compensated path "
+                                        "leaves its chord by more"),
+     1e-4, 0),
     ("App::PropertyLength", "ArcTolerance", _GROUP_COMP,
-     "Largest chord-to-arc deviation of arcs turned into G1 segments", 1e-3, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Largest chord-to-arc deviation of arcs turned into G1 "
+                                        "segments"),
+     1e-3, 0),
     ("App::PropertyStringList", "FitSummary", _GROUP_RESULT,
-     "Fitted error functions and the 12 components", None, 1),
+     QT_TRANSLATE_NOOP("App::Property", "Fitted error functions and the 12 components"),
+     None, 1),
     ("App::PropertyLength", "ErrorBefore", _GROUP_RESULT,
-     "Largest predicted tool-position error of the base path's points", 0.0, 1),
+     QT_TRANSLATE_NOOP("App::Property", "Largest predicted tool-position error of the base path's "
+                                        "points"),
+     0.0, 1),
     ("App::PropertyLength", "ErrorAfter", _GROUP_RESULT,
-     "Largest predicted tool-position error after compensation", 0.0, 1),
+     QT_TRANSLATE_NOOP("App::Property", "Largest predicted tool-position error after compensation"),
+     0.0, 1),
     ("App::PropertyLength", "MaxCorrection", _GROUP_RESULT,
-     "Largest correction applied to a point", 0.0, 1),
+     QT_TRANSLATE_NOOP("App::Property", "Largest correction applied to a point"),
+     0.0, 1),
     ("App::PropertyStringList", "Warnings", _GROUP_RESULT,
-     "What the compensation assumed (e.g. axes not yet programmed)", None, 1),
-    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     QT_TRANSLATE_NOOP("App::Property", "What the compensation assumed (e.g. axes not yet "
+                                        "programmed)"),
+     None, 1),
+    ("App::PropertyInteger", "Version", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, 2),
 )
 

@@ -60,6 +60,7 @@ def import_freecad():
         With a message that says how to install FreeCAD.
     """
     setup_paths()
+    first = "FreeCAD" not in sys.modules
     try:
         import FreeCAD  # noqa: F401  (imported for the side effect and returned)
     except ImportError as exc:
@@ -68,7 +69,26 @@ def import_freecad():
             "freecad-python3' or set FREECAD_LIB to the folder holding FreeCAD.so." % exc
         ) from exc
     import FreeCAD
+    if first:
+        _keep_python_sigint()
     return FreeCAD
+
+
+def _keep_python_sigint():
+    """Give Ctrl-C back to Python after FreeCAD was imported as a library.
+
+    FreeCAD 1.1 installs its own SIGINT handler when it is imported, below Python's, so
+    Ctrl-C no longer raised KeyboardInterrupt: an interrupted job went on and wrote its
+    files. Python's handler (whatever Python code had set) is installed again.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return
+    handler = signal.getsignal(signal.SIGINT)
+    if callable(handler):
+        signal.signal(signal.SIGINT, handler)
 
 
 def _user_mod_dirs():

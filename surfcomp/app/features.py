@@ -45,14 +45,23 @@ from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
+from .nominal import trim_warning
 from .progress import freecad_progress
 from .proxies import Proxy
 from .proxies import migrate as _migrate
 from .reports import deviation_field
 from .shapes import corrected_shape
 
+#: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
+#: context when it shows them)
+QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
+
 #: version of the property sets; onDocumentRestored upgrades older objects
-VERSION = 1
+#: (properties added since, such as VolumeChange, come from the property tables;
+#: 2: short names that fit the property view, see RENAMED)
+VERSION = 2
+#: compensation properties renamed in version 2: old name -> new name
+RENAMED = {"FlipNormals": "Flip", "EdgeTolerance": "EdgeTol", "NominalPoints": "Nodes"}
 
 MEASUREMENT_TYPE = "SurfComp_Measurement"
 COMPENSATION_TYPE = "SurfComp_Compensation"
@@ -67,130 +76,232 @@ _HIDDEN = 2  # editor mode: hidden
 _MEAS = "Measurement"
 MEASUREMENT_PROPERTIES = (
     ("App::PropertyString", "SourceName", _MEAS,
-     "File the measurements were read from (information only: the data is stored below)",
+     QT_TRANSLATE_NOOP("App::Property", "File the measurements were read from (information only: "
+                                        "the data is stored below)"),
      "", _RO),
-    ("App::PropertyString", "SourceSha256", _MEAS, "SHA-256 of the source file's bytes", "",
-     _RO),
+    ("App::PropertyString", "SourceSha256", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "SHA-256 of the source file's bytes"),
+     "", _RO),
     ("App::PropertyString", "Units", _MEAS,
-     "Units of the source file's length columns (the stored values are in mm)", "mm", _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Units of the source file's length columns (the stored "
+                                        "values are in mm)"),
+     "mm", _RO),
     ("App::PropertyString", "Kind", _MEAS,
-     "Columns the file had: nominal+normal+deviation, nominal+measured, ...", "", _RO),
-    ("App::PropertyInteger", "PointCount", _MEAS, "Number of measured points", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Columns the file had: nominal+normal+deviation, "
+                                        "nominal+measured, ..."),
+     "", _RO),
+    ("App::PropertyInteger", "PointCount", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Number of measured points"),
+     0, _RO),
     ("App::PropertyIntegerList", "GridShape", _MEAS,
-     "Rows and columns of the grid when the file gives row/col indices (else empty)", None,
-     _RO),
-    ("App::PropertyFloatList", "NominalX", _MEAS, "Nominal points, x (mm)", None, _RO),
-    ("App::PropertyFloatList", "NominalY", _MEAS, "Nominal points, y (mm)", None, _RO),
-    ("App::PropertyFloatList", "NominalZ", _MEAS, "Nominal points, z (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredX", _MEAS, "Measured points, x (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredY", _MEAS, "Measured points, y (mm)", None, _RO),
-    ("App::PropertyFloatList", "MeasuredZ", _MEAS, "Measured points, z (mm)", None, _RO),
-    ("App::PropertyFloatList", "NormalI", _MEAS, "Normals, x component", None, _RO),
-    ("App::PropertyFloatList", "NormalJ", _MEAS, "Normals, y component", None, _RO),
-    ("App::PropertyFloatList", "NormalK", _MEAS, "Normals, z component", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Rows and columns of the grid when the file gives row/col "
+                                        "indices (else empty)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalX", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, x (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalY", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, y (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NominalZ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal points, z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredX", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, x (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredY", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, y (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "MeasuredZ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Measured points, z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalI", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, x component"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalJ", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, y component"),
+     None, _RO),
+    ("App::PropertyFloatList", "NormalK", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Normals, z component"),
+     None, _RO),
     ("App::PropertyFloatList", "Deviation", _MEAS,
-     "Deviation along the normal (mm, positive = material left)", None, _RO),
-    ("App::PropertyIntegerList", "Row", _MEAS, "Grid row of every point (when given)", None,
-     _RO),
-    ("App::PropertyIntegerList", "Col", _MEAS, "Grid column of every point (when given)",
+     QT_TRANSLATE_NOOP("App::Property", "Deviation along the normal (mm, positive = material "
+                                        "left)"),
      None, _RO),
-    ("App::PropertyIntegerList", "Lines", _MEAS, "Line of every point in the source file",
+    ("App::PropertyIntegerList", "Row", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Grid row of every point (when given)"),
      None, _RO),
-    ("App::PropertyStringList", "Ids", _MEAS, "Point names (when given)", None, _RO),
+    ("App::PropertyIntegerList", "Col", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Grid column of every point (when given)"),
+     None, _RO),
+    ("App::PropertyIntegerList", "Lines", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Line of every point in the source file"),
+     None, _RO),
+    ("App::PropertyStringList", "Ids", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Point names (when given)"),
+     None, _RO),
     ("App::PropertyString", "Columns", _MEAS,
-     "Role -> column name as written in the file (JSON)", "{}", _RO),
-    ("App::PropertyStringList", "ReadWarnings", _MEAS, "Warnings of the file reader", None,
-     _RO),
-    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     QT_TRANSLATE_NOOP("App::Property", "Role -> column name as written in the file (JSON)"),
+     "{}", _RO),
+    ("App::PropertyStringList", "ReadWarnings", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Warnings of the file reader"),
+     None, _RO),
+    ("App::PropertyInteger", "Version", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
 _IN, _RES = "Compensation", "Result"
 COMPENSATION_PROPERTIES = (
-    ("App::PropertyLink", "Nominal", _IN, "Object holding the nominal face", None, 0),
-    ("App::PropertyString", "FaceName", _IN, "The nominal face (FaceN of Nominal)", "Face1",
-     0),
-    ("App::PropertyLink", "Measurement", _IN, "Measurement object (SurfComp_Measurement)",
+    ("App::PropertyLink", "Nominal", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Object holding the nominal face"),
+     None, 0),
+    ("App::PropertyString", "FaceName", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "The nominal face (FaceN of Nominal)"),
+     "Face1", 0),
+    ("App::PropertyLink", "Measurement", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Measurement object (SurfComp_Measurement)"),
      None, 0),
     ("App::PropertyLink", "Base", _IN,
-     "Previous compensation (iterations): this measurement is of the part machined from its "
-     "corrected face; corrections accumulate", None, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Previous compensation (iterations): this measurement is "
+                                        "of the part machined from its corrected face; corrections"
+                                        " accumulate"),
+     None, 0),
     ("App::PropertyEnumeration", "Method", _IN,
-     "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs Stock), offset", list(METHODS), 0),
-    ("App::PropertyInteger", "MaskSize", _IN, "Odd size of the filter mask", 5, 0),
+     QT_TRANSLATE_NOOP("App::Property", "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs "
+                                        "Stock), offset"),
+     list(METHODS), 0),
+    ("App::PropertyInteger", "MaskSize", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Odd size of the filter mask"),
+     5, 0),
     ("App::PropertyString", "Weights", _IN,
-     "Custom mask weights, rows separated by ';' (empty: MaskKind and MaskSize)", "", 0),
-    ("App::PropertyEnumeration", "MaskKind", _IN, "Mask shape without custom weights",
+     QT_TRANSLATE_NOOP("App::Property", "Custom mask weights, rows separated by ';' (empty: "
+                                        "MaskKind and MaskSize)"),
+     "", 0),
+    ("App::PropertyEnumeration", "MaskKind", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Mask shape without custom weights"),
      list(MASK_KINDS), 0),
     ("App::PropertyFloat", "Sigma", _IN,
-     "Gaussian sigma in grid steps (0: MaskSize / 4)", 0.0, 0),
-    ("App::PropertyEnumeration", "Edge", _IN, "Edge handling of the filter", list(EDGE_MODES),
-     0),
+     QT_TRANSLATE_NOOP("App::Property", "Gaussian sigma in grid steps (0: MaskSize / 4)"),
+     0.0, 0),
+    ("App::PropertyEnumeration", "Edge", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Edge handling of the filter"),
+     list(EDGE_MODES), 0),
     ("App::PropertyLength", "Stock", _IN,
-     "Semi-finishing allowance of the mirror method (mm; DH = Stock / 2)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
+                                        "Stock / 2)"),
+     0.0, 0),
     ("App::PropertyLength", "MaxOffset", _IN,
-     "Largest accepted distance of a measured point from the face", 1.0, 0),
-    ("App::PropertyBool", "FlipNormals", _IN,
-     "The file's normals point into the material: flip them and the deviations' sign",
+     QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
+                                        "face"),
+     1.0, 0),
+    ("App::PropertyBool", "Flip", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "The file's normals point into the material: flip them and"
+                                        " the deviations' sign"),
      False, 0),
     ("App::PropertyInteger", "Refine", _IN,
-     "Knot spans of the corrected surface per measurement grid step", 4, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
+                                        "step"),
+     4, 0),
     ("App::PropertyEnumeration", "Output", _IN,
-     "face: the corrected face; solid: the nominal's shape with the face replaced",
+     QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
+                                        " the face replaced and its neighbours re-trimmed to meet"
+                                        " it"),
      list(OUTPUTS), 0),
     ("App::PropertyEnumeration", "Layout", _IN,
-     "auto: a complete grid if the points form one, else scattered; grid: refuse others",
+     QT_TRANSLATE_NOOP("App::Property", "auto: a complete grid if the points form one, else "
+                                        "scattered; grid: refuse others"),
      list(LAYOUTS), 0),
     ("App::PropertyLength", "Smoothing", _IN,
-     "Scattered points: smoothing length of the fit that replaces the mask filter "
-     "(0: chosen by generalized cross-validation)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Scattered points: smoothing length of the fit that "
+                                        "replaces the mask filter (0: chosen by generalized "
+                                        "cross-validation)"),
+     0.0, 0),
     ("App::PropertyLength", "TipRadius", _IN,
-     "Stylus ball radius when the measured points are tip centres (probe logs)", 0.0, 0),
+     QT_TRANSLATE_NOOP("App::Property", "Stylus ball radius when the measured points are tip "
+                                        "centres (probe logs)"),
+     0.0, 0),
     ("App::PropertyBool", "Preview", _IN,
-     "Filter preview (task panel): compute deviations and components only and keep the "
-     "last corrected shape; the panel clears it when it closes", False, _HIDDEN),
+     QT_TRANSLATE_NOOP("App::Property", "Filter preview (task panel): compute deviations and "
+                                        "components only and keep the last corrected shape; the "
+                                        "panel clears it when it closes"),
+     False, _HIDDEN),
     ("App::PropertyInteger", "GridRows", _RES,
-     "Rows of the measurement grid (scattered layouts: the number of points)", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Rows of the measurement grid (scattered layouts: the "
+                                        "number of points)"),
+     0, _RO),
     ("App::PropertyInteger", "GridCols", _RES,
-     "Columns of the measurement grid (scattered layouts: 1)", 0, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Columns of the measurement grid (scattered layouts: 1)"),
+     0, _RO),
     ("App::PropertyBool", "Scattered", _RES,
-     "The points are a scattered layout (not a grid): fields are built over the points",
+     QT_TRANSLATE_NOOP("App::Property", "The points are a scattered layout (not a grid): fields "
+                                        "are built over the points"),
      False, _RO),
     ("App::PropertyFloatList", "FieldScale", _RES,
-     "Scattered layouts: mm per unit parameter along u and v used by the fits", None, _RO),
-    ("App::PropertyFloatList", "U", _RES, "Face parameter u of every grid node (row-major)",
+     QT_TRANSLATE_NOOP("App::Property", "Scattered layouts: mm per unit parameter along u and v "
+                                        "used by the fits"),
      None, _RO),
-    ("App::PropertyFloatList", "V", _RES, "Face parameter v of every grid node (row-major)",
+    ("App::PropertyFloatList", "U", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Face parameter u of every grid node (row-major)"),
      None, _RO),
-    ("App::PropertyFloatList", "NominalPoints", _RES,
-     "Nominal point of every node, flat x y z (mm)", None, _RO),
-    ("App::PropertyFloatList", "Normals", _RES, "Outward normal of every node, flat", None,
-     _RO),
+    ("App::PropertyFloatList", "V", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Face parameter v of every grid node (row-major)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Nodes", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Nominal point of every node, flat x y z (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Normals", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Outward normal of every node, flat"),
+     None, _RO),
     ("App::PropertyFloatList", "Deviation", _RES,
-     "Deviation from the nominal at every node (mm, NaN = not measured)", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Deviation from the nominal at every node (mm, NaN = not "
+                                        "measured)"),
+     None, _RO),
     ("App::PropertyFloatList", "Determined", _RES,
-     "Filtered (determined) component of the deviation (mm)", None, _RO),
-    ("App::PropertyFloatList", "Random", _RES, "Random component: deviation - determined (mm)",
+     QT_TRANSLATE_NOOP("App::Property", "Filtered (determined) component of the deviation (mm)"),
+     None, _RO),
+    ("App::PropertyFloatList", "Random", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Random component: deviation - determined (mm)"),
      None, _RO),
     ("App::PropertyFloatList", "Increment", _RES,
-     "Correction of this round (mm); equals Correction without a Base", None, _RO),
+     QT_TRANSLATE_NOOP("App::Property", "Correction of this round (mm); equals Correction without "
+                                        "a Base"),
+     None, _RO),
     ("App::PropertyFloatList", "Correction", _RES,
-     "Total correction realised by the corrected face (mm, accumulated over the Base chain)",
+     QT_TRANSLATE_NOOP("App::Property", "Total correction realised by the corrected face (mm, "
+                                        "accumulated over the Base chain)"),
      None, _RO),
     ("App::PropertyString", "Statistics", _RES,
-     "name -> statistics (mm) as JSON", "{}", _RO),
-    ("App::PropertyString", "Checks", _RES, "Check figures of the corrected face (JSON)", "{}",
-     _RO),
-    ("App::PropertyStringList", "Warnings", _RES, "What the computation warned about", None,
-     _RO),
-    ("App::PropertyInteger", "Round", _RES, "Iteration round (1 without a Base)", 1, _RO),
-    ("App::PropertyLength", "EdgeTolerance", _RES,
-     "Largest edge tolerance of the output solid (covers the face border's shift)", 0.0,
-     _RO),
+     QT_TRANSLATE_NOOP("App::Property", "name -> statistics (mm) as JSON"),
+     "{}", _RO),
+    ("App::PropertyString", "Checks", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Check figures of the corrected face (JSON)"),
+     "{}", _RO),
+    ("App::PropertyStringList", "Warnings", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "What the computation warned about"),
+     None, _RO),
+    ("App::PropertyInteger", "Round", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Iteration round (1 without a Base)"),
+     1, _RO),
+    ("App::PropertyLength", "EdgeTol", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Largest tolerance of the corrected face's edges and "
+                                        "vertices"),
+     0.0, _RO),
+    ("App::PropertyFloat", "VolumeChange", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Output solid: its volume minus the nominal's (mm^3; 0 for"
+                                        " a face)"),
+     0.0, _RO),
+    ("App::PropertyFloat", "CorrectionVolume", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "Integral of the correction over the face (mm^3, positive"
+                                        " = material removed): the volume change should be minus"
+                                        " this"),
+     0.0, _RO),
     ("App::PropertyString", "ReplacedLinks", "Replace",
-     "Links rebound by surfcomp.app.replace.replace (JSON; restore() reverts them)", "",
-     _HIDDEN),
-    ("App::PropertyInteger", "Version", "Base", "Property set version of this object",
+     QT_TRANSLATE_NOOP("App::Property", "Links rebound by surfcomp.app.replace.replace (JSON; "
+                                        "restore() reverts them)"),
+     "", _HIDDEN),
+    ("App::PropertyInteger", "Version", "Base",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
@@ -371,6 +482,7 @@ class CompensationFeature(_Proxy):
 
     Type = COMPENSATION_TYPE
     PROPERTIES = COMPENSATION_PROPERTIES
+    RENAMED = RENAMED
 
     def execute(self, obj):
         result = _compute(obj)
@@ -389,10 +501,35 @@ def options_of(obj):
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
-                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.FlipNormals),
+                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
                    refine=int(obj.Refine), layout=obj.Layout,
                    smoothing=(float(obj.Smoothing.Value) or None),
                    tip_radius=float(obj.TipRadius.Value))
+
+
+#: compensation property -> core option of the filter (the task panel's fields)
+FILTER_OPTIONS = {"MaskSize": "mask_size", "Weights": "weights", "MaskKind": "mask_kind",
+                  "Edge": "edge"}
+
+
+def check_filter(obj, **values):
+    """Check filter values (``MaskSize=``, ``Weights=``, ``MaskKind=``, ``Edge=``) with the
+    core's option domains before they are set, so a panel can show the message instead
+    of a failed recompute. Returns the mask's size (custom weights set it).
+
+    Raises
+    ------
+    InputError
+        The message of :meth:`surfcomp.core.pipeline.Options.validate`.
+    """
+    kw = {}
+    for name, value in values.items():
+        if name == "Weights":
+            value = value.strip() or None
+        kw[FILTER_OPTIONS[name]] = value
+    options = _dc_replace(options_of(obj), **kw)
+    options.validate()
+    return int(options.mask().shape[0])
 
 
 def chain(obj):
@@ -424,14 +561,15 @@ def chain(obj):
 
 
 class _Result:
-    """What ``_compute`` returns: the core compensation plus the app-side products."""
+    """What ``_compute`` returns: the core compensation plus the app-side products
+    (``output``: a :class:`surfcomp.app.shapes.Output`, None for a preview)."""
 
-    def __init__(self, comp, nominal, increment, shape, edge_tol, round_):
+    def __init__(self, comp, nominal, increment, output, round_):
         self.comp = comp
         self.nominal = nominal
         self.increment = increment
-        self.shape = shape
-        self.edge_tolerance = edge_tol
+        self.output = output
+        self.shape = None if output is None else output.shape
         self.round = round_
 
 
@@ -485,6 +623,9 @@ def _compute(obj):
     with freecad_progress("%s: compensating" % obj.Label) as progress:
         prepared = prepare(nominal.surface, nominal.outward, ms, options,
                            progress=sub(progress, 0.0, 0.3))
+        warning = trim_warning(nominal, prepared)
+        if warning:
+            prepared.warnings.append(warning)
         comp = compensate(nominal.surface, nominal.outward, prepared, options,
                           build=base is None and not preview, progress=sub(progress, 0.3, 1.0))
         increment = comp.correction.delta
@@ -494,10 +635,11 @@ def _compute(obj):
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
     if preview:
-        return _Result(comp, nominal, increment, None, obj.EdgeTolerance.Value, len(links))
-    shape, tol = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
-    shape.Placement = placement
-    return _Result(comp, nominal, increment, shape, tol, len(links))
+        return _Result(comp, nominal, increment, None, len(links))
+    output = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
+    output.shape.Placement = placement
+    comp.prepared.warnings.extend(output.warnings(obj.Label))
+    return _Result(comp, nominal, increment, output, len(links))
 
 
 def _build(nominal, prepared, comp, total, build=True, progress=None):
@@ -527,7 +669,7 @@ def _write_results(obj, r):
     obj.FieldScale = list(comp.scale) if p.scattered else []
     obj.U = _flat(g.take(p.u))
     obj.V = _flat(g.take(p.v))
-    obj.NominalPoints = _flat(g.take(p.nominal))
+    obj.Nodes = _flat(g.take(p.nominal))
     obj.Normals = _flat(g.take(p.normal))
     c = comp.correction
     obj.Deviation = _flat(c.deviation)
@@ -541,7 +683,10 @@ def _write_results(obj, r):
         obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
     obj.Warnings = [str(w) for w in p.warnings]
     obj.Round = r.round
-    obj.EdgeTolerance = float(r.edge_tolerance)
+    if r.output is not None:                  # a preview keeps the shape's figures
+        obj.EdgeTol = float(r.output.edge_tolerance)
+        obj.VolumeChange = float(r.output.volume_change or 0.0)
+        obj.CorrectionVolume = float(r.output.correction_volume)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ..core.pipeline import Options, compensate, prepare
+from ..core.progress import report as report_progress
 from ..core.progress import sub
 from ..errors import InputError
 from ..io import report as report_io
@@ -25,7 +26,10 @@ from . import fcenv
 class Job:
     """A compensation job (paths and options). ``output``/``report``/``points``/``curves``
     are optional outputs: corrected face (STEP/IGES/BREP by extension), JSON report,
-    corrected points (CSV) and the papers' curve net through them (STEP)."""
+    corrected points (CSV) and the papers' curve net through them (STEP).
+
+    ``output`` holds the nominal's whole shape with the face replaced when the face sits in
+    a solid or shell, the corrected face alone when it is a lone face or ``face_only``."""
 
     nominal: str
     measurements: str
@@ -40,6 +44,7 @@ class Job:
     units: str = None
     fmt: str = "auto"
     sample: str = None
+    face_only: bool = False
     options: Options = field(default_factory=Options)
 
     @classmethod
@@ -96,18 +101,26 @@ def run_job(job, progress=None):
     ms = read_any(job.measurements, job.units, job.fmt, job.sample)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
+    _warn_outside_trim(nominal, prepared)
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
-                      progress=sub(progress, 0.3, 0.95))
+                      progress=sub(progress, 0.3, 0.9))
+    # everything is computed before the first file is staged
+    shapes, output = {}, None
+    if build and job.output:
+        from .shapes import corrected_shape
+
+        report_progress(progress, 0.9, "building the output shape")
+        output = corrected_shape(nominal, comp.corrected, "face" if job.face_only else "solid",
+                                 nominal.face_name)
+        prepared.warnings.extend(output.warnings(nominal.face_name))
+        shapes["output"] = output.shape
     rep = report_io.build_report(job.command, _inputs_record(job, nominal, ms), comp,
                                  prepared.warnings,
                                  {attr: os.path.abspath(getattr(job, attr))
                                   for attr, _opt in OUTPUT_OPTIONS if getattr(job, attr)},
-                                 points=bool(job.report or job.html))
-    # everything is computed before the first file is staged
-    shapes = {}
-    if build and job.output:
-        shapes["output"] = corrected_face(comp, nominal)
+                                 points=bool(job.report or job.html),
+                                 output_shape=output.as_dict() if output else None)
     if build and job.curves:
         shapes["curves"] = curve_net(comp)
     texts = {}
@@ -124,6 +137,14 @@ def run_job(job, progress=None):
             tx.stage_text(getattr(job, attr), text)
         tx.commit()
     return comp, rep
+
+
+def _warn_outside_trim(nominal, prepared):
+    from .nominal import trim_warning
+
+    warning = trim_warning(nominal, prepared)
+    if warning:
+        prepared.warnings.append(warning)
 
 
 def _inputs_record(job, nominal, ms):
@@ -147,7 +168,7 @@ def corrected_face(comp, nominal):
     surface, with the nominal's orientation (:func:`surfcomp.app.shapes.corrected_shape`)."""
     from .shapes import corrected_shape
 
-    return corrected_shape(nominal, comp.corrected, "face", nominal.face_name)[0]
+    return corrected_shape(nominal, comp.corrected, "face", nominal.face_name).shape
 
 
 def curve_net(comp):

@@ -6,6 +6,9 @@ The nominal is never modified: everything here works on copies.
 import os
 from dataclasses import dataclass
 
+import numpy as np
+
+from ..core.trimmed import inside
 from ..errors import GeometryError
 from . import fcenv
 from .cadread import read_cad
@@ -24,9 +27,12 @@ class Nominal:
     face : Part.Face
         A copy of the original face (as found in the file/document).
     bspline_face : Part.Face
-        The same geometry as a B-spline face restricted to the face's UV bounds.
+        The same face (geometry, boundary, orientation) as a B-spline face: ``face`` itself,
+        or its ``toNurbs`` form; its pcurves are in the parametrisation of ``surface``.
     surface : surfcomp.core.bspline.Surface
-        Core arrays of ``bspline_face.Surface``; ``u_range``/``v_range`` = the face's UV bounds.
+        Core arrays of ``bspline_face.Surface`` made non-periodic and cut to the face's UV
+        bounds (:func:`work_surface`, same parametrisation); ``u_range``/``v_range`` = those
+        bounds.
     outward : int
         +1 when the face's outward normal is Su x Sv, -1 when the face is reversed.
     source, face_name, object_name : str
@@ -129,23 +135,27 @@ def pick_face(shape, face_name=None, source=None):
 def to_bspline_face(face):
     """Return ``(bspline_face, converted)``: the face's geometry as a B-spline face.
 
-    B-spline faces are kept (segmented to their UV bounds); Bezier, analytic,
-    revolution, extrusion and offset surfaces are converted with OCCT
-    (``Face.toNurbs``), which keeps the geometry.
+    B-spline faces are kept as they are; Bezier, analytic, revolution, extrusion and
+    offset surfaces are converted with OCCT (``Face.toNurbs``), which keeps the geometry,
+    the boundary (its pcurves move to the B-spline's parametrisation), the order of the
+    edges and the orientation.
     """
     import Part
 
     surf = face.Surface
-    converted = None
     if surf.TypeId == "Part::GeomBSplineSurface":
-        bface = face
-    else:
-        converted = surf.TypeId.split("::Geom")[-1]
-        try:
-            bface = face.toNurbs().Faces[0]
-        except (Part.OCCError, RuntimeError, IndexError) as exc:
-            raise GeometryError("cannot convert the %s face to a B-spline surface: %s"
-                                % (converted, exc)) from exc
+        return face, None
+    converted = surf.TypeId.split("::Geom")[-1]
+    try:
+        return face.toNurbs().Faces[0], converted
+    except (Part.OCCError, RuntimeError, IndexError) as exc:
+        raise GeometryError("cannot convert the %s face to a B-spline surface: %s"
+                            % (converted, exc)) from exc
+
+
+def work_surface(bface):
+    """The B-spline surface of ``bface`` made non-periodic and cut to the face's UV bounds
+    (same parametrisation): the surface the compensation works on."""
     u0, u1, v0, v1 = bface.ParameterRange
     bs = bface.Surface.copy()
     if bs.isUPeriodic():
@@ -156,10 +166,7 @@ def to_bspline_face(face):
     tol = 1e-12
     if u0 > bu0 + tol or u1 < bu1 - tol or v0 > bv0 + tol or v1 < bv1 - tol:
         bs.segment(max(u0, bu0), min(u1, bu1), max(v0, bv0), min(v1, bv1))
-    out = Part.Face(bs)
-    if bface.Orientation == "Reversed":
-        out.reverse()
-    return out, converted
+    return bs
 
 
 def load_nominal(path, face_name=None, object_name=None):
@@ -174,7 +181,61 @@ def nominal_from_face(face, source="<document>", face_name="Face1", object_name=
     face = face.copy()
     bface, converted = to_bspline_face(face)
     u0, u1, v0, v1 = bface.ParameterRange
-    surface = surface_from_part(bface.Surface, (u0, u1), (v0, v1))
+    surface = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
     outward = -1 if bface.Orientation == "Reversed" else 1
     return Nominal(face=face, bspline_face=bface, surface=surface, outward=outward, source=source,
                    face_name=face_name, object_name=object_name, converted=converted, shape=shape)
+
+
+#: boundary points per edge for integrals over trimmed faces and the inside test
+EDGE_POINTS = 400
+#: a measured point farther than this (mm) outside the trimmed face is reported
+OUTSIDE_TOLERANCE = 1e-3
+
+
+def boundary_polylines(face, points=EDGE_POINTS):
+    """The face's edges as polylines in (u, v) (pcurves sampled at ``points`` parameters),
+    each in its direction in the face's wire: together they bound the face (outer wire and
+    holes, which run the other way round; a seam edge's two pcurves)."""
+    out = []
+    for e in (e for w in face.Wires for e in w.childShapes()):
+        c2d, a, b = face.curveOnSurface(e)[:3]
+        ts = np.linspace(a, b, points)
+        if e.Orientation == "Reversed":
+            ts = ts[::-1]
+        pts = [c2d.value(float(t)) for t in ts]
+        out.append(np.array([(p.x, p.y) for p in pts], dtype=float))
+    return out
+
+
+def outside_trim(nominal, prepared):
+    """The measured points that lie on the nominal surface but outside the trimmed face:
+    ``(indices, distances)`` in file order, distances (mm) from the face (its boundary)."""
+    import FreeCAD
+    import Part
+
+    face = nominal.bspline_face
+    candidates = np.nonzero(~inside(boundary_polylines(face, 200), prepared.u,
+                                    prepared.v))[0]
+    dist = np.array([face.distToShape(Part.Vertex(FreeCAD.Vector(*prepared.nominal[k])))[0]
+                     for k in candidates])
+    keep = dist > OUTSIDE_TOLERANCE
+    return candidates[keep], dist[keep]
+
+
+def trim_warning(nominal, prepared):
+    """A warning naming how many measured points lie outside the trimmed face and where
+    (None when all lie on the face). Such points are still used: the correction field is
+    defined over the whole surface; the face keeps its boundary."""
+    idx, dist = outside_trim(nominal, prepared)
+    if not idx.size:
+        return None
+    far = idx[np.argmax(dist)]
+    lines = ", ".join(str(int(prepared.lines[k])) for k in idx[:5])
+    more = " and %d more" % (idx.size - 5) if idx.size > 5 else ""
+    return ("%s: %d of %d measured points lie on the surface of %s but outside its trimmed "
+            "boundary (lines %s%s), up to %.3f mm beyond it at (%.3f, %.3f, %.3f), line %d "
+            "(a probe near a fillet or a hole?); they are used for the correction, and the "
+            "corrected face keeps the nominal's boundary"
+            % ((prepared.source, idx.size, prepared.u.size, nominal.face_name, lines, more,
+                float(dist.max())) + tuple(prepared.nominal[far]) + (int(prepared.lines[far]),)))

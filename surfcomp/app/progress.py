@@ -45,3 +45,28 @@ def freecad_progress(title):
         yield bar
     finally:
         bar.stop()
+
+
+def recompute_with_progress(doc, title):
+    """Recompute the objects of ``doc`` that need it, one by one in dependency order,
+    advancing FreeCAD's progress indicator between them (the GUI stays responsive there
+    and Esc raises :class:`surfcomp.errors.Cancelled`); then recompute the rest.
+
+    Returns the names of the objects recomputed. On Cancelled the objects already
+    recomputed keep their new results: the caller undoes its change and recomputes.
+    """
+    order = list(getattr(doc, "TopologicalSortedObjects", doc.Objects))
+    todo, names = [], set()
+    for o in order:
+        if "Touched" in o.State or any(x.Name in names for x in o.OutList):
+            todo.append(o)
+            names.add(o.Name)
+    done = []
+    with freecad_progress(title) as progress:
+        progress(0.0, title)
+        for k, o in enumerate(todo):
+            o.recompute()
+            done.append(o.Name)
+            progress((k + 1.0) / max(len(todo), 1), o.Label)
+    doc.recompute()
+    return done

@@ -25,10 +25,24 @@ def add_properties(obj, table):
     return added
 
 
-def migrate(obj, table, version):
+def rename_properties(obj, renamed):
+    """Move the values of renamed properties (``{old: new}``, the new ones already added)
+    and remove the old ones; return the old names moved."""
+    moved = []
+    for old, new in renamed.items():
+        if old in obj.PropertiesList and new in obj.PropertiesList:
+            setattr(obj, new, getattr(obj, old))
+            obj.removeProperty(old)
+            moved.append(old)
+    return moved
+
+
+def migrate(obj, table, version, renamed=None):
     """Bring an object restored from an older document to the current property set and
-    ``version``; return the names of the properties that were added."""
+    ``version`` (``renamed``: ``{old name: new name}`` whose values move); return the names
+    of the properties that were added."""
     added = add_properties(obj, table)
+    rename_properties(obj, renamed or {})
     if obj.Version < version:
         obj.Version = version
     return added
@@ -40,6 +54,8 @@ class Proxy:
 
     PROPERTIES = ()
     VERSION = 1
+    #: ``{old name: new name}`` of renamed properties (moved on restore)
+    RENAMED = {}
 
     def __init__(self, obj):
         add_properties(obj, self.PROPERTIES)
@@ -58,4 +74,4 @@ class Proxy:
         return None
 
     def onDocumentRestored(self, obj):
-        migrate(obj, self.PROPERTIES, self.VERSION)
+        migrate(obj, self.PROPERTIES, self.VERSION, self.RENAMED)

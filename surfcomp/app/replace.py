@@ -19,6 +19,7 @@ import json
 
 from ..errors import GeometryError, InputError
 from . import features
+from .undo import UndoStep
 
 #: properties never rebound: group membership and the compensation's own inputs
 SKIP_PROPERTIES = ("Group", "ExpressionEngine", "InList", "OutList")
@@ -220,16 +221,8 @@ class _Undo:
 
 def _run(doc, name, work):
     undo = _Undo(doc)
-    doc.openTransaction(name)
-    try:
-        result = work(undo)
-    except BaseException:
-        undo.rollback()
-        doc.abortTransaction()
-        undo.rollback()     # the abort may have replayed older values: ours win
-        raise
-    doc.commitTransaction()
-    return result
+    with UndoStep(doc, name, rollback=undo.rollback):
+        return work(undo)
 
 
 def _check_computed(comp):
@@ -268,12 +261,22 @@ def replace(doc, comp):
 
     def work(undo):
         changes = plan(doc, comp)
-        record = {"links": [], "visibility": {}}
+        if not changes:
+            raise InputError("nothing in the document uses %s (no Path job, clone or other "
+                             "feature links it): there is nothing to replace; export the "
+                             "corrected face with Build corrected face instead"
+                             % nominal.Label)
+        record = {"links": [], "visibility": {}, "labels": {}}
         for o, prop, kind, old, new in changes:
             record["links"].append({"object": o.Name, "property": prop, "kind": kind,
                                     "old": _encode(kind, old)})
             undo.set(o, prop, new)
         _relink_elements(undo, changes)
+        for o in _clones(changes):
+            # a clone named after the nominal (Path's "Model-nominal") is named after comp
+            if nominal.Label in o.Label:
+                record["labels"][o.Name] = o.Label
+                undo.set(o, "Label", o.Label.replace(nominal.Label, comp.Label))
         for o, vis in ((nominal, False), (comp, True)):
             if "Visibility" in o.PropertiesList:
                 record["visibility"][o.Name] = bool(o.Visibility)
@@ -321,10 +324,52 @@ def restore(doc, comp):
             o = doc.getObject(name)
             if o is not None and "Visibility" in o.PropertiesList:
                 undo.set(o, "Visibility", bool(vis))
+        for name, label in record.get("labels", {}).items():
+            o = doc.getObject(name)
+            if o is not None:
+                undo.set(o, "Label", label)
         undo.set(comp, "ReplacedLinks", "")
         return done
 
     return _run(doc, "Restore %s" % getattr(comp.Nominal, "Label", "nominal"), work)
+
+
+def _clones(changes):
+    """The Part features among the changed objects that copy one source (clones, Path's
+    model clone)."""
+    seen = []
+    for o, _prop, kind, _old, new in changes:
+        if kind in ("link", "list") and o.isDerivedFrom("Part::Feature") and o not in seen \
+                and (kind == "link" or len(new) == 1):
+            seen.append(o)
+    return seen
+
+
+def summary(doc, comp):
+    """What :func:`replace` changed, from its record on ``comp``: ``objects`` (labels of
+    the objects whose links were rebound), ``links`` (number of link properties),
+    ``jobs`` (labels of the Path jobs that use a rebound object), ``renamed``
+    (``(old label, new label)``)."""
+    try:
+        record = json.loads(comp.ReplacedLinks or "{}")
+    except ValueError:
+        record = {}
+    names = []
+    for item in record.get("links", []):
+        if item["object"] not in names:
+            names.append(item["object"])
+    objs = [doc.getObject(n) for n in names if doc.getObject(n) is not None]
+    from .pathjob import jobs_of
+
+    jobs = []
+    for job in jobs_of(doc):
+        used = {o.Name for o in job.OutListRecursive} | {job.Name}
+        if used & set(names):
+            jobs.append(job.Label)
+    renamed = [(old, doc.getObject(n).Label) for n, old in record.get("labels", {}).items()
+               if doc.getObject(n) is not None]
+    return {"objects": [o.Label for o in objs], "links": len(record.get("links", [])),
+            "jobs": jobs, "renamed": renamed}
 
 
 def is_replacing(comp):
@@ -332,4 +377,4 @@ def is_replacing(comp):
     return bool(getattr(comp, "ReplacedLinks", ""))
 
 
-__all__ = ["replace", "restore", "plan", "is_replacing"]
+__all__ = ["replace", "restore", "plan", "is_replacing", "summary"]

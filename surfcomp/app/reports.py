@@ -37,11 +37,24 @@ def _fill_gaps(values):
     return values[tuple(idx)]
 
 
+def stock_of(obj):
+    """The stock (mm) the mirror method's deviations carry (measured after
+    semi-finishing), else 0."""
+    return float(obj.Stock.Value) if obj.Method == "mirror" else 0.0
+
+
 def quantity_values(obj, quantity):
     """Node values (mm) of ``quantity`` on the measurement grid, shape (rows, cols); NaN at
-    unmeasured nodes. ``residual`` is ``deviation - increment`` (what this round leaves)."""
+    unmeasured nodes.
+
+    ``residual`` is the predicted residual ``determined - stock - increment``: what this
+    round's correction leaves of the repeatable (determined) error when the next part is
+    cut (its new random scatter comes on top). It is defined for every method: zero for
+    ``filtered``, ``-random`` for ``raw`` and ``mirror`` (they copy this part's random
+    scatter into the face), ``determined - mean`` for ``offset``.
+    """
     if quantity == "residual":
-        return _grid(obj, "Deviation") - _grid(obj, "Increment")
+        return _grid(obj, "Determined") - stock_of(obj) - _grid(obj, "Increment")
     if quantity not in _PROPERTY:
         raise InputError("unknown quantity %r (expected one of %s)"
                          % (quantity, ", ".join(QUANTITIES)))
@@ -96,11 +109,12 @@ def report_of(obj):
     return report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
 
 
-def write_html_report(obj, path):
-    """Write the self-contained HTML report of a compensation object (atomically)."""
+def write_html_report(obj, path, style=None):
+    """Write the self-contained HTML report of a compensation object (atomically);
+    ``style`` (``scheme``, ``range``) as :func:`surfcomp.io.html_report.render_html`."""
     from ..io.html_report import write_html_report as write
 
-    return write(path, report_of(obj))
+    return write(path, report_of(obj), style=style)
 
 
 def corrected_surface(obj):
@@ -116,3 +130,95 @@ def corrected_surface(obj):
         face = shape.Faces[0]
     u0, u1, v0, v1 = face.ParameterRange
     return surface_from_part(face.Surface, (u0, u1), (v0, v1))
+
+
+def rms(values):
+    """Root mean square of the finite values (mm), NaN when there is none."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    return float(np.sqrt(np.mean(v ** 2))) if v.size else float("nan")
+
+
+def filter_summary(obj):
+    """What the filter panel shows of a computed compensation (mm): RMS of the
+    determined and random components, of the predicted residual (see
+    :func:`quantity_values`), and the expected RMS of the next part, the residual plus a
+    new random scatter like this one: ``sqrt(rms(residual)^2 + rms(random)^2)``."""
+    out = {q: rms(quantity_values(obj, q)) for q in ("deviation", "determined", "random",
+                                                      "residual")}
+    out["next_part"] = float(np.hypot(out["residual"], out["random"]))
+    return out
+
+
+def common_range(objs, quantities=("deviation", "determined", "random", "correction")):
+    """One symmetric colour range (mm) over the node values of ``quantities`` of the
+    computed compensations ``objs`` (the maps of one measurement side by side)."""
+    from ..core.colormap import symmetric_range
+
+    values = []
+    for obj in objs:
+        for q in quantities:
+            try:
+                values.append(quantity_values(obj, q).ravel())
+            except InputError:
+                continue            # not computed: no values to share
+    return symmetric_range(np.concatenate(values) if values else [])
+
+
+class PointLocator:
+    """The measured node nearest to a point on the map, with its values.
+
+    Built once per computed compensation (a KD-tree over the nodes, in the nominal
+    object's own coordinates, as the map is drawn); :meth:`at` answers the readout.
+    """
+
+    def __init__(self, obj):
+        from scipy.spatial import cKDTree
+
+        from .features import measurement_set
+
+        self.obj = obj
+        nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
+        dev = np.asarray(obj.Deviation, dtype=float)
+        self.keep = np.flatnonzero(np.isfinite(dev))
+        self.nodes = nodes
+        self.tree = cKDTree(nodes[self.keep])
+        self.values = {q: quantity_values(obj, q).ravel()
+                       for q in ("deviation", "determined", "random", "correction")}
+        self.ids = self._ids(measurement_set(obj.Measurement), cKDTree)
+
+    def _ids(self, ms, tree_type):
+        """Name (or file line) of the measured point at every node."""
+        base = ms.nominal if ms.nominal is not None else ms.measured
+        if base is None or not len(base):
+            return None
+        pl = self.obj.Nominal.Placement if self.obj.Nominal is not None else None
+        if pl is not None and not pl.isIdentity():
+            m = np.array(pl.inverse().toMatrix().A, dtype=float).reshape(4, 4)
+            base = base @ m[:3, :3].T + m[:3, 3]
+        k = tree_type(base).query(self.nodes)[1]
+        if ms.ids:
+            return [ms.ids[i] for i in k]
+        lines = ms.lines if ms.lines is not None else np.arange(len(base)) + 1
+        return ["line %d" % lines[i] for i in k]
+
+    def at(self, local_point):
+        """``dict`` of the nearest measured node to ``local_point`` (nominal object's
+        coordinates, mm): ``node``, ``id``, ``xyz`` (document coordinates), ``distance``
+        and the node's ``deviation``, ``determined``, ``random``, ``correction`` (mm)."""
+        dist, k = self.tree.query(np.asarray(local_point, dtype=float))
+        node = int(self.keep[k])
+        return self.node(node, float(dist))
+
+    def node(self, node, distance=0.0):
+        xyz = self.nodes[node]
+        pl = self.obj.Placement
+        import FreeCAD
+
+        world = pl.multVec(FreeCAD.Vector(*map(float, xyz)))
+        out = {"node": node, "id": self.ids[node] if self.ids else str(node),
+               "xyz": (world.x, world.y, world.z), "local": tuple(map(float, xyz)),
+               "distance": distance}
+        for q, vals in self.values.items():
+            out[q] = float(vals[node])
+        return out

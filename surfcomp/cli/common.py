@@ -76,7 +76,8 @@ def job_from_args(args, command):
     outputs = {k: getattr(args, k, None) for k in ("output", "report", "points", "curves", "html")}
     return Job(nominal=args.nominal, measurements=args.measurements, command=command,
                face=args.face, object=args.object, units=args.units, fmt=args.fmt,
-               sample=args.sample, options=options_from_args(args), **outputs)
+               sample=args.sample, face_only=bool(getattr(args, "face_only", False)),
+               options=options_from_args(args), **outputs)
 
 
 def run_job_command(args, command):
@@ -173,3 +174,27 @@ def print_summary(comp, rep, out=sys.stdout):
           % ((ch.max_zero_deviation * 1e3,) + tuple(ch.dense_shape)), file=out)
     print("  largest correction anywhere on the face %.3f um (largest intended %.3f um)"
           % (ch.max_realised * 1e3, ch.max_intended * 1e3), file=out)
+    for line in output_lines(rep.get("output_shape")):
+        print(line, file=out)
+
+
+def output_lines(shape):
+    """What the written shape is: the report's ``output_shape``, as summary lines."""
+    if not shape:
+        return []
+    if shape["kind"] == "face":
+        return ["Output:       the corrected face alone (largest edge tolerance %.2g mm)"
+                % shape["max_edge_tolerance_mm"],
+                "  the correction integrates to %.4f mm^3 over it (positive = material removed)"
+                % shape["correction_integral_mm3"]]
+    lines = ["Output:       the nominal's shape with the face replaced (%d faces, %d solids; "
+             "re-trimmed neighbours: %s; largest edge tolerance of the face %.2g mm)"
+             % (shape["faces"], shape["solids"], ", ".join(shape["retrimmed_faces"]) or "none",
+                shape["max_edge_tolerance_mm"])]
+    if shape["volume_change_mm3"] is not None:
+        mismatch = shape["volume_change_vs_integral"]
+        lines.append("  volume change %.4f mm^3; the correction integrates to %.4f mm^3 "
+                     "(-integral of delta dA)%s"
+                     % (shape["volume_change_mm3"], -shape["correction_integral_mm3"],
+                        "" if mismatch is None else ", %+.2f %%" % (100 * mismatch)))
+    return lines

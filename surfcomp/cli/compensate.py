@@ -17,7 +17,12 @@ def add_parser(subparsers):
                     "(Werner 2022 raw/filtered, mirror method, uniform offset).")
     add_input_options(p)
     p.add_argument("-o", "--output", metavar="OUT.step",
-                   help="corrected face (STEP; .iges/.brep by extension)")
+                   help="the nominal's shape with the face replaced by the corrected face (its "
+                        "neighbours re-trimmed), or the corrected face when the nominal is a "
+                        "lone face (STEP; .iges/.brep by extension)")
+    p.add_argument("--face-only", action="store_true",
+                   help="write the corrected face alone, also when it is a face of a solid or "
+                        "shell")
     add_method_options(p)
     p.add_argument("--points", metavar="OUT.csv", help="also write the corrected points (CSV)")
     p.add_argument("--curves", metavar="OUT.step",
@@ -73,6 +78,7 @@ def run_document(args):
                            save=args.save, replace=args.replace, gcode=args.gcode,
                            post=args.post, post_args=args.post_args, job_name=args.job,
                            units=args.units or "mm", options=options_from_args(args),
+                           output="face" if args.face_only else None,
                            overwrite_input=args.overwrite_input, fmt=args.fmt,
                            sample=args.sample, progress=ProgressLine(args.quiet))
     for line in summary_lines(res):

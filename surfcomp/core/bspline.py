@@ -2,12 +2,23 @@
 
 The app layer converts ``Part.BSplineSurface`` to and from :class:`Surface`
 (``surfcomp.app.convert``). Everything numeric on surfaces (evaluation,
-derivatives, normals, projection) works on this type.
+derivatives, normals, projection) works on this type. This module evaluates;
+:mod:`surfcomp.core.bspline_basis` holds the basis functions and
+:mod:`surfcomp.core.bspline_fit` the fits and knot refinement, both re-exported
+here (``bspline.basis_matrix``, ``bspline.fit_grid_lsq``).
 """
 
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from ..errors import GeometryError
+from .bspline_basis import basis_functions, basis_matrix, find_spans, greville
+from .bspline_fit import fit_grid_lsq, interpolate_grid, refine_knots
+
+__all__ = ["Surface", "CHUNK_VALUES", "evaluate", "derivatives", "normals", "evaluate_grid",
+           "insert_knots", "find_spans", "basis_functions", "basis_matrix", "greville",
+           "refine_knots", "interpolate_grid", "fit_grid_lsq"]
 
 
 @dataclass(frozen=True)
@@ -78,16 +89,10 @@ class Surface:
 
 
 # ---------------------------------------------------------------------------
-# Numeric engine: spans, basis functions, evaluation, derivatives, normals,
-# grid evaluation, knot insertion, interpolation and least-squares fitting.
-# References: Piegl & Tiller, "The NURBS Book", 2nd ed. (algorithms A2.1-A2.3,
-# A4.4, A5.1, eq. 9.4-9.9); de Boor, "A Practical Guide to Splines" (Greville).
+# Evaluation, derivatives, normals, grid evaluation, knot insertion. The basis
+# functions are in bspline_basis, interpolation and least squares in bspline_fit.
+# References: Piegl & Tiller, "The NURBS Book", 2nd ed. (A3.5, A4.4, eq. 4.20).
 # ---------------------------------------------------------------------------
-
-import scipy.sparse as _sp  # noqa: E402  (kept below the public type on purpose)
-import scipy.sparse.linalg as _spla  # noqa: E402
-
-from ..errors import ComputationError, GeometryError, GridError  # noqa: E402
 
 #: points per inner chunk: keeps temporaries of a bicubic rational surface
 #: around 50 MB whatever the number of points
@@ -96,138 +101,6 @@ CHUNK_VALUES = 4_000_000
 
 def _chunk_size(degree_u, degree_v, extra=1):
     return max(1024, CHUNK_VALUES // ((degree_u + 1) * (degree_v + 1) * 4 * max(1, extra)))
-
-
-def find_spans(knots, degree, n_poles, t):
-    """Knot span indices of parameters (NURBS book A2.1, vectorised).
-
-    Parameters
-    ----------
-    knots : array_like, shape (n_poles + degree + 1,)
-        Flat knot vector.
-    degree : int
-    n_poles : int
-    t : array_like, any shape
-        Parameters. Values outside ``[knots[degree], knots[n_poles]]`` get the
-        first or last span (polynomial extrapolation).
-
-    Returns
-    -------
-    ndarray of int, shape of ``t``
-        ``span`` with ``knots[span] <= t < knots[span + 1]`` and
-        ``degree <= span <= n_poles - 1``; ``t`` at the domain end maps to the
-        last non-empty span.
-    """
-    knots = np.asarray(knots, dtype=float)
-    t = np.asarray(t, dtype=float)
-    span = np.searchsorted(knots, t, side="right") - 1
-    # last non-empty span: the one ending at knots[n_poles]
-    last = int(np.searchsorted(knots, knots[n_poles], side="left")) - 1
-    last = max(degree, min(last, n_poles - 1))
-    span = np.where(t >= knots[n_poles], last, span)
-    return np.clip(span, degree, last).astype(np.intp)
-
-
-def basis_functions(knots, degree, t, nderiv=0):
-    """Non-zero B-spline basis functions and their derivatives (NURBS book A2.2/A2.3).
-
-    Vectorised over ``t``: the triangular recurrences loop over the degree
-    only.
-
-    Parameters
-    ----------
-    knots : array_like, shape (n_poles + degree + 1,)
-        Flat knot vector.
-    degree : int
-    t : array_like, shape (N,) (or any shape; flattened)
-        Parameters.
-    nderiv : int
-        Highest derivative order; derivatives above ``degree`` are zero.
-
-    Returns
-    -------
-    ders : ndarray, shape (nderiv + 1, N, degree + 1)
-        ``ders[k, i, j]`` is the k-th derivative of basis function
-        ``spans[i] - degree + j`` at ``t[i]``.
-    spans : ndarray of int, shape (N,)
-        See :func:`find_spans`.
-    """
-    knots = np.asarray(knots, dtype=float)
-    t = np.asarray(t, dtype=float).ravel()
-    p = int(degree)
-    n_poles = knots.size - p - 1
-    span = find_spans(knots, p, n_poles, t)
-    n = t.size
-    ders = np.zeros((nderiv + 1, n, p + 1))
-    left = [None] + [t - knots[span + 1 - j] for j in range(1, p + 1)]
-    right = [None] + [knots[span + j] - t for j in range(1, p + 1)]
-    # ndu[j][r]: upper triangle basis functions, lower triangle knot differences
-    ndu = [[None] * (p + 1) for _ in range(p + 1)]
-    ndu[0][0] = np.ones(n)
-    for j in range(1, p + 1):
-        saved = np.zeros(n)
-        for r in range(j):
-            ndu[j][r] = right[r + 1] + left[j - r]
-            temp = ndu[r][j - 1] / ndu[j][r]
-            ndu[r][j] = saved + right[r + 1] * temp
-            saved = left[j - r] * temp
-        ndu[j][j] = saved
-    for j in range(p + 1):
-        ders[0, :, j] = ndu[j][p]
-    nd = min(nderiv, p)
-    for r in range(p + 1):
-        a = [[None] * (nd + 1) for _ in range(2)]
-        s1, s2 = 0, 1
-        a[0][0] = np.ones(n)
-        for k in range(1, nd + 1):
-            d = np.zeros(n)
-            rk, pk = r - k, p - k
-            if r >= k:
-                a[s2][0] = a[s1][0] / ndu[pk + 1][rk]
-                d = a[s2][0] * ndu[rk][pk]
-            j1 = 1 if rk >= -1 else -rk
-            j2 = k - 1 if r - 1 <= pk else p - r
-            for j in range(j1, j2 + 1):
-                a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][rk + j]
-                d = d + a[s2][j] * ndu[rk + j][pk]
-            if r <= pk:
-                a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r]
-                d = d + a[s2][k] * ndu[r][pk]
-            ders[k, :, r] = d
-            s1, s2 = s2, s1
-    factor = float(p)
-    for k in range(1, nd + 1):
-        ders[k] *= factor
-        factor *= p - k
-    return ders, span
-
-
-def basis_matrix(knots, degree, n_poles, t, deriv=0):
-    """Sparse collocation matrix of the B-spline basis (or a derivative of it).
-
-    Parameters
-    ----------
-    knots : array_like, shape (n_poles + degree + 1,)
-    degree, n_poles : int
-    t : array_like, shape (M,)
-        Parameters.
-    deriv : int
-        Derivative order of the basis functions.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, shape (M, n_poles)
-        ``B[i, j] = N_j^(deriv)(t[i])``; at most ``degree + 1`` non-zeros a row.
-    """
-    t = np.asarray(t, dtype=float).ravel()
-    knots = np.asarray(knots, dtype=float)
-    if knots.size != n_poles + degree + 1:
-        raise ValueError("knot vector length %d does not match n_poles + degree + 1 = %d"
-                         % (knots.size, n_poles + degree + 1))
-    ders, span = basis_functions(knots, degree, t, deriv)
-    cols = (span[:, None] - degree + np.arange(degree + 1)).ravel()
-    indptr = np.arange(0, t.size * (degree + 1) + 1, degree + 1)
-    return _sp.csr_matrix((ders[deriv].ravel(), cols, indptr), shape=(t.size, n_poles))
 
 
 def _homogeneous(surf):
@@ -268,12 +141,16 @@ def _ders_chunk(surf, Pw, u, v, order):
     Nv, sv = basis_functions(surf.knots_v, pv, v, order)
     iu = su[:, None] - pu + np.arange(pu + 1)
     iv = sv[:, None] - pv + np.arange(pv + 1)
-    n, k_u, k_v = u.size, pu + 1, pv + 1
-    G = Pw[iu[:, :, None], iv[:, None, :]].reshape(n, k_u * k_v, -1)  # (n, (pu+1)(pv+1), dim)
-    # one contraction per derivative with the outer product of the two bases (faster
-    # than two chained einsums over these short axes)
-    A = {(k, kv): np.einsum("nk,nkc->nc",
-                            (Nu[k][:, :, None] * Nv[kv][:, None, :]).reshape(n, -1), G)
+    n = u.size
+    nv, dim = Pw.shape[1], Pw.shape[2]
+    # the (pu+1)(pv+1) poles of every point, gathered by flat index (several times faster
+    # than indexing the (nu, nv) net with two index arrays)
+    flat = (iu[:, :, None] * nv + iv[:, None, :]).reshape(n, -1)
+    G = np.take(Pw.reshape(-1, dim), flat, axis=0)             # (n, (pu+1)(pv+1), dim)
+    # one contraction per derivative with the outer product of the two bases, as a
+    # stack of (1 x k) (k x dim) products
+    A = {(k, kv): np.matmul((Nu[k][:, :, None] * Nv[kv][:, None, :]).reshape(n, 1, -1),
+                            G)[:, 0, :]
          for (k, kv) in _ORDER_KEYS[order]}
     if surf.weights is None:
         return {key: val[:, :3] for key, val in A.items()}
@@ -455,76 +332,6 @@ def evaluate_grid(surf, us, vs, order=0):
     return out[0] if order == 0 else tuple(out)
 
 
-def greville(knots, degree):
-    """Greville abscissae ``(t[i+1] + ... + t[i+degree]) / degree``.
-
-    Parameters
-    ----------
-    knots : array_like, shape (n_poles + degree + 1,)
-    degree : int
-
-    Returns
-    -------
-    ndarray, shape (n_poles,)
-        Non-decreasing; for ``degree == 0`` the span midpoints.
-    """
-    knots = np.asarray(knots, dtype=float)
-    n = knots.size - degree - 1
-    if degree == 0:
-        return 0.5 * (knots[:-1] + knots[1:])
-    c = np.concatenate([[0.0], np.cumsum(knots)])
-    i = np.arange(n)
-    return (c[i + degree + 1] - c[i + 1]) / degree
-
-
-def refine_knots(knots, degree, ctrl, new_knots, axis=0):
-    """Insert knots into a spline without changing it (same result as Boehm, NURBS book A5.1).
-
-    Parameters
-    ----------
-    knots : array_like, shape (n + degree + 1,)
-    degree : int
-    ctrl : array_like, shape (..., n, ...)
-        Control values along ``axis`` (use homogeneous coordinates for a
-        rational spline).
-    new_knots : array_like, shape (K,)
-        Knots to insert (any order, repeats allowed); each must lie strictly
-        inside the domain ``(knots[degree], knots[n])`` and the resulting
-        multiplicity may not exceed ``degree``.
-    axis : int
-
-    Returns
-    -------
-    knots : ndarray, shape (n + K + degree + 1,)
-    ctrl : ndarray, shape of ``ctrl`` with n + K along ``axis``
-    """
-    knots = np.asarray(knots, dtype=float)
-    p = int(degree)
-    Q = np.moveaxis(np.asarray(ctrl, dtype=float), axis, 0)
-    lo, hi = knots[p], knots[knots.size - p - 1]
-    add = np.sort(np.asarray(new_knots, dtype=float).ravel())
-    if add.size == 0:
-        return knots.copy(), np.moveaxis(Q, 0, axis)
-    bad = np.nonzero(~((add > lo) & (add < hi)))[0]
-    if bad.size:
-        raise ValueError("knot %g lies outside the open domain (%g, %g)" % (add[bad[0]], lo, hi))
-    merged = np.sort(np.concatenate([knots, add]))
-    values, counts = np.unique(merged[p + 1:merged.size - p - 1], return_counts=True)
-    if counts.size and counts.max() > p:
-        raise ValueError("knot %g would get multiplicity above the degree %d"
-                         % (values[np.argmax(counts)], p))
-    # The refined space contains the spline, so interpolating the spline's own values at
-    # the refined space's Greville abscissae gives the refined coefficients exactly (up to
-    # rounding; the collocation matrix is banded and well conditioned). One banded solve
-    # for all knots instead of one Boehm step (and one copy of the net) per knot.
-    n_old, n_new = Q.shape[0], merged.size - p - 1
-    g = greville(merged, p)
-    values_at_g = basis_matrix(knots, p, n_old, g) @ Q.reshape(n_old, -1)
-    solve = _factor(basis_matrix(merged, p, n_new, g), "knot refinement matrix")
-    R = solve(values_at_g).reshape((n_new,) + Q.shape[1:])
-    return merged, np.moveaxis(R, 0, axis)
-
-
 def insert_knots(surf, new_u=(), new_v=()):
     """Return the same surface with more knots (Boehm knot insertion).
 
@@ -547,147 +354,3 @@ def insert_knots(surf, new_u=(), new_v=()):
     poles = Pw[:, :, :3] / w[:, :, None]
     return Surface(poles, ku, kv, surf.degree_u, surf.degree_v,
                    None if surf.weights is None else w, surf.u_range, surf.v_range)
-
-
-def _grid_inputs(us, vs, points, knots_u, knots_v, degree_u, degree_v):
-    us = np.asarray(us, dtype=float).ravel()
-    vs = np.asarray(vs, dtype=float).ravel()
-    X = np.asarray(points, dtype=float)
-    if X.shape != (us.size, vs.size, 3):
-        raise GridError("points must have shape (len(us), len(vs), 3) = (%d, %d, 3), got %r"
-                        % (us.size, vs.size, X.shape))
-    if not np.all(np.isfinite(X)):
-        raise GridError("grid points contain NaN or infinite values; a fit needs every grid node")
-    ku = np.asarray(knots_u, dtype=float)
-    kv = np.asarray(knots_v, dtype=float)
-    nu, nv = ku.size - degree_u - 1, kv.size - degree_v - 1
-    Bu = basis_matrix(ku, degree_u, nu, us)
-    Bv = basis_matrix(kv, degree_v, nv, vs)
-    return us, vs, X, Bu, Bv, nu, nv
-
-
-def _homogeneous_target(X, Bu, Bv, weights):
-    """``W(u, v) * X`` with W the denominator of the rational spline on the grid."""
-    if weights is None:
-        return X
-    W = Bu @ (Bv @ np.asarray(weights, dtype=float).T).T
-    return X * W[:, :, None]
-
-
-def _kron_solve(solve_u, solve_v, X, nu, nv):
-    """Apply ``solve_u`` along the first and ``solve_v`` along the second grid axis."""
-    Mu, Mv = X.shape[:2]
-    Y = solve_u(X.reshape(Mu, Mv * 3)).reshape(nu, Mv, 3)
-    Z = solve_v(np.ascontiguousarray(Y.transpose(1, 0, 2)).reshape(Mv, nu * 3))
-    return np.ascontiguousarray(Z.reshape(nv, nu, 3).transpose(1, 0, 2))
-
-
-def _factor(M, what):
-    try:
-        lu = _spla.splu(_sp.csc_matrix(M))
-    except RuntimeError as exc:
-        raise GridError("the %s is singular (%s): the sample parameters do not fit the knot "
-                        "vector (Schoenberg-Whitney condition: every basis function needs "
-                        "samples inside its support)" % (what, exc)) from exc
-    return lu.solve
-
-
-def _finish(Q, weights):
-    if not np.all(np.isfinite(Q)):
-        raise ComputationError("spline fit produced non-finite poles (ill-conditioned system)")
-    if weights is None:
-        return Q
-    return Q / np.asarray(weights, dtype=float)[:, :, None]
-
-
-def interpolate_grid(us, vs, points, knots_u, knots_v, degree_u, degree_v, weights=None):
-    """Poles of the surface that interpolates a grid of points (NURBS book eq. 9.4-9.9).
-
-    The tensor-product system ``(Bu kron Bv) vec(P) = vec(X)`` is solved as two
-    sparse LU solves, first along u, then along v.
-
-    Parameters
-    ----------
-    us : array_like, shape (nu,)
-    vs : array_like, shape (nv,)
-        Grid parameters (e.g. :func:`greville` of the knots).
-    points : array_like, shape (nu, nv, 3)
-        Points in mm to interpolate, ``points[i, j]`` at ``(us[i], vs[j])``.
-    knots_u, knots_v : array_like
-        Flat knot vectors with ``nu + degree_u + 1`` and ``nv + degree_v + 1`` knots.
-    degree_u, degree_v : int
-    weights : array_like, shape (nu, nv), optional
-        Fixed rational weights: the homogeneous system ``sum N N (w P) = W X``
-        is solved, so a rational nominal sampled and refitted with its own
-        weights comes back exactly.
-
-    Returns
-    -------
-    ndarray, shape (nu, nv, 3)
-        Poles in mm.
-
-    Raises
-    ------
-    GridError
-        Wrong shapes, NaN points, or parameters that make the system singular.
-    """
-    us, vs, X, Bu, Bv, nu, nv = _grid_inputs(us, vs, points, knots_u, knots_v,
-                                             degree_u, degree_v)
-    if us.size != nu or vs.size != nv:
-        raise GridError("interpolation needs as many grid parameters as poles: got %d x %d "
-                        "parameters for %d x %d poles (use fit_grid_lsq for more samples)"
-                        % (us.size, vs.size, nu, nv))
-    X = _homogeneous_target(X, Bu, Bv, weights)
-    Q = _kron_solve(_factor(Bu, "u collocation matrix"), _factor(Bv, "v collocation matrix"),
-                    X, nu, nv)
-    return _finish(Q, weights)
-
-
-def fit_grid_lsq(us, vs, points, knots_u, knots_v, degree_u, degree_v, weights=None):
-    """Least-squares poles for a grid with at least as many samples as poles.
-
-    Minimises ``sum_ij |S(us[i], vs[j]) - X[i, j]|^2`` (for rational weights the
-    homogeneous residual ``W (S - X)``). Because the pseudo-inverse of a
-    Kronecker product is the Kronecker product of the pseudo-inverses, the
-    fit is two banded normal-equation solves (NURBS book eq. 9.66-9.67 per
-    direction).
-
-    Parameters
-    ----------
-    us : array_like, shape (Mu,), Mu >= nu
-    vs : array_like, shape (Mv,), Mv >= nv
-    points : array_like, shape (Mu, Mv, 3)
-        Points in mm.
-    knots_u, knots_v : array_like
-        Flat knot vectors of the result.
-    degree_u, degree_v : int
-    weights : array_like, shape (nu, nv), optional
-        Fixed rational weights (see :func:`interpolate_grid`).
-
-    Returns
-    -------
-    ndarray, shape (nu, nv, 3)
-        Poles in mm.
-
-    Raises
-    ------
-    GridError
-        Wrong shapes, NaN points, or a basis function without samples in its
-        support (singular normal equations).
-    """
-    us, vs, X, Bu, Bv, nu, nv = _grid_inputs(us, vs, points, knots_u, knots_v,
-                                             degree_u, degree_v)
-    if us.size < nu or vs.size < nv:
-        raise GridError("least-squares fit needs at least as many samples as poles: got "
-                        "%d x %d samples for %d x %d poles" % (us.size, vs.size, nu, nv))
-    for B, name in ((Bu, "u"), (Bv, "v")):
-        empty = np.flatnonzero(np.asarray(abs(B).sum(axis=0)).ravel() <= 1e-12)
-        if empty.size:
-            raise GridError("no %s samples in the support of basis function(s) %s: add samples "
-                            "or use fewer knots" % (name, empty[:5].tolist()))
-    X = _homogeneous_target(X, Bu, Bv, weights)
-    BuT, BvT = Bu.T.tocsr(), Bv.T.tocsr()
-    su = _factor(BuT @ Bu, "u normal matrix")
-    sv = _factor(BvT @ Bv, "v normal matrix")
-    Q = _kron_solve(lambda R: su(BuT @ R), lambda R: sv(BvT @ R), X, nu, nv)
-    return _finish(Q, weights)

@@ -29,11 +29,20 @@ DEFAULT_SCHEME = "rainbow"
 #: tolerance-band colours: below the band, inside, above
 TOLERANCE_COLORS = {"below": (0.0, 0.0, 1.0), "inside": (0.0, 0.8, 0.0), "above": (1.0, 0.0, 0.0)}
 
+#: warning band colour (inside the tolerance, beyond the warning limit)
+WARNING_COLOR = (1.0, 0.85, 0.0)
+
 #: colour of values that are not a number (unmeasured nodes)
 NAN_COLOR = (0.5, 0.5, 0.5)
 
+#: colours of values outside a manual range (``out_of_range=True``): dark grey below,
+#: light grey above, so a saturated map never passes for an end colour of the scheme
+OUT_OF_RANGE_COLORS = {"below": (0.25, 0.25, 0.25), "above": (0.75, 0.75, 0.75)}
+
 #: display units of the legend and labels: name -> factor from mm, number format
 UNITS = {"mm": (1.0, "%+.4f"), "um": (1000.0, "%+.1f")}
+#: how a unit is written
+UNIT_TEXT = {"mm": "mm", "um": "\u00b5m"}
 
 #: the smallest half range of an automatic range (mm), for an all-zero field
 MIN_HALF_RANGE = 1e-6
@@ -61,17 +70,23 @@ def symmetric_range(values):
     return -a, a
 
 
-def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME):
+def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME, levels=None,
+               out_of_range=False):
     """RGB colours of ``values`` on the scheme spread linearly over ``[vmin, vmax]``.
 
     Parameters
     ----------
     values : array_like, shape (N,)
-        Values (mm); NaN gives :data:`NAN_COLOR`; values outside the range take the end
-        colours.
+        Values (mm); NaN gives :data:`NAN_COLOR`.
     vmin, vmax : float
         Range (mm), ``vmin < vmax``.
     scheme_name : str
+    levels : int, optional
+        Stepped colours: the range split into ``levels`` equal steps, each drawn in the
+        colour of its middle (as the stepped legend shows them).
+    out_of_range : bool
+        Values below ``vmin`` / above ``vmax`` take :data:`OUT_OF_RANGE_COLORS`; else the
+        end colours of the scheme.
 
     Returns
     -------
@@ -82,16 +97,30 @@ def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME):
     ctrl = scheme(scheme_name)
     v = np.asarray(values, dtype=float).ravel()
     f = np.clip((v - vmin) / (vmax - vmin), 0.0, 1.0)
+    if levels:
+        f = (np.minimum(np.floor(f * levels), levels - 1) + 0.5) / levels
     pos = np.linspace(0.0, 1.0, len(ctrl))
     fin = np.isfinite(f)
     out = np.empty((v.size, 3))
     for c in range(3):
         out[:, c] = np.interp(np.where(fin, f, 0.0), pos, ctrl[:, c])
+    if out_of_range:
+        eps = 1e-9 * (vmax - vmin)
+        with np.errstate(invalid="ignore"):
+            out[v < vmin - eps] = OUT_OF_RANGE_COLORS["below"]
+            out[v > vmax + eps] = OUT_OF_RANGE_COLORS["above"]
     out[~fin] = NAN_COLOR
     return out
 
 
-def tolerance_colors(values, lower, upper, colors=None):
+def warning_limits(lower, upper, warning):
+    """The warning limits inside a tolerance band: ``warning`` (0 .. 1) of each half of
+    the band from its centre (0.8: the outer 20 % of the tolerance warn)."""
+    mid = 0.5 * (lower + upper)
+    return mid + warning * (lower - mid), mid + warning * (upper - mid)
+
+
+def tolerance_colors(values, lower, upper, colors=None, warning=None):
     """Tolerance-band colouring: ``lower <= v <= upper`` inside, else below/above.
 
     Parameters
@@ -101,7 +130,11 @@ def tolerance_colors(values, lower, upper, colors=None):
     lower, upper : float
         Band limits (mm), ``lower <= upper`` (e.g. -0.01, +0.01).
     colors : dict, optional
-        ``below``/``inside``/``above`` -> RGB (default :data:`TOLERANCE_COLORS`).
+        ``below``/``inside``/``above``/``warning`` -> RGB (default :data:`TOLERANCE_COLORS`,
+        :data:`WARNING_COLOR`).
+    warning : float, optional
+        Warning band (see :func:`warning_limits`): values inside the band but beyond the
+        warning limits take the warning colour.
 
     Returns
     -------
@@ -109,28 +142,83 @@ def tolerance_colors(values, lower, upper, colors=None):
     """
     if lower > upper:
         raise ValueError("tolerance band needs lower <= upper, got %r .. %r" % (lower, upper))
-    cols = dict(TOLERANCE_COLORS, **(colors or {}))
+    cols = dict(TOLERANCE_COLORS, warning=WARNING_COLOR, **(colors or {}))
     v = np.asarray(values, dtype=float).ravel()
     out = np.empty((v.size, 3))
     out[:] = cols["inside"]
-    out[v < lower] = cols["below"]
-    out[v > upper] = cols["above"]
+    with np.errstate(invalid="ignore"):
+        if warning is not None:
+            w_lo, w_hi = warning_limits(lower, upper, warning)
+            out[(v < w_lo) | (v > w_hi)] = cols["warning"]
+        out[v < lower] = cols["below"]
+        out[v > upper] = cols["above"]
     out[~np.isfinite(v)] = NAN_COLOR
     return out
 
 
+def band_fractions(values, lower, upper, warning=None):
+    """Percent of the finite ``values`` below, inside and above a band (and, with a
+    ``warning`` band, inside it but beyond the warning limits).
+
+    Returns
+    -------
+    dict
+        ``below``, ``inside``, ``above`` (and ``warning``, part of ``inside``), in %;
+        all 0 without a finite value.
+    """
+    v = np.asarray(values, dtype=float).ravel()
+    v = v[np.isfinite(v)]
+    n = max(v.size, 1)
+    out = {"below": 100.0 * np.count_nonzero(v < lower) / n,
+           "above": 100.0 * np.count_nonzero(v > upper) / n}
+    out["inside"] = 100.0 * np.count_nonzero((v >= lower) & (v <= upper)) / n
+    if warning is not None:
+        w_lo, w_hi = warning_limits(lower, upper, warning)
+        out["warning"] = 100.0 * np.count_nonzero(((v >= lower) & (v < w_lo)) |
+                                                  ((v <= upper) & (v > w_hi))) / n
+    return {k: float(x) for k, x in out.items()}
+
+
+def histogram(values, vmin, vmax, bins=20, scheme_name=DEFAULT_SCHEME, tolerance=None,
+              warning=None, levels=None):
+    """Histogram of ``values`` over ``[vmin, vmax]`` coloured like the map's legend.
+
+    Values outside the range are counted in ``below``/``above``, not in the bins.
+
+    Returns
+    -------
+    dict
+        ``edges`` (bins + 1,), ``counts`` (bins,), ``colors`` (bins, 3) (colour of each
+        bin's centre), ``below``, ``above`` (counts outside), ``total`` finite values.
+    """
+    v = np.asarray(values, dtype=float).ravel()
+    v = v[np.isfinite(v)]
+    edges = np.linspace(vmin, vmax, int(bins) + 1)
+    counts, _ = np.histogram(v[(v >= vmin) & (v <= vmax)], bins=edges)
+    mid = 0.5 * (edges[:-1] + edges[1:])
+    if tolerance is not None:
+        colors = tolerance_colors(mid, tolerance[0], tolerance[1], warning=warning)
+    else:
+        colors = map_colors(mid, vmin, vmax, scheme_name, levels=levels)
+    return {"edges": edges, "counts": counts, "colors": colors,
+            "below": int(np.count_nonzero(v < vmin)), "above": int(np.count_nonzero(v > vmax)),
+            "total": int(v.size)}
+
+
 def format_value(value, unit="mm"):
-    """Text of a value (mm) in the display unit: ``'+0.0450 mm'``, ``'-12.3 um'``, ``'0.0 um'``."""
+    """Text of a value (mm) in the display unit: ``'+0.0450 mm'``, ``'-12.3 µm'``, ``'0.0 µm'``
+    (``unit`` ``'um'`` is written ``µm``)."""
     if unit not in UNITS:
         raise ValueError("unknown display unit %r (expected one of %s)" % (unit, ", ".join(UNITS)))
     factor, fmt = UNITS[unit]
     text = fmt % (value * factor)
     if float(text) == 0.0:
         text = (fmt % 0.0).lstrip("+")
-    return text + " " + unit
+    return text + " " + UNIT_TEXT[unit]
 
 
-def legend(vmin, vmax, scheme_name=DEFAULT_SCHEME, unit="mm", levels=10, tolerance=None):
+def legend(vmin, vmax, scheme_name=DEFAULT_SCHEME, unit="mm", levels=10, tolerance=None,
+           stepped=False, warning=None):
     """What a colour bar shows, from bottom (low values) to top.
 
     Parameters
@@ -144,34 +232,58 @@ def legend(vmin, vmax, scheme_name=DEFAULT_SCHEME, unit="mm", levels=10, toleran
     tolerance : (float, float), optional
         Tolerance band ``(lower, upper)`` (mm): the bar then has three blocks (below,
         inside, above) labelled at the band limits and the range ends.
+    stepped : bool
+        One flat colour per interval (as :func:`map_colors` with ``levels``).
+    warning : float, optional
+        Warning band of the tolerance mode (:func:`warning_limits`): two more blocks.
 
     Returns
     -------
     dict
         ``stops``: list of ``(fraction, rgb)`` with fraction in [0, 1] along the bar
         (consecutive equal fractions make sharp edges); ``labels``: list of
-        ``(fraction, text)``.
+        ``(fraction, text)``; ``blocks``: ``(name, f0, f1)`` of the tolerance mode's blocks.
     """
     if not vmax > vmin:
         raise ValueError("colour range needs vmin < vmax, got %r .. %r" % (vmin, vmax))
+
+    def frac(x):
+        return float(np.clip((x - vmin) / (vmax - vmin), 0.0, 1.0))
+
     if tolerance is not None:
         lo, hi = tolerance
-        cols = TOLERANCE_COLORS
-        f_lo = float(np.clip((lo - vmin) / (vmax - vmin), 0.0, 1.0))
-        f_hi = float(np.clip((hi - vmin) / (vmax - vmin), 0.0, 1.0))
-        stops = [(0.0, cols["below"]), (f_lo, cols["below"]), (f_lo, cols["inside"]),
-                 (f_hi, cols["inside"]), (f_hi, cols["above"]), (1.0, cols["above"])]
-        labels = [(0.0, format_value(vmin, unit)), (f_lo, format_value(lo, unit)),
-                  (f_hi, format_value(hi, unit)), (1.0, format_value(vmax, unit))]
-        return {"stops": [(f, tuple(map(float, c))) for f, c in stops], "labels": labels}
+        cols = dict(TOLERANCE_COLORS, warning=WARNING_COLOR)
+        bounds = [("below", 0.0, frac(lo))]
+        if warning is not None:
+            w_lo, w_hi = warning_limits(lo, hi, warning)
+            bounds += [("warning", frac(lo), frac(w_lo)), ("inside", frac(w_lo), frac(w_hi)),
+                       ("warning", frac(w_hi), frac(hi))]
+        else:
+            bounds.append(("inside", frac(lo), frac(hi)))
+        bounds.append(("above", frac(hi), 1.0))
+        stops = []
+        for name, f0, f1 in bounds:
+            stops += [(f0, cols[name]), (f1, cols[name])]
+        labels = [(0.0, format_value(vmin, unit)), (frac(lo), format_value(lo, unit)),
+                  (frac(hi), format_value(hi, unit)), (1.0, format_value(vmax, unit))]
+        return {"stops": [(f, tuple(map(float, c))) for f, c in stops], "labels": labels,
+                "blocks": bounds}
     fr = np.linspace(0.0, 1.0, levels + 1)
     values = vmin + fr * (vmax - vmin)
+    labels = [(float(f), format_value(v, unit)) for f, v in zip(fr, values)]
+    if stepped:
+        cols = map_colors(vmin + 0.5 * (fr[:-1] + fr[1:]) * (vmax - vmin), vmin, vmax,
+                          scheme_name)
+        stops = []
+        for f0, f1, c in zip(fr[:-1], fr[1:], cols):
+            stops += [(float(f0), tuple(map(float, c))), (float(f1), tuple(map(float, c)))]
+        return {"stops": stops, "labels": labels, "blocks": []}
     # fine colour stops so the bar shows the scheme's interpolation exactly
     ctrl_fr = np.linspace(0.0, 1.0, len(scheme(scheme_name)))
     stop_fr = np.union1d(fr, ctrl_fr)
     cols = map_colors(vmin + stop_fr * (vmax - vmin), vmin, vmax, scheme_name)
     return {"stops": [(float(f), tuple(map(float, c))) for f, c in zip(stop_fr, cols)],
-            "labels": [(float(f), format_value(v, unit)) for f, v in zip(fr, values)]}
+            "labels": labels, "blocks": []}
 
 
 def extremes(values):

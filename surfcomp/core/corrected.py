@@ -429,14 +429,20 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
         ub = us[start:start + step]
         S, Su, Sv = bspline.evaluate_grid(nominal, ub, vs, order=1)
         n = np.cross(Su, Sv)
-        n *= outward / np.linalg.norm(n, axis=-1, keepdims=True)
+        length = np.linalg.norm(n, axis=-1, keepdims=True)
+        # no normal where the surface degenerates (a sphere's pole: Su x Sv is zero or
+        # rounding noise there): NaN, left out below
+        degenerate = length <= 1e-9 * max(float(np.max(length)), 1e-300)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            n *= outward / np.where(degenerate, np.nan, length)
         # on the dense grid the normal line meets the corrected surface within the fit
         # error of the same (u, v), so the normal component of S - S_c(u, v) is the
         # realised correction to second order (exact Newton intersections at the points)
         real = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(corrected, ub, vs), n)
         zero_dev = np.einsum("ijk,ijk->ij", S - bspline.evaluate_grid(zero, ub, vs), n)
-        max_real = max(max_real, float(np.max(np.abs(real))))
-        max_zero = max(max_zero, float(np.max(np.abs(zero_dev))))
+        if np.isfinite(real).any():
+            max_real = max(max_real, float(np.nanmax(np.abs(real))))
+            max_zero = max(max_zero, float(np.nanmax(np.abs(zero_dev))))
     return CheckFigures(max_error_at_points=float(np.max(np.abs(np.ravel(realised)
                                                                 - np.ravel(delta)))),
                         max_zero_deviation=max_zero, max_realised=max_real,

@@ -74,69 +74,97 @@ def grid_from_indices(row, col, u, v, lines=None, source=None):
     return _oriented(Grid(index, "row/col columns"), u, v, source)
 
 
-def _clusters(x, count, order=None):
-    """Split sorted values into ``count`` groups at the largest gaps; return (order, labels, ratio).
+#: a row break must be wider than this many times every gap inside the rows
+ROW_GAP_RATIO = 3.0
 
-    ``order`` (``argsort(x)``) may be given when the same values are split several times.
+
+def _sorted_gaps(a):
+    """The gaps between consecutive values of ``a`` in increasing order."""
+    return np.diff(np.sort(a))
+
+
+def _row_candidates(gaps, n_pts):
+    """Row counts that can split ``n_pts`` sorted values into equal rows (linear work).
+
+    Rows of ``n_pts // rows`` points break at every ``m``-th gap; :func:`_try_rows` needs
+    each break wider than :data:`ROW_GAP_RATIO` times every gap inside the rows. With at
+    most ``n_pts // 2`` rows at least half of the gaps lie inside rows, so the median
+    gap is a lower bound of the widest inside gap, and a row count whose narrowest break
+    is not wider than the ratio times that median cannot give a grid. One partition for
+    the median and ``rows - 1`` gaps per divisor: O(N) after the sort, however many
+    divisors N has. Returns ``(rows, ...)`` increasing and the median gap.
     """
-    if order is None:
-        order = np.argsort(x, kind="stable")
-    if count <= 1:
-        return order, np.zeros(x.size, dtype=int), 0.0
-    xs = x[order]
-    gaps = np.diff(xs)
-    cut = np.sort(np.argpartition(gaps, -(count - 1))[-(count - 1):])
-    labels_sorted = np.zeros(x.size, dtype=int)
-    labels_sorted[cut + 1] = 1
-    labels_sorted = np.cumsum(labels_sorted)
-    inside = np.delete(gaps, cut)
-    big = gaps[cut].min()
-    small = inside.max() if inside.size else 0.0
-    ratio = big / max(small, 1e-15 * max(1.0, np.abs(xs).max()))
-    labels = np.empty(x.size, dtype=int)
-    labels[order] = labels_sorted
-    return order, labels, ratio
+    k = (n_pts + 1) // 2 - 1
+    median = float(np.partition(gaps, k)[k])
+    out = [rows for rows in _divisors(n_pts) if 2 <= rows <= n_pts // 2
+           and gaps[n_pts // rows - 1::n_pts // rows].min() > ROW_GAP_RATIO * median]
+    return out, median
 
 
-def _try_rows(a, b, name_a, name_b):
-    """Points in rows of nearly constant ``a``; within a row ordered by ``b``."""
+def _divisors(n):
+    """The divisors of n, increasing."""
+    small = [k for k in range(1, int(np.sqrt(n)) + 1) if n % k == 0]
+    return sorted(set(small + [n // k for k in small]))
+
+
+def _row_ratio(gaps, rows, scale):
+    """Narrowest break over widest inside gap when ``rows`` equal rows break at every
+    ``m``-th sorted gap (the largest ``rows - 1`` gaps whenever the ratio exceeds 1)."""
+    m = gaps.size // rows + 1
+    inside = np.ones(gaps.size, dtype=bool)
+    inside[m - 1::m] = False
+    small = gaps[inside].max() if inside.any() else 0.0
+    return gaps[~inside].min() / max(small, 1e-15 * scale)
+
+
+def _try_rows(a, b, name_a, name_b, gaps=None):
+    """Points in rows of nearly constant ``a``; within a row ordered by ``b``.
+
+    Of the row counts dividing N whose equal rows each break on a gap wider than
+    :data:`ROW_GAP_RATIO` times every gap inside them, the one with the largest ratio
+    (the fewest rows among equals). Points that are plainly not in rows cost one sort
+    and linear work (:func:`_row_candidates`); only the few row counts that pass it
+    are checked against every gap.
+    """
     n_pts = a.size
+    gaps = _sorted_gaps(a) if gaps is None else gaps
+    candidates, _ = _row_candidates(gaps, n_pts)
+    scale = max(1.0, float(np.abs(a).max()))
     best = None
-    order = np.argsort(a, kind="stable")
-    for rows in range(2, n_pts // 2 + 1):
-        if n_pts % rows:
-            continue
-        _, labels, ratio = _clusters(a, rows, order)
-        if ratio <= 3.0 or (best is not None and ratio <= best[0]):
-            continue
-        sizes = np.bincount(labels, minlength=rows)
-        if np.all(sizes == n_pts // rows):
-            best = (ratio, rows, labels)
+    for rows in candidates:
+        ratio = _row_ratio(gaps, rows, scale)
+        if ratio > ROW_GAP_RATIO and (best is None or ratio > best[0]):
+            best = (ratio, rows)
     if best is None:
         return None
-    _, rows, labels = best
+    rows = best[1]
     cols = n_pts // rows
-    # labels grow with a, so rows are consecutive runs of the points sorted by a
-    members = order.reshape(rows, cols)
+    # rows are consecutive runs of the points sorted by a
+    members = np.argsort(a, kind="stable").reshape(rows, cols)
     within = np.argsort(b[members], axis=1, kind="stable")
     return np.take_along_axis(members, within, axis=1)
 
 
-def _describe_incomplete(a, b, name_a, name_b):
+def _describe_incomplete(a, b, name_a, name_b, gaps=None):
     """A message that says which row is short when points almost form a grid."""
-    order = np.argsort(a)
-    gaps = np.diff(a[order])
+    gaps = _sorted_gaps(a) if gaps is None else gaps
     if gaps.size == 0:
         return "only one point"
-    thresh = 0.3 * np.sort(gaps)[-max(1, int(np.sqrt(a.size)) // 2):].mean()
+    top = max(1, int(np.sqrt(a.size)) // 2)
+    thresh = 0.3 * np.sort(np.partition(gaps, gaps.size - top)[gaps.size - top:]).mean()
     labels = np.concatenate([[0], np.cumsum(gaps > thresh)])
     sizes = np.bincount(labels)
     if sizes.size < 2:
         return "the points do not fall into rows of constant %s or %s" % (name_a, name_b)
     common = np.bincount(sizes).argmax()
+    if common == 1:
+        return ("the points do not fall into rows of constant %s or %s (most of the %d groups "
+                "of nearly equal %s hold a single point: a scattered layout)"
+                % (name_a, name_b, sizes.size, name_a))
     odd = [k for k in range(sizes.size) if sizes[k] != common]
     if not odd:
         return "found %d rows of %d points" % (sizes.size, common)
+    order = np.argsort(a, kind="stable")
     full = order[labels == next(k for k in range(sizes.size) if sizes[k] == common)]
     ref = np.sort(b[full])
     half = 0.5 * np.min(np.diff(ref)) if ref.size > 1 else np.inf
@@ -165,9 +193,10 @@ def grid_from_uv(u, v, lines=None, source=None):
     if u.size < 4:
         raise GridError("%d measured points cannot form a grid (expected at least 2 x 2)" % u.size,
                         file=source)
-    for a, b, na, nb, how in ((v, u, "v", "u", "rows of constant v"),
-                              (u, v, "u", "v", "rows of constant u")):
-        index = _try_rows(a, b, na, nb)
+    sorted_v = _sorted_gaps(v)
+    for a, b, na, nb, how, sg in ((v, u, "v", "u", "rows of constant v", sorted_v),
+                                  (u, v, "u", "v", "rows of constant u", None)):
+        index = _try_rows(a, b, na, nb, sg)
         if index is not None:
             if how.endswith("v"):
                 index = index.T  # (rows of v, points along u) -> first axis along u
@@ -181,7 +210,7 @@ def grid_from_uv(u, v, lines=None, source=None):
             pass  # not a proper grid after all: report why the other ways failed
     raise GridError("the %d measured points do not form a complete n x m grid on the face: %s "
                     "(expected rows of equal length; add row/col columns, or --layout "
-                    "scattered)" % (u.size, _describe_incomplete(v, u, "v", "u")),
+                    "scattered)" % (u.size, _describe_incomplete(v, u, "v", "u", sorted_v)),
                     file=source)
 
 
@@ -189,13 +218,14 @@ def grid_from_uv(u, v, lines=None, source=None):
 _ROW_TURN = np.cos(np.radians(45.0))
 
 
-def _rows_in_file_order(u, v, turn=_ROW_TURN):
-    """Rows of a raster or serpentine scan written line by line, whatever their angle to
-    the parameter lines: a row ends where the scan direction turns by more than 45
-    degrees on both sides of one step (the step to the next line). Returns the index
-    (n, m) with every row running the first row's way, or None when the points are not
-    n equal lines of m >= 3 evenly spaced points (within 25 %; n >= 2)."""
-    x = np.stack([u / (np.ptp(u) or 1.0), v / (np.ptp(v) or 1.0)], axis=1)
+#: points whose scan lines are checked first (a scattered file fails within them)
+_SCAN_PREFIX = 4096
+
+
+def _line_sizes(x, turn):
+    """Lengths of the scan lines of points ``x`` (k, 2) in file order (None for repeated
+    points): a line ends where the scan direction turns by more than ``turn`` (a cosine)
+    on both sides of one step."""
     d = np.diff(x, axis=0)
     length = np.linalg.norm(d, axis=1)
     if d.shape[0] < 3 or np.any(length == 0):
@@ -206,8 +236,27 @@ def _rows_in_file_order(u, v, turn=_ROW_TURN):
     # step k (1..N-3) links two lines when the direction turns before and after it
     links = np.nonzero(turned[:-1] & turned[1:])[0] + 1
     starts = np.concatenate([[0], links + 1])
-    sizes = np.diff(np.concatenate([starts, [u.size]]))
-    if sizes.size < 2 or sizes[0] < 3 or np.any(sizes != sizes[0]):
+    return np.diff(np.concatenate([starts, [x.shape[0]]]))
+
+
+def _rows_in_file_order(u, v, turn=_ROW_TURN):
+    """Rows of a raster or serpentine scan written line by line, whatever their angle to
+    the parameter lines: a row ends where the scan direction turns by more than 45
+    degrees on both sides of one step (the step to the next line). Returns the index
+    (n, m) with every row running the first row's way, or None when the points are not
+    n equal lines of m >= 3 evenly spaced points (within 25 %; n >= 2).
+
+    The first :data:`_SCAN_PREFIX` points are looked at first: the lines complete in
+    them are the file's first lines, so unequal ones there (a scattered file) decide
+    without a pass over all points."""
+    x = np.stack([u / (np.ptp(u) or 1.0), v / (np.ptp(v) or 1.0)], axis=1)
+    if u.size > 2 * _SCAN_PREFIX:
+        head = _line_sizes(x[:_SCAN_PREFIX], turn)
+        if head is None or (head.size > 1 and (head[0] < 3 or np.any(head[1:-1] != head[0])
+                                               or head[-1] > head[0])):
+            return None
+    sizes = _line_sizes(x, turn)
+    if sizes is None or sizes.size < 2 or sizes[0] < 3 or np.any(sizes != sizes[0]):
         return None
     index = np.arange(u.size).reshape(sizes.size, sizes[0])
     # a scan grid steps evenly along its lines; points placed adaptively along curves

@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
-from . import bspline
+from . import bspline, plausibility
 from .corrected import DEFAULT_REFINE, construct
 from .deviations import deviation_components, statistics
 from .field import GridField
@@ -20,7 +20,7 @@ from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
 from .methods import METHODS, compute_correction
 from .progress import report, sub
-from .projection import project
+from .projection import project, tangent_lengths
 from .scattered import ScatteredField, smooth
 
 #: a given normal more than this many degrees off the face normal is reported
@@ -201,6 +201,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
     else:
         d = dist
     _check_deviations(ms, d, options)
+    _check_units(surface, d, warnings, ms.source)
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
     grid = _arrange(ms, proj, options, warnings)
@@ -288,6 +289,17 @@ def _check_deviations(ms, d, options):
                "exceed it): %s" % (shown, options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
                                     bad.size, hint))
+
+
+def _check_units(surface, d, warnings, source):
+    """Warn when every deviation is far beyond the face's size tolerance (see
+    :mod:`surfcomp.core.plausibility`): plausible against max-offset, but not for a part."""
+    us = np.linspace(surface.u_range[0], surface.u_range[1], 9)
+    vs = np.linspace(surface.v_range[0], surface.v_range[1], 9)
+    size = plausibility.largest_dimension(bspline.evaluate_grid(surface, us, vs))
+    message = plausibility.units_warning(d, size)
+    if message:
+        warnings.append("%s: %s" % (source, message))
 
 
 #: fewest points of a scattered layout (its smoothing fit needs them off one line)
@@ -445,9 +457,8 @@ def build_surface(result, surface, outward, delta, progress=None):
 def parameter_scale(surface, prepared):
     """Median length per unit parameter (mm) along u and along v at the measured points,
     so that fits over (u, v) are isotropic on the face."""
-    _, Su, Sv = bspline.derivatives(surface, prepared.u, prepared.v, order=1)
-    return (float(np.median(np.linalg.norm(Su, axis=-1))) or 1.0,
-            float(np.median(np.linalg.norm(Sv, axis=-1))) or 1.0)
+    lu, lv = tangent_lengths(surface, prepared.u, prepared.v)
+    return float(np.median(lu)) or 1.0, float(np.median(lv)) or 1.0
 
 
 def scattered_spacing(prepared, scale):

@@ -16,8 +16,9 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features
+from ..app.undo import UndoStep
 from ..errors import ComputationError, InputError, SurfcompError
-from . import dialogs, prefs
+from . import dialogs, fcgui, prefs
 
 translate = FreeCAD.Qt.translate
 
@@ -96,17 +97,11 @@ class Command:
     def macro(label, lines, modules=()):
         """Run ``lines`` with ``Gui.doCommand`` (so they are recorded in macros) inside one
         transaction of the active document; abort it on any error and re-raise."""
-        doc = FreeCAD.ActiveDocument
         for mod in modules:
             FreeCADGui.addModule(mod)
-        doc.openTransaction(label)
-        try:
+        with UndoStep(FreeCAD.ActiveDocument, label):
             for line in lines:
                 FreeCADGui.doCommand(line)
-        except BaseException:
-            doc.abortTransaction()
-            raise
-        doc.commitTransaction()
 
     @staticmethod
     def new_objects(before):
@@ -138,8 +133,7 @@ def create_compensation(label, display="Map", quantity="deviation"):
              # the map lies on the nominal face: hide what would cover it
              "_doc.getObject(%r).ViewObject.Visibility = False" % nom.Name,
              "_doc.getObject(%r).ViewObject.Visibility = False" % meas.Name]
-    doc.openTransaction(label)
-    try:
+    with UndoStep(doc, label, rollback=doc.recompute):
         FreeCADGui.addModule("surfcomp.app.features")
         FreeCADGui.addModule("surfcomp.gui.viewproviders")
         for line in lines:
@@ -148,11 +142,6 @@ def create_compensation(label, display="Map", quantity="deviation"):
         if "Invalid" in comp.State or "Error" in comp.State or comp.Shape.isNull():
             raise _state_error(comp)
         comp.ViewObject.DisplayMode = display
-    except BaseException:
-        doc.abortTransaction()
-        doc.recompute()
-        raise
-    doc.commitTransaction()
     return comp
 
 
@@ -173,10 +162,15 @@ class LoadNominal(Command):
             from ..app.nominal import nominal_from_face
 
             obj, name = sel
-            nom = nominal_from_face(getattr(obj.Shape, name), source=obj.Label, face_name=name)
-            FreeCAD.Console.PrintMessage(
-                "SurfComp nominal: %s.%s (%s, %d x %d poles)\n"
-                % (obj.Label, name, nom.converted or "BSplineSurface", *nom.surface.shape))
+            face = getattr(obj.Shape, name)
+            nom = nominal_from_face(face, source=obj.Label, face_name=name)
+            text = ("SurfComp nominal: %s.%s (%s, %d x %d poles)"
+                    % (obj.Label, name, nom.converted or "BSplineSurface", *nom.surface.shape))
+            FreeCAD.Console.PrintMessage(text + "\n")
+            fcgui.show_status(text)
+            dialogs.show_info(self.MENU, text + "\n" + translate(
+                "SurfComp", "Area %.1f mm², ready to use as the nominal: select it with a "
+                            "measurement and run Deviation map.") % face.Area)
             return
         path = dialogs.ask_open_file(translate("SurfComp", "Nominal face"), CAD_FILTER)
         if not path:
@@ -189,7 +183,8 @@ class LoadNominal(Command):
             "_nominal = App.ActiveDocument.addObject('Part::Feature', 'Nominal')",
             "_nominal.Shape = _shape",
             "_nominal.Label = %r" % label,
-            "App.ActiveDocument.recompute()"], modules=("surfcomp.app.nominal",))
+            "App.ActiveDocument.recompute()",
+            "Gui.SendMsgToActiveView('ViewFit')"], modules=("surfcomp.app.nominal",))
 
 
 class ImportMeasurements(Command):
@@ -201,16 +196,18 @@ class ImportMeasurements(Command):
 
     def run(self):
         from ..io.readers import read_any
-        from .panels import PreviewDialog
+        from .preview import PreviewDialog
 
         path = dialogs.ask_open_file(translate("SurfComp", "Measurement file"),
                                      MEASUREMENT_FILTER)
         if not path:
             return
-        units = prefs.file_units()
-        ms = read_any(path, units=units)
-        if not dialogs.run_dialog(PreviewDialog(ms)):
+        ms = read_any(path, units=prefs.file_units())
+        dlg = PreviewDialog(ms, reader=lambda units: read_any(path, units=units))
+        # a file with implausible deviations never reaches the document
+        if not dialogs.run_dialog(dlg) or not dlg.accepted_ok():
             return
+        units = dlg.units()
         self.macro(translate("SurfComp", "Import measurements"), [
             "_meas = surfcomp.app.features.make_measurement(App.ActiveDocument, %r, units=%r)"
             % (path, units),
@@ -222,7 +219,7 @@ class ImportMeasurements(Command):
 class _MapCommand(Command):
     QUANTITY = "deviation"
 
-    def active(self):
+    def active(self=None):
         if selected_compensation() is not None:
             return True
         return selected_face() is not None and \
@@ -247,6 +244,64 @@ class _MapCommand(Command):
         for other in (comp.Nominal, comp.Measurement):
             if other is not None and other.ViewObject is not None:
                 other.ViewObject.Visibility = False
+
+
+class ShowDeviation(_MapCommand):
+    ID = "SurfComp_ShowDeviation"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowDeviation", "Deviation")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowDeviation",
+                            "Show the measured deviation on the selected compensation's map "
+                            "(+ = material left)")
+
+
+class ShowDetermined(_MapCommand):
+    ID = "SurfComp_ShowDetermined"
+    QUANTITY = "determined"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Determined component")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowDetermined",
+                            "Show the determined (filtered, repeatable) component of the "
+                            "deviation")
+
+
+class ShowRandom(_MapCommand):
+    ID = "SurfComp_ShowRandom"
+    QUANTITY = "random"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowRandom", "Random component")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowRandom",
+                            "Show the random component: deviation - determined")
+
+
+class ShowCorrection(_MapCommand):
+    ID = "SurfComp_ShowCorrection"
+    QUANTITY = "correction"
+    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowCorrection", "Correction")
+    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowCorrection",
+                            "Show the correction the corrected face realises (+ = material "
+                            "removed: the face moves in by it)")
+
+
+class ShowMaps:
+    """Toolbar drop-down of the four maps (a FreeCAD command group)."""
+
+    ID = "SurfComp_ShowMaps"
+    ITEMS = ("SurfComp_ShowDeviation", "SurfComp_ShowDetermined", "SurfComp_ShowRandom",
+             "SurfComp_ShowCorrection")
+
+    def GetCommands(self):
+        return self.ITEMS
+
+    def GetDefaultCommand(self):
+        return 0
+
+    def GetResources(self):
+        return {"Pixmap": paths.icon(self.ID + ".svg"),
+                "MenuText": QT_TRANSLATE_NOOP("SurfComp_ShowMaps", "Show map"),
+                "ToolTip": QT_TRANSLATE_NOOP("SurfComp_ShowMaps",
+                                             "Deviation, determined, random or correction map "
+                                             "of the selected compensation")}
+
+    def IsActive(self):
+        return FreeCAD.ActiveDocument is not None and _MapCommand.active(None)
 
 
 class DeviationMap(_MapCommand):
@@ -284,8 +339,7 @@ class Mirror(Command):
 
     def run(self):
         comp = selected_compensation()
-        stock = dialogs.ask_float(self.MENU, translate("SurfComp", "Stock (mm)"),
-                                  float(comp.Stock.Value) or 0.1, 0.0, 100.0)
+        stock = dialogs.ask_stock(self.MENU, float(comp.Stock.Value) or 0.1)
         if stock is None:
             return
         doc = FreeCAD.ActiveDocument
@@ -321,50 +375,87 @@ class BuildFace(Command):
             "_comp = App.ActiveDocument.getObject(%r)" % comp.Name,
             "_face = App.ActiveDocument.addObject('Part::Feature', 'CorrectedFace')",
             "_face.Shape = _comp.Shape.copy()",
-            "_face.Label = %r" % (comp.Label + " corrected face"),
+            "_face.Label = %r" % face_label(comp),
+            # it lies on the map (within the correction): drawn over it, it z-fights
+            "_face.ViewObject.Visibility = False",
             "App.ActiveDocument.recompute()"])
 
 
-class ReplaceInDocument(Command):
+def face_label(comp):
+    """Label of a built face: nominal, method and iteration round
+    (``nominal filtered r1``; mirror with its stock)."""
+    nominal = comp.Nominal.Label if comp.Nominal is not None else comp.Label
+    method = comp.Method
+    if method == "mirror":
+        method += " %gmm" % float(comp.Stock.Value)
+    return "%s %s r%d" % (nominal, method, int(comp.Round))
+
+
+class _ReplaceCommand(Command):
+    """Replace in document / Restore nominal: one command, two directions."""
+
+    #: ``surfcomp.app.replace`` function to call, and whether it needs a replacing compensation
+    ACTION = "replace"
+    WHILE_REPLACING = False
+
+    def active(self):
+        from ..app import replace
+
+        comp = selected_compensation()
+        return comp is not None and replace.is_replacing(comp) == self.WHILE_REPLACING
+
+    def run(self):
+        from ..app import progress, replace
+        from ..errors import Cancelled
+
+        # surfcomp.app.replace opens and commits its own transaction
+        comp = selected_compensation()
+        doc = comp.Document
+        before = replace.summary(doc, comp) if self.WHILE_REPLACING else None
+        FreeCADGui.addModule("surfcomp.app.replace")
+        FreeCADGui.doCommand("surfcomp.app.replace.%s(App.ActiveDocument, "
+                             "App.ActiveDocument.getObject(%r))" % (self.ACTION, comp.Name))
+        # the users (Path operations) regenerate with progress; Esc undoes the step
+        try:
+            progress.recompute_with_progress(doc, "%s: %s" % (self.MENU, comp.Label))
+        except Cancelled:
+            doc.undo()
+            doc.recompute()
+            dialogs.show_info(self.MENU, translate("SurfComp", "Cancelled: the document is "
+                                                               "as before."))
+            return
+        done = before or replace.summary(doc, comp)
+        dialogs.show_info(self.MENU, self.summary_text(done))
+
+    def summary_text(self, s):
+        verb = translate("SurfComp", "Restored") if self.WHILE_REPLACING \
+            else translate("SurfComp", "Rebound")
+        lines = [translate("SurfComp", "%s %d link(s) of %d object(s): %s")
+                 % (verb, s["links"], len(s["objects"]), ", ".join(s["objects"]) or "-"),
+                 translate("SurfComp", "Path jobs touched: %s") % (", ".join(s["jobs"]) or
+                                                                  translate("SurfComp", "none"))]
+        for old, new in s["renamed"]:
+            lines.append(translate("SurfComp", "Renamed %s -> %s") % ((new, old) if
+                                                                     self.WHILE_REPLACING
+                                                                     else (old, new)))
+        return "\n".join(lines)
+
+
+class ReplaceInDocument(_ReplaceCommand):
     ID = "SurfComp_ReplaceInDocument"
     MENU = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Replace in document")
     TIP = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument",
                             "Let the users of the nominal (Path jobs, links) use the corrected "
                             "face instead; Restore puts the nominal back")
 
-    def active(self):
-        from ..app import replace
 
-        comp = selected_compensation()
-        return comp is not None and not replace.is_replacing(comp)
-
-    def run(self):
-        # surfcomp.app.replace opens and commits its own transaction
-        comp = selected_compensation()
-        FreeCADGui.addModule("surfcomp.app.replace")
-        FreeCADGui.doCommand("surfcomp.app.replace.replace(App.ActiveDocument, "
-                             "App.ActiveDocument.getObject(%r))" % comp.Name)
-        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
-
-
-class RestoreNominal(Command):
+class RestoreNominal(_ReplaceCommand):
     ID = "SurfComp_RestoreNominal"
     MENU = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Restore nominal")
     TIP = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal",
                             "Undo Replace in document: the users of the nominal use it again")
-
-    def active(self):
-        from ..app import replace
-
-        comp = selected_compensation()
-        return comp is not None and replace.is_replacing(comp)
-
-    def run(self):
-        comp = selected_compensation()
-        FreeCADGui.addModule("surfcomp.app.replace")
-        FreeCADGui.doCommand("surfcomp.app.replace.restore(App.ActiveDocument, "
-                             "App.ActiveDocument.getObject(%r))" % comp.Name)
-        FreeCADGui.doCommand("App.ActiveDocument.recompute()")
+    ACTION = "restore"
+    WHILE_REPLACING = True
 
 
 class Report(Command):
@@ -384,18 +475,21 @@ class Report(Command):
         dialogs.run_dialog(ReportDialog(selected_compensation()))
 
 
-COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, Filter, Mirror, BuildFace,
-            ReplaceInDocument, RestoreNominal, Report)
+COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
+            ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
+            RestoreNominal, Report)
+#: command groups (toolbar drop-downs)
+GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
-           "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
+           "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
            "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report")
 
 
 def register():
-    """Add every command to FreeCAD (idempotent)."""
+    """Add every command and command group to FreeCAD (idempotent)."""
     known = set(FreeCADGui.listCommands())
-    for cls in COMMANDS:
+    for cls in COMMANDS + GROUPS:
         if cls.ID not in known:
             FreeCADGui.addCommand(cls.ID, cls())
-    return [c.ID for c in COMMANDS]
+    return [c.ID for c in COMMANDS + GROUPS]

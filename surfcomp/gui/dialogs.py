@@ -45,7 +45,16 @@ def ask_float(title, label, value, minimum, maximum, decimals=4):
     return float(val) if ok else None
 
 
+def ask_stock(title, value):
+    """The mirror method's stock (mm) from the explained stock dialog, or None."""
+    from .panels import StockDialog
+
+    dlg = StockDialog(title, value, _parent())
+    return dlg.value() if run_dialog(dlg) else None
+
+
 def run_dialog(dialog):
     """Run a modal dialog; True when accepted."""
-    run = getattr(dialog, "exec", None) or dialog.exec_     # Qt6 drops the exec_ alias
-    return run() == QtGui.QDialog.Accepted
+    from .fcgui import run_modal
+
+    return run_modal(dialog) == QtGui.QDialog.Accepted

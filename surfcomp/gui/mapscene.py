@@ -22,11 +22,30 @@ from pivy import coin
 
 from ..core import colormap
 
-#: legend placement in normalised device coordinates (-1 .. 1 across the view)
+#: legend placement in normalised device coordinates (-1 .. 1 across the view): the bar's
+#: x extent, the labels' x, and the vertical region the legends share (stacked top down)
 BAR_X = (0.74, 0.79)
-BAR_Y = (-0.70, 0.70)
 LABEL_X = 0.805
-TITLE_Y = 0.78
+REGION_Y = (-0.92, 0.86)
+#: room above a bar for its title (NDC)
+TITLE_ROOM = 0.14
+#: pixels kept free around the navigation cube
+CUBE_MARGIN = 16
+
+
+def legend_layout(slot=0, slots=1, clear_top_px=0, clear_bottom_px=0, view_height=1000):
+    """Where legend ``slot`` of ``slots`` sits (NDC): ``bar_x``, ``bar_y``, ``label_x``,
+    ``title_y``. The legends of the visible maps share the region on the right, one
+    above the other, so they never overlap; ``clear_top_px``/``clear_bottom_px`` keep
+    the region clear of the navigation cube in a view ``view_height`` pixels high."""
+    h = max(float(view_height), 100.0)
+    y0 = max(REGION_Y[0], -1.0 + 2.0 * clear_bottom_px / h)
+    y1 = min(REGION_Y[1], 1.0 - 2.0 * clear_top_px / h)
+    step = (y1 - y0) / max(int(slots), 1)
+    top = y1 - slot * step
+    bar = (top - step + 0.05, top - TITLE_ROOM)
+    return {"bar_x": BAR_X, "bar_y": bar, "label_x": LABEL_X, "title_y": top - 0.04,
+            "slot": slot, "slots": slots}
 
 
 @dataclass
@@ -34,31 +53,45 @@ class MapStyle:
     """Display choices of a map (all lengths in mm).
 
     ``vmin``/``vmax`` None: symmetric range around zero from the values;
-    ``tolerance`` ``(lower, upper)`` switches to the tolerance-band colouring.
+    ``tolerance`` ``(lower, upper)`` switches to the tolerance-band colouring, with a
+    ``warning`` band (fraction of the tolerance, :func:`surfcomp.core.colormap.warning_limits`);
+    ``stepped`` draws one flat colour per legend step; ``out_of_range`` gives values
+    outside a manual range their own colours (with arrows on the legend); ``note`` is a
+    second title line (the sign convention of a correction map).
     """
 
     scheme: str = colormap.DEFAULT_SCHEME
     vmin: float = None
     vmax: float = None
     tolerance: tuple = None
+    warning: float = None
     unit: str = "mm"
     levels: int = 10
+    stepped: bool = False
+    out_of_range: bool = True
     show_points: bool = True
     show_labels: bool = True
     show_legend: bool = True
     point_size: int = 7
+    note: str = ""
+    layout: dict = None
+
+    def manual(self):
+        return self.vmin is not None and self.vmax is not None and self.vmax > self.vmin
 
     def range_for(self, values):
         """The colour range for ``values``: the style's own or the symmetric default."""
-        if self.vmin is not None and self.vmax is not None and self.vmax > self.vmin:
+        if self.manual():
             return float(self.vmin), float(self.vmax)
         return colormap.symmetric_range(values)
 
 
 def _colors(values, style, vmin, vmax):
     if style.tolerance is not None:
-        return colormap.tolerance_colors(values, *style.tolerance)
-    return colormap.map_colors(values, vmin, vmax, style.scheme)
+        return colormap.tolerance_colors(values, *style.tolerance, warning=style.warning)
+    return colormap.map_colors(values, vmin, vmax, style.scheme,
+                               levels=style.levels if style.stepped else None,
+                               out_of_range=style.out_of_range and style.manual())
 
 
 def _text(position, text, color=(0.0, 0.0, 0.0), size=15, justification=None):
@@ -132,19 +165,27 @@ class MapScene:
         self.labels = coin.SoAnnotation()      # drawn over the surface
         self.labels_switch.addChild(self.labels)
 
-        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes
+        # flags: labels the user placed at measured points (value and id)
+        self.flags = coin.SoAnnotation()
+
+        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes;
+        # not pickable: a hit on it is no point of the map (its coordinates are the legend
+        # camera's), so the readout would show, and a click flag, an unrelated point
         self.legend_switch = coin.SoSwitch()
         self.legend = coin.SoAnnotation()
         self.legend_switch.addChild(self.legend)
+        unpickable = coin.SoPickStyle()
+        unpickable.style = coin.SoPickStyle.UNPICKABLE
         skip = coin.SoType.fromName(coin.SbName("SoSkipBoundingGroup")).createInstance()
+        skip.addChild(unpickable)
         skip.addChild(self.legend_switch)
 
-        for node in (self.surface, self.markers_switch, self.labels_switch, skip):
+        for node in (self.surface, self.markers_switch, self.labels_switch, self.flags, skip):
             self.root.addChild(node)
 
     # -- data --------------------------------------------------------------------------
     def set_data(self, points, triangles, values, marker_points=None, marker_values=None,
-                 title=""):
+                 title="", restyle=True):
         """New geometry and values.
 
         Parameters
@@ -158,6 +199,8 @@ class MapScene:
             Measured points drawn as markers, coloured by ``marker_values`` (K,).
         title : str
             Legend title (e.g. ``'Deviation'``).
+        restyle : bool
+            Recolour with the current style now (False: the caller sets a style next).
         """
         points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
         tri = np.asarray(triangles, dtype=np.int32).reshape(-1, 3)
@@ -180,7 +223,8 @@ class MapScene:
             self._marker_points = self._marker_values = None
             self.marker_coords.point.setNum(0)
         self._title = title
-        self.set_style(self._style)
+        if restyle:
+            self.set_style(self._style)
 
     def clear(self):
         """Show nothing (no data)."""
@@ -190,6 +234,7 @@ class MapScene:
             field.setNum(0)
         self.labels.removeAllChildren()
         self.legend.removeAllChildren()
+        self.flags.removeAllChildren()
         self.range = None
 
     # -- style ------------------------------------------------------------------------
@@ -231,10 +276,18 @@ class MapScene:
                 vals[idx], style.unit))))
         self.extreme_indices = (i_max, i_min)
 
+    def set_flags(self, flags):
+        """Flag labels: ``[(point (3,), text)]`` in the map's coordinates."""
+        self.flags.removeAllChildren()
+        for point, text in flags:
+            self.flags.addChild(_flag(point, text))
+
     def _draw_legend(self, style, vmin, vmax):
         leg = self.legend
         leg.removeAllChildren()
         self.legend_switch.whichChild = 0 if style.show_legend else -1
+        lay = style.layout or legend_layout()
+        self.legend_layout = lay
         cam = coin.SoOrthographicCamera()
         cam.viewportMapping = coin.SoCamera.LEAVE_ALONE
         cam.position.setValue(0.0, 0.0, 1.0)
@@ -246,47 +299,108 @@ class MapScene:
         leg.addChild(cam)
         leg.addChild(light)
         data = colormap.legend(vmin, vmax, style.scheme, style.unit, style.levels,
-                               style.tolerance)
-        stops = data["stops"]
-        y0, y1 = BAR_Y
-        x0, x1 = BAR_X
-        coords, colors, index = [], [], []
-        for (f0, c0), (f1, c1) in zip(stops[:-1], stops[1:]):
-            if f1 <= f0:
-                continue
-            ya, yb = y0 + f0 * (y1 - y0), y0 + f1 * (y1 - y0)
-            k = len(coords)
-            coords += [(x0, ya, 0.0), (x1, ya, 0.0), (x1, yb, 0.0), (x0, yb, 0.0)]
-            colors += [c0, c0, c1, c1]
-            index += [k, k + 1, k + 2, k + 3, -1]
-        bar = coin.SoSeparator()
-        c3 = coin.SoCoordinate3()
-        c3.point.setValues(0, len(coords), coords)
-        bc = coin.SoBaseColor()
-        bc.rgb.setValues(0, len(colors), colors)
-        mb = coin.SoMaterialBinding()
-        mb.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
-        fs = coin.SoIndexedFaceSet()
-        fs.coordIndex.setValues(0, len(index), index)
-        fs.materialIndex.setValues(0, len(index), index)
-        frame_c = coin.SoCoordinate3()
-        frame_c.point.setValues(0, 5, [(x0, y0, 0.01), (x1, y0, 0.01), (x1, y1, 0.01),
-                                       (x0, y1, 0.01), (x0, y0, 0.01)])
-        frame_col = coin.SoBaseColor()
-        frame_col.rgb.setValue(0.0, 0.0, 0.0)
-        frame = coin.SoLineSet()
-        frame.numVertices.setValue(5)
-        for node in (c3, bc, mb, fs):
-            bar.addChild(node)
-        fsep = coin.SoSeparator()
-        for node in (frame_c, frame_col, frame):
-            fsep.addChild(node)
-        leg.addChild(bar)
-        leg.addChild(fsep)
+                               style.tolerance, stepped=style.stepped, warning=style.warning)
+        y0, y1 = lay["bar_y"]
+        x0, x1 = lay["bar_x"]
+
+        def y_of(f):
+            return y0 + f * (y1 - y0)
+
+        quads = []
+        for (f0, c0), (f1, c1) in zip(data["stops"][:-1], data["stops"][1:]):
+            if f1 > f0:
+                quads.append(([(x0, y_of(f0)), (x1, y_of(f0)), (x1, y_of(f1)), (x0, y_of(f1))],
+                              [c0, c0, c1, c1]))
+        values = self._marker_values if self._marker_values is not None else self._values
+        if style.out_of_range and style.manual() and style.tolerance is None:
+            # arrows past the ends: the colours of values outside the manual range
+            below = colormap.OUT_OF_RANGE_COLORS["below"]
+            above = colormap.OUT_OF_RANGE_COLORS["above"]
+            xm, a = 0.5 * (x0 + x1), 0.035
+            quads.append(([(x0, y0 - 0.005), (x1, y0 - 0.005), (xm, y0 - a), (xm, y0 - a)],
+                          [below] * 4))
+            quads.append(([(x0, y1 + 0.005), (x1, y1 + 0.005), (xm, y1 + a), (xm, y1 + a)],
+                          [above] * 4))
+            fr = colormap.band_fractions(values, vmin, vmax)
+            leg.addChild(_text((x0 - 0.01, y0 - a, 0.0), "< %.1f %%" % fr["below"], size=13,
+                               justification=coin.SoText2.RIGHT))
+            leg.addChild(_text((x0 - 0.01, y1 + 0.01, 0.0), "> %.1f %%" % fr["above"], size=13,
+                               justification=coin.SoText2.RIGHT))
+        leg.addChild(_quads(quads))
+        leg.addChild(_polyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]))
         for f, text in data["labels"]:
-            leg.addChild(_text((LABEL_X, y0 + f * (y1 - y0) - 0.01, 0.0), text))
-        title = self._title + (" [%s]" % style.unit if self._title else "")
+            leg.addChild(_text((lay["label_x"], y_of(f) - 0.01, 0.0), text))
+        if style.tolerance is not None:
+            # percent of the measured points in each block, left of the bar
+            fr = colormap.band_fractions(values, *style.tolerance, warning=style.warning)
+            words = {"below": "below", "inside": "in", "above": "above", "warning": "warn"}
+            done = set()
+            for name, f0, f1 in data["blocks"]:
+                if name in done:
+                    continue
+                done.add(name)
+                leg.addChild(_text((x0 - 0.01, y_of(0.5 * (f0 + f1)) - 0.01, 0.0),
+                                   "%s %.1f %%" % (words[name], fr[name]), size=13,
+                                   justification=coin.SoText2.RIGHT))
+        title = self._title + (" [%s]" % colormap.UNIT_TEXT[style.unit] if self._title else "")
         if style.tolerance is not None:
             title += " - tolerance band"
-        leg.addChild(_text((x1, TITLE_Y, 0.0), title, size=17,
+        leg.addChild(_text((x1, lay["title_y"], 0.0), title, size=17,
                            justification=coin.SoText2.RIGHT))
+        if style.note:
+            leg.addChild(_text((x1, lay["title_y"] - 0.05, 0.0), style.note, size=14,
+                               justification=coin.SoText2.RIGHT))
+
+
+def _quads(quads):
+    """One face set of quadrilaterals ``[(4 xy corners, 4 rgb)]`` with per-vertex colours."""
+    coords, colors, index = [], [], []
+    for corners, cols in quads:
+        k = len(coords)
+        coords += [(x, y, 0.0) for x, y in corners]
+        colors += list(cols)
+        index += [k, k + 1, k + 2, k + 3, -1]
+    sep = coin.SoSeparator()
+    c3 = coin.SoCoordinate3()
+    c3.point.setValues(0, len(coords), coords)
+    bc = coin.SoBaseColor()
+    bc.rgb.setValues(0, len(colors), colors)
+    mb = coin.SoMaterialBinding()
+    mb.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
+    fs = coin.SoIndexedFaceSet()
+    fs.coordIndex.setValues(0, len(index), index)
+    fs.materialIndex.setValues(0, len(index), index)
+    for node in (c3, bc, mb, fs):
+        sep.addChild(node)
+    return sep
+
+
+def _polyline(points, color=(0.0, 0.0, 0.0)):
+    sep = coin.SoSeparator()
+    c3 = coin.SoCoordinate3()
+    c3.point.setValues(0, len(points), [(x, y, 0.01) for x, y in points])
+    col = coin.SoBaseColor()
+    col.rgb.setValue(*color)
+    line = coin.SoLineSet()
+    line.numVertices.setValue(len(points))
+    for node in (c3, col, line):
+        sep.addChild(node)
+    return sep
+
+
+def _flag(point, text):
+    """A flag at a measured point: a black dot and its text over everything."""
+    sep = coin.SoSeparator()
+    c3 = coin.SoCoordinate3()
+    c3.point.setValue(*map(float, point))
+    col = coin.SoBaseColor()
+    col.rgb.setValue(0.0, 0.0, 0.0)
+    style = coin.SoDrawStyle()
+    style.pointSize = 9
+    for node in (col, style, c3, coin.SoPointSet()):
+        sep.addChild(node)
+    label = _text(point, "", size=14)
+    # on the line below the point: the min/max label may sit on the point's own line
+    label.getChild(3).string.setValues(0, 2, ["", "  " + text])
+    sep.addChild(label)
+    return sep

@@ -1,8 +1,8 @@
-"""Task panels and dialogs of the workbench: measurement preview, filter panel, report.
+"""Task panels and dialogs of the workbench: filter panel, report (the import preview is
+in :mod:`surfcomp.gui.preview`).
 
-No numerics: the preview shows what :func:`surfcomp.io.readers.read_any` found, the
-filter panel edits the compensation's properties and recomputes it, the report shows
-the statistics the compensation stored.
+No numerics: the filter panel edits the compensation's properties and recomputes it, the
+report shows the statistics the compensation stored.
 """
 
 import json
@@ -10,8 +10,11 @@ import json
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
+from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from ..app import reports
+from ..app.undo import UndoStep
+from ..core import colormap
 from ..core.deviations import Statistics, format_table
 from ..core.filters import EDGE_MODES
 from ..errors import SurfcompError
@@ -25,51 +28,24 @@ REPORT_COLUMNS = (("deviation", "Deviation"), ("determined", "Determined"),
                   ("correction", "Correction"))
 
 
-def preview_text(ms):
-    """What the import preview says about a measurement set (plain text)."""
-    lines = [translate("SurfComp", "File: %s") % ms.source,
-             translate("SurfComp", "Points: %d") % len(ms),
-             translate("SurfComp", "Columns: %s") % ms.kind(),
-             translate("SurfComp", "Units of the file: %s (stored in mm)") % ms.units]
-    if ms.columns:
-        lines.append(translate("SurfComp", "Detected columns: %s") % ", ".join(
-            "%s=%s" % (k, v) for k, v in ms.columns.items()))
-    if ms.ignored_columns:
-        lines.append(translate("SurfComp", "Ignored columns: %s") % ", ".join(ms.ignored_columns))
-    if ms.row is not None and ms.col is not None:
-        lines.append(translate("SurfComp", "Grid: %d x %d (from row/col indices)")
-                     % (int(ms.row.max()) + 1, int(ms.col.max()) + 1))
-    else:
-        lines.append(translate("SurfComp", "Grid: detected on the face when the map is made"))
-    if ms.warnings:
-        lines.append(translate("SurfComp", "Problems found (%d):") % len(ms.warnings))
-        lines += ["  " + w for w in ms.warnings[:50]]
-    else:
-        lines.append(translate("SurfComp", "Problems found: none"))
-    return "\n".join(lines)
-
-
-class PreviewDialog(QtGui.QDialog):
-    """Shows what a measurement file holds before anything is added to the document."""
-
-    def __init__(self, ms, parent=None):
-        super().__init__(parent or FreeCADGui.getMainWindow())
-        self.setWindowTitle(translate("SurfComp", "Import measurements: preview"))
-        lay = QtGui.QVBoxLayout(self)
-        self.text = QtGui.QPlainTextEdit(preview_text(ms))
-        self.text.setReadOnly(True)
-        self.text.setMinimumSize(560, 260)
-        lay.addWidget(self.text)
-        box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
-        box.accepted.connect(self.accept)
-        box.rejected.connect(self.reject)
-        lay.addWidget(box)
-
-
 def statistics_columns(obj):
     """``[(header, Statistics)]`` of a computed compensation, in report order."""
     data = json.loads(obj.Statistics or "{}")
     return [(head, Statistics(**data[key])) for key, head in REPORT_COLUMNS if key in data]
+
+
+def map_style(obj):
+    """Scheme and range of the object's map, for the HTML report: the range when the map
+    has a manual or shared one, else None (each map on its own symmetric range, as the
+    GUI's automatic range)."""
+    vobj = obj.ViewObject
+    if vobj is None or "Scheme" not in vobj.PropertiesList:
+        return None
+    proxy = getattr(vobj, "Proxy", None)
+    scene = getattr(proxy, "scene", None)
+    fixed = not vobj.AutoRange or vobj.Shared
+    rng = tuple(scene.range) if fixed and scene is not None and scene.range else None
+    return {"scheme": vobj.Scheme, "range": rng}
 
 
 class ReportDialog(QtGui.QDialog):
@@ -96,7 +72,8 @@ class ReportDialog(QtGui.QDialog):
                 self.table.setItem(i, j, item)
         self.table.resizeColumnsToContents()
         lay = QtGui.QVBoxLayout(self)
-        lay.addWidget(QtGui.QLabel(translate("SurfComp", "Deviations in %s") % self.unit))
+        lay.addWidget(QtGui.QLabel(translate("SurfComp", "Deviations in %s")
+                                   % colormap.UNIT_TEXT[self.unit]))
         lay.addWidget(self.table)
         box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Close)
         copy = box.addButton(translate("SurfComp", "Copy"), QtGui.QDialogButtonBox.ActionRole)
@@ -121,7 +98,7 @@ class ReportDialog(QtGui.QDialog):
         if not path:
             return None
         try:
-            reports.write_html_report(self.obj, path)
+            reports.write_html_report(self.obj, path, style=map_style(self.obj))
         except SurfcompError as exc:
             dialogs.show_error(translate("SurfComp", "Report"), str(exc))
             return None
@@ -129,13 +106,20 @@ class ReportDialog(QtGui.QDialog):
 
 
 class FilterPanel:
-    """Task panel: mask size, weights, edge handling, with live maps of the determined
-    and random components. OK keeps the change (one undo step), Cancel reverts it."""
+    """Task panel: mask size, kind, weights, edge handling, with live maps of the
+    determined and random components and their RMS. Every change is checked first (no
+    failed recompute), then recomputed as a preview and redrawn after a short debounce.
+    The weights, when given, set the mask size. OK keeps the change (one undo step),
+    Cancel reverts it."""
 
     #: the open panel (None when closed), for scripts and tests
     instance = None
+    #: debounce of the live preview (ms)
+    DEBOUNCE = 120
 
     def __init__(self, obj):
+        from ..app.features import MASK_KINDS
+
         FilterPanel.instance = self
         self.obj = obj
         self.doc = obj.Document
@@ -146,37 +130,79 @@ class FilterPanel:
         self.mask.setRange(1, 99)
         self.mask.setSingleStep(2)
         self.mask.setValue(int(obj.MaskSize))
+        self.mask.setToolTip(translate("SurfComp", "Odd number of grid nodes across the mask "
+                                                   "(Werner 2022: 5); custom weights set it"))
+        self.kind = QtGui.QComboBox()
+        self.kind.addItems(list(MASK_KINDS))
+        self.kind.setCurrentIndex(list(MASK_KINDS).index(obj.MaskKind))
         self.weights = QtGui.QLineEdit(obj.Weights)
         self.weights.setPlaceholderText(translate("SurfComp", "e.g. 1 2 1; 2 4 2; 1 2 1"))
+        self.weights.setToolTip(translate("SurfComp", "Custom mask weights, rows separated by "
+                                                      "';': they set the mask size and kind"))
         self.edge = QtGui.QComboBox()
         self.edge.addItems(list(EDGE_MODES))
         self.edge.setCurrentIndex(list(EDGE_MODES).index(obj.Edge))
         self.show = QtGui.QComboBox()
-        self.show.addItems(["determined", "random", "deviation"])
+        self.show.addItems(["determined", "random", "deviation", "residual"])
         self.status = QtGui.QLabel("")
         self.status.setWordWrap(True)
+        self.figures = QtGui.QLabel("")
+        self.figures.setWordWrap(True)
+        self.figures.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
         lay.addRow(translate("SurfComp", "Mask size"), self.mask)
+        lay.addRow(translate("SurfComp", "Mask kind"), self.kind)
         lay.addRow(translate("SurfComp", "Weights"), self.weights)
         lay.addRow(translate("SurfComp", "Edge handling"), self.edge)
         lay.addRow(translate("SurfComp", "Show map"), self.show)
+        lay.addRow(self.figures)
         lay.addRow(self.status)
         self.timer = QtCore.QTimer()
         self.timer.setSingleShot(True)
-        self.timer.setInterval(300)
+        self.timer.setInterval(self.DEBOUNCE)
         self.timer.timeout.connect(self.update)
-        self.mask.valueChanged.connect(self.timer.start)
-        self.weights.editingFinished.connect(self.timer.start)
-        self.edge.currentIndexChanged.connect(self.timer.start)
+        self.mask.valueChanged.connect(self.changed)
+        self.kind.currentIndexChanged.connect(self.changed)
+        self.weights.textChanged.connect(self.changed)
+        self.edge.currentIndexChanged.connect(self.changed)
         self.show.currentIndexChanged.connect(self.show_map)
-        self.doc.openTransaction(translate("SurfComp", "Filter %s") % obj.Label)
+        self.step = UndoStep(self.doc, translate("SurfComp", "Filter %s") % obj.Label).open()
         vobj = obj.ViewObject
         if vobj is not None and "Map" in vobj.PropertiesList:
             vobj.DisplayMode = "Map"
+        self._sync_mask()
         self.show_map()
+        self._show_figures()
 
     def values(self):
         return {"MaskSize": int(self.mask.value()), "Weights": self.weights.text().strip(),
-                "Edge": self.edge.currentText()}
+                "MaskKind": self.kind.currentText(), "Edge": self.edge.currentText()}
+
+    def changed(self, *_args):
+        """A field changed: check it now, recompute after the debounce."""
+        if self._sync_mask():
+            self.timer.start()
+        else:
+            self.timer.stop()
+
+    def _sync_mask(self):
+        """Check the values; weights set the size (the spin box follows, disabled).
+        Returns False (message shown) when they are not valid."""
+        from ..app.features import check_filter
+
+        custom = bool(self.weights.text().strip())
+        self.mask.setEnabled(not custom)
+        self.kind.setEnabled(not custom)
+        try:
+            size = check_filter(self.obj, **self.values())
+        except SurfcompError as exc:
+            self._message(str(exc), bad=True)
+            return False
+        if custom and size != self.mask.value():
+            self.mask.blockSignals(True)
+            self.mask.setValue(size)
+            self.mask.blockSignals(False)
+        self._message("")
+        return True
 
     def show_map(self, *_args):
         vobj = self.obj.ViewObject
@@ -184,7 +210,8 @@ class FilterPanel:
             vobj.Map = self.show.currentText()
 
     def update(self):
-        """Apply the panel's values and recompute (live preview inside the transaction)."""
+        """Apply the panel's values and recompute (live preview inside the transaction);
+        redraw the map at once. False when the values are not valid."""
         self.timer.stop()
         if getattr(self, "_busy", False):
             return False
@@ -195,23 +222,48 @@ class FilterPanel:
             self._busy = False
 
     def _update(self):
+        if not self._sync_mask():
+            return False
         for name, value in self.values().items():
             if getattr(self.obj, name) != value:
                 setattr(self.obj, name, value)
         if not self.obj.Preview:  # live maps without rebuilding the face on every change
             self.obj.Preview = True
         self.doc.recompute()
-        return self._show_state()
+        ok = self._show_state()
+        proxy = getattr(self.obj.ViewObject, "Proxy", None)
+        if ok and getattr(proxy, "_dirty", False):
+            proxy.redraw()      # not yet drawn while the recompute processed events
+        self._show_figures()
+        return ok
+
+    def _show_figures(self):
+        try:
+            fig = reports.filter_summary(self.obj)
+        except SurfcompError:
+            self.figures.setText("")
+            return
+        um = 1000.0
+        self.figures.setText(translate(
+            "SurfComp", "RMS  deviation %.2f µm, determined %.2f µm, random %.2f µm.\n"
+                        "Predicted residual %.2f µm RMS; next part %.2f µm RMS "
+                        "(residual + a new random scatter).")
+            % (fig["deviation"] * um, fig["determined"] * um, fig["random"] * um,
+               fig["residual"] * um, fig["next_part"] * um))
+
+    def _message(self, text, bad=False):
+        self.status.setText(text)
+        self.status.setStyleSheet("color: #c53030;" if bad else "")
 
     def _show_state(self):
         bad = "Invalid" in self.obj.State or "Error" in self.obj.State
-        message = self.obj.getStatusString() if bad else ""
-        self.status.setText(message)
-        self.status.setStyleSheet("color: #c53030;" if bad else "")
+        self._message(self.obj.getStatusString() if bad else "", bad)
         return not bad
 
     def accept(self):
         self.timer.stop()
+        if not self._sync_mask():
+            return False        # not valid: keep the panel open with the message
         applied = all(getattr(self.obj, k) == v for k, v in self.values().items())
         if applied and not self._show_state():
             return False        # these values already failed: keep the panel open
@@ -223,13 +275,13 @@ class FilterPanel:
             FreeCADGui.doCommand(line)
         if not self._show_state():
             return False
-        self.doc.commitTransaction()
+        self.step.commit()
         self._close()
         return True
 
     def reject(self):
         self.timer.stop()
-        self.doc.abortTransaction()
+        self.step.abort()
         self._close()
         vobj = self.obj.ViewObject
         if vobj is not None and vobj.Proxy is not None and hasattr(vobj.Proxy, "redraw"):
@@ -247,3 +299,85 @@ class FilterPanel:
         buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
         # Qt5 flags convert with int(); Qt6 (PySide6) flags are Python enums with .value
         return buttons.value if hasattr(buttons, "value") else int(buttons)
+
+
+STOCK_TIP = QT_TRANSLATE_NOOP(
+    "SurfComp",
+    "Stock = the semi-finishing allowance: the part is measured after a semi-finishing pass "
+    "programmed this far outside the nominal, so every measured deviation d carries it. The "
+    "mirror method moves the face by -(d - stock): a point measured exactly at the stock "
+    "stays; one with more material left moves inwards (Huang et al., mirror compensation, "
+    "eq. 1-2).")
+
+
+class StockDrawing(QtGui.QWidget):
+    """The mirror method in one picture: nominal, semi-finished surface (nominal + stock),
+    measured surface (nominal + d) and the corrected face (nominal - (d - stock))."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setMinimumSize(360, 190)
+        self.stock = 0.1
+
+    def paintEvent(self, _event):
+        import math
+
+        p = QtGui.QPainter(self)
+        p.setRenderHint(QtGui.QPainter.Antialiasing)
+        p.fillRect(self.rect(), QtGui.QColor(255, 255, 255))
+        w, h = self.width(), self.height()
+        y0, scale = 0.62 * h, 0.22 * h      # nominal line; 1 unit of stock in pixels
+        s = 1.0
+
+        def curve(offset, color, label, dash=False):
+            pen = QtGui.QPen(QtGui.QColor(*color), 2)
+            if dash:
+                pen.setStyle(QtCore.Qt.DashLine)
+            p.setPen(pen)
+            pts = [QtCore.QPointF(x, y0 - scale * offset(x / w)) for x in range(10, w - 110, 4)]
+            for a, b in zip(pts[:-1], pts[1:]):
+                p.drawLine(a, b)
+            p.drawText(QtCore.QPointF(w - 105, pts[-1].y() + 4), label)
+
+        def d(t):
+            return s + 0.45 * math.sin(6.0 * t)          # measured: stock + machining error
+
+        curve(lambda t: 0.0, (0, 0, 0), translate("SurfComp", "nominal"))
+        curve(lambda t: s, (120, 120, 120), translate("SurfComp", "nominal + stock"), True)
+        curve(d, (43, 108, 176), translate("SurfComp", "measured (d)"))
+        curve(lambda t: -(d(t) - s), (197, 48, 48), translate("SurfComp", "corrected face"))
+        p.setPen(QtGui.QColor(0, 0, 0))
+        p.drawText(QtCore.QPointF(8, 16), translate("SurfComp", "corrected = nominal - (d - "
+                                                                "stock) along the normal"))
+        p.end()
+
+
+class StockDialog(QtGui.QDialog):
+    """The mirror method's stock, explained: tooltip, text and drawing."""
+
+    def __init__(self, title, value, parent=None):
+        super().__init__(parent or FreeCADGui.getMainWindow())
+        self.setWindowTitle(title)
+        lay = QtGui.QVBoxLayout(self)
+        text = QtGui.QLabel(translate("SurfComp", STOCK_TIP))
+        text.setWordWrap(True)
+        lay.addWidget(text)
+        self.drawing = StockDrawing()
+        lay.addWidget(self.drawing)
+        row = QtGui.QFormLayout()
+        self.spin = QtGui.QDoubleSpinBox()
+        self.spin.setDecimals(4)
+        self.spin.setRange(0.0, 10.0)
+        self.spin.setSingleStep(0.05)
+        self.spin.setSuffix(" mm")
+        self.spin.setValue(float(value))
+        self.spin.setToolTip(translate("SurfComp", STOCK_TIP))
+        row.addRow(translate("SurfComp", "Stock (semi-finishing allowance)"), self.spin)
+        lay.addLayout(row)
+        box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
+        box.accepted.connect(self.accept)
+        box.rejected.connect(self.reject)
+        lay.addWidget(box)
+
+    def value(self):
+        return float(self.spin.value())

@@ -13,69 +13,130 @@ The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
 import FreeCAD
 import numpy as np
 from PySide import QtCore
+from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features, reports
 from ..core import colormap
 from ..errors import SurfcompError
 from . import prefs
-from .mapscene import MapScene, MapStyle
+from .mapscene import MapScene, MapStyle, legend_layout
 
-VERSION = 1
+#: 2: short property names that fit the property view (RENAMED)
+VERSION = 2
+#: view properties renamed in version 2: old name -> new name (moved on restore)
+RENAMED = {"ToleranceBand": "TolBand", "ToleranceLower": "TolLow", "ToleranceUpper": "TolHigh",
+           "LegendUnit": "Unit", "ShowLegend": "Legend", "ShowPoints": "Points",
+           "ShowLabels": "Labels"}
 
 QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
 TITLES = {"deviation": "Deviation", "determined": "Determined component",
           "random": "Random component", "correction": "Correction",
           "increment": "Correction of this round", "residual": "Predicted residual"}
+#: the sign convention under the title of the maps whose sign is not a deviation's
+NOTES = {"correction": "+ = material removed (the face moves in by it)",
+         "increment": "+ = material removed (the face moves in by it)",
+         "deviation": "+ = material left", "residual": "left of the repeatable error"}
 #: view properties whose change only recolours the map
-STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "ToleranceBand",
-                    "ToleranceLower", "ToleranceUpper", "LegendUnit", "ShowPoints",
-                    "ShowLabels", "ShowLegend")
+STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "TolBand",
+                    "TolLow", "TolHigh", "Unit", "Points",
+                    "Labels", "Legend", "Stepped", "Shared", "WarnBand",
+                    "Histogram")
 
 #: compensation properties whose change invalidates the drawn map
-RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "NominalPoints", "Deviation",
+RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "Nodes", "Deviation",
                      "Determined", "Random", "Increment", "Correction", "Version")
 
 _G = "Colour map"
 # (type, name, tooltip, default)
 MAP_PROPERTIES = (
-    ("App::PropertyEnumeration", "Map", "Quantity drawn in the Map display mode",
+    ("App::PropertyEnumeration", "Map",
+     QT_TRANSLATE_NOOP("App::Property", "Quantity drawn in the Map display mode"),
      list(QUANTITIES)),
-    ("App::PropertyEnumeration", "Scheme", "Colour scheme", list(colormap.SCHEMES)),
+    ("App::PropertyEnumeration", "Scheme",
+     QT_TRANSLATE_NOOP("App::Property", "Colour scheme"),
+     list(colormap.SCHEMES)),
     ("App::PropertyBool", "AutoRange",
-     "Symmetric range from the largest absolute value (off: RangeMin .. RangeMax)", True),
-    ("App::PropertyDistance", "RangeMin", "Lower end of the colour range (AutoRange off)",
-     -0.05),
-    ("App::PropertyDistance", "RangeMax", "Upper end of the colour range (AutoRange off)",
-     0.05),
-    ("App::PropertyBool", "ToleranceBand",
-     "Tolerance band mode: in tolerance one colour, below and above their own", False),
-    ("App::PropertyDistance", "ToleranceLower", "Lower limit of the tolerance band", -0.01),
-    ("App::PropertyDistance", "ToleranceUpper", "Upper limit of the tolerance band", 0.01),
-    ("App::PropertyEnumeration", "LegendUnit", "Unit of the legend and labels", ["mm", "um"]),
-    ("App::PropertyBool", "ShowPoints", "Draw the measured points as coloured markers", True),
-    ("App::PropertyBool", "ShowLabels", "Label the largest positive and negative value",
+     QT_TRANSLATE_NOOP("App::Property", "Symmetric range from the largest absolute value (off: "
+                                        "RangeMin .. RangeMax)"),
      True),
-    ("App::PropertyBool", "ShowLegend", "Draw the colour bar legend", True),
-    ("App::PropertyInteger", "MapVersion", "Property set version of this view", VERSION),
+    ("App::PropertyDistance", "RangeMin",
+     QT_TRANSLATE_NOOP("App::Property", "Lower end of the colour range (AutoRange off)"),
+     -0.05),
+    ("App::PropertyDistance", "RangeMax",
+     QT_TRANSLATE_NOOP("App::Property", "Upper end of the colour range (AutoRange off)"),
+     0.05),
+    ("App::PropertyBool", "TolBand",
+     QT_TRANSLATE_NOOP("App::Property", "Tolerance band mode: in tolerance one colour, below and "
+                                        "above their own"),
+     False),
+    ("App::PropertyDistance", "TolLow",
+     QT_TRANSLATE_NOOP("App::Property", "Lower limit of the tolerance band"),
+     -0.01),
+    ("App::PropertyDistance", "TolHigh",
+     QT_TRANSLATE_NOOP("App::Property", "Upper limit of the tolerance band"),
+     0.01),
+    ("App::PropertyEnumeration", "Unit",
+     QT_TRANSLATE_NOOP("App::Property", "Unit of the legend and labels"),
+     ["mm", "um"]),
+    ("App::PropertyBool", "Points",
+     QT_TRANSLATE_NOOP("App::Property", "Draw the measured points as coloured markers"),
+     True),
+    ("App::PropertyBool", "Labels",
+     QT_TRANSLATE_NOOP("App::Property", "Label the largest positive and negative value"),
+     True),
+    ("App::PropertyBool", "Legend",
+     QT_TRANSLATE_NOOP("App::Property", "Draw the colour bar legend"),
+     True),
+    ("App::PropertyBool", "Stepped",
+     QT_TRANSLATE_NOOP("App::Property", "Stepped colour bar: one flat colour per legend step"),
+     False),
+    ("App::PropertyBool", "Shared",
+     QT_TRANSLATE_NOOP("App::Property", "AutoRange over every map of the same measurement "
+                                        "(deviation, determined, random, correction), so the "
+                                        "maps compare by colour"),
+     False),
+    ("App::PropertyFloat", "WarnBand",
+     QT_TRANSLATE_NOOP("App::Property", "Tolerance band mode: warning limit as a fraction of the "
+                                        "tolerance (0.8: the outer 20 % warn in yellow; 0: off)"),
+     0.0),
+    ("App::PropertyBool", "Histogram",
+     QT_TRANSLATE_NOOP("App::Property", "Show the histogram panel of this map, coloured like its "
+                                        "legend"),
+     False),
+    ("App::PropertyIntegerList", "Flags",
+     QT_TRANSLATE_NOOP("App::Property", "Measured nodes flagged on the map (click the map to add "
+                                        "or remove one; empty this list to remove all)"),
+     None),
+    ("App::PropertyInteger", "MapVersion",
+     QT_TRANSLATE_NOOP("App::Property", "Property set version of this view"),
+     VERSION),
 )
 
 
 def add_map_properties(vobj, from_preferences=True):
-    """Add the missing colour-map properties to ``vobj`` (new objects, old documents)."""
+    """Add the missing colour-map properties to ``vobj`` (new objects, old documents: their
+    renamed properties' values move to the new names)."""
+    old_names = [o for o in RENAMED if o in vobj.PropertiesList]
     for typ, name, tip, default in MAP_PROPERTIES:
         if name in vobj.PropertiesList:
             continue
         vobj.addProperty(typ, name, _G, tip)
-        setattr(vobj, name, default)
+        if default is not None:
+            setattr(vobj, name, default)
         if typ == "App::PropertyEnumeration":
             setattr(vobj, name, default[0])
     vobj.setEditorMode("MapVersion", 2)
+    for old in old_names:
+        setattr(vobj, RENAMED[old], getattr(vobj, old))
+        vobj.removeProperty(old)
+    if old_names or vobj.MapVersion < VERSION:
+        vobj.MapVersion = VERSION
     if from_preferences:
         vobj.Scheme = prefs.scheme()
-        vobj.ToleranceBand = prefs.tolerance_band()
-        vobj.ToleranceLower, vobj.ToleranceUpper = prefs.tolerance()
-        vobj.LegendUnit = prefs.display_unit()
+        vobj.TolBand = prefs.tolerance_band()
+        vobj.TolLow, vobj.TolHigh = prefs.tolerance()
+        vobj.Unit = prefs.display_unit()
 
 
 def has_map_properties(vobj):
@@ -85,20 +146,79 @@ def has_map_properties(vobj):
     return all(p[1] in names for p in MAP_PROPERTIES)
 
 
-def style_of(vobj):
-    """The :class:`MapStyle` the view properties describe."""
+def style_of(vobj, quantity=None, layout=None, shared=None):
+    """The :class:`MapStyle` the view properties describe (``shared``: the common range
+    when Shared is on)."""
     auto = vobj.AutoRange
-    tol = (float(vobj.ToleranceLower.Value), float(vobj.ToleranceUpper.Value)) \
-        if vobj.ToleranceBand else None
-    return MapStyle(scheme=vobj.Scheme,
-                    vmin=None if auto else float(vobj.RangeMin.Value),
-                    vmax=None if auto else float(vobj.RangeMax.Value),
-                    tolerance=tol, unit=vobj.LegendUnit, show_points=vobj.ShowPoints,
-                    show_labels=vobj.ShowLabels, show_legend=vobj.ShowLegend)
+    tol = (float(vobj.TolLow.Value), float(vobj.TolHigh.Value)) \
+        if vobj.TolBand else None
+    warn = float(vobj.WarnBand) if 0.0 < float(vobj.WarnBand) < 1.0 else None
+    vmin = None if auto else float(vobj.RangeMin.Value)
+    vmax = None if auto else float(vobj.RangeMax.Value)
+    if auto and shared is not None:
+        vmin, vmax = shared
+    return MapStyle(scheme=vobj.Scheme, vmin=vmin, vmax=vmax, tolerance=tol, warning=warn,
+                    unit=vobj.Unit, stepped=bool(vobj.Stepped),
+                    out_of_range=not auto, show_points=vobj.Points,
+                    show_labels=vobj.Labels, show_legend=vobj.Legend,
+                    note=NOTES.get(quantity, ""), layout=layout)
 
 
-def map_data(obj, quantity, samples=None):
-    """Mesh and values of a computed compensation's map (no drawing).
+def _shows_legend(vobj):
+    proxy = getattr(vobj, "Proxy", None)
+    if not has_map_properties(vobj) or not vobj.Legend or not vobj.Visibility:
+        return False
+    scene = getattr(proxy, "scene", None)
+    if scene is None or scene.range is None:
+        return False
+    return vobj.DisplayMode in ("Map", "Points")
+
+
+def arrange_legends(doc, changed=None):
+    """Give every visible map of ``doc`` its own legend slot (stacked on the right, clear of
+    the navigation cube); restyle those whose slot moved, except ``changed`` (the caller
+    restyles it). Returns ``{object name: layout}``."""
+    from . import fcgui
+
+    top, bottom, height = fcgui.legend_clearance()
+    shown = [o.ViewObject for o in doc.Objects
+             if o.ViewObject is not None and
+             isinstance(getattr(o.ViewObject, "Proxy", None),
+                        (ViewProviderCompensation, ViewProviderMeasurement)) and
+             _shows_legend(o.ViewObject)]
+    out = {}
+    for k, vobj in enumerate(shown):
+        lay = legend_layout(k, len(shown), top, bottom, height)
+        proxy = vobj.Proxy
+        moved = getattr(proxy, "_layout", None) != lay
+        proxy._layout = lay
+        out[vobj.Object.Name] = lay
+        if moved and vobj.Object is not changed:
+            proxy.restyle(arrange=False)
+    return out
+
+
+def map_mesh(obj, samples=None):
+    """``(points, triangles, u, v)``: the map's mesh of the nominal face (see
+    :func:`surfcomp.core.colormap.uv_grid_mesh`), in the nominal object's own coordinates."""
+    nominal, _placement = features.nominal_of(obj)
+    n, m = int(obj.GridRows), int(obj.GridCols)
+    samples = samples or colormap.mesh_resolution((n, m))
+    return colormap.uv_grid_mesh(nominal.surface, samples)
+
+
+def mesh_key(obj):
+    """What the mesh depends on: the nominal face's shape and the grid's shape."""
+    nom = obj.Nominal
+    shape = getattr(nom, "Shape", None)
+    code = shape.hashCode() if shape is not None and hasattr(shape, "hashCode") else id(shape)
+    return (getattr(nom, "Name", None), obj.FaceName, int(obj.GridRows), int(obj.GridCols),
+            code)
+
+
+def map_data(obj, quantity, samples=None, mesh=None):
+    """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
+    :func:`map_mesh` returns it (made when not given).
 
     Returns
     -------
@@ -107,12 +227,9 @@ def map_data(obj, quantity, samples=None):
         ``markers`` (K, 3) measured nodes and ``marker_values`` (K,), mm, in the
         nominal object's own coordinates.
     """
-    nominal, _placement = features.nominal_of(obj)
-    n, m = int(obj.GridRows), int(obj.GridCols)
-    samples = samples or colormap.mesh_resolution((n, m))
-    pts, tri, u, v = colormap.uv_grid_mesh(nominal.surface, samples)
+    pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
     values = reports.deviation_field(obj, quantity)(u, v)
-    nodes = np.asarray(obj.NominalPoints, dtype=float).reshape(-1, 3)
+    nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
     dev = np.asarray(obj.Deviation, dtype=float)
     node_values = reports.quantity_values(obj, quantity).ravel()
     keep = np.isfinite(dev) & np.isfinite(node_values)
@@ -166,15 +283,19 @@ class ViewProviderCompensation:
             self._schedule()        # properties arrive one by one: draw once they are all in
         elif prop == "Shape":       # written last by a recompute
             self.redraw()
+        else:                       # a preview recompute writes the components, no Shape
+            self._schedule()
 
     def _schedule(self):
+        self._dirty = True
         if not getattr(self, "_pending", False):
             self._pending = True
             QtCore.QTimer.singleShot(0, self._deferred)
 
     def _deferred(self):
         self._pending = False
-        if getattr(self, "vobj", None) is not None and self.vobj.DisplayMode == "Map":
+        if getattr(self, "_dirty", False) and getattr(self, "vobj", None) is not None \
+                and self.vobj.DisplayMode == "Map":
             self.redraw()
 
     def finishRestoring(self):
@@ -188,6 +309,12 @@ class ViewProviderCompensation:
             self.restyle()
         elif prop == "Map" and vobj.DisplayMode == "Map":
             self.redraw()
+        elif prop == "Flags":
+            self.draw_flags()
+        elif prop in ("Visibility", "DisplayMode"):
+            doc = getattr(vobj.Object, "Document", None)
+            if doc is not None:
+                arrange_legends(doc)
 
     def onDocumentRestored(self, vobj):
         add_map_properties(vobj, from_preferences=False)
@@ -197,6 +324,7 @@ class ViewProviderCompensation:
         vobj = getattr(self, "vobj", None)
         if vobj is None or not has_map_properties(vobj):
             return
+        self._dirty = False
         obj = vobj.Object
         q = vobj.Map
         if not obj.GridRows or not obj.GridCols or obj.Shape.isNull():
@@ -204,20 +332,42 @@ class ViewProviderCompensation:
             return
         try:
             if q not in self._data:
-                self._data[q] = map_data(obj, q)
+                key = mesh_key(obj)     # the mesh outlives result changes (filter preview)
+                if getattr(self, "_mesh", (None,))[0] != key:
+                    self._mesh = (key, map_mesh(obj))
+                self._data[q] = map_data(obj, q, mesh=self._mesh[1])
         except SurfcompError as exc:
             self.scene.clear()
             FreeCAD.Console.PrintWarning("%s: no map: %s\n" % (obj.Label, exc))
             return
         d = self._data[q]
         self.scene.set_data(d["points"], d["triangles"], d["values"], d["markers"],
-                            d["marker_values"], title=TITLES[q])
+                            d["marker_values"], title=TITLES[q], restyle=False)
         self.restyle()
+        self.draw_flags()
+        from . import readout
 
-    def restyle(self):
+        readout.install()
+
+    def shared_range(self):
+        """The common range of the maps of this measurement (Shared), or None."""
+        vobj = self.vobj
+        if not vobj.Shared or not vobj.AutoRange:
+            return None
+        obj = vobj.Object
+        same = [o for o in obj.Document.Objects if features.is_compensation(o)
+                and o.Measurement is obj.Measurement and o.GridRows]
+        return reports.common_range(same)
+
+    def restyle(self, arrange=True):
         """Recolour from the view properties (no new geometry, no recompute)."""
         vobj = self.vobj
-        self.scene.set_style(style_of(vobj))
+        if arrange and vobj.Object.Document is not None:
+            if self.scene.range is None:    # first drawing: arrange_legends needs a range
+                self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None)))
+            arrange_legends(vobj.Object.Document, changed=vobj.Object)
+        self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
+                                      self.shared_range()))
         if vobj.AutoRange and self.scene.range is not None:
             # show the automatic range in the (then unused) manual fields
             self._syncing = True
@@ -225,6 +375,44 @@ class ViewProviderCompensation:
                 vobj.RangeMin, vobj.RangeMax = self.scene.range
             finally:
                 self._syncing = False
+        if vobj.Histogram and self.scene.range is not None:
+            from . import histogram
+
+            histogram.show_map(vobj, self.scene)
+
+    def locator(self):
+        """The :class:`~surfcomp.app.reports.PointLocator` of the drawn result (cached)."""
+        if "_locator" not in self._data:
+            self._data["_locator"] = reports.PointLocator(self.vobj.Object)
+        return self._data["_locator"]
+
+    def draw_flags(self):
+        """Flag labels at the nodes listed in the view's ``Flags``."""
+        vobj = getattr(self, "vobj", None)
+        if vobj is None or not has_map_properties(vobj) or self.scene.range is None:
+            return
+        flags = []
+        unit = vobj.Unit
+        try:
+            loc = self.locator() if len(vobj.Flags) else None
+        except SurfcompError:
+            loc = None
+        for node in vobj.Flags if loc is not None else ():
+            if 0 <= node < len(loc.nodes):
+                info = loc.node(node)
+                value = info[vobj.Map] if vobj.Map in info else info["deviation"]
+                flags.append((info["local"], "%s  %s" % (info["id"], colormap.format_value(
+                    value, unit))))
+        self.scene.set_flags(flags)
+
+    def toggle_flag(self, node):
+        """Add a flag at ``node`` or remove the one there (saved with the document)."""
+        flags = list(self.vobj.Flags)
+        if node in flags:
+            flags.remove(node)
+        else:
+            flags.append(int(node))
+        self.vobj.Flags = flags
 
     def setEdit(self, vobj, mode=0):
         if mode != 0:
@@ -292,8 +480,12 @@ class ViewProviderMeasurement:
             self.redraw()
 
     def onChanged(self, vobj, prop):
-        if prop in STYLE_PROPERTIES and hasattr(self, "scene") and has_map_properties(vobj):
+        if not hasattr(self, "scene") or not has_map_properties(vobj):
+            return
+        if prop in STYLE_PROPERTIES:
             self.redraw()
+        elif prop in ("Visibility", "DisplayMode") and vobj.Object.Document is not None:
+            arrange_legends(vobj.Object.Document)
 
     def onDocumentRestored(self, vobj):
         add_map_properties(vobj, from_preferences=False)
@@ -311,10 +503,18 @@ class ViewProviderMeasurement:
         values = ms.deviation if ms.deviation is not None else np.zeros(len(pts))
         self.scene.set_data(np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int32), values,
                             pts, values, title="Deviation (file)")
-        style = style_of(vobj)
-        if ms.deviation is None:
+        self.restyle()
+
+    def restyle(self, arrange=True):
+        vobj = self.vobj
+        style = style_of(vobj, "deviation", getattr(self, "_layout", None))
+        if not has_deviation(vobj.Object):
             style.show_legend = style.show_labels = False
         self.scene.set_style(style)
+        if arrange and vobj.Object.Document is not None:
+            arrange_legends(vobj.Object.Document, changed=vobj.Object)
+            style.layout = getattr(self, "_layout", None)
+            self.scene.set_style(style)
 
     def dumps(self):
         return None
@@ -326,6 +526,11 @@ class ViewProviderMeasurement:
 
     def __setstate__(self, state):
         return None
+
+
+def has_deviation(obj):
+    """True when a measurement object holds deviations (its map has a legend)."""
+    return len(getattr(obj, "Deviation", [])) > 0
 
 
 def attach(obj):

@@ -19,9 +19,15 @@ no external resources. Sections carry stable ids for tools and tests:
                 (``id="simulated-maps"``, :func:`simulation_maps`)
 ``warnings``    messages of the run
 
-The predicted residual is what is left if the machine repeats the measured error
-exactly: ``d - s - delta`` (``s`` the stock for the mirror method, else 0): zero for
-raw, the random component for filtered, ``d - mean(d)`` for offset.
+The predicted residual is what the correction leaves of the repeatable (determined)
+error when the next part is cut: ``d_f - s - delta`` (``s`` the stock for the mirror
+method, else 0); the next part's new random scatter comes on top. It is defined for every
+method: zero for filtered, ``-(d - d_f)`` for raw and mirror (they copy this part's random
+scatter into the face), ``d_f - mean(d)`` for offset. The statistics add the expected RMS of
+the next part, ``sqrt(rms(residual)^2 + rms(random)^2)``.
+
+Maps use the colour scheme of :mod:`surfcomp.core.colormap` (the GUI's, default rainbow)
+and, when given, the GUI map's range, values beyond it in the out-of-range colours.
 """
 
 import base64
@@ -30,7 +36,11 @@ import io
 
 import numpy as np
 
+from ..core import colormap
 from .atomic import write_text
+
+#: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
+DEFAULT_STYLE = {"scheme": colormap.DEFAULT_SCHEME, "range": None}
 
 #: section ids in document order
 SECTIONS = ("inputs", "method", "maps", "histograms", "statistics", "checks", "simulation",
@@ -111,7 +121,7 @@ def grid_arrays(report):
     out["x"], out["y"] = put(nominal[:, 0]), put(nominal[:, 1])
     for key in ("deviation", "determined", "random", "correction"):
         out[key] = put(pts[key])
-    out["residual"] = out["deviation"] - predicted_stock(report) - out["correction"]
+    out["residual"] = out["determined"] - predicted_stock(report) - out["correction"]
     return out
 
 
@@ -121,14 +131,32 @@ def predicted_stock(report):
     return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
 
 
-def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None):
+def _cmap(scheme):
+    from matplotlib.colors import LinearSegmentedColormap
+
+    cmap = LinearSegmentedColormap.from_list(scheme, colormap.scheme(scheme))
+    cmap.set_under(colormap.OUT_OF_RANGE_COLORS["below"])
+    cmap.set_over(colormap.OUT_OF_RANGE_COLORS["above"])
+    cmap.set_bad(colormap.NAN_COLOR)
+    return cmap
+
+
+def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None, style=None):
     if ax is None:
         fig = _figure()
         ax = fig.add_subplot()
+    style = style or DEFAULT_STYLE
     finite = values_um[np.isfinite(values_um)]
     lim = float(np.max(np.abs(finite))) if finite.size else 1.0
     lim = lim or 1.0
-    kw = dict(vmin=-lim, vmax=lim, cmap="RdBu_r") if symmetric else dict(cmap="viridis")
+    extend = "neither"
+    if style.get("range") is not None:
+        lo, hi = (1e3 * float(r) for r in style["range"])
+        extend = "both"
+    else:
+        lo, hi = -lim, lim
+    kw = dict(vmin=lo, vmax=hi, cmap=_cmap(style["scheme"])) if symmetric \
+        else dict(cmap="viridis")
     if x.ndim == 1:  # scattered points: Delaunay triangles of the nominal x, y
         mesh = ax.tripcolor(x, y, values_um, shading="gouraud", **kw)
         ax.plot(x, y, ".", color="k", markersize=1.5)
@@ -144,7 +172,7 @@ def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None):
         mesh = ax.imshow(values_um.T, origin="lower", **kw)
         ax.set_xlabel("grid row")
         ax.set_ylabel("grid column")
-    cb = fig.colorbar(mesh, ax=ax, shrink=0.85)
+    cb = fig.colorbar(mesh, ax=ax, shrink=0.85, extend=extend if symmetric else "neither")
     cb.set_label("µm (along the outward normal)")
     ax.set_title(title, fontsize=11)
     return fig
@@ -225,18 +253,27 @@ def _section_method(report):
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
 
 
-def _section_maps(arrays):
+def _section_maps(arrays, style=None):
     figs = []
     for key, title in (("deviation", "Raw deviation d"),
                        ("determined", "Determined (filtered) d_f"),
                        ("random", "Random d - d_f"), ("correction", "Correction applied delta"),
                        ("residual", "Predicted residual")):
-        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]"),
-                         "map of " + key, title))
+        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]",
+                              style=style), "map of " + key, title))
     return ('<section id="maps"><h2>Maps</h2><p>Values along the outward normal in µm; '
-            'positive = material left. Predicted residual = d - stock - delta (what remains if '
-            'the machine repeats the measured error).</p><div class="figs">%s</div></section>'
-            % "".join(figs))
+            'positive = material left; correction positive = material removed (the face moves '
+            'inwards by it). Predicted residual = d_f - stock - delta: what the correction '
+            'leaves of the repeatable error; the next part\'s random scatter comes on top. '
+            'Colour scheme %s%s.</p><div class="figs">%s</div></section>'
+            % (_e((style or DEFAULT_STYLE)["scheme"]), _range_note(style), "".join(figs)))
+
+
+def _range_note(style):
+    if not style or style.get("range") is None:
+        return ", each map on its own symmetric range"
+    lo, hi = style["range"]
+    return ", range %.1f .. %.1f µm as in the GUI (beyond it: grey)" % (1e3 * lo, 1e3 * hi)
 
 
 def _section_histograms(arrays):
@@ -254,15 +291,22 @@ def _section_statistics(report, arrays):
                                     ("random", "Random"),
                                     ("correction", "Correction"))] if st else []
     res = arrays["residual"][np.isfinite(arrays["residual"])]
+    note = ""
     if res.size:
         std = float(np.std(res, ddof=1)) if res.size > 1 else 0.0
+        rms_res = float(np.sqrt(np.mean(res ** 2)))
         cols.append(("Predicted residual", {"count": res.size, "max_negative": res.min(),
                                             "max_positive": res.max(), "mean": res.mean(),
-                                            "std": std, "rms": float(np.sqrt(np.mean(res ** 2))),
+                                            "std": std, "rms": rms_res,
                                             "profile": 2 * np.abs(res).max()}))
+        rnd = arrays["random"][np.isfinite(arrays["random"])]
+        rms_rnd = float(np.sqrt(np.mean(rnd ** 2))) if rnd.size else 0.0
+        note = ("<p>Expected RMS of the next part (predicted residual plus a new random scatter "
+                'like this one): <span class="num">%.2f µm</span>.</p>'
+                % (1e3 * float(np.hypot(rms_res, rms_rnd))))
     return ('<section id="statistics"><h2>Statistics</h2><p>Werner 2022 Tab. 1 and 3 form; '
-            'standard deviation with ddof=%s.</p>%s</section>'
-            % (_e(report.get("statistics_ddof", 1)), _stat_table(cols)))
+            'standard deviation with ddof=%s.</p>%s%s</section>'
+            % (_e(report.get("statistics_ddof", 1)), _stat_table(cols), note))
 
 
 def _section_checks(report):
@@ -453,7 +497,7 @@ def _section_simulation(sim):
                _preset_html(sim), _simulated_maps_html(sim.get("maps")), params))
 
 
-def render_html(report, simulation=None):
+def render_html(report, simulation=None, style=None):
     """The report as one HTML document (str).
 
     Parameters
@@ -463,6 +507,9 @@ def render_html(report, simulation=None):
     simulation : dict, optional
         From :meth:`SimulationResult.as_dict` (adds the ``simulation`` section); a
         ``'maps'`` entry (:func:`simulation_maps`) adds the simulated parts' maps.
+    style : dict, optional
+        ``scheme`` and ``range`` ((lo, hi) mm or None) of the maps (default
+        :data:`DEFAULT_STYLE`): the GUI passes its map's so both show the same colours.
     """
     arrays = grid_arrays(report)
     warn = report.get("warnings") or []
@@ -473,7 +520,7 @@ def render_html(report, simulation=None):
     parts = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
              "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
              "<h1>%s</h1>" % _e(title),
-             _section_inputs(report), _section_method(report), _section_maps(arrays),
+             _section_inputs(report), _section_method(report), _section_maps(arrays, style),
              _section_histograms(arrays), _section_statistics(report, arrays),
              _section_checks(report), _section_simulation(simulation),
              '<section id="warnings"><h2>Warnings</h2>%s</section>' % warn_html,
@@ -481,7 +528,7 @@ def render_html(report, simulation=None):
     return "\n".join(parts)
 
 
-def write_html_report(path, report, simulation=None):
+def write_html_report(path, report, simulation=None, style=None):
     """Write :func:`render_html` to ``path`` atomically (temporary file, then rename)."""
-    write_text(path, render_html(report, simulation))
+    write_text(path, render_html(report, simulation, style))
     return path

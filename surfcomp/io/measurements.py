@@ -450,16 +450,17 @@ class _Parser:
 
     def run(self, sha256):
         lines = self.lines
-        content = [k for k, ln in enumerate(lines)
-                   if (s := ln.lstrip()) and not s.startswith(("#", "//"))]
-        if not content:
+        # the header first (the first line that is no comment): a file whose header
+        # names no known column fails before its data rows are looked at
+        h = next((k for k, ln in enumerate(lines)
+                  if (s := ln.lstrip()) and not s.startswith(("#", "//"))), None)
+        if h is None:
             if not any(ln.strip() for ln in lines):
                 raise self.error("the file is empty (expected a header row naming the columns, "
                                  "then one row per point)")
             last = max(k for k, ln in enumerate(lines) if ln.strip())
             raise self.error("the file holds only comments and blank lines (expected a header "
                              "row naming the columns, then one row per point)", last)
-        h = content[0]
         self.sep = sep = _detect_separator(lines[h])
         self.split = split = _splitter(sep)
         names = [_unquote(f) for f in split(lines[h])]
@@ -469,7 +470,8 @@ class _Parser:
                              "x_nom,y_nom,z_nom,i,j,k,dev)%s" % self._commented_header_hint(h), h)
         roles, factors, ignored = self._header(names, h)
         numeric = [c for c, r in roles.items() if r != "id"]
-        data = content[1:]
+        data = [k for k in range(h + 1, len(lines))
+                if (s := lines[k].lstrip()) and not s.startswith(("#", "//"))]
         if sep is not None:
             blank = " \t" + sep
             data = [k for k in data if lines[k].strip(blank)]

@@ -23,7 +23,8 @@ def _list(a, digits=9):
     return np.where(np.isfinite(r) | ~np.isfinite(a), r, a).tolist()
 
 
-def build_report(command, inputs, comp, warnings=(), outputs=None, points=True):
+def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
+                 output_shape=None):
     """Assemble the report dict.
 
     Parameters
@@ -38,6 +39,9 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True):
     points : bool
         Include the per-point arrays (``points``); without them the report is the
         summary (the CLI's printout needs no more; a million points take seconds).
+    output_shape : dict, optional
+        What the written shape is (``kind`` face or shape, faces, solids, edge tolerance,
+        the correction's integral and the solid's volume change, re-trimmed faces).
     """
     p, c, o = comp.prepared, comp.correction, comp.options
     g = p.grid
@@ -87,6 +91,8 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True):
         out["corrected_face"] = comp.checks.as_dict()
         out["corrected_face"]["degree"] = [comp.corrected.degree_u, comp.corrected.degree_v]
         out["corrected_face"]["rational"] = comp.corrected.weights is not None
+    if output_shape is not None:
+        out["output_shape"] = output_shape
     if outputs:
         out["outputs"] = outputs
     return out

@@ -232,11 +232,3 @@ def test_recomputes_in_freecadcmd(tmp_path):
     assert "Invalid" not in r["state"]
     assert r["g2"] == 0 and r["n"] > r["n_base"]
     assert r["f"] == r["f_base"] == [600.0]
-
-
-def test_app_module_does_not_import_gui():
-    import re
-    src = open(dressup_axis.__file__, encoding="utf-8").read()
-    imports = re.findall(r"^\s*(?:import|from)\s+([\w.]+)", src, re.M)
-    assert "FreeCAD" in imports and "Path" in imports
-    assert not [m for m in imports if m.split(".")[0] in ("FreeCADGui", "PySide", "PySide2")]

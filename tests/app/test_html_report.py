@@ -13,7 +13,7 @@ import pytest
 from numpy.testing import assert_allclose
 from PIL import Image
 
-from surfcomp.core import bspline, presets
+from surfcomp.core import bspline, colormap, presets
 from surfcomp.core import simulate as sm
 from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.io import report as report_io
@@ -113,22 +113,44 @@ def test_screenshot_shows_the_colour_maps(rendered):
     nonwhite = np.mean(np.any(a < 245, axis=2))
     assert nonwhite > 0.10, nonwhite
     r, g, b = a[..., 0], a[..., 1], a[..., 2]
-    red = np.mean((r > 150) & (g < 90) & (b < 90))       # RdBu_r positive end
-    blue = np.mean((b > 120) & (r < 80) & (g < 130))      # RdBu_r negative end
+    red = np.mean((r > 150) & (g < 90) & (b < 90))       # rainbow positive end
+    blue = np.mean((b > 120) & (r < 80) & (g < 130))      # rainbow negative end
     assert red > 0.002 and blue > 0.002, (red, blue)
     assert len(np.unique(a.reshape(-1, 3)[::37], axis=0)) > 200  # pictures, not only text
 
 
 def test_predicted_residual_by_method():
-    """d - s - delta: 0 for raw and mirror, the random component for filtered, d - mean for
-    offset."""
+    """d_f - s - delta, defined for every method: -random for raw and mirror (they copy the
+    random scatter into the face), 0 for filtered, d_f - mean for offset; never all zero for
+    mirror (issue 13)."""
     for method, stock in (("raw", None), ("mirror", 0.25)):
         arr = grid_arrays(_report(method, stock, n=7, build=False))
-        assert_allclose(arr["residual"], 0.0, atol=1e-9)
+        assert_allclose(arr["residual"], -arr["random"], atol=1e-9)
+        assert np.nanmax(np.abs(arr["residual"])) > 1e-4, method
     arr = grid_arrays(_report("filtered", n=7, build=False))
-    assert_allclose(arr["residual"], arr["random"], atol=1e-9)
+    assert_allclose(arr["residual"], 0.0, atol=1e-9)
     arr = grid_arrays(_report("offset", n=7, build=False))
-    assert_allclose(arr["residual"], arr["deviation"] - np.mean(arr["deviation"]), atol=1e-8)
+    assert_allclose(arr["residual"], arr["determined"] - np.mean(arr["deviation"]), atol=1e-8)
+    page = render_html(_report("mirror", 0.25, n=7, build=False))
+    assert "Expected RMS of the next part" in page
+
+
+def test_maps_use_the_gui_scheme_and_range():
+    """The report's maps use the GUI's rainbow (red at the top of the range) and, when the
+    GUI passes its range, grey beyond it (colorbar arrows)."""
+    from surfcomp.io import html_report
+
+    rep = _report("filtered", n=7, build=False)
+    arr = grid_arrays(rep)
+    fig = html_report._map(arr["x"], arr["y"], arr["deviation"] * 1e3, "d",
+                           style={"scheme": "rainbow", "range": (-1e-4, 1e-4)})
+    mesh = fig.axes[0].collections[0]
+    assert_allclose(mesh.cmap(1.0)[:3], (1, 0, 0))
+    assert_allclose(mesh.cmap(0.5)[:3], (0, 1, 0), atol=0.01)
+    assert_allclose(mesh.cmap.get_over()[:3], colormap.OUT_OF_RANGE_COLORS["above"])
+    assert_allclose(mesh.get_clim(), (-0.1, 0.1))
+    page = render_html(rep, style={"scheme": "rainbow", "range": (-0.02, 0.02)})
+    assert "range -20.0 .. 20.0 µm as in the GUI" in page
 
 
 def test_inspection_report_without_simulation_and_atomic_write(tmp_path):

@@ -40,7 +40,11 @@ out = {"aliased": aliased, "unimportable": unimportable, "branches": cam.branche
                    if "Proxy" in o.PropertiesList},
        "versions": {n: doc.getObject(n).Version for n in ("Meas1", "Round1", "Round2",
                                                           "DressupAxisErrors")},
-       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")]}
+       "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")],
+       "renamed": {n: {p: (len(getattr(doc.getObject(n), p)) if p == "Nodes" else True)
+                       for p in ("Flip", "EdgeTol", "Nodes", "FlipNormals", "EdgeTolerance",
+                                 "NominalPoints") if p in doc.getObject(n).PropertiesList}
+                   for n in ("Round1", "Round2")}}
 for o in doc.Objects:
     o.touch()
 doc.recompute()
@@ -52,6 +56,9 @@ out.update({
     "poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")],
     "correction2": list(r2.Correction), "faces": len(r2.Shape.Faces),
     "volume2": r2.Shape.Volume, "valid2": r2.Shape.isValid(),
+    "closed2": all(s.isClosed() for s in r2.Shape.Shells),
+    "tolerance2": max(e.Tolerance for e in r2.Shape.Edges),
+    "volume_change2": r2.VolumeChange, "correction_volume2": r2.CorrectionVolume,
     "op_base": [[o.Name, list(s)] for o, s in op.Base],
     "cl": pathjob.cutter_locations(op).tolist(),
     "dressup": {"base": d.Base.Name, "commands": len(d.Path.Commands),
@@ -100,7 +107,15 @@ def test_every_object_restores_with_its_proxy(reopened):
     else:
         assert r["aliased"] == {}
     # old objects are brought to the current property set
-    assert set(r["versions"].values()) == {features.VERSION}
+    from surfcomp.app import dressup_axis
+
+    versions = dict(r["versions"])
+    assert versions.pop("DressupAxisErrors") == dressup_axis.VERSION
+    assert set(versions.values()) == {features.VERSION}
+    # the properties renamed in version 2 keep their saved values under the new names
+    for name, props in r["renamed"].items():
+        assert set(props) == {"Flip", "EdgeTol", "Nodes"}, name
+        assert props["Nodes"] > 0, name
 
 
 def test_recomputes_to_what_0_20_computed(reopened):
@@ -113,7 +128,12 @@ def test_recomputes_to_what_0_20_computed(reopened):
         np.testing.assert_allclose(now, saved, atol=1e-9)
     np.testing.assert_allclose(r["correction2"], expected["correction2"], atol=1e-12)
     assert r["valid2"] and r["faces"] == expected["faces"] == 6
-    assert abs(r["volume2"] - expected["volume2"]) < 1e-6 * expected["volume2"]
+    # issue 17: 0.20 (and surfcomp before it) left the side faces as they were and covered
+    # the gap to the corrected top with edge tolerance; the recompute re-trims them, so the
+    # solid is closed for real and its volume changes by what the correction implies
+    assert r["closed2"] and r["tolerance2"] <= 1e-4
+    assert r["volume_change2"] == pytest.approx(-r["correction_volume2"], rel=0.02)
+    assert abs(r["volume2"] - expected["volume2"]) < 1e-3 * expected["volume2"]
 
 
 def test_cam_job_regenerates_on_the_compensated_face(reopened):

@@ -155,8 +155,10 @@ def test_old_documents_are_migrated(tmp_path):
     c = features.make_compensation(doc, nom, "Face1", m)
     doc.recompute()
     correction = list(c.Correction)
-    # an older property set: no Refine / ReadWarnings, version 0
+    # an older property set: no Refine / ReadWarnings / volumes (issue 17), version 0
     c.removeProperty("Refine")
+    c.removeProperty("VolumeChange")
+    c.removeProperty("CorrectionVolume")
     c.Version = 0
     m.removeProperty("ReadWarnings")
     m.Version = 0
@@ -171,9 +173,13 @@ def test_old_documents_are_migrated(tmp_path):
         assert isinstance(c.Proxy, features.CompensationFeature)
         assert c.Version == features.VERSION and m.Version == features.VERSION
         assert c.Refine == 4 and list(m.ReadWarnings) == []
+        assert c.VolumeChange == 0.0 and c.CorrectionVolume == 0.0
+        assert c.getEditorMode("VolumeChange") == ["ReadOnly"]
         c.touch()
         old.recompute()
         assert c.State == ["Up-to-date"]
+        # the face output: the correction's integral over the face (mean ~10 um x 2120 mm^2)
+        assert 10.0 < c.CorrectionVolume < 40.0 and c.VolumeChange == 0.0
         np.testing.assert_allclose(c.Correction, correction, atol=1e-15)
     finally:
         FreeCAD.closeDocument(old.Name)

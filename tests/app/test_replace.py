@@ -221,3 +221,28 @@ def test_undo_in_the_document(setup):
     for key in before:
         if key[1] != "touched":
             assert after[key] == before[key], key
+
+
+def test_nothing_to_replace_is_refused_and_the_document_unchanged(setup):
+    doc, nom, comp, clone, other, user = setup
+    for o in (clone, user):
+        doc.removeObject(o.Name)
+    doc.recompute()
+    before = snapshot(doc)
+    with pytest.raises(InputError, match="nothing in the document uses Block"):
+        replace.replace(doc, comp)
+    assert snapshot(doc) == before
+
+
+def test_clones_named_after_the_nominal_are_renamed_and_named_back(setup):
+    """Path's model clone keeps the label "Model-<nominal>" (issue 13): Replace names it
+    after the compensation, Restore gives the old label back; summary() tells both."""
+    doc, nom, comp, clone, other, user = setup
+    clone.Label = "Model-Block"
+    replace.replace(doc, comp)
+    assert clone.Label == "Model-Compensation"
+    s = replace.summary(doc, comp)
+    assert s["links"] == 5 and sorted(s["objects"]) == sorted([clone.Label, user.Label])
+    assert s["renamed"] == [("Model-Block", "Model-Compensation")] and s["jobs"] == []
+    replace.restore(doc, comp)
+    assert clone.Label == "Model-Block"

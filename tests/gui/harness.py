@@ -102,3 +102,16 @@ def read_image(path):
     if img.dtype.kind in "ui":
         img = img / 255.0
     return img[..., :3]
+
+
+def run_session(name, tmp_path, home=None, timeout=300):
+    """Run ``tests/gui/session_<name>.py`` after the shared prologue ``gui_common.py``;
+    return the results dict with the process output under ``'output'``."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    parts = []
+    for fname in ("gui_common.py", "session_%s.py" % name):
+        with open(os.path.join(here, fname), encoding="utf-8") as f:
+            parts.append(f.read())
+    results, output = run_gui("\n".join(parts), tmp_path, home=home, timeout=timeout)
+    results["output"] = output
+    return results

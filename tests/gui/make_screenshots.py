@@ -3,8 +3,8 @@
     xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 tests/gui/make_screenshots.py
 
 Not a test: it runs the bundled example through the workbench's commands and saves
-the deviation map, the tolerance-band map, the random component and the whole window
-with the filter task panel open.
+the deviation map (in µm, with a flagged point), the tolerance-band map (warning band,
+percentages) and the whole window with the filter task panel and the histogram panel open.
 """
 
 import os
@@ -18,6 +18,7 @@ sys.path.insert(0, ROOT)
 from tests.gui.harness import run_gui  # noqa: E402
 
 BODY = r'''
+import numpy as np
 from surfcomp.gui import dialogs, panels
 Gui = FreeCADGui
 root = os.environ["SURFCOMP_ROOT"]
@@ -43,16 +44,23 @@ view.viewIsometric()
 view.fitAll()
 Gui.updateGui()
 vobj = comp.ViewObject
-vobj.LegendUnit = "um"
+vobj.Unit = "um"
+# flag a point, as a click on the map does
+dev = np.array(comp.Deviation)
+vobj.Flags = [int(np.nanargmin(np.abs(dev - 0.03)))]
 view.saveImage(os.path.join(outdir, "deviation_map.png"), 1000, 650, "White")
-vobj.ToleranceBand = True
-vobj.ToleranceLower = -0.01
-vobj.ToleranceUpper = 0.01
+vobj.Flags = []
+vobj.TolBand = True
+vobj.TolLow = -0.01
+vobj.TolHigh = 0.01
+vobj.WarnBand = 0.8
 view.saveImage(os.path.join(outdir, "tolerance_band.png"), 1000, 650, "White")
-vobj.ToleranceBand = False
+vobj.TolBand = False
+vobj.WarnBand = 0.0
 Gui.Selection.addSelection(doc.Name, comp.Name)
 Gui.runCommand("SurfComp_Filter")
 panels.FilterPanel.instance.show.setCurrentIndex(1)
+vobj.Histogram = True
 Gui.updateGui()
 view.fitAll()
 for _ in range(5):

@@ -568,7 +568,7 @@ def test_span_table_matches_derivatives():
         u, v = rng.uniform(0, 1, 500), rng.uniform(-1, 2, 500)
         u[:2], v[:2] = [0, 1], [-1, 2]
         ref = bs.derivatives(s, u, v, order=2)
-        got = pj._SpanTable(s).evaluate(u, v, 2)
+        got = pj.SpanTable(s).evaluate(u, v, 2)
         for a, b in zip(ref, got):
             assert_allclose(b.T, a, atol=1e-10 * np.abs(a).max())
 
@@ -610,10 +610,10 @@ def test_project_generic_evaluator_fallback_agrees(monkeypatch):
     u, v = rng.uniform(0, 1, 500), rng.uniform(-1, 2, 500)
     X = bs.evaluate(s, u, v) + rng.uniform(-1, 1, (500, 1)) * bs.normals(s, u, v)
     fast = pj.Projector(s)
-    assert isinstance(fast.ev, pj._SpanTable)
+    assert isinstance(fast.ev, pj.SpanTable)
     monkeypatch.setattr(pj, "MAX_TABLE_VALUES", 0)
     slow = pj.Projector(s)
-    assert isinstance(slow.ev, pj._GenericEval)
+    assert isinstance(slow.ev, pj.GenericEval)
     a, b = fast.project(X), slow.project(X)
     assert_allclose(b.distance, a.distance, atol=1e-9, rtol=0)
     assert_allclose(b.foot, a.foot, atol=1e-8, rtol=0)

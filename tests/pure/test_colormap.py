@@ -53,8 +53,8 @@ def test_tolerance_band_colours():
 
 def test_format_value_units():
     assert cm.format_value(0.045) == "+0.0450 mm"
-    assert cm.format_value(-0.0123, "um") == "-12.3 um"
-    assert cm.format_value(-1e-9, "um") == "0.0 um"
+    assert cm.format_value(-0.0123, "um") == "-12.3 µm"
+    assert cm.format_value(-1e-9, "um") == "0.0 µm"
     assert cm.format_value(0.0) == "0.0000 mm"
     with pytest.raises(ValueError, match="display unit"):
         cm.format_value(1.0, "in")
@@ -64,9 +64,9 @@ def test_legend_levels_and_colours():
     lg = cm.legend(-0.04, 0.04, "rainbow", unit="um", levels=8)
     fr = [f for f, _ in lg["labels"]]
     assert_allclose(fr, np.linspace(0, 1, 9), atol=1e-15)
-    assert lg["labels"][0][1] == "-40.0 um"
-    assert lg["labels"][4][1] == "0.0 um"
-    assert lg["labels"][-1][1] == "+40.0 um"
+    assert lg["labels"][0][1] == "-40.0 µm"
+    assert lg["labels"][4][1] == "0.0 µm"
+    assert lg["labels"][-1][1] == "+40.0 µm"
     stops = dict(lg["stops"])
     assert_allclose(stops[0.0], (0, 0, 1))
     assert_allclose(stops[0.5], (0, 1, 0))
@@ -134,3 +134,52 @@ def test_uv_grid_mesh_matches_evaluate_grid_on_a_cubic():
     pts, _, u, v = cm.uv_grid_mesh(surf, (7, 9))
     ref = evaluate_grid(surf, np.linspace(0, 1, 7), np.linspace(0, 1, 9)).reshape(-1, 3)
     assert_allclose(pts, ref, atol=1e-12)
+
+
+def test_out_of_range_colours_are_distinct_from_the_scheme_ends():
+    cols = cm.map_colors([-0.03, -0.02, 0.0, 0.02, 0.03, np.nan], -0.02, 0.02,
+                         out_of_range=True)
+    assert_allclose(cols[0], cm.OUT_OF_RANGE_COLORS["below"])
+    assert_allclose(cols[4], cm.OUT_OF_RANGE_COLORS["above"])
+    assert_allclose(cols[1], (0, 0, 1))           # the range's ends keep the scheme's colours
+    assert_allclose(cols[3], (1, 0, 0))
+    assert_allclose(cols[5], cm.NAN_COLOR)
+    # without the option a manual range saturates to the end colours
+    assert_allclose(cm.map_colors([0.03], -0.02, 0.02)[0], (1, 0, 0))
+
+
+def test_stepped_colours_are_the_middles_of_the_legend_steps():
+    lg = cm.legend(-1.0, 1.0, levels=4, stepped=True)
+    # sharp edges: every colour appears twice, at both ends of its step
+    assert [f for f, _ in lg["stops"]] == pytest.approx([0, .25, .25, .5, .5, .75, .75, 1])
+    steps = cm.map_colors([-0.75, -0.25, 0.25, 0.75], -1, 1)
+    assert_allclose([c for _, c in lg["stops"][::2]], steps, atol=1e-12)
+    # any value of a step takes the step's colour
+    assert_allclose(cm.map_colors([-0.99, -0.51], -1, 1, levels=4), steps[[0, 0]], atol=1e-12)
+
+
+def test_band_fractions_and_warning_band():
+    v = np.array([-0.02, -0.009, -0.004, 0.0, 0.004, 0.009, 0.011, 0.03, np.nan, 0.01])
+    fr = cm.band_fractions(v, -0.01, 0.01, warning=0.8)
+    assert fr["below"] == pytest.approx(100 / 9)
+    assert fr["above"] == pytest.approx(200 / 9)
+    assert fr["inside"] == pytest.approx(600 / 9)
+    # warning limits +-0.008: -0.009, 0.009, 0.01 warn
+    assert fr["warning"] == pytest.approx(300 / 9)
+    cols = cm.tolerance_colors(v, -0.01, 0.01, warning=0.8)
+    assert_allclose(cols[1], cm.WARNING_COLOR)
+    assert_allclose(cols[2], cm.TOLERANCE_COLORS["inside"])
+    assert_allclose(cols[6], cm.TOLERANCE_COLORS["above"])
+    blocks = cm.legend(-0.02, 0.02, tolerance=(-0.01, 0.01), warning=0.8)["blocks"]
+    assert [b[0] for b in blocks] == ["below", "warning", "inside", "warning", "above"]
+    assert_allclose([b[1] for b in blocks], [0, 0.25, 0.3, 0.7, 0.75])
+
+
+def test_histogram_counts_and_legend_colours():
+    rng = np.random.default_rng(0)
+    v = rng.normal(0, 0.01, 1000)
+    h = cm.histogram(v, -0.02, 0.02, bins=8)
+    assert h["counts"].sum() + h["below"] + h["above"] == 1000
+    assert h["below"] == np.count_nonzero(v < -0.02)
+    assert_allclose(h["colors"], cm.map_colors(0.5 * (h["edges"][1:] + h["edges"][:-1]),
+                                               -0.02, 0.02))

@@ -86,3 +86,22 @@ def test_node_line_knots_keep_the_nominal_knots_and_fill_the_ends():
     np.testing.assert_allclose(k[:2], [0.05, 0.1])     # continued to the border
     assert k.max() == pytest.approx(0.95) and np.all(np.diff(k) > 0)
     assert aligned_lines(*np.meshgrid(lines, lines, indexing="ij"), refine=4) is None  # not dense
+
+
+def test_check_figures_skip_a_degenerate_edge_not_the_whole_surface():
+    """A pole row collapsed to a point (as at a sphere's pole) has no normal there: the
+    check figures leave those dense points out instead of turning NaN or losing the rest."""
+    nominal = bicubic()
+    poles = nominal.poles.copy()
+    poles[0, :, :] = poles[0, 3, :]                      # the u = 0 edge is one point
+    nominal = bspline.Surface(poles, nominal.knots_u, nominal.knots_v, 3, 3)
+    lifted = bspline.Surface(poles + [0.0, 0.0, 0.005], nominal.knots_u, nominal.knots_v, 3, 3)
+    u = v = np.array([0.5])
+    figures = corrected.check_figures(nominal, lifted, nominal, u, v, np.array([0.0]), 1.0,
+                                      (5, 5), realised=np.array([0.0]))
+    us, vs = corrected.dense_parameters(nominal, (5, 5), 4)
+    _, Su, Sv = bspline.evaluate_grid(nominal, us[1:], vs, order=1)
+    n = np.cross(Su, Sv)
+    nz = n[..., 2] / np.linalg.norm(n, axis=-1)
+    assert figures.max_realised == pytest.approx(0.005 * np.max(np.abs(nz)), rel=1e-9)
+    assert figures.max_realised > 0.004 and figures.max_zero_deviation == 0.0

@@ -15,6 +15,8 @@ from scipy.sparse.linalg import spsolve
 from examples.make_example import example_surface
 from surfcomp.core import bspline, corrected
 from surfcomp.core import scattered as sc
+from surfcomp.core import scattered_field as scf
+from surfcomp.core.pspline import PSplineSolver, tensor_rows
 from surfcomp.core.scattered import ScatteredField, smooth
 from surfcomp.errors import InputError
 
@@ -69,15 +71,15 @@ def test_pspline_loo_equals_brute_force_refits():
     rng = np.random.default_rng(1)
     x = rng.random((150, 2)) * [30.0, 10.0]
     d = 0.01 * np.sin(x[:, 0] / 5) * np.cos(x[:, 1] / 4) + rng.normal(0, 0.002, 150)
-    solver = sc._PSplineSolver(x, d, x.min(axis=0), x.max(axis=0))
+    solver = PSplineSolver(x, d, x.min(axis=0), x.max(axis=0))
     rho = 0.3
     resid, loo, _ = solver.solve(rho)
-    B = solver.B.toarray()
+    B = tensor_rows(solver.ku, solver.kv, solver.nu, solver.nv, x).toarray()
     for k in range(0, 150, 7):
         keep = np.arange(150) != k
-        c = np.linalg.solve(B[keep].T @ B[keep] + rho * solver._J, B[keep].T @ d[keep])
+        c = np.linalg.solve(B[keep].T @ B[keep] + rho * solver.J, B[keep].T @ d[keep])
         assert_allclose(loo[k], d[k] - B[k] @ c, atol=1e-12)
-    c = np.linalg.solve(B.T @ B + rho * solver._J, B.T @ d)
+    c = np.linalg.solve(B.T @ B + rho * solver.J, B.T @ d)
     assert_allclose(resid, d - B @ c, atol=1e-12)
 
 
@@ -148,21 +150,21 @@ def test_clough_tocher_parts_equal_scipy():
     ip = CloughTocher2DInterpolator(x, f, tol=1e-14, maxiter=100000)
     tri = ip.tri
     # gradients: our sparse system is the functional scipy iterates on
-    M, inv, R = sc._gradient_system(x, tri)
+    M, inv, R = scf._gradient_system(x, tri)
     assert_allclose(spsolve(M.tocsc(), R @ f).reshape(-1, 2), ip.grad.reshape(-1, 2), atol=1e-10)
     assert_allclose(np.linalg.inv(inv), M.toarray().reshape(60, 2, 60, 2)[np.arange(60), :,
                                                                          np.arange(60), :],
                     atol=1e-9)
     # patches: same values as scipy's with scipy's gradients
-    T, r = sc._transforms(x, tri.simplices)
+    T, r = scf._transforms(x, tri.simplices)
     assert_allclose(T, tri.transform[:, :2], atol=1e-12)
     q = rng.random((2000, 2)) * 0.8 + 0.1
     s = tri.find_simplex(q)
     q, s = q[s >= 0], s[s >= 0]
     b = np.einsum("mij,mj->mi", T[s], q - r[s])
-    coef = sc._ct_coefficients(x, tri.simplices, sc._ct_gfactors(tri, T, r), f[:, None],
+    coef = scf._ct_coefficients(x, tri.simplices, scf._ct_gfactors(tri, T, r), f[:, None],
                                ip.grad.reshape(-1, 2)[:, :, None])
-    val = sc._ct_evaluate(coef, s, np.column_stack([b, 1 - b.sum(axis=1)]))[:, 0]
+    val = scf._ct_evaluate(coef, s, np.column_stack([b, 1 - b.sum(axis=1)]))[:, 0]
     assert_allclose(val, ip(q), atol=1e-12)
 
 

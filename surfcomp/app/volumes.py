@@ -1,0 +1,92 @@
+"""The volume a replaced face adds to or removes from its solid, and the correction's integral.
+
+OCCT's default volume integration (``Shape.Volume``) is off by about 1e-4 of the volume on
+trimmed B-spline faces - a few percent of the change a correction of some micrometres
+makes. The change is computed here instead by the divergence theorem over the faces that
+changed: with ``F(x) = (x - c) / 3`` (``div F = 1``),
+
+    dV = [flux of F through the corrected face - through the nominal face]
+         + sum over re-trimmed neighbours of the flux through the strip they gained or lost,
+
+the first term by :func:`surfcomp.core.trimmed.domain_integral` over both faces' (u, v)
+regions on one scan grid broken at the knots of both surfaces, the strips from the re-trimmed
+edges' samples (strip width times the flux density, along the edge; their error is of
+second order in the correction).
+"""
+
+import numpy as np
+
+from ..core import bspline
+from ..core.trimmed import correction_integral, domain_integral, knots_of
+from .nominal import boundary_polylines
+
+#: knots per direction above which the volume change's panels ignore them
+_MAX_KNOTS = 400
+
+
+def correction_volume(nominal, corrected):
+    """The integral of the correction over the (trimmed) nominal face (mm^3, positive =
+    material removed): :func:`surfcomp.core.trimmed.correction_integral` inside the face's
+    boundary in (u, v)."""
+    return correction_integral(nominal.surface, corrected, nominal.outward,
+                               boundary_polylines(nominal.bspline_face))
+
+
+def _flux_density(surface, outward, centre):
+    def func(u, v):
+        s, su, sv = bspline.derivatives(surface, u, v, order=1)
+        return outward * np.einsum("ij,ij->i", s - centre, np.cross(su, sv)) / 3.0
+    return func
+
+
+def _box(*polylines):
+    pts = np.concatenate([p for group in polylines for p in group])
+    (u0, v0), (u1, v1) = pts.min(0), pts.max(0)
+    return u0, u1, v0, v1
+
+
+def _strip_flux(p, centre):
+    """Flux of F through the strip the neighbour of re-trimmed edge ``p`` loses (its
+    boundary moved into it) or gains: ``-integral (F . n_g) (d . m) ds``, ``d`` the move of
+    the edge, ``m`` the unit vector into the neighbour across the edge."""
+    import FreeCAD
+
+    ts, old, new, ab = p.samples
+    g = p.neighbour
+    normals = np.array([tuple(g.normalAt(float(a), float(b))) for a, b in ab])
+    deriv = np.gradient(old, ts, axis=0)
+    speed = np.linalg.norm(deriv, axis=1)
+    across = np.cross(normals, deriv / speed[:, None])
+    k = len(ts) // 2
+    step = min(0.01, 1e-3 * g.BoundBox.DiagonalLength)
+    probe = FreeCAD.Vector(*(old[k] + step * across[k]))
+    if not g.isPartOfDomain(*g.Surface.parameter(probe)):
+        across = -across
+    move = np.einsum("ij,ij->i", new - old, across)
+    density = np.einsum("ij,ij->i", (old - centre) / 3.0, normals)
+    return -float(np.trapz(density * move * speed, ts))
+
+
+def volume_change(nominal, corrected, new_face, plan):
+    """The solid's volume after minus before (mm^3) when the nominal face is replaced by
+    ``new_face`` on ``corrected`` and its neighbours re-trimmed as ``plan`` says
+    (:class:`surfcomp.app.retrim.Plan`)."""
+    old_lines = boundary_polylines(nominal.bspline_face)
+    new_lines = boundary_polylines(new_face)
+    box = _box(old_lines, new_lines)
+    bb = nominal.bspline_face.BoundBox
+    centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
+    knots = knots_of(nominal.surface, corrected)
+    panels = 16
+    if max(len(k) for k in knots) > _MAX_KNOTS:      # very fine corrections: a fixed grid
+        knots, panels = knots_of(nominal.surface), 256
+    # one scan grid with panels broken at both surfaces' knots: the quadrature errors of
+    # the two fluxes cancel to far below the change
+    change = (domain_integral(_flux_density(corrected, nominal.outward, centre), new_lines,
+                              box=box, knots=knots, panels=panels)
+              - domain_integral(_flux_density(nominal.surface, nominal.outward, centre),
+                                old_lines, box=box, knots=knots, panels=panels))
+    for p in plan.edges:
+        if p.samples is not None:
+            change += _strip_flux(p, centre)
+    return change

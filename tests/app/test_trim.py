@@ -1,0 +1,692 @@
+"""Issue 17: trimmed faces keep their boundary; a face of a solid comes back as the whole
+solid with its neighbours re-trimmed, through one face builder for every route.
+
+Faces: the example surface trimmed by a circle in (u, v) (1 edge, 457.5 mm^2), the same with
+a hole, both as the top of a solid extruded 20 mm (raw deviations of about 14 um), B-spline
+faces of axom's ``boxed_sphere.step`` (all neighbours tangent: fillets, blends, a sphere
+half) and of PyGeM's pipe sewn into a solid.
+"""
+
+import json
+import os
+import subprocess
+import sys
+
+import FreeCAD
+import numpy as np
+import Part
+import pytest
+
+from surfcomp.app import features
+from surfcomp.app.convert import surface_from_part, surface_to_part
+from surfcomp.app.job import Job, run_job
+from surfcomp.app.nominal import boundary_polylines, nominal_from_face
+from surfcomp.app.shapes import corrected_shape
+from surfcomp.core import bspline
+from surfcomp.core.pipeline import Options
+from surfcomp.core.trimmed import domain_integral, knots_of
+from surfcomp.errors import GeometryError
+from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt, write_cmm_csv
+from tests.conftest import REALDATA
+
+UM = 1e-3
+BOXED_SPHERE = os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")
+PIPE = os.path.join(REALDATA, "cad", "PyGeM", "test_pipe.step")
+
+
+# -- the test parts ------------------------------------------------------------------------
+
+def circle_face(r=0.35, hole=None):
+    """The example surface trimmed by the circle of radius ``r`` around (0.5, 0.5) in (u, v)
+    (r = 0.35: 1 edge, 457.5 mm^2), optionally with a circular hole ``((u, v), radius)``."""
+    bs = Part.read(EXAMPLE_STEP).Faces[0].Surface
+    c = Part.Geom2d.Circle2d(FreeCAD.Base.Vector2d(0.5, 0.5), r)
+    face = Part.Face(bs, Part.Wire([c.toShape(bs)]))
+    if hole:
+        h = Part.Geom2d.Circle2d(FreeCAD.Base.Vector2d(*hole[0]), hole[1])
+        face.cutHoles([Part.Wire([h.toShape(bs)])])
+        face.fix(1e-7, 1e-7, 1e-7)                  # the hole's wire runs the other way
+    assert face.isValid()
+    return face
+
+
+HOLE = ((0.5, 0.55), 0.1)
+
+
+def extruded(face, height=20.0):
+    """``face`` as the top of a solid extruded ``height`` mm down; (solid, top index)."""
+    solid = face.extrude(FreeCAD.Vector(0, 0, -height))
+    top = max(range(len(solid.Faces)), key=lambda k: solid.Faces[k].CenterOfMass.z)
+    assert solid.isValid() and solid.ShapeType == "Solid"
+    return solid, top
+
+
+def pipe_solid():
+    """PyGeM's pipe (6 NURBS faces, separate shells in the file) sewn into a solid."""
+    from surfcomp.app.cadread import read_cad
+
+    shell = Part.Shape(read_cad(PIPE))
+    shell.sewShape(1e-2)
+    solid = Part.Solid(shell)
+    if solid.Volume < 0:
+        solid.reverse()
+    assert solid.isValid() and len(solid.Faces) == 6 and len(solid.Edges) == 12
+    return solid
+
+
+def raw_deviation(P):
+    """The machined part's deviation (mm) at points P: 14 um mean, smooth."""
+    x, y = P[..., 0], P[..., 1]
+    return (0.0115 + 0.010 * np.sin(np.pi * x / 45.0) * np.cos(np.pi * y / 60.0)
+            - 0.004 * (y / 45.0) ** 2)
+
+
+def grid(nominal, n, box=None, margin=0.0):
+    """Points, outward normals and (u, v) of an n x n grid over ``box`` (fractions of the
+    face's UV range: (u0, u1, v0, v1)) shrunk by ``margin``."""
+    (u0, u1), (v0, v1) = nominal.surface.u_range, nominal.surface.v_range
+    a0, a1, b0, b1 = box or (0.0, 1.0, 0.0, 1.0)
+    s = np.linspace(a0 + margin, a1 - margin, n)
+    t = np.linspace(b0 + margin, b1 - margin, n)
+    U, V = np.meshgrid(u0 + (u1 - u0) * s, v0 + (v1 - v0) * t, indexing="ij")
+    P = bspline.evaluate(nominal.surface, U, V)
+    N = bspline.normals(nominal.surface, U, V) * nominal.outward
+    return P, N, U, V
+
+
+#: the square inscribed in the circle (fractions of the face's UV box, the circle's
+#: bounding square): the probe stays on the trimmed face
+INSIDE = (0.16, 0.84, 0.16, 0.84)
+
+
+def measure(path, nominal, n, dev, box=None, margin=0.0):
+    """Write a CMM file with deviations ``dev(P, U, V)``; return (P, N, U, V, d)."""
+    P, N, U, V = grid(nominal, n, box, margin)
+    d = dev(P, U, V)
+    write_cmm_csv(path, P, N, d)
+    return P, N, U, V, d
+
+
+def bump(nominal, amplitude=0.014, shrink=0.6):
+    """Deviations that vanish near the face's boundary: a cos^4 bump around the (u, v)
+    point farthest from the trim, of radius ``shrink`` times that distance."""
+    (u0, u1), (v0, v1) = nominal.surface.u_range, nominal.surface.v_range
+    face = nominal.bspline_face
+    edge = (np.concatenate(boundary_polylines(face, 200)) - [u0, v0]) / [u1 - u0, v1 - v0]
+    best, centre = 0.0, None
+    for a in np.linspace(0.05, 0.95, 31):
+        for b in np.linspace(0.05, 0.95, 31):
+            if face.isPartOfDomain(u0 + a * (u1 - u0), v0 + b * (v1 - v0)):
+                dist = np.hypot(edge[:, 0] - a, edge[:, 1] - b).min()
+                if dist > best:
+                    best, centre = dist, (a, b)
+    radius = shrink * best
+
+    def dev(P, U, V):
+        r = np.hypot((U - u0) / (u1 - u0) - centre[0], (V - v0) / (v1 - v0) - centre[1])
+        return amplitude * np.cos(0.5 * np.pi * np.minimum(r / radius, 1.0)) ** 4
+
+    return dev
+
+
+# -- independent checks --------------------------------------------------------------------
+
+def realised_ok(face, P, N, d, on_face=None, reach=0.5, sample=40):
+    """Largest |realised - intended| correction (mm) at a seeded sample of the measured
+    points on the face, measured by OCCT on ``face`` along the nominal normals (the
+    pipeline's own check figure covers every point)."""
+    P, N, d = P.reshape(-1, 3), N.reshape(-1, 3), np.ravel(d)
+    k = np.arange(d.size) if on_face is None else np.nonzero(on_face)[0]
+    k = np.random.default_rng(17).choice(k, size=min(sample, k.size), replace=False)
+    return float(np.abs(realised_by_occt(face, P[k], N[k], reach=reach) - d[k]).max())
+
+
+def max_tolerance(shape):
+    return max([e.Tolerance for e in shape.Edges] + [v.Tolerance for v in shape.Vertexes])
+
+
+def boundary_move(nominal_face, new_face, corrected, samples=60):
+    """Per sample of the nominal face's boundary: (distance to the new face's boundary,
+    the correction there = |S_c - S| at the same (u, v)) in mm."""
+    s = nominal_face.Surface
+    new_edges = Part.Compound(new_face.Edges)
+    out = []
+    for e in nominal_face.Edges:
+        c2d, a, b = nominal_face.curveOnSurface(e)[:3]
+        for t in np.linspace(a, b, samples):
+            w = c2d.value(float(t))
+            x = s.value(w.x, w.y)
+            out.append((new_edges.distToShape(Part.Vertex(x))[0],
+                        (corrected.value(w.x, w.y) - x).Length))
+    return np.array(out)
+
+
+def flux_change(old_face, new_face, field):
+    """Flux of ``field(points) . (Su x Sv)`` through ``new_face`` minus through
+    ``old_face`` (both B-spline faces, same parametrisation), on one scan grid: the volume
+    change of a solid whose other faces carry no flux of that field (div field = 1)."""
+    sa, sb = surface_from_part(old_face.Surface), surface_from_part(new_face.Surface)
+    la, lb = boundary_polylines(old_face), boundary_polylines(new_face)
+    pts = np.concatenate(la + lb)
+    box = (pts[:, 0].min(), pts[:, 0].max())
+    knots = knots_of(sa, sb)
+
+    def density(surf):
+        def f(u, v):
+            p, su, sv = bspline.derivatives(surf, u, v, order=1)
+            return np.einsum("ij,ij->i", field(p), np.cross(su, sv))
+        return f
+
+    sign = -1.0 if old_face.Orientation == "Reversed" else 1.0
+    return sign * (domain_integral(density(sb), lb, box=box, knots=knots)
+                   - domain_integral(density(sa), la, box=box, knots=knots))
+
+
+def z_field(p):
+    """(0, 0, z): no flux through vertical walls."""
+    out = np.zeros_like(p)
+    out[:, 2] = p[:, 2]
+    return out
+
+
+def radial_field(p):
+    """(x, y, 0) / 2: no flux through planes normal to z."""
+    out = 0.5 * p.copy()
+    out[:, 2] = 0.0
+    return out
+
+
+def mesh_volume(shape, max_length):
+    import MeshPart
+
+    return MeshPart.meshFromShape(Shape=shape, MaxLength=max_length).Volume
+
+
+def other_faces_untouched(before, after, changed):
+    """Faces other than ``changed`` (0-based) keep their surfaces: same type and points."""
+    for k, (a, b) in enumerate(zip(before.Faces, after.Faces)):
+        if k in changed:
+            continue
+        assert a.Surface.TypeId == b.Surface.TypeId, k
+        u0, u1, v0, v1 = a.ParameterRange
+        for s, t in ((0.3, 0.4), (0.7, 0.6)):
+            uv = (u0 + s * (u1 - u0), v0 + t * (v1 - v0))
+            assert (a.Surface.value(*uv) - b.Surface.value(*uv)).Length < 1e-12, k
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "surfcomp", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+# -- a trimmed face alone -------------------------------------------------------------------
+
+def test_trimmed_face_keeps_its_boundary(tmp_path):
+    """The issue's case: a face trimmed by a circle (1 edge, 457.5 mm^2), measured inside.
+    Before, the face written had 4 edges and 640.6 mm^2 (the trim's UV bounding box)."""
+    face = circle_face()
+    assert len(face.Edges) == 1 and face.Area == pytest.approx(457.5, abs=0.05)
+    src = tmp_path / "trimmed.step"
+    face.exportStep(str(src))
+    nominal = nominal_from_face(Part.read(str(src)).Faces[0])
+    P, N, U, V, d = measure(tmp_path / "meas.csv", nominal, 12, lambda P, U, V:
+                            raw_deviation(P), box=INSIDE)
+    out = run_cli("compensate", src, tmp_path / "meas.csv", "-o", tmp_path / "out.step",
+                  "--method", "raw", "--report", tmp_path / "r.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "outside its trimmed boundary" not in out.stderr      # measured inside
+    assert "the corrected face alone" in out.stdout
+    written = Part.read(str(tmp_path / "out.step")).Faces
+    assert len(written) == 1
+    new = written[0]
+    assert new.isValid() and len(new.Wires) == 1 and len(new.Edges) == 1
+    assert new.Area == pytest.approx(face.Area, rel=0.005)
+    # the boundary moved by the correction there, not to the UV box
+    corrected = new.Surface
+    moves = boundary_move(face, new, corrected)
+    assert np.all(moves[:, 0] <= moves[:, 1] + 2 * UM)
+    assert 5 * UM < moves[:, 1].max() < 40 * UM
+    # the realised correction at the measured points (OCCT on the written STEP)
+    assert realised_ok(new, P, N, d) <= 0.1 * UM
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
+    shape = rep["output_shape"]
+    assert shape["kind"] == "face" and shape["volume_change_mm3"] is None
+    # the correction integrates over the trimmed face, not the UV box: mean d x area
+    assert shape["correction_integral_mm3"] == pytest.approx(d.mean() * face.Area, rel=0.05)
+
+
+def test_face_with_a_hole_keeps_it(tmp_path):
+    face = circle_face(hole=HOLE)
+    assert len(face.Wires) == 2 and len(face.Edges) == 2
+    src = tmp_path / "hole.brep"
+    face.exportBrep(str(src))
+    nominal = nominal_from_face(face)
+    P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 12, lambda P, U, V: raw_deviation(P),
+                            box=INSIDE)
+    inner = face.isPartOfDomain
+    comp, rep = run_job(Job(nominal=str(src), measurements=str(tmp_path / "m.csv"),
+                            output=str(tmp_path / "out.brep"), options=Options(method="raw")))
+    # the probe crossed the hole: those points are named, not silently used
+    hole = [not inner(u, v) for u, v in zip(U.ravel(), V.ravel())]
+    assert sum(hole) > 0
+    warning = [w for w in rep["warnings"] if "outside its trimmed boundary" in w]
+    assert len(warning) == 1 and ("%d of %d measured points" % (sum(hole), U.size)) in warning[0]
+    new = Part.read(str(tmp_path / "out.brep")).Faces[0]
+    assert new.isValid() and len(new.Wires) == 2 and len(new.Edges) == 2
+    assert new.Area == pytest.approx(face.Area, rel=0.005)
+    moves = boundary_move(face, new, new.Surface)
+    assert np.all(moves[:, 0] <= moves[:, 1] + 2 * UM)
+    on_face = ~np.array(hole)
+    assert realised_ok(new, P, N, d, on_face) <= 0.1 * UM
+    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
+
+
+def test_points_outside_the_trim_are_reported(tmp_path):
+    """A grid over the whole UV box of the circle face: the corner points lie on the surface
+    but off the face (as a probe near a fillet). They are counted and located."""
+    face = circle_face()
+    src = tmp_path / "trimmed.brep"
+    face.exportBrep(str(src))
+    nominal = nominal_from_face(face)
+    P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 9, lambda P, U, V: raw_deviation(P))
+    r = np.hypot(U - 0.5, V - 0.5).ravel()
+    comp, rep = run_job(Job(nominal=str(src), measurements=str(tmp_path / "m.csv"),
+                            command="inspect"))
+    warning = [w for w in rep["warnings"] if "outside its trimmed boundary" in w]
+    assert len(warning) == 1
+    assert "%d of 81 measured points" % np.sum(r > 0.35) in warning[0]
+    # the farthest: a corner of the face's UV box (the circle's bounding square), 0.145 off
+    # the circle in (u, v): its distance from the face as OCCT measures it
+    import re
+
+    far = float(re.search(r"up to ([0-9.]+) mm beyond it", warning[0]).group(1))
+    corners = P.reshape(-1, 3)[r == r.max()]
+    expected = max(face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0] for p in corners)
+    assert far == pytest.approx(expected, abs=1e-3) and 5.0 < far < 8.0
+
+
+# -- a trimmed face as the top of a solid ---------------------------------------------------
+
+@pytest.fixture(scope="module")
+def circle_solid(tmp_path_factory):
+    """The circle face extruded 20 mm, written as STEP and read back, its measurements."""
+    from surfcomp.app.cadread import read_cad
+
+    tmp = tmp_path_factory.mktemp("circle_solid")
+    solid, _ = extruded(circle_face())
+    src = tmp / "part.step"
+    solid.exportStep(str(src))
+    solid = read_cad(str(src))
+    top = max(range(len(solid.Faces)), key=lambda k: solid.Faces[k].CenterOfMass.z)
+    nominal = nominal_from_face(solid.Faces[top], face_name="Face%d" % (top + 1), shape=solid)
+    P, N, U, V, d = measure(tmp / "meas.csv", nominal, 12, lambda P, U, V: raw_deviation(P),
+                            box=INSIDE)
+    assert 0.0130 < d.mean() < 0.0150          # raw deviations of about 14 um
+    return {"tmp": tmp, "src": src, "solid": solid, "top": top, "nominal": nominal,
+            "P": P, "N": N, "d": d, "mesh": {}}
+
+
+def _check_replaced_solid(case, out, volume_change, correction):
+    """The checks of a face of a solid replaced, for every route."""
+    solid, top = case["solid"], case["top"]
+    assert out.ShapeType == "Solid" and out.isValid() and len(out.Solids) == 1
+    assert all(s.isClosed() for s in out.Shells)
+    assert len(out.Faces) == len(solid.Faces) == 3
+    assert len(out.Edges) == len(solid.Edges) and len(out.Vertexes) == len(solid.Vertexes)
+    assert max_tolerance(out) <= 1e-4            # closed for real, not by tolerance
+    # the bottom is untouched, the side keeps its surface (re-trimmed at the top)
+    other_faces_untouched(solid, out, {top})
+    new = out.Faces[top]
+    assert len(new.Wires) == 1 and len(new.Edges) == 1
+    # the correction's integral: mean deviation x area, to the 5 % the mean varies
+    assert correction == pytest.approx(case["d"].mean() * solid.Faces[top].Area, rel=0.05)
+    # volume change (reported) = -integral of delta dA, and = the exact change of this solid
+    # (z-flux through the top only: the side wall is vertical, the bottom unchanged)
+    assert volume_change == pytest.approx(-correction, rel=0.02)
+    exact = flux_change(solid.Faces[top], new, z_field)
+    assert exact == pytest.approx(-correction, rel=0.02)
+    assert volume_change == pytest.approx(exact, rel=0.005)
+    # a mesh of each solid (max. edge 1 mm) agrees
+    if "nominal" not in case["mesh"]:
+        case["mesh"]["nominal"] = mesh_volume(solid, 1.0)
+    mesh = mesh_volume(out, 1.0) - case["mesh"]["nominal"]
+    assert mesh == pytest.approx(-correction, rel=0.02)
+    # the boundary moved along the vertical wall: by the correction / sin(wall angle)
+    s = solid.Faces[top].Surface
+    side = [f for f in solid.ancestorsOfType(solid.Faces[top].Edges[0], Part.Face)
+            if not f.isSame(solid.Faces[top])][0]
+    moves = boundary_move(solid.Faces[top], new, new.Surface, samples=40)
+    c2d, a, b = solid.Faces[top].curveOnSurface(solid.Faces[top].Edges[0])[:3]
+    ts = np.linspace(a, b, 40)
+    sines = []
+    for t in ts:
+        w = c2d.value(float(t))
+        n_top = s.normal(w.x, w.y)
+        n_side = side.normalAt(*side.Surface.parameter(s.value(w.x, w.y)))
+        sines.append(n_top.cross(n_side).Length)
+    assert np.all(moves[:, 0] <= moves[:, 1] / np.array(sines) + 2 * UM)
+    # the realised correction at the measured points
+    assert realised_ok(new, case["P"], case["N"], case["d"]) <= 0.1 * UM
+    return mesh, exact
+
+
+def test_face_of_a_solid_on_the_command_line(circle_solid):
+    case = circle_solid
+    tmp, top = case["tmp"], case["top"]
+    out = run_cli("compensate", case["src"], tmp / "meas.csv", "--face", "Face%d" % (top + 1),
+                  "-o", tmp / "out.step", "--report", tmp / "r.json", "--method", "raw",
+                  "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "the nominal's shape with the face replaced (3 faces, 1 solids" in out.stdout
+    assert "volume change" in out.stdout
+    rep = json.loads((tmp / "r.json").read_text())["output_shape"]
+    assert rep["kind"] == "shape" and rep["faces"] == 3 and rep["solids"] == 1
+    assert rep["retrimmed_faces"] and rep["max_edge_tolerance_mm"] <= 1e-4
+    assert abs(rep["volume_change_vs_integral"]) < 0.02
+    written = Part.read(str(tmp / "out.step"))
+    case["cli"] = written.Solids[0]
+    mesh, exact = _check_replaced_solid(case, written.Solids[0], rep["volume_change_mm3"],
+                                        rep["correction_integral_mm3"])
+    case["figures"] = {"cli_volume_change": rep["volume_change_mm3"],
+                       "integral": -rep["correction_integral_mm3"], "exact": exact,
+                       "mesh": mesh}
+    # --face-only writes the corrected face alone
+    out = run_cli("compensate", case["src"], tmp / "meas.csv", "--face", "Face%d" % (top + 1),
+                  "-o", tmp / "face.step", "--method", "raw", "--face-only", "--quiet")
+    assert out.returncode == 0, out.stderr
+    alone = Part.read(str(tmp / "face.step"))
+    assert len(alone.Faces) == 1 and not alone.Solids and len(alone.Faces[0].Edges) == 1
+
+
+def test_face_of_a_solid_in_the_document(circle_solid):
+    """The document route (Output = solid) builds the same solid as the command line."""
+    case = circle_solid
+    doc = FreeCAD.newDocument("trim_solid")
+    try:
+        part = doc.addObject("Part::Feature", "Part")
+        part.Shape = case["solid"]
+        m = features.make_measurement(doc, str(case["tmp"] / "meas.csv"))
+        c = features.make_compensation(doc, part, "Face%d" % (case["top"] + 1), m,
+                                       method="raw", output="solid")
+        doc.recompute()
+        assert c.State == ["Up-to-date"], c.State
+        assert c.EdgeTol.Value <= 1e-4
+        assert json.loads(c.Checks)["max_error_at_points_mm"] <= 0.1 * UM
+        _check_replaced_solid(case, c.Shape, c.VolumeChange, c.CorrectionVolume)
+        if "cli" in case:          # the same construction as the command line's
+            np.testing.assert_allclose(
+                np.array(c.Shape.Faces[case["top"]].Surface.getPoles(), dtype=float),
+                np.array(case["cli"].Faces[case["top"]].Surface.getPoles(), dtype=float),
+                atol=1e-9)
+            assert c.VolumeChange == pytest.approx(case["figures"]["cli_volume_change"],
+                                                   abs=1e-6)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+
+
+def test_face_with_a_hole_in_a_solid(tmp_path):
+    """Both walls (outside and the hole's) are re-trimmed to meet the corrected top."""
+    solid, top = extruded(circle_face(hole=HOLE))
+    nominal = nominal_from_face(solid.Faces[top], face_name="Face%d" % (top + 1), shape=solid)
+    P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 12, lambda P, U, V:
+                            raw_deviation(P), box=INSIDE)
+    comp, rep = run_job(Job(nominal=str(_brep(solid, tmp_path)),
+                            measurements=str(tmp_path / "m.csv"), face="Face%d" % (top + 1),
+                            output=str(tmp_path / "out.brep"), options=Options(method="raw")))
+    out = Part.read(str(tmp_path / "out.brep"))
+    shape = rep["output_shape"]
+    assert out.isValid() and len(out.Solids) == 1 and out.Shells[0].isClosed()
+    assert len(out.Faces) == 4 and max_tolerance(out) <= 1e-4
+    assert len(shape["retrimmed_faces"]) == 2           # the outer wall and the hole's
+    new = out.Faces[top]
+    assert len(new.Wires) == 2 and len(new.Edges) == 2
+    exact = flux_change(solid.Faces[top], new, z_field)
+    assert shape["volume_change_mm3"] == pytest.approx(-shape["correction_integral_mm3"],
+                                                       rel=0.02)
+    assert exact == pytest.approx(shape["volume_change_mm3"], rel=0.005)
+    on_face = np.array([nominal.bspline_face.isPartOfDomain(u, v)
+                        for u, v in zip(U.ravel(), V.ravel())])
+    assert realised_ok(new, P, N, d, on_face) <= 0.1 * UM
+    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
+
+
+def _brep(shape, tmp_path, name="part.brep"):
+    path = tmp_path / name
+    shape.exportBrep(str(path))
+    return path
+
+
+# -- real parts: every neighbour tangent (boxed_sphere), a sewn pipe --------------------------
+
+@pytest.fixture(scope="module")
+def boxed_sphere():
+    from surfcomp.app.cadread import read_cad
+
+    shape = read_cad(BOXED_SPHERE)
+    # the file is in cm; OCCT reads it in mm: a sphere of radius 5 mm in a 10 mm box
+    sphere = min(shape.Solids, key=lambda s: len(s.Faces))
+    assert sphere.Volume == pytest.approx(4 / 3 * np.pi * 5.0 ** 3, rel=1e-3)
+    assert shape.BoundBox.XLength == pytest.approx(10.0, abs=1e-6)
+    return shape
+
+
+#: a fillet (4 edges), a trimmed blend (9 edges, half of its UV box), a sphere half (two
+#: poles), each meeting all its neighbours tangentially
+SPHERE_FACES = ("Face5", "Face8", "Face191")
+
+
+@pytest.mark.parametrize("face", SPHERE_FACES)
+def test_tangent_neighbours_need_a_vanishing_correction(boxed_sphere, face, tmp_path):
+    """Where the correction vanishes along the tangent edges, the face is replaced without
+    re-trimming; a constant 14 um one gives the clear error, nothing is written."""
+    k = int(face[4:]) - 1
+    shape = boxed_sphere
+    nominal = nominal_from_face(shape.Faces[k], face_name=face, shape=shape)
+    P, N, U, V, d = measure(tmp_path / "bump.csv", nominal, 21, bump(nominal), margin=0.02)
+    comp, rep = run_job(Job(nominal=BOXED_SPHERE, measurements=str(tmp_path / "bump.csv"),
+                            face=face, output=str(tmp_path / "out.brep"),
+                            options=Options(method="raw")))
+    out = Part.read(str(tmp_path / "out.brep"))
+    info = rep["output_shape"]
+    assert info["kind"] == "shape" and info["retrimmed_faces"] == []
+    assert out.isValid() and len(out.Faces) == len(shape.Faces) == 192
+    assert len(out.Solids) == 2 and all(s.isClosed() for s in out.Shells)
+    new = out.Faces[k]
+    assert len(new.Edges) == len(shape.Faces[k].Edges)
+    # the file's own tolerances (up to 0.06 mm, from Rhino) stay; nothing is added
+    assert max_tolerance(new) <= max_tolerance(shape.Faces[k]) + 1e-4
+    other_faces_untouched(shape, out, {k})
+    # no neighbour moved: the volume change is the flux of any field of divergence 1
+    # through the face (before and after), here (0, 0, z)
+    exact = flux_change(shape.Faces[k], new, z_field)
+    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
+    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
+    on_face = np.array([nominal.bspline_face.isPartOfDomain(u, v)
+                        for u, v in zip(U.ravel(), V.ravel())])
+    assert realised_ok(new, P, N, d, on_face, reach=0.05) <= 0.1 * UM
+    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
+    # a constant correction lifts the face off its tangent neighbours
+    measure(tmp_path / "const.csv", nominal, 21, lambda P, U, V: np.full(U.shape, 0.014),
+            margin=0.02)
+    with pytest.raises(GeometryError, match=r"Edge\d+ between %s and Face\d+ is tangent to "
+                                            r"its neighbour \(0\.\d degrees\) and the "
+                                            r"corrected face lies up to 14\.\d\d um off"
+                       % face):
+        run_job(Job(nominal=BOXED_SPHERE, measurements=str(tmp_path / "const.csv"), face=face,
+                    output=str(tmp_path / "const.brep"), options=Options(method="raw")))
+    assert not os.path.exists(tmp_path / "const.brep")
+
+
+@pytest.fixture(scope="module")
+def pipe(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("pipe")
+    solid = pipe_solid()
+    return solid, _brep(solid, tmp, "pipe.brep")
+
+
+def _pipe_run(pipe, k, dev, tmp_path, box=None):
+    solid, src = pipe
+    nominal = nominal_from_face(solid.Faces[k], face_name="Face%d" % (k + 1), shape=solid)
+    P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 13, dev(nominal), box=box)
+    comp, rep = run_job(Job(nominal=str(src), measurements=str(tmp_path / "m.csv"),
+                            face="Face%d" % (k + 1), output=str(tmp_path / "out.brep"),
+                            options=Options(method="raw")))
+    out = Part.read(str(tmp_path / "out.brep"))
+    assert out.isValid() and len(out.Solids) == 1 and out.Shells[0].isClosed()
+    assert len(out.Faces) == 6 and max_tolerance(out) <= 1e-4
+    assert realised_ok(out.Faces[k], P, N, d) <= 0.1 * UM
+    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
+    return out, rep["output_shape"]
+
+
+def _across(nominal, amplitude=0.014):
+    """Vanishes along the quarter's long edges (tangent to the next quarters), not at its
+    ends (the disks)."""
+    (v0, v1) = nominal.surface.v_range
+    return lambda P, U, V: amplitude * np.sin(np.pi * (V - v0) / (v1 - v0)) ** 2
+
+
+def test_pipe_quarter_retrims_the_disks(pipe, tmp_path):
+    solid, _ = pipe
+    out, info = _pipe_run(pipe, 1, _across, tmp_path)
+    assert info["retrimmed_faces"] == ["Face1", "Face3"]          # the two disks
+    other_faces_untouched(solid, out, {1})
+    exact = flux_change(solid.Faces[1], out.Faces[1], radial_field)
+    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
+    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
+    # the re-trimmed end of the quarter lies on OCCT's own intersection of the corrected
+    # surface with the disk's plane (the reference for the Newton samples)
+    disk = solid.Faces[0]
+    sc = out.Faces[1].Surface
+    curves = sc.intersectSS(disk.Surface, 1e-7)
+    pieces = Part.Compound([c.toShape() for c in curves])
+    end = [e for e in out.Faces[1].Edges if abs(e.CenterOfMass.z - disk.CenterOfMass.z) < 1.0]
+    assert len(end) == 1
+    dist = [pieces.distToShape(Part.Vertex(p))[0] for p in end[0].discretize(50)]
+    assert max(dist) < 1e-5
+
+
+def test_pipe_disk_retrims_the_four_quarters(pipe, tmp_path):
+    solid, _ = pipe
+    # measured inside the disk (the square inscribed in its circle)
+    out, info = _pipe_run(pipe, 0, lambda nominal: lambda P, U, V: raw_deviation(P / 100.0),
+                          tmp_path, box=(0.16, 0.84, 0.16, 0.84))
+    assert info["retrimmed_faces"] == ["Face2", "Face4", "Face5", "Face6"]
+    exact = flux_change(solid.Faces[0], out.Faces[0], z_field)
+    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
+    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
+
+
+def test_pipe_quarter_with_a_constant_correction_is_refused(pipe, tmp_path):
+    solid, src = pipe
+    nominal = nominal_from_face(solid.Faces[1], face_name="Face2", shape=solid)
+    measure(tmp_path / "m.csv", nominal, 9, lambda P, U, V: np.full(U.shape, 0.014))
+    out = run_cli("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
+                  tmp_path / "out.brep", "--method", "raw", "--quiet")
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert "between Face2 and Face" in out.stderr and "14.00 um off" in out.stderr
+    assert not os.path.exists(tmp_path / "out.brep")
+    # the face alone is fine
+    out = run_cli("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
+                  tmp_path / "face.brep", "--method", "raw", "--face-only", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert len(Part.read(str(tmp_path / "face.brep")).Faces) == 1
+
+
+# -- the freecadcmd job and a saved document --------------------------------------------------
+
+def test_job_file_face_only_key(circle_solid):
+    case = circle_solid
+    tmp = case["tmp"]
+    for face_only, faces in ((True, 1), (False, 3)):
+        job = tmp / ("job%d.json" % face_only)
+        job.write_text(json.dumps({"nominal": str(case["src"]),
+                                   "measurements": str(tmp / "meas.csv"),
+                                   "face": "Face%d" % (case["top"] + 1), "method": "raw",
+                                   "face_only": face_only, "output": "job%d.brep" % face_only}))
+        out = subprocess.run(["freecadcmd", os.path.join(ROOT, "macros", "surfcomp_job.py")],
+                             env=dict(os.environ, SURFCOMP_JOB=str(job)), capture_output=True,
+                             text=True, timeout=600)
+        assert out.returncode == 0, out.stdout + out.stderr
+        assert len(Part.read(str(tmp / ("job%d.brep" % face_only))).Faces) == faces
+
+
+SCRIPT = r"""
+import json, os, sys
+sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
+import FreeCAD
+from surfcomp.app import documents, features   # this checkout's proxies, not the Mod link's
+doc = FreeCAD.openDocument(os.environ["SURFCOMP_DOC"])
+c = doc.getObject("Compensation")
+saved = c.Shape.copy()
+c.touch()
+doc.recompute()
+s = c.Shape
+print("RESULT " + json.dumps({
+    "problems": documents.restore_failures(doc, os.environ["SURFCOMP_DOC"]),
+    "state": c.State, "valid": s.isValid(), "closed": all(x.isClosed() for x in s.Shells),
+    "faces": len(s.Faces), "edges": [len(f.Edges) for f in s.Faces],
+    "tolerance": max(e.Tolerance for e in s.Edges),
+    "poles": [list(p) for row in s.Faces[%d].Surface.getPoles() for p in row],
+    "saved_poles": [list(p) for row in saved.Faces[%d].Surface.getPoles() for p in row],
+    "volume": s.Volume, "saved_volume": saved.Volume, "volume_change": c.VolumeChange,
+    "correction_volume": c.CorrectionVolume, "warnings": list(c.Warnings)}))
+sys.stdout.flush()
+os._exit(0)
+"""
+
+
+def test_document_with_a_trimmed_face_is_saved_and_reopened(circle_solid, tmp_path):
+    case = circle_solid
+    doc = FreeCAD.newDocument("trim_persist")
+    try:
+        part = doc.addObject("Part::Feature", "Part")
+        part.Shape = case["solid"]
+        csv = tmp_path / "meas.csv"
+        csv.write_bytes((case["tmp"] / "meas.csv").read_bytes())
+        m = features.make_measurement(doc, str(csv))
+        c = features.make_compensation(doc, part, "Face%d" % (case["top"] + 1), m,
+                                       method="raw", output="solid")
+        doc.recompute()
+        before = {"volume_change": c.VolumeChange, "edges": [len(f.Edges) for f in c.Shape.Faces]}
+        path = str(tmp_path / "trim.FCStd")
+        doc.saveAs(path)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    os.unlink(csv)
+    script = tmp_path / "reopen.py"
+    script.write_text(SCRIPT % (case["top"], case["top"]))
+    out = subprocess.run(["freecadcmd", str(script)], capture_output=True, text=True,
+                         timeout=600, cwd=str(tmp_path),
+                         env=dict(os.environ, SURFCOMP_DOC=path, SURFCOMP_ROOT=ROOT))
+    line = [s for s in out.stdout.replace("\r", "\n").split("\n") if s.startswith("RESULT ")]
+    assert line, out.stdout[-3000:] + out.stderr[-3000:]
+    r = json.loads(line[0][len("RESULT "):])
+    assert r["problems"] == [] and r["state"] == ["Up-to-date"]
+    assert r["valid"] and r["closed"] and r["faces"] == 3 and r["tolerance"] <= 1e-4
+    assert r["edges"] == before["edges"]
+    np.testing.assert_allclose(r["poles"], r["saved_poles"], atol=1e-9)
+    assert abs(r["volume"] - r["saved_volume"]) < 1e-6
+    assert r["volume_change"] == pytest.approx(before["volume_change"], abs=1e-9)
+    assert r["volume_change"] == pytest.approx(-r["correction_volume"], rel=0.02)
+
+
+def test_corrected_face_builder_is_the_one_for_every_route(circle_solid):
+    """The face output of the solid's top is the lone-face builder's face, and the solid's
+    top has the same corrected surface (one builder, two boundaries)."""
+    case = circle_solid
+    nominal = case["nominal"]
+    from surfcomp.core.pipeline import compensate, prepare
+    from surfcomp.io.readers import read_any
+
+    prep = prepare(nominal.surface, nominal.outward, read_any(str(case["tmp"] / "meas.csv")),
+                   Options(method="raw"))
+    comp = compensate(nominal.surface, nominal.outward, prep, Options(method="raw"))
+    face = corrected_shape(nominal, comp.corrected, "face").shape
+    solid = corrected_shape(nominal, comp.corrected, "solid")
+    assert face.ShapeType == "Face" and solid.kind == "shape"
+    poles = np.array(surface_to_part(comp.corrected).getPoles(), dtype=float)
+    np.testing.assert_allclose(np.array(face.Surface.getPoles(), dtype=float), poles, atol=0)
+    np.testing.assert_allclose(
+        np.array(solid.shape.Faces[case["top"]].Surface.getPoles(), dtype=float), poles, atol=0)

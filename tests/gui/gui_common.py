@@ -1,0 +1,170 @@
+# Shared prologue of the GUI sessions (tests/gui/session_*.py): runs inside `freecad` (see
+# harness.py; it provides RESULTS, FreeCAD, FreeCADGui, QtGui, QtCore). Commands run through
+# FreeCAD's command mechanism (Gui.runCommand); dialogs are replaced by recorders
+# (surfcomp.gui.dialogs is the one place commands ask the user).
+import time  # noqa: F401  (for the sessions)
+
+import numpy as np
+
+Gui = FreeCADGui
+ROOT = os.environ["SURFCOMP_ROOT"]
+TMP = os.environ["SURFCOMP_TMP"]
+NOMINAL = os.path.join(ROOT, "examples", "nominal.step")
+MEAS = os.path.join(ROOT, "examples", "measurements.csv")
+
+import surfcomp  # noqa: F401
+from surfcomp.core import colormap  # noqa: F401
+from surfcomp.gui import (  # noqa: F401
+    commands,
+    dialogs,
+    fcgui,
+    mapscene,
+    panels,
+    prefs,
+    preview,
+    readout,
+)
+
+Gui.activateWorkbench("SurfCompWorkbench")
+mw = Gui.getMainWindow()
+
+# -- dialog recorders --------------------------------------------------------------------
+ERRORS, PREVIEWS, DIALOGS, INFOS, FILES = [], [], [], [], []
+STOCKS = [0.1]
+dialogs.show_error = lambda title, message: ERRORS.append([title, message])
+dialogs.show_info = lambda title, message: INFOS.append([title, message])
+dialogs.ask_open_file = lambda title, filters: FILES.pop(0)
+dialogs.ask_stock = lambda title, value: STOCKS[0]
+dialogs.ask_save_file = lambda title, filters, default="": os.path.join(TMP, "report.html")
+#: what a dialog does when it is "run": a function(dialog) -> accepted
+ON_DIALOG = []
+
+
+def _run_dialog(dlg):
+    DIALOGS.append(dlg)
+    if isinstance(dlg, preview.PreviewDialog):
+        PREVIEWS.append(dlg.text.toPlainText())
+    if ON_DIALOG:
+        return ON_DIALOG.pop(0)(dlg)
+    return True
+
+
+dialogs.run_dialog = _run_dialog
+
+
+def active(cls):
+    return bool(cls().IsActive())
+
+
+def load_example(doc):
+    """Load nominal and measurements through the commands; (nominal, measurement)."""
+    FILES.append(NOMINAL)
+    Gui.runCommand("SurfComp_LoadNominal")
+    FILES.append(MEAS)
+    Gui.runCommand("SurfComp_ImportMeasurements")
+    meas = [o for o in doc.Objects if o.Name.startswith("Measurement")][-1]
+    return doc.getObject("Nominal"), meas
+
+
+def make_map(doc, nominal, meas, command="SurfComp_DeviationMap"):
+    Gui.Selection.clearSelection()
+    Gui.Selection.addSelection(doc.Name, nominal.Name, "Face1")
+    Gui.Selection.addSelection(doc.Name, meas.Name)
+    Gui.runCommand(command)
+    Gui.updateGui()
+    Gui.Selection.clearSelection()
+    return [o for o in doc.Objects if o.Name.startswith("Compensation")][-1]
+
+
+def view_top():
+    view = Gui.ActiveDocument.ActiveView
+    view.viewTop()
+    view.fitAll()
+    Gui.updateGui()
+    return view
+
+
+def project(view, points):
+    """The pixels (origin bottom left, device pixels as ``getSize``) where ``points`` are
+    drawn. Coin's own projection, as rendering and picking do it: ``getPointOnScreen`` leaves
+    out the camera's widening of a view taller than wide (``ADJUST_CAMERA``), which the
+    Qt6 layouts give the 3D view beside the docks at a device pixel ratio of 2."""
+    from pivy import coin
+
+    region = view.getViewer().getSoRenderManager().getViewportRegion()
+    aspect = region.getViewportAspectRatio()
+    size = region.getViewportSizePixels()
+    volume = view.getCameraNode().getViewVolume(aspect)
+    if aspect < 1.0:
+        volume.scale(1.0 / aspect)
+    out = []
+    for p in points:
+        s = volume.projectToScreen(coin.SbVec3f(*map(float, p)))
+        out.append([int(round(s[0] * size[0])), int(round(s[1] * size[1]))])
+    return out
+
+
+def shot(view, name):
+    Gui.updateGui()
+    path = os.path.join(TMP, name + ".png")
+    W, H = view.getSize()
+    view.saveImage(path, W, H, "White")
+    return path
+
+
+def gl_widget():
+    """The active 3D view's OpenGL viewport (where the mouse events go): the viewport of the
+    visible 3D viewer (a QGraphicsView) whose size in device pixels is the view's
+    (``getSize``). FreeCAD 1.1 also keeps a small visible GL widget on the main window, and
+    with a device pixel ratio other than 1 the sizes in device and in Qt pixels differ."""
+    W, H = Gui.ActiveDocument.ActiveView.getSize()
+    for v in mw.findChildren(QtGui.QGraphicsView):
+        w = v.viewport()
+        r = w.devicePixelRatioF()
+        if v.isVisible() and abs(w.width() * r - W) <= 1 and abs(w.height() * r - H) <= 1:
+            return w
+    raise RuntimeError("no 3D viewer of %d x %d device pixels" % (W, H))
+
+
+def mouse(kind, xy, button=None):
+    """A real Qt mouse event on the 3D view at ``xy`` (view pixels, origin bottom left, as
+    getPointOnScreen gives them)."""
+    w = gl_widget()
+    view = Gui.ActiveDocument.ActiveView
+    W, H = view.getSize()
+    ratio = float(W) / w.width()        # the view counts device pixels
+    pos = QtCore.QPointF((xy[0] + 0.5) / ratio, (H - 1 - xy[1] + 0.5) / ratio)
+    glob = QtCore.QPointF(w.mapToGlobal(pos.toPoint()))
+    types = {"move": QtCore.QEvent.MouseMove, "press": QtCore.QEvent.MouseButtonPress,
+             "release": QtCore.QEvent.MouseButtonRelease}
+    b = QtCore.Qt.LeftButton if button is None else button
+    btn = QtCore.Qt.NoButton if kind == "move" else b
+    btns = QtCore.Qt.NoButton if kind in ("move", "release") else b
+    ev = QtGui.QMouseEvent(types[kind], pos, glob, btn, btns, QtCore.Qt.NoModifier)
+    QtGui.QApplication.sendEvent(w, ev)
+    Gui.updateGui()
+
+
+def selection():
+    """``[[object name, [sub-element names]]]`` as the click made it: unresolved
+    (``resolve=0``, there since 0.19). Resolving (the default) checks the names against the
+    object's shape: FreeCAD 1.x drops those the shape lacks, such as a map mesh's
+    ``Vertex-1635``, which would make an element pick look like a whole-object one."""
+    return [[s.ObjectName, list(s.SubElementNames)] for s in Gui.Selection.getSelectionEx("", 0)]
+
+
+def legend_pixel(img, layout, fraction, dx=0.5):
+    h, w = img.shape[:2]
+    x = layout["bar_x"][0] + dx * (layout["bar_x"][1] - layout["bar_x"][0])
+    y0, y1 = layout["bar_y"]
+    y = y0 + fraction * (y1 - y0)
+    return img[int(round((1 - (y + 1) / 2) * h)), int(round((x + 1) / 2 * w))].tolist()
+
+
+def read_png(path):
+    img = QtGui.QImage(path).convertToFormat(QtGui.QImage.Format_RGB888)
+    w, h = img.width(), img.height()
+    ptr = img.constBits()
+    data = bytes(ptr) if not hasattr(ptr, "asstring") else ptr.asstring(img.sizeInBytes())
+    arr = np.frombuffer(data, dtype=np.uint8)[: h * img.bytesPerLine()]
+    return arr.reshape(h, img.bytesPerLine())[:, : 3 * w].reshape(h, w, 3) / 255.0
