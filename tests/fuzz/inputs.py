@@ -187,8 +187,8 @@ _DOCUMENT = []
 
 def document_bytes():
     """A small FreeCAD document (made once): ``Nominal``, a Part::Feature holding the example
-    face, and ``Helper``, an App::FeaturePython with surfcomp's plain proxy, whose module
-    name the hostile variants replace."""
+    face, ``Mirror``, a feature using it, and ``Helper``, an App::FeaturePython with
+    surfcomp's plain proxy, whose module name the hostile variants replace."""
     if not _DOCUMENT:
         from surfcomp.app import fcenv
 
@@ -203,6 +203,8 @@ def document_bytes():
         try:
             nominal = doc.addObject("Part::Feature", "Nominal")
             nominal.Shape = Part.read(EXAMPLE_STEP)
+            # a user of the nominal (the document route refuses documents without one)
+            doc.addObject("Part::Mirroring", "Mirror").Source = nominal
             Proxy(doc.addObject("App::FeaturePython", "Helper"))
             doc.recompute()
             doc.saveAs(path)
