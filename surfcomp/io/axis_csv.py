@@ -51,7 +51,7 @@ import numpy as np
 from ..errors import InputError, MeasurementFileError
 from .atomic import write_text
 from .files import clip, read_bytes
-from .measurements import MAX_COORDINATE
+from .measurement_set import MAX_COORDINATE
 from .units import split_unit_suffix, unit_factor
 
 AXES = ("x", "y", "z")

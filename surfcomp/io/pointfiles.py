@@ -42,7 +42,7 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .files import clip, read_bytes
-from .measurements import (
+from .measurement_set import (
     NORMAL_LENGTH_TOL,
     NORMAL_ZERO,
     MeasurementSet,

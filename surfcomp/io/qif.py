@@ -63,7 +63,7 @@ import numpy as np
 
 from ..errors import InputError, MeasurementFileError
 from .files import clip, read_bytes
-from .measurements import (
+from .measurement_set import (
     DEV_CHECK_TOL,
     MAX_POINT_WARNINGS,
     NORMAL_LENGTH_TOL,
