@@ -1,6 +1,6 @@
 """Document objects of the compensation: a measurement object and the compensation feature.
 
-Both are thin proxies (see /work/shared/STYLE.md, "Document objects"): every input and
+Both are thin proxies (see docs/architecture.md, "Document objects"): every input and
 result lives in properties, ``execute`` turns properties into arrays, calls the core
 pipeline (:func:`surfcomp.core.pipeline.prepare` / :func:`~surfcomp.core.pipeline.compensate`)
 and writes the results back. No FreeCADGui, no PySide: everything recomputes in
@@ -40,270 +40,26 @@ import numpy as np
 from ..core.deviations import statistics
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
-from ..core.pipeline import LAYOUTS, Options, build_surface, compensate, prepare
+from ..core.pipeline import Options, build_surface, compensate, prepare
 from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
 from .nominal import trim_warning
 from .progress import freecad_progress
+from .properties import (
+    COMPENSATION_PROPERTIES,
+    COMPENSATION_TYPE,
+    MEASUREMENT_PROPERTIES,
+    MEASUREMENT_TYPE,
+    OUTPUTS,
+    RENAMED,
+    VERSION,
+)
 from .proxies import Proxy
 from .proxies import migrate as _migrate
 from .reports import deviation_field
 from .shapes import corrected_shape
-
-#: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
-#: context when it shows them)
-QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
-
-#: version of the property sets; onDocumentRestored upgrades older objects
-#: (properties added since, such as VolumeChange, come from the property tables;
-#: 2: short names that fit the property view, see RENAMED)
-VERSION = 2
-#: compensation properties renamed in version 2: old name -> new name
-RENAMED = {"FlipNormals": "Flip", "EdgeTolerance": "EdgeTol", "NominalPoints": "Nodes"}
-
-MEASUREMENT_TYPE = "SurfComp_Measurement"
-COMPENSATION_TYPE = "SurfComp_Compensation"
-
-OUTPUTS = ("face", "solid")
-MASK_KINDS = ("box", "gaussian")
-
-_RO = 1      # editor mode: read-only
-_HIDDEN = 2  # editor mode: hidden
-
-# (type, name, group, tooltip, default, editor mode)
-_MEAS = "Measurement"
-MEASUREMENT_PROPERTIES = (
-    ("App::PropertyString", "SourceName", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "File the measurements were read from (information only: "
-                                        "the data is stored below)"),
-     "", _RO),
-    ("App::PropertyString", "SourceSha256", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "SHA-256 of the source file's bytes"),
-     "", _RO),
-    ("App::PropertyString", "Units", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Units of the source file's length columns (the stored "
-                                        "values are in mm)"),
-     "mm", _RO),
-    ("App::PropertyString", "Kind", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Columns the file had: nominal+normal+deviation, "
-                                        "nominal+measured, ..."),
-     "", _RO),
-    ("App::PropertyInteger", "PointCount", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Number of measured points"),
-     0, _RO),
-    ("App::PropertyIntegerList", "GridShape", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Rows and columns of the grid when the file gives row/col "
-                                        "indices (else empty)"),
-     None, _RO),
-    ("App::PropertyFloatList", "NominalX", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Nominal points, x (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "NominalY", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Nominal points, y (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "NominalZ", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Nominal points, z (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "MeasuredX", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Measured points, x (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "MeasuredY", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Measured points, y (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "MeasuredZ", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Measured points, z (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "NormalI", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Normals, x component"),
-     None, _RO),
-    ("App::PropertyFloatList", "NormalJ", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Normals, y component"),
-     None, _RO),
-    ("App::PropertyFloatList", "NormalK", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Normals, z component"),
-     None, _RO),
-    ("App::PropertyFloatList", "Deviation", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Deviation along the normal (mm, positive = material "
-                                        "left)"),
-     None, _RO),
-    ("App::PropertyIntegerList", "Row", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Grid row of every point (when given)"),
-     None, _RO),
-    ("App::PropertyIntegerList", "Col", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Grid column of every point (when given)"),
-     None, _RO),
-    ("App::PropertyIntegerList", "Lines", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Line of every point in the source file"),
-     None, _RO),
-    ("App::PropertyStringList", "Ids", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Point names (when given)"),
-     None, _RO),
-    ("App::PropertyString", "Columns", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Role -> column name as written in the file (JSON)"),
-     "{}", _RO),
-    ("App::PropertyStringList", "ReadWarnings", _MEAS,
-     QT_TRANSLATE_NOOP("App::Property", "Warnings of the file reader"),
-     None, _RO),
-    ("App::PropertyInteger", "Version", "Base",
-     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
-     VERSION, _HIDDEN),
-)
-
-_IN, _RES = "Compensation", "Result"
-COMPENSATION_PROPERTIES = (
-    ("App::PropertyLink", "Nominal", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Object holding the nominal face"),
-     None, 0),
-    ("App::PropertyString", "FaceName", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "The nominal face (FaceN of Nominal)"),
-     "Face1", 0),
-    ("App::PropertyLink", "Measurement", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Measurement object (SurfComp_Measurement)"),
-     None, 0),
-    ("App::PropertyLink", "Base", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Previous compensation (iterations): this measurement is "
-                                        "of the part machined from its corrected face; corrections"
-                                        " accumulate"),
-     None, 0),
-    ("App::PropertyEnumeration", "Method", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs "
-                                        "Stock), offset"),
-     list(METHODS), 0),
-    ("App::PropertyInteger", "MaskSize", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Odd size of the filter mask"),
-     5, 0),
-    ("App::PropertyString", "Weights", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Custom mask weights, rows separated by ';' (empty: "
-                                        "MaskKind and MaskSize)"),
-     "", 0),
-    ("App::PropertyEnumeration", "MaskKind", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Mask shape without custom weights"),
-     list(MASK_KINDS), 0),
-    ("App::PropertyFloat", "Sigma", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Gaussian sigma in grid steps (0: MaskSize / 4)"),
-     0.0, 0),
-    ("App::PropertyEnumeration", "Edge", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Edge handling of the filter"),
-     list(EDGE_MODES), 0),
-    ("App::PropertyLength", "Stock", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
-                                        "Stock / 2)"),
-     0.0, 0),
-    ("App::PropertyLength", "MaxOffset", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
-                                        "face"),
-     1.0, 0),
-    ("App::PropertyBool", "Flip", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "The file's normals point into the material: flip them and"
-                                        " the deviations' sign"),
-     False, 0),
-    ("App::PropertyInteger", "Refine", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
-                                        "step"),
-     4, 0),
-    ("App::PropertyEnumeration", "Output", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
-                                        " the face replaced and its neighbours re-trimmed to meet"
-                                        " it"),
-     list(OUTPUTS), 0),
-    ("App::PropertyEnumeration", "Layout", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "auto: a complete grid if the points form one, else "
-                                        "scattered; grid: refuse others"),
-     list(LAYOUTS), 0),
-    ("App::PropertyLength", "Smoothing", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Scattered points: smoothing length of the fit that "
-                                        "replaces the mask filter (0: chosen by generalized "
-                                        "cross-validation)"),
-     0.0, 0),
-    ("App::PropertyLength", "TipRadius", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Stylus ball radius when the measured points are tip "
-                                        "centres (probe logs)"),
-     0.0, 0),
-    ("App::PropertyBool", "Preview", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Filter preview (task panel): compute deviations and "
-                                        "components only and keep the last corrected shape; the "
-                                        "panel clears it when it closes"),
-     False, _HIDDEN),
-    ("App::PropertyInteger", "GridRows", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Rows of the measurement grid (scattered layouts: the "
-                                        "number of points)"),
-     0, _RO),
-    ("App::PropertyInteger", "GridCols", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Columns of the measurement grid (scattered layouts: 1)"),
-     0, _RO),
-    ("App::PropertyBool", "Scattered", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "The points are a scattered layout (not a grid): fields "
-                                        "are built over the points"),
-     False, _RO),
-    ("App::PropertyFloatList", "FieldScale", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Scattered layouts: mm per unit parameter along u and v "
-                                        "used by the fits"),
-     None, _RO),
-    ("App::PropertyFloatList", "U", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Face parameter u of every grid node (row-major)"),
-     None, _RO),
-    ("App::PropertyFloatList", "V", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Face parameter v of every grid node (row-major)"),
-     None, _RO),
-    ("App::PropertyFloatList", "Nodes", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Nominal point of every node, flat x y z (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "Normals", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Outward normal of every node, flat"),
-     None, _RO),
-    ("App::PropertyFloatList", "Deviation", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Deviation from the nominal at every node (mm, NaN = not "
-                                        "measured)"),
-     None, _RO),
-    ("App::PropertyFloatList", "Determined", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Filtered (determined) component of the deviation (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "Random", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Random component: deviation - determined (mm)"),
-     None, _RO),
-    ("App::PropertyFloatList", "Increment", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Correction of this round (mm); equals Correction without "
-                                        "a Base"),
-     None, _RO),
-    ("App::PropertyFloatList", "Correction", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Total correction realised by the corrected face (mm, "
-                                        "accumulated over the Base chain)"),
-     None, _RO),
-    ("App::PropertyString", "Statistics", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "name -> statistics (mm) as JSON"),
-     "{}", _RO),
-    ("App::PropertyString", "Checks", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Check figures of the corrected face (JSON)"),
-     "{}", _RO),
-    ("App::PropertyStringList", "Warnings", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "What the computation warned about"),
-     None, _RO),
-    ("App::PropertyInteger", "Round", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Iteration round (1 without a Base)"),
-     1, _RO),
-    ("App::PropertyLength", "EdgeTol", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Largest tolerance of the corrected face's edges and "
-                                        "vertices"),
-     0.0, _RO),
-    ("App::PropertyFloat", "VolumeChange", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Output solid: its volume minus the nominal's (mm^3; 0 for"
-                                        " a face)"),
-     0.0, _RO),
-    ("App::PropertyFloat", "CorrectionVolume", _RES,
-     QT_TRANSLATE_NOOP("App::Property", "Integral of the correction over the face (mm^3, positive"
-                                        " = material removed): the volume change should be minus"
-                                        " this"),
-     0.0, _RO),
-    ("App::PropertyString", "ReplacedLinks", "Replace",
-     QT_TRANSLATE_NOOP("App::Property", "Links rebound by surfcomp.app.replace.replace (JSON; "
-                                        "restore() reverts them)"),
-     "", _HIDDEN),
-    ("App::PropertyInteger", "Version", "Base",
-     QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
-     VERSION, _HIDDEN),
-)
 
 
 class _Proxy(Proxy):
