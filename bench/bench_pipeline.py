@@ -64,7 +64,7 @@ def run_case(nominal, meas, out_dir):
     from surfcomp.app import fcenv
 
     fcenv.import_freecad()
-    from surfcomp.app import job as jobmod
+    from surfcomp.app import file_route
 
     marks = {}
 
@@ -75,16 +75,16 @@ def run_case(nominal, meas, out_dir):
         if fraction >= 0.95:
             marks.setdefault("computed", time.perf_counter())
 
-    job = jobmod.Job(nominal=nominal, measurements=meas, output=os.path.join(out_dir, "c.step"))
+    job = file_route.Job(nominal=nominal, measurements=meas, output=os.path.join(out_dir, "c.step"))
     t0 = time.perf_counter()
-    comp, _ = jobmod.run_job(job, progress=progress)
+    comp, _ = file_route.run_job(job, progress=progress)
     t_end = time.perf_counter()
     times = {"read": marks["read"] - t0, "locate+grid": marks["located"] - marks["read"],
              "filter+surface+checks": marks["computed"] - marks["located"],
              "write STEP": t_end - marks["computed"], "whole job": t_end - t0}
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     t = time.perf_counter()
-    jobmod.run_job(jobmod.Job(nominal=nominal, measurements=meas,
+    file_route.run_job(file_route.Job(nominal=nominal, measurements=meas,
                               report=os.path.join(out_dir, "r.json"), command="inspect"))
     times["inspect + JSON report"] = time.perf_counter() - t
     print(json.dumps({"points": int(comp.prepared.u.size), "grid": list(comp.prepared.grid.shape),

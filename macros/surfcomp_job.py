@@ -19,7 +19,7 @@ def _main():
     root = os.path.dirname(here)
     if root not in sys.path:
         sys.path.insert(0, root)
-    from surfcomp.app.job import load_job_file, run_job
+    from surfcomp.app.file_route import load_job_file, run_job
     from surfcomp.cli.common import ProgressLine, print_summary
     from surfcomp.errors import SurfcompError
 

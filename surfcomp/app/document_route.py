@@ -26,7 +26,7 @@ from ..core.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
-from . import cam, features, pathjob
+from . import cam, cam_job, features
 from .documents import open_document, restore_failures
 
 
@@ -65,7 +65,7 @@ def _find_object(doc, name, source):
 
 def _jobs_using(doc, comp):
     jobs = []
-    for job in pathjob.jobs_of(doc):
+    for job in cam_job.jobs_of(doc):
         if any(comp in list(getattr(c, "Objects", []) or []) or c is comp for c in job.Model.Group):
             jobs.append(job)
     return jobs
@@ -159,12 +159,12 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         _recompute(doc)
         jobs = _jobs_using(doc, comp)
         result.jobs = [j.Name for j in jobs]
-        result.operations = [op.Name for j in jobs for op in pathjob.operations_of(j)]
+        result.operations = [op.Name for j in jobs for op in cam_job.operations_of(j)]
         text = None
         if gcode:
             job = _one_job(jobs, job_name)
             report(progress, 0.9, "post-processing %s with %s" % (job.Label, post))
-            text = pathjob.post_process(job, post, post_args)
+            text = cam_job.post_process(job, post, post_args)
         result.statistics = json.loads(comp.Statistics)
         result.checks = json.loads(comp.Checks)
         result.warnings = list(comp.Warnings)

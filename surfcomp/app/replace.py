@@ -359,7 +359,7 @@ def summary(doc, comp):
         if item["object"] not in names:
             names.append(item["object"])
     objs = [doc.getObject(n) for n in names if doc.getObject(n) is not None]
-    from .pathjob import jobs_of
+    from .cam_job import jobs_of
 
     jobs = []
     for job in jobs_of(doc):

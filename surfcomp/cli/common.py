@@ -70,8 +70,8 @@ def add_method_options(p):
 
 
 def job_from_args(args, command):
-    """The :class:`surfcomp.app.job.Job` of a ``compensate``/``inspect`` command line."""
-    from ..app.job import Job
+    """The :class:`surfcomp.app.file_route.Job` of a ``compensate``/``inspect`` command line."""
+    from ..app.file_route import Job
 
     outputs = {k: getattr(args, k, None) for k in ("output", "report", "points", "curves", "html")}
     return Job(nominal=args.nominal, measurements=args.measurements, command=command,
@@ -82,7 +82,7 @@ def job_from_args(args, command):
 
 def run_job_command(args, command):
     """Run a job command line: progress on stderr, the summary, the files written."""
-    from ..app.job import run_job
+    from ..app.file_route import run_job
 
     job = job_from_args(args, command)
     comp, rep = run_job(job, progress=ProgressLine(args.quiet))

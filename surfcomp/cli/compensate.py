@@ -72,7 +72,7 @@ def run_document(args):
     from ..app import fcenv
 
     fcenv.import_freecad()
-    from ..app.docjob import run_document_job, summary_lines
+    from ..app.document_route import run_document_job, summary_lines
 
     res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,
                            save=args.save, replace=args.replace, gcode=args.gcode,

@@ -8,7 +8,8 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import cam, docjob, documents, features, pathjob
+from surfcomp.app import cam, cam_job, documents, features
+from surfcomp.app.document_route import run_document_job
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.pipeline import Options
 from surfcomp.errors import InputError, MeasurementFileError
@@ -31,15 +32,15 @@ def shop(tmp_path_factory):
     doc = FreeCAD.newDocument("shop")
     solid = block_solid()
     add_part(doc, solid, "Block")
-    job = pathjob.create_job(doc, [doc.getObject("Block")])
-    tc = pathjob.ball_end_tool_controller(job, 6.0)
-    op = pathjob.surface_operation(job, doc.getObject("Block"), ["Face2"], tc, step_over=100.0,
+    job = cam_job.create_job(doc, [doc.getObject("Block")])
+    tc = cam_job.ball_end_tool_controller(job, 6.0)
+    op = cam_job.surface_operation(job, doc.getObject("Block"), ["Face2"], tc, step_over=100.0,
                                    sample_interval=2.0, linear_deflection=0.005)
     doc.recompute()
-    pathjob.model_clone(job, doc.getObject("Block")).touch()   # settle Path's stock box
+    cam_job.model_clone(job, doc.getObject("Block")).touch()   # settle Path's stock box
     doc.recompute()
-    cl = pathjob.cutter_locations(op)
-    gcode = pathjob.post_process(job, "linuxcnc", POST_ARGS)
+    cl = cam_job.cutter_locations(op)
+    gcode = cam_job.post_process(job, "linuxcnc", POST_ARGS)
     path = str(tmp / "shop.FCStd")
     doc.saveAs(path)
     FreeCAD.closeDocument(doc.Name)
@@ -53,9 +54,9 @@ def shop(tmp_path_factory):
 def test_update_a_shop_document(shop, tmp_path):
     digest = sha(shop["doc"])
     out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
-    res = docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2", save=out,
-                                  replace=True, gcode=ngc, post="linuxcnc", post_args=POST_ARGS,
-                                  options=Options(refine=1))
+    res = run_document_job(shop["doc"], shop["meas"], "Block", face="Face2", save=out,
+                           replace=True, gcode=ngc, post="linuxcnc", post_args=POST_ARGS,
+                           options=Options(refine=1))
     assert sha(shop["doc"]) == digest                       # the input is untouched
     assert res.saved == out and res.gcode == ngc and res.jobs == ["Job"]
     assert res.operations == ["Surface"] and res.replaced == [("Clone", "Objects")]
@@ -73,7 +74,7 @@ def test_update_a_shop_document(shop, tmp_path):
         assert len(clone.Shape.Faces) == 6 and clone.Shape.isValid()
         op = doc.getObject("Surface")
         assert op.Base == [(clone, ("Face2",))]
-        cl = pathjob.cutter_locations(op)
+        cl = cam_job.cutter_locations(op)
         # the regenerated path went down where the correction removes material (t > 0)
         assert abs(len(cl) - len(shop["cl"])) <= 0.05 * len(cl)
         corr = np.asarray(comp.Correction)
@@ -88,17 +89,17 @@ def test_update_a_shop_document(shop, tmp_path):
     # the written program is the saved document's program (FreeCAD stores paths with
     # fewer digits, so a last 4th decimal may differ by one)
     text = open(ngc).read()
-    again = pathjob_gcode_of(out)
+    again = cam_gcode_of(out)
     np.testing.assert_allclose(g1_points(text), g1_points(again), atol=1.01e-4)
     assert [s for s in text.splitlines() if not s.startswith("G1 ")] == \
         [s for s in again.splitlines() if not s.startswith("G1 ")]
     assert text != shop["gcode"] and text.count("\nG1 ") > 50
 
 
-def pathjob_gcode_of(path):
+def cam_gcode_of(path):
     doc = FreeCAD.openDocument(path)
     try:
-        return pathjob.post_process(doc.getObject("Job"), "linuxcnc", POST_ARGS)
+        return cam_job.post_process(doc.getObject("Job"), "linuxcnc", POST_ARGS)
     finally:
         FreeCAD.closeDocument(doc.Name)
 
@@ -107,10 +108,10 @@ def test_never_overwrites_the_input(shop, tmp_path):
     digest = sha(shop["doc"])
     with pytest.raises(InputError,
                        match=r"--save would overwrite the input document \(--overwrite-input"):
-        docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
-                                save=shop["doc"])
+        run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                         save=shop["doc"])
     with pytest.raises(InputError, match="need --save"):
-        docjob.run_document_job(shop["doc"], shop["meas"], "Block", face="Face2")
+        run_document_job(shop["doc"], shop["meas"], "Block", face="Face2")
     assert sha(shop["doc"]) == digest
     assert FreeCAD.listDocuments() == {}
 
@@ -119,11 +120,11 @@ def test_bad_measurements_write_nothing(shop, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("x_nom,y_nom,z_nom,i,j,k,dev\n1,2,3,0,0,1,0.01\n1,2,abc,0,0,1,0.02\n")
     with pytest.raises(MeasurementFileError, match=r"bad.csv:3"):
-        docjob.run_document_job(shop["doc"], str(bad), "Block", face="Face2",
-                                save=str(tmp_path / "o.FCStd"), gcode=str(tmp_path / "o.ngc"))
+        run_document_job(shop["doc"], str(bad), "Block", face="Face2",
+                         save=str(tmp_path / "o.FCStd"), gcode=str(tmp_path / "o.ngc"))
     assert sorted(os.listdir(tmp_path)) == ["bad.csv"]
     with pytest.raises(Exception, match="no object 'Nope'"):
-        docjob.run_document_job(shop["doc"], shop["meas"], "Nope", save=str(tmp_path / "o.FCStd"))
+        run_document_job(shop["doc"], shop["meas"], "Nope", save=str(tmp_path / "o.FCStd"))
     assert FreeCAD.listDocuments() == {}
 
 
@@ -162,7 +163,7 @@ def test_refuses_a_document_whose_objects_did_not_restore(shop, tmp_path, monkey
     with pytest.raises(InputError, match=r"1 object\(s\) did not restore.*Thing "
                                          r"\(App::FeaturePython, label 'Thing'\): its Python "
                                          r"proxy was not restored"):
-        docjob.run_document_job(broken, shop["meas"], "Block", face="Face2", save=str(out))
+        run_document_job(broken, shop["meas"], "Block", face="Face2", save=str(out))
     assert not out.exists()
     assert FreeCAD.listDocuments() == {}
 
@@ -185,7 +186,7 @@ def test_the_batch_command_line(shop, tmp_path):
     assert "regenerated: Surface" in run.stdout and "wrote %s" % out in run.stdout
     assert sha(shop["doc"]) == digest
     # the same program as the library route of test_update_a_shop_document
-    np.testing.assert_allclose(g1_points(ngc.read_text()), g1_points(pathjob_gcode_of(str(out))),
+    np.testing.assert_allclose(g1_points(ngc.read_text()), g1_points(cam_gcode_of(str(out))),
                                atol=1.01e-4)
     assert ngc.read_text() != shop["gcode"]
     # files and the document route do not mix; the input is refused as output

@@ -11,7 +11,7 @@ import Part
 import pytest
 
 from surfcomp.app import features, reports
-from surfcomp.app.job import corrected_face
+from surfcomp.app.file_route import corrected_face
 from surfcomp.app.nominal import load_nominal, nominal_from_face
 from surfcomp.core.corrected import realised_correction
 from surfcomp.core.filters import make_mask, mask_filter

@@ -23,7 +23,7 @@ DOCS = os.path.join(ROOT, "tests", "data", "documents")
 SCRIPT = r"""
 import json, os, sys
 sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
-from surfcomp.app import cam, documents, pathjob
+from surfcomp.app import cam, documents, cam_job
 cam.setup_workbench()
 path = os.environ["SURFCOMP_DOC"]
 doc, unimportable, info = documents.open_document(path)
@@ -60,11 +60,11 @@ out.update({
     "tolerance2": max(e.Tolerance for e in r2.Shape.Edges),
     "volume_change2": r2.VolumeChange, "correction_volume2": r2.CorrectionVolume,
     "op_base": [[o.Name, list(s)] for o, s in op.Base],
-    "cl": pathjob.cutter_locations(op).tolist(),
+    "cl": cam_job.cutter_locations(op).tolist(),
     "dressup": {"base": d.Base.Name, "commands": len(d.Path.Commands),
                 "error_before": float(d.ErrorBefore), "error_after": float(d.ErrorAfter),
                 "max_correction": float(d.MaxCorrection)},
-    "gcode": pathjob.post_process(doc.getObject("Job"), "linuxcnc",
+    "gcode": cam_job.post_process(doc.getObject("Job"), "linuxcnc",
                                   "--no-show-editor --no-header --precision=4")})
 print("RESULT " + json.dumps(out))
 sys.stdout.flush()

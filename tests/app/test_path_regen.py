@@ -19,7 +19,7 @@ import numpy as np
 import Part
 import pytest
 
-from surfcomp.app import cam, features, pathjob, replace, reports
+from surfcomp.app import cam, cam_job, features, replace, reports
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.corrected import realised_correction
 from surfcomp.core.projection import project
@@ -77,9 +77,9 @@ def regenerated():
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)
     doc.recompute()
-    job = pathjob.create_job(doc, [nom])
-    tc = pathjob.ball_end_tool_controller(job, 2 * R)
-    op = pathjob.surface_operation(job, nom, ["Face1"], tc, step_over=50.0, sample_interval=1.0,
+    job = cam_job.create_job(doc, [nom])
+    tc = cam_job.ball_end_tool_controller(job, 2 * R)
+    op = cam_job.surface_operation(job, nom, ["Face1"], tc, step_over=50.0, sample_interval=1.0,
                                    linear_deflection=0.001)
     m = features.make_measurement(doc, EXAMPLE_CSV)
     comp = features.make_compensation(doc, nom, "Face1", m)
@@ -88,15 +88,15 @@ def regenerated():
     # Path's stock follows the model clones' bounding boxes, which become tight once the
     # operation has meshed the clone (OCCT then bounds the triangulation): settle it now,
     # so that only the compensation changes the program
-    pathjob.model_clone(job, nom).touch()
+    cam_job.model_clone(job, nom).touch()
     doc.recompute()
-    before = {"cl": pathjob.cutter_locations(op),
-              "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
+    before = {"cl": cam_job.cutter_locations(op),
+              "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
               "state": list(op.State), "nominal": nom.Shape.copy()}
     links = replace.replace(doc, comp)
     doc.recompute()
-    after = {"cl": pathjob.cutter_locations(op),
-             "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
+    after = {"cl": cam_job.cutter_locations(op),
+             "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
              "invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in o.State],
              "links": links}
     yield doc, nom, comp, job, op, before, after
@@ -106,7 +106,7 @@ def regenerated():
 def test_replace_regenerates_the_operation(regenerated):
     doc, nom, comp, job, op, before, after = regenerated
     assert before["state"] == ["Up-to-date"] and after["invalid"] == []
-    clone = pathjob.model_clone(job, comp)
+    clone = cam_job.model_clone(job, comp)
     assert clone is not None and clone.Objects == [comp]
     assert after["links"] == [(clone.Name, "Objects")]
     assert op.Base == [(clone, ("Face1",))]
@@ -174,7 +174,7 @@ def test_restore_brings_the_nominal_tool_path_back(regenerated):
     doc, nom, comp, job, op, before, after = regenerated
     replace.restore(doc, comp)
     doc.recompute()
-    clone = pathjob.model_clone(job, nom)
+    clone = cam_job.model_clone(job, nom)
     assert clone.Objects == [nom] and nom.Visibility is True
-    np.testing.assert_allclose(pathjob.cutter_locations(op), before["cl"], atol=1e-9)
-    assert pathjob.post_process(job, "linuxcnc", POST_ARGS) == before["gcode"]
+    np.testing.assert_allclose(cam_job.cutter_locations(op), before["cl"], atol=1e-9)
+    assert cam_job.post_process(job, "linuxcnc", POST_ARGS) == before["gcode"]

@@ -16,7 +16,7 @@ import FreeCAD
 import numpy as np
 import pytest
 
-from surfcomp.app import cam, documents, features, pathjob, replace
+from surfcomp.app import cam, cam_job, documents, features, replace
 from surfcomp.app.nominal import nominal_from_face
 from tests.app.helpers import grid_on_face, write_cmm_csv
 from tests.app.test_features import add_part, block_solid, error_model
@@ -32,7 +32,7 @@ cam.setup_ocl()                   # before opening: the 3D Surface op imports oc
 import FreeCAD
 path = os.environ["SURFCOMP_DOC"]
 doc = FreeCAD.openDocument(path)
-from surfcomp.app import documents, features, pathjob
+from surfcomp.app import documents, features, cam_job
 
 def poles(shape, k):
     return [[tuple(p) for p in row] for row in shape.Faces[k].Surface.getPoles()]
@@ -52,8 +52,8 @@ out.update({"invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "
             "poles2": poles(doc.getObject("Round2").Shape, 1),
             "correction2": list(doc.getObject("Round2").Correction),
             "versions": [doc.getObject(n).Version for n in ("Round1", "Round2", "Meas1")],
-            "cl": pathjob.cutter_locations(op).tolist(),
-            "gcode": pathjob.post_process(job, "linuxcnc", os.environ["SURFCOMP_POST_ARGS"])})
+            "cl": cam_job.cutter_locations(op).tolist(),
+            "gcode": cam_job.post_process(job, "linuxcnc", os.environ["SURFCOMP_POST_ARGS"])})
 print("RESULT " + json.dumps(out))
 sys.stdout.flush()
 os._exit(0)
@@ -82,9 +82,9 @@ def saved(tmp_path_factory):
     c1 = features.make_compensation(doc, nom, "Face2", m1, output="solid", name="Round1")
     c2 = features.make_compensation(doc, nom, "Face2", m2, base=c1, output="solid", name="Round2")
     c1.Refine = c2.Refine = 1
-    job = pathjob.create_job(doc, [nom])
-    tc = pathjob.ball_end_tool_controller(job, 6.0)
-    op = pathjob.surface_operation(job, nom, ["Face2"], tc, step_over=100.0, sample_interval=2.0,
+    job = cam_job.create_job(doc, [nom])
+    tc = cam_job.ball_end_tool_controller(job, 6.0)
+    op = cam_job.surface_operation(job, nom, ["Face2"], tc, step_over=100.0, sample_interval=2.0,
                                    linear_deflection=0.005)
     doc.recompute()
     replace.replace(doc, c2)
@@ -93,8 +93,8 @@ def saved(tmp_path_factory):
     path = str(tmp / "shop.FCStd")
     doc.saveAs(path)
     before = {"poles1": _poles(c1.Shape, 1), "poles2": _poles(c2.Shape, 1),
-              "correction2": list(c2.Correction), "cl": pathjob.cutter_locations(op),
-              "gcode": pathjob.post_process(job, "linuxcnc", POST_ARGS),
+              "correction2": list(c2.Correction), "cl": cam_job.cutter_locations(op),
+              "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
               "objects": {o.Name for o in doc.Objects}}
     FreeCAD.closeDocument(doc.Name)
     os.unlink(csv1)

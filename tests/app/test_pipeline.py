@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.app.job import Job, run_job
+from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import load_nominal
 from surfcomp.core.corrected import dense_parameters, realised_correction
 from surfcomp.core.pipeline import Options

@@ -19,7 +19,7 @@ import pytest
 
 from surfcomp.app import features
 from surfcomp.app.convert import surface_from_part, surface_to_part
-from surfcomp.app.job import Job, run_job
+from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import boundary_polylines, nominal_from_face
 from surfcomp.app.shapes import corrected_shape
 from surfcomp.core import bspline

@@ -37,7 +37,7 @@ FreeCAD = fcenv.import_freecad()
 
 import numpy as np  # noqa: E402
 
-from surfcomp.app import cam, dressup_axis, features, pathjob, replace  # noqa: E402
+from surfcomp.app import cam, dressup_axis, features, cam_job, replace  # noqa: E402
 from surfcomp.app.nominal import nominal_from_face  # noqa: E402
 from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine  # noqa: E402
 from tests.app.helpers import grid_on_face, write_cmm_csv  # noqa: E402
@@ -72,9 +72,9 @@ def main():
     c2 = features.make_compensation(doc, block, "Face2", m2, base=c1, output="solid",
                                     name="Round2")
     c1.Refine = c2.Refine = 1
-    job = pathjob.create_job(doc, [block])
-    tc = pathjob.ball_end_tool_controller(job, 6.0)
-    op = pathjob.surface_operation(job, block, ["Face2"], tc, step_over=100.0,
+    job = cam_job.create_job(doc, [block])
+    tc = cam_job.ball_end_tool_controller(job, 6.0)
+    op = cam_job.surface_operation(job, block, ["Face2"], tc, step_over=100.0,
                                    sample_interval=3.0, linear_deflection=0.01)
     doc.recompute()
     replace.replace(doc, c2)
@@ -92,7 +92,7 @@ def main():
         "objects": sorted(o.Name for o in doc.Objects),
         "poles_shape": [np.shape(poles(c.Shape, 1)) for c in (c1, c2)],
         "correction2": list(c2.Correction),
-        "cl": pathjob.cutter_locations(op).tolist(),
+        "cl": cam_job.cutter_locations(op).tolist(),
         "faces": len(c2.Shape.Faces), "volume2": c2.Shape.Volume,
         "dressup": {"base": dressup.Base.Name, "commands": len(dressup.Path.Commands),
                     "error_before": float(dressup.ErrorBefore), "error_after": float(dressup.ErrorAfter),
