@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # surfcomp: the workbench class (FreeCAD executes this file when the GUI starts).
 # The GUI modules are imported lazily in Initialize, so start-up stays fast; resource
 # paths come from surfcomp.paths (this file is exec'd: no __file__ here).

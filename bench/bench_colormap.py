@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """How fast a colour map appears in the FreeCAD GUI for a 200 x 200 measurement grid.
 
     xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 bench/bench_colormap.py

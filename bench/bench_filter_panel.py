@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """How fast the filter task panel redraws the live map after a change, on the example's
 45 x 45 grid (issue 13: within 0.3 s).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Speed of the G-code axis error compensation on CAMotics' bear.nc (15163 lines).
 
     /usr/bin/python3 bench/bench_gcode.py [--repeat 3] [--segment-length 2]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """End-to-end benchmark of ``compensate``: the bundled example and n x n grids up to 1000 x 1000.
 
     /usr/bin/python3 bench/bench_pipeline.py [--sizes 45,200,500,1000] [--rotated 500,1000]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Throughput of surfcomp's point projection against FreeCAD's Inspection feature.
 
 Run: /usr/bin/python3 bench/bench_projection.py [--points N] [--fc-points M] [--workers W]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Scan scale: inspect and compensate on scattered points, projection on a real blade face,
 each figure next to its reference measured in the same run.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Virtual machining: every preset's time and the paper's table beside the simulated one,
 then the papers' table on the bundled example's face.
 

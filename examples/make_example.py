@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Generate the bundled example (reproducible: fixed seed; run from the repository root).
 
     /usr/bin/python3 examples/make_example.py

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Run a surfcomp job file inside ``freecadcmd`` (the FreeCAD route of the batch CLI).
 
     SURFCOMP_JOB=job.json freecadcmd macros/surfcomp_job.py

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """surfcomp: machining-error compensation of free-form B-spline surfaces.
 
 Layers (imports point downwards only): ``gui`` -> ``app`` -> ``io``/``core``.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The one exception hierarchy of surfcomp (pure Python, no FreeCAD)."""
 
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Paths of the addon's resources (computed here, never in Init files: those are exec'd)."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Shared test set-up: the repository root on sys.path and the path to the real test data."""
 
 import os

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The long fuzz run before a release: every bad-input case of tests/fuzz and the
 # property-based layer with many random (not derandomized) examples per property.
 #   bash tools/fuzz.sh                 2000 examples per property (about 10 minutes)

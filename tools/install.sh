@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Install everything surfcomp needs on Debian 12 (FreeCAD 0.20), Debian 13 (FreeCAD 1.0) or
 # Debian testing/sid (FreeCAD 1.1); run as root. Idempotent: a second run skips what is
 # installed. Used by the README's two commands, by .ci/run and inside the version matrix.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # The version matrix: run the README's command 2 (install everything, run every test) on
 # each FreeCAD that users have, and print one summary line per FreeCAD version.
 #

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Run the lint gate and the whole test suite: pure, FreeCAD headless and GUI (under Xvfb).
 # Arguments go to pytest (e.g. tests/pure); the lint gate runs only for a full run.
 set -euo pipefail

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Print the versions surfcomp runs on: FreeCAD, Python, numpy, scipy, OpenCamLib, Qt and
 the branches the version adapter (surfcomp.app.cam) takes. One line, for install.sh, the
 version matrix and bug reports.

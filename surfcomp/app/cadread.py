@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Read a user's STEP/IGES/BREP file in a child process, so a damaged file cannot take ours down.
 
 OpenCASCADE's STEP reader segfaults on some damaged files (a STEP with one entity line

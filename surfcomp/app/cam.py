@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The one place that knows how FreeCAD versions differ: Path (0.20) versus CAM (1.0, 1.1).
 
 Every branch is chosen by looking at what the installed FreeCAD has, never by parsing its

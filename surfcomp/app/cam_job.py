@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """CAM helpers: a Job with a 3D Surface finishing operation, post-processing to text.
 
 Written once for every FreeCAD version: what differs between 0.20 (``PathScripts.*``)

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Conversion between ``Part.BSplineSurface`` and :class:`surfcomp.core.bspline.Surface`."""
 
 import numpy as np

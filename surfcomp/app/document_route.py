@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The batch route on a shop document: compensate a face in an FCStd, replace the nominal,
 let Path regenerate, save a new document and (optionally) post the G-code.
 

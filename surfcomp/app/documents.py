@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Open a user's FreeCAD document (.FCStd) safely, on every route that reads one.
 
 - ``Document.xml`` is checked before FreeCAD sees it (:mod:`surfcomp.io.fcstd`: size limits,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Path dressup: compensate the machine's axis errors on every move of a base operation.
 
 A thin proxy in the manner of Path's own dressups (``PathDressupPathBoundary``): the proxy

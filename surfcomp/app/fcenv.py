@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Make FreeCAD importable from a plain ``python3`` and set up what ``freecadcmd`` sets up.
 
 Importing FreeCAD as a library (``/usr/bin/python3`` with the FreeCAD lib folder on

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Document objects of the compensation: a measurement object and the compensation feature.
 
 Both are thin proxies (see docs/architecture.md, "Document objects"): every input and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """One batch job: nominal face + measurement file -> corrected face (STEP), report (JSON).
 
 Shared by ``python3 -m surfcomp compensate|inspect`` and the ``freecadcmd`` job macro.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Load the nominal face from STEP/IGES/BREP or an FCStd document (app layer, headless).
 
 The nominal is never modified: everything here works on copies.

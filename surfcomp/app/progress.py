@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """FreeCAD's progress indicator as a core ``progress(fraction, message)`` callback.
 
 In the GUI it drives the status bar's progress bar (Esc interrupts: the callback raises

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """What every surfcomp document-object proxy shares (STYLE: state lives in properties).
 
 A property table is a tuple of ``(type, name, group, tooltip, default, editor_mode)``;

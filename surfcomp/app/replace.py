@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Replace the nominal by the compensation in the document, and restore it.
 
 :func:`replace` rebinds every object that uses the nominal (a Path Job's model clone,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Queries on a computed compensation object: its node values and C1 fields per quantity
 (the one source of the GUI's colour maps and the reports), the corrected surface, and the
 JSON/HTML reports as the command line writes them.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Where a corrected face meets its neighbours in a solid or shell: the geometry of a CAD
 system's "replace face" (app layer; Part surfaces and curves, numpy for the small solves).
 

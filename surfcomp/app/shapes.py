@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The one face builder: the corrected face (and the nominal's shape with it) for every
 route - the command line's ``-o``, the freecadcmd job, the document features and the GUI.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """One undo step: a FreeCAD document transaction that is committed, or aborted on any error.
 
 The one transaction helper of surfcomp (commands, task panels, replace/restore)::

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The volume a replaced face adds to or removes from its solid, and the correction's integral.
 
 OCCT's default volume integration (``Shape.Volume``) is off by about 1e-4 of the volume on

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Command-line front end: ``python3 -m surfcomp <command> ...``.
 
 Each subcommand lives in its own module of this package with two functions,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Options and printing shared by the CLI subcommands."""
 
 import sys

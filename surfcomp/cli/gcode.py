@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp gcode``: compensate a G-code program for machine-axis errors.
 
 Dobariya et al. 2015: per-axis error measurements -> 1-D linear/quadratic error functions

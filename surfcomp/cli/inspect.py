@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp inspect``: deviations and statistics only."""
 
 from .common import add_input_options, run_job_command

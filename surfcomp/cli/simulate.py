@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp simulate``: virtual machining loop before cutting metal.
 
 For every method and replica: machine a part (a semi-finishing and a finishing pass)

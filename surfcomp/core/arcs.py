@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Circular and helical arcs of G2/G3 moves: centres, points, chord counts (no FreeCAD).
 
 An arc lies in one of three planes, named by their G code: ``17`` (XY), ``18`` (ZX) and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The three linear axes of a 3-axis machine: names and point arrays (no FreeCAD)."""
 
 import numpy as np

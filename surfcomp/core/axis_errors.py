@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Geometric error model of a 3-axis machine and its compensation (Dobariya et al. 2015).
 
 The model (Dobariya 2015, eq. 6-16)

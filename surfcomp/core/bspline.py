@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """B-spline surfaces as plain numpy arrays (no FreeCAD).
 
 The app layer converts ``Part.BSplineSurface`` to and from :class:`Surface`

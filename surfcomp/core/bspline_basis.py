@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """B-spline basis functions on one flat knot vector (no FreeCAD).
 
 Knot spans, the non-zero basis functions and their derivatives, sparse

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Fitting B-spline surfaces and refining knot vectors (no FreeCAD).
 
 Interpolation and least-squares fits of point grids in a given tensor-product

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Colour mapping of deviation values for the GUI's maps (numpy only, no FreeCAD, no Qt).
 
 The GUI draws a value field (mm) on a face; everything numeric about that drawing

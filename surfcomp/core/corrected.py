@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The corrected B-spline surface and its check figures (no FreeCAD).
 
 Construction (why not the papers' interpolation through the corrected points:

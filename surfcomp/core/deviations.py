@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Deviations along the nominal normal and their statistics (no FreeCAD).
 
 Sign convention (as CMM reports and Werner 2022): a positive deviation means the

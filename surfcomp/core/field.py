@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Smooth correction fields over the face's (u, v), built on the measurement grid (no FreeCAD).
 
 The measured nodes form an n x m grid in index space (s, t) = (i, j), each node

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Image-style mask filters on the n x m deviation grid (Werner 2022, eq. 3-5).
 
 The filtered value at node (i, j) is the weighted sum of the deviations in the

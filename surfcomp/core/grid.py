@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Arrange measured points on their n x m measurement grid (no FreeCAD).
 
 A grid is an index array ``index[i, j]`` -> point number, oriented so that the

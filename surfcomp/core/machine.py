@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """A 3-axis machine with known geometric errors, to validate a compensation (no FreeCAD).
 
 It stands in for the real machine in tests and benchmarks: it moves the tool by the error

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Correction methods: the intended correction at every measured point (no FreeCAD).
 
 The corrected surface is ``S_c(u, v) = S(u, v) - delta(u, v) n(u, v)``: a positive

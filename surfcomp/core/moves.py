@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Move planning for the axis error compensation: sample, compensate and split moves.
 
 Works on the moves of a program as arrays (no FreeCAD, no G-code text): any object with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The compensation pipeline on core arrays (no FreeCAD): measurement set + nominal surface
 -> deviations, statistics, filtered components, intended corrections, corrected surface.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Plausibility of measured deviations before they reach a compensation (no FreeCAD).
 
 Two checks, shared by the command line (through :func:`surfcomp.core.pipeline.prepare`)

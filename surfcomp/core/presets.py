@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Named virtual-machining cases that imitate the seed papers (no FreeCAD).
 
 A preset is a nominal surface (built here as a core :class:`~surfcomp.core.bspline.Surface`,

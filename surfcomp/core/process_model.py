@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The machining-process model of virtual machining: where a pass leaves the surface (no FreeCAD).
 
 Two passes, one CAM surface

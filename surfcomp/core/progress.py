@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Progress reporting and cancellation for long core steps (no FreeCAD).
 
 Core functions that can take long accept ``progress=None``: a callable

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Orthogonal projection of points onto a B-spline face (no FreeCAD).
 
 Method: a dense sample grid of the face (:func:`bspline.evaluate_grid` with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Evaluation and Newton iterations of point projection (no FreeCAD).
 
 The machinery under :class:`surfcomp.core.projection.Projector`: a per-span

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Per-region certificate that a projected foot point is the global one (no FreeCAD).
 
 A foot point ``F`` found by Newton's method is a local minimum of ``|S - P|``; with

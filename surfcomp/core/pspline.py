@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Penalised cubic tensor B-spline smoothing of scattered values ("P-spline", no FreeCAD).
 
 The large-N branch of :func:`surfcomp.core.scattered_fit.smooth`: minimise

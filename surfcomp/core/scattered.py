@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Deviation fields from scattered (non-grid) points over the face's (u, v) (no FreeCAD).
 
 The scattered counterparts of the grid path's mask filter and correction field, in two

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """C1 field through values at scattered points over the face's (u, v) (no FreeCAD).
 
 The scattered counterpart of the grid path's correction field

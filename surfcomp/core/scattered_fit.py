@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Smoothing fit of scattered deviations over the face's (u, v) (no FreeCAD).
 
 The scattered counterpart of the grid path's mask filter

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Tables of virtual machining: spread over replicas, the papers' table form, and the
 papers' published values beside the simulated ones (no FreeCAD).
 

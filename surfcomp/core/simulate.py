@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Virtual machining: see what a compensation does before cutting metal (no FreeCAD).
 
 The loop of the papers (Werner 2022 Tab. 1-5; mirror paper 2019 Tab. 2-4, 4 replicas),

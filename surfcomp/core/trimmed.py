@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Integrals over a trimmed face: the parameter domain bounded by the face's wires.
 
 Pure numpy (no FreeCAD): the app layer gives the boundary as polylines in (u, v), one per

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """(u, v) points of a scattered layout: scaling and the checks every scattered fit needs.
 
 Shared by the smoothing fit (:mod:`surfcomp.core.scattered_fit`) and the

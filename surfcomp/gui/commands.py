@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The workbench's commands (ids ``SurfComp_<Verb><Noun>``).
 
 One base class, :class:`Command`, carries the boilerplate: resources (icon named after

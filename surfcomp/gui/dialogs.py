@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The workbench's modal questions and messages, in one place.
 
 Commands never call Qt dialogs directly: they call these functions, so scripts and the

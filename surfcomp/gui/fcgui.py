@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """What differs between FreeCAD 0.20, 1.0 and 1.1 in the GUI, detected, in one place.
 
 - the navigation cube: 0.20 keeps its corner under ``Preferences/View``, 1.x under

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The histogram panel: the distribution of the shown map's measured values, each bar
 coloured like the legend (same scheme, range, steps or tolerance band), with the counts
 beyond the range at both ends. A dock widget beside the 3D view (FreeCAD GUI only).

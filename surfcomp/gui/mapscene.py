@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Coin scene of a colour map: coloured face mesh, coloured point markers, labels at the
 extremes and a colour-bar legend drawn over the 3D view (FreeCAD GUI only).
 

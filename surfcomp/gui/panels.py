@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Task panels and dialogs of the workbench: filter panel, report (the import preview is
 in :mod:`surfcomp.gui.preview`).
 

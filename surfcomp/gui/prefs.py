@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """User preferences of the SurfComp workbench: group, keys, typed getters with defaults.
 
 The preferences page (``resources/ui/preferences.ui``) writes the same keys with

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The import preview: what a measurement file holds, before anything enters the document.
 
 Sample rows, the value ranges in the unit chosen for columns without a unit of their own,

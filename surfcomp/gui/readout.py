@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Point readout on the colour maps: hovering shows the values of the nearest measured
 point in the status bar; a click flags that point on the map (``Flags`` of the view,
 saved with the document) or removes its flag.

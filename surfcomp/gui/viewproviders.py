@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """View providers of the surfcomp document objects (FreeCAD GUI only).
 
 ``ViewProviderCompensation`` adds the display mode ``Map``: the chosen quantity

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Output files that are written together or not at all, and never over an input.
 
 Every command declares its inputs and outputs before it does any work

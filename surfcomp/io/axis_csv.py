@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Per-axis error measurement files (no FreeCAD): the input of the axis error model.
 
 Two layouts are read; the first non-blank, non-comment line tells which.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Look inside a FreeCAD document (.FCStd) before FreeCAD opens it (no FreeCAD needed).
 
 An FCStd is a zip archive whose ``Document.xml`` lists the objects and the Python modules

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Reading input files: the one place that turns an unreadable file into the project's error."""
 
 from ..errors import MeasurementFileError

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """SHA-256 of input files for reports."""
 
 import hashlib

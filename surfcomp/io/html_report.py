@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """One self-contained HTML inspection report per compensation (no FreeCAD).
 
 Input: the JSON report dict of :func:`surfcomp.io.report.build_report` (schema

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Measurement files: nominal points, measured points, normals and deviations (no FreeCAD).
 
 A measurement file is a text table with one row per measured point, as CMM software

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Readers for measurement files that carry measured points only (no FreeCAD).
 
 Formats

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """QIF 3.0 measurement results (ISO 23952): surface points with nominal, normal, actual
 and the file's own deviations (no FreeCAD).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """One entry point for every measurement file format (no FreeCAD).
 
 QIF, PC-DMIS XYZIJK and LinuxCNC probe logs are recognised by their content

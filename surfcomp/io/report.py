@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The JSON report of a compensation or inspection (schema in README.md, "JSON report").
 
 Pure: takes core results and plain input descriptions, returns JSON-able dicts.

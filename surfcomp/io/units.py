@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Length units in column names and options (no FreeCAD).
 
 Every value inside surfcomp is in millimetres; files and options may use other

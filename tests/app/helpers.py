@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Shared helpers of the FreeCAD-headless tests: synthetic measurement files on real faces."""
 
 import os

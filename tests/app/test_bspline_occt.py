@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The numeric B-spline engine against OCCT (Part.BSplineSurface) on real and random faces."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The version adapter (surfcomp.app.cam) takes the branch the installed FreeCAD needs, and
 each branch works: the version matrix runs this file on 0.20 (PathScripts, Factory tool
 bits, PySide2), 1.0 (Path, Factory, PySide2) and 1.1 (Path, tool-bit library, PySide6)."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The batch CLI: exit codes, messages, atomic outputs (subprocesses of
 /usr/bin/python3 -m surfcomp)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The batch route on a shop document: open, compensate, replace, regenerate, save, post."""
 
 import hashlib

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The axis-error compensation dressup on real Path operations, headless."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The measurement object and the compensation feature, headless (issue 3)."""
 
 import hashlib

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The self-contained HTML report (surfcomp.io.html_report) rendered by headless Chromium:
 every section in the DOM, every image an embedded PNG that decodes, a non-blank screenshot
 showing the colour maps; predicted residuals by hand; atomic writing."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The layers import only downwards (STYLE: gui -> app -> io -> core; cli over io, core, app).
 
 For each layer a subprocess imports every module of the layer (sub-packages included) while

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """A shop document saved by FreeCAD 0.20 opens, restores and recomputes on this FreeCAD.
 
 ``tests/data/documents/shop-0.20.FCStd`` was made by ``make_shop_document.py`` with FreeCAD

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Path regenerates the finishing tool path from the corrected face (real OpenCamLib, no mocks).
 
 Set-up: a Job with a 3D Surface operation (6 mm ball end mill, line pattern, every

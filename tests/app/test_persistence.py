@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Save, close, reopen in a fresh freecadcmd: everything restores and recomputes the same.
 
 The saved document holds a block whose free-form top is compensated in two rounds

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """End-to-end compensation on real FreeCAD faces: the corrected-face requirements of issue 2.
 
 Requirements checked on several faces (bicubic with interior knots, rational, a real blade):

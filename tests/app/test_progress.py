@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """FreeCAD's progress indicator as the core's progress callback (Esc -> Cancelled)."""
 
 import types

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Point projection (surfcomp.core.projection) against OCCT's ``face.distToShape``.
 
 OCCT's BRepExtrema answer is the reference: the closest point on the trimmed face

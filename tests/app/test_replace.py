@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Replace the nominal by the compensation and restore it: links, visibility, failure safety."""
 
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp simulate`` on the bundled example and the presets: exit codes, JSON
 content, model options, the papers' tables beside the simulated ones, refused options."""
 

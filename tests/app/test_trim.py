@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Issue 17: trimmed faces keep their boundary; a face of a solid comes back as the whole
 solid with its neighbours re-trimmed, through one face builder for every route.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Fixtures of the bad-input cases. FreeCAD is imported only by the tests that need it
 (the property-based tests of the readers stay pure)."""
 

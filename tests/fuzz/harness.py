@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Run the command line on bad input and check what it leaves behind (issue 12).
 
 Every case runs in its own folder, the sandbox, as the working directory, with its inputs

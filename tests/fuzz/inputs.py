@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The inputs of the bad-input cases: good files to start from and the ways to damage them.
 
 A setup is a callable ``setup(sandbox)``; :func:`setup` chains the small steps below

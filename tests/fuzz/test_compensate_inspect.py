@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``compensate`` (file route) and ``inspect`` on bad input: every case exits 2 with a
 clear message, or 0 where the README says so; nothing left behind, inputs unchanged.
 

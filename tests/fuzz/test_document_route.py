@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``compensate DOC.FCStd MEAS --object O --replace --save OUT.FCStd`` on bad input.
 
 The document (``inputs.document_bytes``) holds ``Nominal`` (the example face) and

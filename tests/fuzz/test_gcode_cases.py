@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``gcode IN.ngc --axis-errors E.csv -o OUT.ngc`` on bad input (no FreeCAD needed)."""
 
 import pytest

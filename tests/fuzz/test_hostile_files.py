@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Files that attack the process: a CAD reader that crashes or hangs, documents naming
 modules that must not be imported (a module in the working directory, the standard
 library's ``this``).

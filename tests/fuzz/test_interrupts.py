@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """SIGTERM, SIGHUP and Ctrl-C while the outputs are being written: exit 143, 129 or 130,
 nothing written, no temporary file, an output that existed before keeps its content.
 

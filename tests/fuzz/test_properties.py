@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Property-based fuzzing of the readers and validators (hypothesis; no FreeCAD).
 
 Generated measurement tables, point files (XYZ, XYZIJK, probe logs), QIF and FCStd

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """``simulate NOMINAL|--preset NAME`` on bad input: loop options, model options, outputs."""
 
 import pytest

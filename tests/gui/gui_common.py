@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # Shared prologue of the GUI sessions (tests/gui/session_*.py): runs inside `freecad` (see
 # harness.py; it provides RESULTS, FreeCAD, FreeCADGui, QtGui, QtCore). Commands run through
 # FreeCAD's command mechanism (Gui.runCommand); dialogs are replaced by recorders

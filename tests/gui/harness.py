@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Run a script inside the real FreeCAD GUI (``freecad script.py``) and collect its results.
 
 Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cfg, and a

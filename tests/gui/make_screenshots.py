@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Regenerate the README's screenshots (docs/screenshots/*.png) in the real FreeCAD GUI.
 
     xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 tests/gui/make_screenshots.py

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # GUI session of test_workbench.py: workbench, toolbar, preferences, Load nominal, the
 # import preview and its plausibility checks, errors as dialogs, property names.
 RESULTS["surfcomp_file"] = surfcomp.__file__

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # GUI session of test_filter.py: the filter task panel (live map on every change, RMS
 # figures, weights that set the mask size, a bad mask shown without a traceback), Report and
 # its HTML, the Mirror command with its stock dialog.

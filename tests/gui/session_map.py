@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # GUI session of test_map.py: the colour map, its legend (ranges, out-of-range colours,
 # tolerance and warning bands, steps, shared range, stacking, navigation cube), the
 # histogram panel, the point readout and flags, save and reopen.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 # GUI session of test_replace.py: Build corrected face (hidden, named by method and round),
 # Replace in document with a Path job (summary, the model clone renamed, Esc cancels),
 # Replace refused without users, Restore.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Addon Manager install: ``git clone`` of the repository into a fresh user's Mod folder
 makes the workbench appear and work in the FreeCAD GUI, and a document saved with it
 reopens after a restart. ``package.xml`` is read with FreeCAD's own parser.

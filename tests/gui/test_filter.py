@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The filter task panel, the report and the mirror command in the real FreeCAD GUI (under
 Xvfb), part 3: the live map follows every change of mask size, weights, kind and edge
 handling (the issue's stale map: mask 5 -> 11 left the picture unchanged), the RMS figures,

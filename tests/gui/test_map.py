@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The colour map in the real FreeCAD GUI (under Xvfb), part 2: screenshots checked pixel by
 pixel (legend, manual range with out-of-range colours, steps, tolerance and warning bands
 with percentages), the other maps, a shared range, the histogram panel, the point readout in

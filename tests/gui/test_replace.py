@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Build corrected face and Replace in document / Restore nominal in the real FreeCAD GUI
 (under Xvfb), part 4: the built face hidden (it z-fought with the map) and named by method
 and round; Replace refused when nothing uses the nominal, its summary (links, objects, Path

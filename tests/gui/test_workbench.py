@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The workbench in the real FreeCAD GUI (under Xvfb), part 1: workbench, toolbar and its
 map drop-down, preferences, Load nominal, the import preview with its plausibility checks,
 errors as dialogs, property names that fit the property view.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Axis error model (Dobariya 2015, eq. 6-16), its fitting, compensation and CSV input."""
 
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The numeric B-spline engine against analytic and library references (no FreeCAD).
 
 References: de Casteljau's algorithm (written here, independent of the engine),

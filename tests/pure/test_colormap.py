@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Colour mapping of the GUI's maps (surfcomp.core.colormap), without FreeCAD."""
 
 import numpy as np

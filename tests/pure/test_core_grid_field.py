@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Grid detection from (u, v) and the C1 correction field."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Deviations, statistics, mask filter and correction methods against the papers' equations."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The corrected-surface construction on dense grids, where MAX_SPANS caps the pole net.
 
 MAX_SPANS is lowered so that small grids take the dense paths: node-line knots (one

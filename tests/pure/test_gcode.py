@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """G-code parsing, axis error compensation and byte-exact rewriting (surfcomp.io.gcode)."""
 
 import math

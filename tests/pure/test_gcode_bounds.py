@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Bounds on G-code values and axis errors (issue 12): every refusal exits 2, writes nothing."""
 
 import math

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """LinuxCNC's own interpreter reads our compensated G-code as we do.
 
 ``rs274 -g IN OUT`` (Debian package ``linuxcnc-uspace``; CI installs it) runs LinuxCNC's

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Grid detection at scale (surfcomp.core.grid): scattered points are told apart without
 the per-row-count search, and the search finds the same rows as the exhaustive one
 (every row count dividing N split at its largest gaps) that it replaced."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The measurement-file reader: accepted forms, every error class, checks and a large round trip."""
 
 import hashlib

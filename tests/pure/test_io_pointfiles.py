@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Readers of measured-points-only files: plain XYZ, PC-DMIS XYZIJK, LinuxCNC probe logs.
 
 The samples under tests/data/pointfiles were written by hand for these tests; every

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """QIF 3.0 results: real samples (qif-community, Boost licence, read by path) and a
 hand-made two-part inch file with malformed variants.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Plausibility of deviations: max offset per line, ISO 2768-1 fine size tolerance."""
 
 import numpy as np

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The per-region certificate of projected feet (surfcomp.core.projection_regions): it
 follows the curvature towards the point, refuses where another part of the face is
 within reach, and never changes a projection (same feet as the point-by-point search

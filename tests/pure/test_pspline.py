@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """The P-spline smoothing fit (surfcomp.core.pspline) against dense reference solves of
 the same penalised least-squares problem, and its GCV choice against the former
 implementation (sparse N-row product B^T B), whose results are recorded below."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Scattered deviation fields (surfcomp.core.scattered): the smoothing fit against scipy's
 thin-plate RBF and brute-force leave-one-out, its transfer function against the analytic
 one, the Clough-Tocher field against scipy's, bounds, and the corrected face on a 7 x 10

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Virtual machining (surfcomp.core.simulate, process_model, sim_tables, presets): model
 equations with hand-computed numbers, the random field's statistics, the papers' orderings
 over replicas on a Werner-like case, and the presets that imitate the papers' tables."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Integrals and the inside test over trimmed (u, v) regions, against analytic values."""
 
 import numpy as np

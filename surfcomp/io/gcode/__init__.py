@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """3-axis G-code: parse, compensate machine-axis errors, rewrite (no FreeCAD).
 
 Modules: :mod:`.lexer` (lines and words), :mod:`.interpreter` (modal state, moves),

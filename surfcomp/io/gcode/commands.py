@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """FreeCAD Path command lists (``(Name, Parameters)`` pairs): compensate without text.
 
 The adaptor behind the Path dressup (:mod:`surfcomp.app.dressup_axis`); it needs no

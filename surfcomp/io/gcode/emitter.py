@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Rewrite G-code text: compensated moves written into the original lines.
 
 Every line the compensation does not change is written back byte for byte; changed lines

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Interpreter of 3-axis G-code: modal state, positions and the moves of a program.
 
 Turns the words of every line (:mod:`.lexer`) into a :class:`Program`: what each line does

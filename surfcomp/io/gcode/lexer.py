@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Lexer of G-code text: lines, words and comments (no FreeCAD).
 
 The file is handled as Latin-1 text, which maps every byte to one character and back, so

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """What a compensation returns, and the bookkeeping both writers share.
 
 Both writers (G-code text, :mod:`.emitter`; Path command lists, :mod:`.commands`) return

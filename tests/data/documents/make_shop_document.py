@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
 """Make ``shop-0.20.FCStd`` (committed test data): a shop document saved by FreeCAD 0.20.
 
 It holds every kind of surfcomp object a user's document can hold, as 0.20 saves them, so
