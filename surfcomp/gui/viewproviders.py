@@ -238,37 +238,68 @@ def map_data(obj, quantity, samples=None, mesh=None):
             "marker_values": node_values[keep]}
 
 
-class ViewProviderCompensation:
-    """View provider of ``SurfComp_Compensation``: Part display modes plus ``Map``."""
+class _MapViewProvider:
+    """What both view providers share: the map properties, one Coin display mode (``MODE``)
+    holding a :class:`MapScene`, and no saved state (the data lives in the object)."""
+
+    MODE = ""
+    ICON = ""
 
     def __init__(self, vobj):
         add_map_properties(vobj)
         vobj.Proxy = self
 
-    # transient state only (never saved)
     def _reset(self):
-        self._data = {}
+        """Forget transient state (never saved)."""
 
     def attach(self, vobj):
         self.Object = vobj.Object
         self.vobj = vobj
-        self._data = {}
+        self._reset()
         self.scene = MapScene()
-        vobj.addDisplayMode(self.scene.root, "Map")
+        vobj.addDisplayMode(self.scene.root, self.MODE)
 
     def getDisplayModes(self, vobj):
-        return ["Map"]
+        return [self.MODE]
 
     def getDefaultDisplayMode(self):
-        return "Map"
+        return self.MODE
 
     def setDisplayMode(self, mode):
-        if mode == "Map":
+        if mode == self.MODE:
             self.redraw()
         return mode
 
     def getIcon(self):
-        return paths.icon("SurfComp_DeviationMap.svg")
+        return paths.icon(self.ICON)
+
+    def onDocumentRestored(self, vobj):
+        add_map_properties(vobj, from_preferences=False)
+
+    def redraw(self):
+        raise NotImplementedError
+
+    def dumps(self):
+        return None
+
+    def loads(self, state):
+        return None
+
+    __getstate__ = dumps
+
+    def __setstate__(self, state):
+        return None
+
+
+class ViewProviderCompensation(_MapViewProvider):
+    """View provider of ``SurfComp_Compensation``: Part display modes plus ``Map``."""
+
+    MODE = "Map"
+    ICON = "SurfComp_DeviationMap.svg"
+
+    # transient state only (never saved)
+    def _reset(self):
+        self._data = {}
 
     def claimChildren(self):
         meas = getattr(self.Object, "Measurement", None)
@@ -316,9 +347,6 @@ class ViewProviderCompensation:
             doc = getattr(vobj.Object, "Document", None)
             if doc is not None:
                 arrange_legends(doc)
-
-    def onDocumentRestored(self, vobj):
-        add_map_properties(vobj, from_preferences=False)
 
     def redraw(self):
         """Draw the current quantity (mesh and values are cached per Shape)."""
@@ -437,44 +465,14 @@ class ViewProviderCompensation:
         FreeCADGui.ActiveDocument.setEdit(vobj.Object.Name, 0)
         return True
 
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    __getstate__ = dumps
-
-    def __setstate__(self, state):
-        return None
 
 
-class ViewProviderMeasurement:
+class ViewProviderMeasurement(_MapViewProvider):
     """View provider of ``SurfComp_Measurement``: the points as markers, coloured by the
     file's deviation when it has one."""
 
-    def __init__(self, vobj):
-        add_map_properties(vobj)
-        vobj.Proxy = self
-
-    def attach(self, vobj):
-        self.Object = vobj.Object
-        self.vobj = vobj
-        self.scene = MapScene()
-        vobj.addDisplayMode(self.scene.root, "Points")
-
-    def getDisplayModes(self, vobj):
-        return ["Points"]
-
-    def getDefaultDisplayMode(self):
-        return "Points"
-
-    def setDisplayMode(self, mode):
-        self.redraw()
-        return mode
-
-    def getIcon(self):
-        return paths.icon("SurfComp_ImportMeasurements.svg")
+    MODE = "Points"
+    ICON = "SurfComp_ImportMeasurements.svg"
 
     def updateData(self, obj, prop):
         if prop in ("NominalX", "MeasuredX", "Deviation") and hasattr(self, "scene"):
@@ -487,9 +485,6 @@ class ViewProviderMeasurement:
             self.redraw()
         elif prop in ("Visibility", "DisplayMode") and vobj.Object.Document is not None:
             arrange_legends(vobj.Object.Document)
-
-    def onDocumentRestored(self, vobj):
-        add_map_properties(vobj, from_preferences=False)
 
     def redraw(self):
         vobj = getattr(self, "vobj", None)
@@ -517,16 +512,6 @@ class ViewProviderMeasurement:
             style.layout = getattr(self, "_layout", None)
             self.scene.set_style(style)
 
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    __getstate__ = dumps
-
-    def __setstate__(self, state):
-        return None
 
 
 def has_deviation(obj):
