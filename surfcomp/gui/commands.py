@@ -63,13 +63,84 @@ def _state_error(obj):
                                                               ", ".join(obj.State)))
 
 
+#: menu text and tooltip of every command, marked for translation in the command's context
+TEXTS = {
+    "SurfComp_LoadNominal": (
+        QT_TRANSLATE_NOOP("SurfComp_LoadNominal", "Load nominal"),
+        QT_TRANSLATE_NOOP("SurfComp_LoadNominal", "Check the selected face as nominal, or read a "
+                                                  "STEP/IGES/BREP file into the document")),
+    "SurfComp_ImportMeasurements": (
+        QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements", "Import measurements"),
+        QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements", "Read a measurement file (CSV, XYZ, "
+                                                         "XYZIJK, probe log, QIF): preview of "
+                                                         "columns, units, points and problems "
+                                                         "first")),
+    "SurfComp_DeviationMap": (
+        QT_TRANSLATE_NOOP("SurfComp_DeviationMap", "Deviation map"),
+        QT_TRANSLATE_NOOP("SurfComp_DeviationMap", "Colour map of the deviations on the nominal "
+                                                   "face (select the face and a measurement, or a"
+                                                   " compensation)")),
+    "SurfComp_ShowDeviation": (
+        QT_TRANSLATE_NOOP("SurfComp_ShowDeviation", "Deviation"),
+        QT_TRANSLATE_NOOP("SurfComp_ShowDeviation", "Show the measured deviation on the selected "
+                          "compensation's map (+ = material left)")),
+    "SurfComp_ShowDetermined": (
+        QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Determined component"),
+        QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Show the determined (filtered, repeatable) "
+                          "component of the deviation")),
+    "SurfComp_ShowRandom": (
+        QT_TRANSLATE_NOOP("SurfComp_ShowRandom", "Random component"),
+        QT_TRANSLATE_NOOP("SurfComp_ShowRandom", "Show the random component: deviation - "
+                          "determined")),
+    "SurfComp_ShowCorrection": (
+        QT_TRANSLATE_NOOP("SurfComp_ShowCorrection", "Correction"),
+        QT_TRANSLATE_NOOP("SurfComp_ShowCorrection", "Show the correction the corrected face "
+                          "realises (+ = material removed: the face moves in by it)")),
+    "SurfComp_Filter": (
+        QT_TRANSLATE_NOOP("SurfComp_Filter", "Filter"),
+        QT_TRANSLATE_NOOP("SurfComp_Filter", "Mask size, weights and edge handling of the filter,"
+                                             " with live maps of the determined and random "
+                                             "components")),
+    "SurfComp_Mirror": (
+        QT_TRANSLATE_NOOP("SurfComp_Mirror", "Mirror (stock)"),
+        QT_TRANSLATE_NOOP("SurfComp_Mirror", "Mirror method with a semi-finishing allowance: the "
+                                             "corrected face mirrors the determined error (stock "
+                                             "in mm)")),
+    "SurfComp_BuildFace": (
+        QT_TRANSLATE_NOOP("SurfComp_BuildFace", "Build corrected face"),
+        QT_TRANSLATE_NOOP("SurfComp_BuildFace", "Add the corrected face of the selected "
+                                                "compensation as a plain Part feature (for "
+                                                "export); with a face and a measurement selected,"
+                                                " compute the compensation first")),
+    "SurfComp_ReplaceInDocument": (
+        QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Replace in document"),
+        QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Let the users of the nominal (Path jobs,"
+                                                        " links) use the corrected face instead; "
+                                                        "Restore puts the nominal back")),
+    "SurfComp_RestoreNominal": (
+        QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Restore nominal"),
+        QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Undo Replace in document: the users of the "
+                                                     "nominal use it again")),
+    "SurfComp_Report": (
+        QT_TRANSLATE_NOOP("SurfComp_Report", "Report"),
+        QT_TRANSLATE_NOOP("SurfComp_Report", "Statistics of deviations, determined and random "
+                                             "components and correction (like the papers' "
+                                             "tables), copyable")),
+}
+
 # -- the base command -----------------------------------------------------------------------
 class Command:
     """Boilerplate of every SurfComp command; subclasses set the texts and ``run``."""
 
     ID = ""
-    MENU = ""
-    TIP = ""
+
+    @property
+    def MENU(self):
+        return TEXTS[self.ID][0]
+
+    @property
+    def TIP(self):
+        return TEXTS[self.ID][1]
 
     def GetResources(self):
         return {"Pixmap": paths.icon(self.ID + ".svg"), "MenuText": self.MENU,
@@ -149,10 +220,6 @@ def create_compensation(label, display="Map", quantity="deviation"):
 # -- the commands -----------------------------------------------------------------------------
 class LoadNominal(Command):
     ID = "SurfComp_LoadNominal"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_LoadNominal", "Load nominal")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_LoadNominal",
-                            "Check the selected face as nominal, or read a STEP/IGES/BREP file "
-                            "into the document")
 
     def IsActive(self):
         return True
@@ -190,10 +257,6 @@ class LoadNominal(Command):
 
 class ImportMeasurements(Command):
     ID = "SurfComp_ImportMeasurements"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements", "Import measurements")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ImportMeasurements",
-                            "Read a measurement file (CSV, XYZ, XYZIJK, probe log, QIF): "
-                            "preview of columns, units, points and problems first")
 
     def run(self):
         from ..io.readers import read_any
@@ -247,46 +310,20 @@ class _MapCommand(Command):
                 other.ViewObject.Visibility = False
 
 
-class ShowDeviation(_MapCommand):
-    ID = "SurfComp_ShowDeviation"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowDeviation", "Deviation")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowDeviation",
-                            "Show the measured deviation on the selected compensation's map "
-                            "(+ = material left)")
+#: the four maps: command and quantity
+MAP_COMMANDS = (("SurfComp_ShowDeviation", "deviation"), ("SurfComp_ShowDetermined", "determined"),
+                ("SurfComp_ShowRandom", "random"), ("SurfComp_ShowCorrection", "correction"))
 
-
-class ShowDetermined(_MapCommand):
-    ID = "SurfComp_ShowDetermined"
-    QUANTITY = "determined"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Determined component")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowDetermined",
-                            "Show the determined (filtered, repeatable) component of the "
-                            "deviation")
-
-
-class ShowRandom(_MapCommand):
-    ID = "SurfComp_ShowRandom"
-    QUANTITY = "random"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowRandom", "Random component")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowRandom",
-                            "Show the random component: deviation - determined")
-
-
-class ShowCorrection(_MapCommand):
-    ID = "SurfComp_ShowCorrection"
-    QUANTITY = "correction"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ShowCorrection", "Correction")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ShowCorrection",
-                            "Show the correction the corrected face realises (+ = material "
-                            "removed: the face moves in by it)")
+ShowDeviation, ShowDetermined, ShowRandom, ShowCorrection = (
+    type(cid[len("SurfComp_"):], (_MapCommand,), {"ID": cid, "QUANTITY": quantity})
+    for cid, quantity in MAP_COMMANDS)
 
 
 class ShowMaps:
     """Toolbar drop-down of the four maps (a FreeCAD command group)."""
 
     ID = "SurfComp_ShowMaps"
-    ITEMS = ("SurfComp_ShowDeviation", "SurfComp_ShowDetermined", "SurfComp_ShowRandom",
-             "SurfComp_ShowCorrection")
+    ITEMS = tuple(row[0] for row in MAP_COMMANDS)
 
     def GetCommands(self):
         return self.ITEMS
@@ -307,39 +344,32 @@ class ShowMaps:
 
 class DeviationMap(_MapCommand):
     ID = "SurfComp_DeviationMap"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_DeviationMap", "Deviation map")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_DeviationMap",
-                            "Colour map of the deviations on the nominal face (select the "
-                            "face and a measurement, or a compensation)")
 
 
-class Filter(Command):
-    ID = "SurfComp_Filter"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_Filter", "Filter")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_Filter",
-                            "Mask size, weights and edge handling of the filter, with live "
-                            "maps of the determined and random components")
+class _CompensationCommand(Command):
+    """A command on the selected compensation: ``apply(comp)``."""
 
     def active(self):
         return selected_compensation() is not None
 
     def run(self):
-        comp = selected_compensation()
+        self.apply(selected_compensation())
+
+    def apply(self, comp):
+        raise NotImplementedError
+
+
+class Filter(_CompensationCommand):
+    ID = "SurfComp_Filter"
+
+    def apply(self, comp):
         FreeCADGui.ActiveDocument.setEdit(comp.Name, 0)
 
 
-class Mirror(Command):
+class Mirror(_CompensationCommand):
     ID = "SurfComp_Mirror"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_Mirror", "Mirror (stock)")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_Mirror",
-                            "Mirror method with a semi-finishing allowance: the corrected face "
-                            "mirrors the determined error (stock in mm)")
 
-    def active(self):
-        return selected_compensation() is not None
-
-    def run(self):
-        comp = selected_compensation()
+    def apply(self, comp):
         stock = dialogs.ask_stock(self.MENU, float(comp.Stock.Value) or 0.1)
         if stock is None:
             return
@@ -359,11 +389,6 @@ class Mirror(Command):
 
 class BuildFace(Command):
     ID = "SurfComp_BuildFace"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_BuildFace", "Build corrected face")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_BuildFace",
-                            "Add the corrected face of the selected compensation as a plain "
-                            "Part feature (for export); with a face and a measurement selected, "
-                            "compute the compensation first")
 
     def active(self):
         return _MapCommand.active(self)
@@ -444,36 +469,25 @@ class _ReplaceCommand(Command):
 
 class ReplaceInDocument(_ReplaceCommand):
     ID = "SurfComp_ReplaceInDocument"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument", "Replace in document")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_ReplaceInDocument",
-                            "Let the users of the nominal (Path jobs, links) use the corrected "
-                            "face instead; Restore puts the nominal back")
 
 
 class RestoreNominal(_ReplaceCommand):
     ID = "SurfComp_RestoreNominal"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal", "Restore nominal")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_RestoreNominal",
-                            "Undo Replace in document: the users of the nominal use it again")
     ACTION = "restore"
     WHILE_REPLACING = True
 
 
-class Report(Command):
+class Report(_CompensationCommand):
     ID = "SurfComp_Report"
-    MENU = QT_TRANSLATE_NOOP("SurfComp_Report", "Report")
-    TIP = QT_TRANSLATE_NOOP("SurfComp_Report",
-                            "Statistics of deviations, determined and random components and "
-                            "correction (like the papers' tables), copyable")
 
     def active(self):
         comp = selected_compensation()
         return comp is not None and comp.Statistics not in ("", "{}")
 
-    def run(self):
+    def apply(self, comp):
         from .panels import ReportDialog
 
-        dialogs.run_dialog(ReportDialog(selected_compensation()))
+        dialogs.run_dialog(ReportDialog(comp))
 
 
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
