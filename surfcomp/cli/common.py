@@ -11,6 +11,13 @@ from ..core.pipeline import Options
 from ..io.readers import FORMATS
 
 
+def add_job_parser(subparsers, name, summary, description):
+    """The parser of a job command (``compensate``, ``inspect``) with its input options."""
+    p = subparsers.add_parser(name, help=summary, description=description)
+    add_input_options(p)
+    return p
+
+
 def add_input_options(p):
     """NOMINAL MEASUREMENTS, face choice, units, and the measurement checks."""
     p.add_argument("nominal", metavar="NOMINAL",

@@ -4,7 +4,7 @@
 from ..errors import InputError
 from .common import (
     ProgressLine,
-    add_input_options,
+    add_job_parser,
     add_method_options,
     options_from_args,
     run_job_command,
@@ -12,11 +12,11 @@ from .common import (
 
 
 def add_parser(subparsers):
-    p = subparsers.add_parser(
-        "compensate", help="build the corrected face that pre-compensates the systematic error",
-        description="Build a corrected B-spline face from a nominal face and a measurement file "
-                    "(Werner 2022 raw/filtered, mirror method, uniform offset).")
-    add_input_options(p)
+    p = add_job_parser(
+        subparsers, "compensate",
+        "build the corrected face that pre-compensates the systematic error",
+        "Build a corrected B-spline face from a nominal face and a measurement file (Werner "
+        "2022 raw/filtered, mirror method, uniform offset).")
     p.add_argument("-o", "--output", metavar="OUT.step",
                    help="the nominal's shape with the face replaced by the corrected face (its "
                         "neighbours re-trimmed), or the corrected face when the nominal is a "

@@ -1,15 +1,14 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp inspect``: deviations and statistics only."""
 
-from .common import add_input_options, run_job_command
+from .common import add_job_parser, run_job_command
 
 
 def add_parser(subparsers):
-    p = subparsers.add_parser(
-        "inspect", help="deviations and statistics only (nothing is built)",
-        description="Compute deviations along the nominal normal, the 5x5 filtered (determined) "
-                    "and random components, and the papers' statistics.")
-    add_input_options(p)
+    p = add_job_parser(
+        subparsers, "inspect", "deviations and statistics only (nothing is built)",
+        "Compute deviations along the nominal normal, the 5x5 filtered (determined) and random "
+        "components, and the papers' statistics.")
     p.add_argument("--mask", type=int, default=5, metavar="N",
                    help="mask size of the filter used to split determined/random (default 5)")
     p.add_argument("--weights", metavar="W", help="custom mask weights (see compensate)")
