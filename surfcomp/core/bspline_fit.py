@@ -178,16 +178,9 @@ def fit_grid_lsq(us, vs, points, knots_u, knots_v, degree_u, degree_v, weights=N
     weights : array_like, shape (nu, nv), optional
         Fixed rational weights (see :func:`interpolate_grid`).
 
-    Returns
-    -------
-    ndarray, shape (nu, nv, 3)
-        Poles in mm.
-
-    Raises
-    ------
-    GridError
-        Wrong shapes, NaN points, or a basis function without samples in its
-        support (singular normal equations).
+    Returns the poles in mm, shape (nu, nv, 3), or raises :class:`GridError` for wrong
+    shapes, NaN points, or a basis function without samples in its support (singular
+    normal equations).
     """
     us, vs, X, Bu, Bv, nu, nv = _grid_inputs(us, vs, points, knots_u, knots_v,
                                              degree_u, degree_v)

@@ -195,18 +195,11 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
     source : str
         Name used in messages and stored as ``MeasurementSet.source``.
     units : str or None
-        Unit of the length columns without a unit suffix (``mm``, ``um``, ``in``; None
-        means ``mm``).
+        As for :func:`read_measurements`.
 
-    Returns
-    -------
-    MeasurementSet
-        Every length in mm; see the module docstring for formats and checks.
-
-    Raises
-    ------
-    MeasurementFileError
-        On the first problem, with file, line and (for a field) column.
+    Returns a :class:`MeasurementSet` (every length in mm; formats and checks: see the
+    module docstring) or raises :class:`MeasurementFileError` on the first problem, with
+    file, line and (for a field) column.
     """
     try:
         default_factor = unit_factor("mm" if units is None else str(units))
