@@ -70,3 +70,12 @@ class Cancelled(SurfcompError):
     """The user interrupted a long step; nothing was written."""
 
     exit_code = 130
+
+
+def lookup(table, name, what):
+    """``table[name]``, or an InputError naming ``what`` and the known names."""
+    try:
+        return table[name]
+    except KeyError:
+        raise InputError("unknown %s %r (expected one of %s)"
+                         % (what, name, ", ".join(table))) from None

@@ -11,6 +11,7 @@ Colours are floats in [0, 1], arrays of shape (N, 3).
 
 import numpy as np
 
+from ..errors import lookup
 from .bspline import evaluate_grid
 
 #: colour schemes: control colours at equally spaced positions from the range's low
@@ -51,11 +52,7 @@ MIN_HALF_RANGE = 1e-6
 
 def scheme(name):
     """Control colours (K, 3) of the scheme ``name`` (one of :data:`SCHEMES`)."""
-    try:
-        return SCHEMES[name]
-    except KeyError:
-        raise ValueError("unknown colour scheme %r (expected one of %s)"
-                         % (name, ", ".join(SCHEMES))) from None
+    return lookup(SCHEMES, name, "colour scheme")
 
 
 def symmetric_range(values):

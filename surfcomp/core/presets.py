@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import lookup
 from . import bspline
 from .process_model import MachiningModel
 from .sim_tables import PaperRow, PaperTable
@@ -216,11 +216,7 @@ PRESETS = {p.name: p for p in (
 
 def get_preset(name):
     """The :class:`Preset` called ``name``; InputError naming the known ones otherwise."""
-    try:
-        return PRESETS[name]
-    except KeyError:
-        raise InputError("unknown preset %r (expected one of %s)"
-                         % (name, ", ".join(PRESETS))) from None
+    return lookup(PRESETS, name, "preset")
 
 
 def run_preset(name, surface=None, outward=1, model=None, grid=None, replicas=None, seed=0,

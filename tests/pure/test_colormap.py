@@ -8,6 +8,7 @@ from numpy.testing import assert_allclose
 
 from surfcomp.core import colormap as cm
 from surfcomp.core.bspline import Surface, evaluate_grid
+from surfcomp.errors import InputError
 
 
 def test_rainbow_ends_and_zero():
@@ -32,7 +33,7 @@ def test_nan_is_grey_and_bad_range_raises():
     assert_allclose(c[0], cm.NAN_COLOR)
     with pytest.raises(ValueError, match="vmin < vmax"):
         cm.map_colors([0.0], 1.0, 1.0)
-    with pytest.raises(ValueError, match="unknown colour scheme"):
+    with pytest.raises(InputError, match="unknown colour scheme"):
         cm.map_colors([0.0], -1, 1, "jet")
 
 
