@@ -85,7 +85,7 @@ MAX_SLOPE = 10.0
 MAX_LATTICE = 1024
 #: default stock (mm) the semi-finishing pass leaves (Werner 2022: 0.3 mm)
 DEFAULT_STOCK = 0.3
-#: what the model contains and what it leaves out, in words (reports, README)
+#: what the model contains and what it leaves out, in words (reports; docs/method.md)
 SUMMARY = {
     "contains": "Every part is cut in two passes from the surface given to CAM: "
                 "semi-finishing, programmed the stock outside it, then finishing. Each pass "

@@ -103,7 +103,7 @@ def correction_integral(nominal, corrected, outward, polylines):
     the volume of the layer between the nominal and the corrected face.
 
     The correction at ``(u, v)`` is ``delta = n . (S - S_c)`` with the outward unit normal
-    ``n`` (``S_c = S - delta n``, README "The method"). The layer swept along the normals
+    ``n`` (``S_c = S - delta n``, docs/method.md). The layer swept along the normals
     has the volume ``integral of (delta - H delta^2 + K delta^3 / 3) dA`` (``H``, ``K`` the
     mean and Gaussian curvature, ``H > 0`` where the face is convex outwards; the parallel
     surface at depth ``s`` has the area element ``(1 - 2 H s + K s^2) dA``), which is
