@@ -170,8 +170,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         result.checks = json.loads(comp.Checks)
         result.warnings = list(comp.Warnings)
         result.output = comp.Output
-        result.volume_change = float(comp.VolumeChange)
-        result.correction_volume = float(comp.CorrectionVolume)
+        result.volume_change = float(comp.VolChange)
+        result.correction_volume = float(comp.CorrVol)
         report(progress, 0.95, "saving")
         _write(doc, result, save, gcode, text, _declared(document, measurements, save, gcode,
                                                          overwrite_input))

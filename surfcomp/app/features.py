@@ -442,8 +442,8 @@ def _write_results(obj, r):
     obj.Round = r.round
     if r.output is not None:                  # a preview keeps the shape's figures
         obj.EdgeTol = float(r.output.edge_tolerance)
-        obj.VolumeChange = float(r.output.volume_change or 0.0)
-        obj.CorrectionVolume = float(r.output.correction_volume)
+        obj.VolChange = float(r.output.volume_change or 0.0)
+        obj.CorrVol = float(r.output.correction_volume)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,

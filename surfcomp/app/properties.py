@@ -20,7 +20,7 @@ from ..core.pipeline import LAYOUTS
 QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 #: version of the property sets; onDocumentRestored upgrades older objects
-#: (properties added since, such as VolumeChange, come from the property tables;
+#: (properties added since, such as VolChange, come from the property tables;
 #: 2: short names that fit the property view, see RENAMED)
 VERSION = 2
 #: compensation properties renamed in version 2: old name -> new name
@@ -250,11 +250,11 @@ COMPENSATION_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Largest tolerance of the corrected face's edges and "
                                         "vertices"),
      0.0, _RO),
-    ("App::PropertyFloat", "VolumeChange", _RES,
+    ("App::PropertyFloat", "VolChange", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Output solid: its volume minus the nominal's (mm^3; 0 for"
                                         " a face)"),
      0.0, _RO),
-    ("App::PropertyFloat", "CorrectionVolume", _RES,
+    ("App::PropertyFloat", "CorrVol", _RES,
      QT_TRANSLATE_NOOP("App::Property", "Integral of the correction over the face (mm^3, positive"
                                         " = material removed): the volume change should be minus"
                                         " this"),

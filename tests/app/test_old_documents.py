@@ -59,7 +59,7 @@ out.update({
     "volume2": r2.Shape.Volume, "valid2": r2.Shape.isValid(),
     "closed2": all(s.isClosed() for s in r2.Shape.Shells),
     "tolerance2": max(e.Tolerance for e in r2.Shape.Edges),
-    "volume_change2": r2.VolumeChange, "correction_volume2": r2.CorrectionVolume,
+    "volume_change2": r2.VolChange, "correction_volume2": r2.CorrVol,
     "op_base": [[o.Name, list(s)] for o, s in op.Base],
     "cl": cam_job.cutter_locations(op).tolist(),
     "dressup": {"base": d.Base.Name, "commands": len(d.Path.Commands),

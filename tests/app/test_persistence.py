@@ -158,8 +158,8 @@ def test_old_documents_are_migrated(tmp_path):
     correction = list(c.Correction)
     # an older property set: no Refine / ReadWarnings / volumes (issue 17), version 0
     c.removeProperty("Refine")
-    c.removeProperty("VolumeChange")
-    c.removeProperty("CorrectionVolume")
+    c.removeProperty("VolChange")
+    c.removeProperty("CorrVol")
     c.Version = 0
     m.removeProperty("ReadWarnings")
     m.Version = 0
@@ -174,13 +174,13 @@ def test_old_documents_are_migrated(tmp_path):
         assert isinstance(c.Proxy, features.CompensationFeature)
         assert c.Version == features.VERSION and m.Version == features.VERSION
         assert c.Refine == 4 and list(m.ReadWarnings) == []
-        assert c.VolumeChange == 0.0 and c.CorrectionVolume == 0.0
-        assert c.getEditorMode("VolumeChange") == ["ReadOnly"]
+        assert c.VolChange == 0.0 and c.CorrVol == 0.0
+        assert c.getEditorMode("VolChange") == ["ReadOnly"]
         c.touch()
         old.recompute()
         assert c.State == ["Up-to-date"]
         # the face output: the correction's integral over the face (mean ~10 um x 2120 mm^2)
-        assert 10.0 < c.CorrectionVolume < 40.0 and c.VolumeChange == 0.0
+        assert 10.0 < c.CorrVol < 40.0 and c.VolChange == 0.0
         np.testing.assert_allclose(c.Correction, correction, atol=1e-15)
     finally:
         FreeCAD.closeDocument(old.Name)

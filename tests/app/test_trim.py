@@ -414,13 +414,13 @@ def test_face_of_a_solid_in_the_document(circle_solid):
         assert c.State == ["Up-to-date"], c.State
         assert c.EdgeTol.Value <= 1e-4
         assert json.loads(c.Checks)["max_error_at_points_mm"] <= 0.1 * UM
-        _check_replaced_solid(case, c.Shape, c.VolumeChange, c.CorrectionVolume)
+        _check_replaced_solid(case, c.Shape, c.VolChange, c.CorrVol)
         if "cli" in case:          # the same construction as the command line's
             np.testing.assert_allclose(
                 np.array(c.Shape.Faces[case["top"]].Surface.getPoles(), dtype=float),
                 np.array(case["cli"].Faces[case["top"]].Surface.getPoles(), dtype=float),
                 atol=1e-9)
-            assert c.VolumeChange == pytest.approx(case["figures"]["cli_volume_change"],
+            assert c.VolChange == pytest.approx(case["figures"]["cli_volume_change"],
                                                    abs=1e-6)
     finally:
         FreeCAD.closeDocument(doc.Name)
@@ -631,8 +631,8 @@ print("RESULT " + json.dumps({
     "tolerance": max(e.Tolerance for e in s.Edges),
     "poles": [list(p) for row in s.Faces[%d].Surface.getPoles() for p in row],
     "saved_poles": [list(p) for row in saved.Faces[%d].Surface.getPoles() for p in row],
-    "volume": s.Volume, "saved_volume": saved.Volume, "volume_change": c.VolumeChange,
-    "correction_volume": c.CorrectionVolume, "warnings": list(c.Warnings)}))
+    "volume": s.Volume, "saved_volume": saved.Volume, "volume_change": c.VolChange,
+    "correction_volume": c.CorrVol, "warnings": list(c.Warnings)}))
 sys.stdout.flush()
 os._exit(0)
 """
@@ -650,7 +650,7 @@ def test_document_with_a_trimmed_face_is_saved_and_reopened(circle_solid, tmp_pa
         c = features.make_compensation(doc, part, "Face%d" % (case["top"] + 1), m,
                                        method="raw", output="solid")
         doc.recompute()
-        before = {"volume_change": c.VolumeChange, "edges": [len(f.Edges) for f in c.Shape.Faces]}
+        before = {"volume_change": c.VolChange, "edges": [len(f.Edges) for f in c.Shape.Faces]}
         path = str(tmp_path / "trim.FCStd")
         doc.saveAs(path)
     finally:
