@@ -2,6 +2,8 @@
 # GUI session of test_map.py: the colour map, its legend (ranges, out-of-range colours,
 # tolerance and warning bands, steps, shared range, stacking, navigation cube), the
 # histogram panel, the point readout and flags, save and reopen.
+import Path
+
 doc = FreeCAD.newDocument("Map")
 nominal, meas = load_example(doc)
 t0 = time.perf_counter()
@@ -140,12 +142,25 @@ Gui.Selection.clearSelection()
 mouse("press", px)
 mouse("release", px)
 RESULTS["click_without_readout"] = selection()
+# a tool path in front of the map (5 mm above the face, a cut along x through the node)
+x0, y0, z0 = (float(c) for c in nodes[k2])
+tool_path = doc.addObject("Path::Feature", "ToolPath")
+tool_path.Path = Path.Path([Path.Command("G0", {"X": x0 - 10.0, "Y": y0, "Z": z0 + 5.0}),
+                            Path.Command("G1", {"X": x0 + 10.0, "Y": y0, "Z": z0 + 5.0})])
+doc.recompute()
+Gui.updateGui()
+Gui.Selection.clearSelection()
+mouse("press", px)
+mouse("release", px)
+RESULTS["click_path_without_readout"] = selection()
 Gui.Selection.clearSelection()
 readout.install()
 mouse("press", px)
 mouse("release", px)
 RESULTS["click_over_path"] = {"selection": selection(),
                               "flags": list(vobj.Flags), "node": readout.LAST.get("node")}
+doc.removeObject(tool_path.Name)
+Gui.updateGui()
 # click the same node again: the flag goes; once more: it stays
 mouse("press", px)
 mouse("release", px)

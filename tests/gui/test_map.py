@@ -218,8 +218,10 @@ def test_hover_shows_the_point_in_the_status_bar(session):
 def test_click_flags_the_point_and_removes_it(session):
     (name, subs), = session["click_without_readout"]
     assert name == "Compensation" and subs and subs[0].startswith(("Vertex", "Face"))
+    # a tool path drawn in front takes a click on its line while the readout is off ...
+    assert [name for name, _subs in session["click_path_without_readout"]] == ["ToolPath"]
     click = session["click_over_path"]
-    assert click["selection"] == [["Compensation", []]]    # the map took the click
+    assert click["selection"] == [["Compensation", []]]    # ... the map takes it while shown
     assert click["flags"] == [click["node"]]
     assert session["flags_after_second_click"] == []
     assert len(session["flags_kept"]) == 1 and session["flag_nodes_drawn"] == 1
