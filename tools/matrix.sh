@@ -153,6 +153,7 @@ command2() {
   grep -m1 -E '^bash tools/install.sh && bash tools/test.sh' "$repo/README.md"
 }
 
+# run_entry SUITE [FIRST X SERVER NUMBER]
 run_entry() {
   local suite=$1 log="$logs/$1.test.log" rc=0 cmd versions result
   cmd=$(command2)
@@ -165,7 +166,10 @@ run_entry() {
     local root="$cache/$suite"
     mount_root "$root"
     say "$suite: $cmd"
-    in_root "$root" bash -c "cd /root/surfcomp && $cmd" >"$log" 2>&1 || rc=$?
+    # the roots share the host's network namespace, where X servers listen: each root's
+    # Xvfb gets numbers of its own (tools/test.sh), as the roots run side by side
+    in_root "$root" bash -c "cd /root/surfcomp && export SURFCOMP_XVFB_FROM=${2:-99} && $cmd" \
+      >"$log" 2>&1 || rc=$?
     versions=$(in_root "$root" /usr/bin/python3 /root/surfcomp/tools/versions.py --summary 2>/dev/null) || true
   fi
   # pytest's last line: "560 passed in 347.38s (0:05:47)" or "2 failed, 558 passed in ..."
@@ -214,10 +218,16 @@ main() {
   if [ -n "$bg" ]; then
     wait "$bg" || { status=1; cat "$logs/prepare.log" >&2; }
   fi
+  # the roots run side by side (one pytest each, about one core each on 2 cores)
+  local pids=() n=0 p
   for e in "${roots[@]}"; do
     grep -q "Debian $e: the root could not" "$logs/summary.txt" && continue
-    run_entry "$e" || status=1
+    mount_root "$cache/$e"           # here, so that the exit trap unmounts it
+    n=$((n + 1))
+    run_entry "$e" $((100 + 20 * n)) &
+    pids+=("$!")
   done
+  for p in "${pids[@]}"; do wait "$p" || status=1; done
   echo
   echo "=== version matrix (logs in $logs) ==="
   cat "$logs/summary.txt"

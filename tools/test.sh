@@ -9,4 +9,7 @@ if [ $# -eq 0 ]; then
   ruff check --no-cache .
 fi
 export QTWEBENGINE_CHROMIUM_FLAGS="${QTWEBENGINE_CHROMIUM_FLAGS:---no-sandbox}"
-exec xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 -m pytest "$@"
+# -a: the first free X server number from SURFCOMP_XVFB_FROM (default 99; the version
+# matrix gives each root its own range)
+exec xvfb-run -a -n "${SURFCOMP_XVFB_FROM:-99}" -s "-screen 0 1600x1200x24" \
+  /usr/bin/python3 -m pytest "$@"
