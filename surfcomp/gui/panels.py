@@ -119,7 +119,7 @@ class FilterPanel:
     DEBOUNCE = 120
 
     def __init__(self, obj):
-        from ..app.features import MASK_KINDS
+        from ..app.properties import MASK_KINDS
 
         FilterPanel.instance = self
         self.obj = obj
