@@ -112,6 +112,17 @@ def _text(position, text, color=(0.0, 0.0, 0.0), size=15, justification=None):
     return sep
 
 
+def _gate_for_picking(gate, action):
+    """SoCallback: close ``gate`` (an SoSwitch) to pick actions, open it to all others.
+    The field changes without notification: no redraw is scheduled by the traversal."""
+    want = coin.SO_SWITCH_NONE if action.isOfType(coin.SoPickAction.getClassTypeId()) \
+        else coin.SO_SWITCH_ALL
+    if gate.whichChild.getValue() != want:
+        gate.enableNotify(False)
+        gate.whichChild = want
+        gate.enableNotify(True)
+
+
 class MapScene:
     """The scene nodes of one colour map (see module docstring). ``root`` is the node
     to add to a view provider's display mode or to a scene graph."""
@@ -170,16 +181,21 @@ class MapScene:
         self.flags = coin.SoAnnotation()
 
         # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes;
-        # not pickable: a hit on it is no point of the map (its coordinates are the legend
-        # camera's), so the readout would show, and a click flag, an unrelated point
+        # left out of picking (the gate): a camera node sets the pick ray of the whole pick
+        # action, not only below its separator, so a pick through the legend's camera would
+        # miss every object drawn after the map (a tool path could not be selected), and a
+        # hit on the legend is no point of the map anyway
         self.legend_switch = coin.SoSwitch()
         self.legend = coin.SoAnnotation()
         self.legend_switch.addChild(self.legend)
-        unpickable = coin.SoPickStyle()
-        unpickable.style = coin.SoPickStyle.UNPICKABLE
+        self._legend_gate = coin.SoSwitch()
+        self._legend_gate.whichChild = coin.SO_SWITCH_ALL
+        self._legend_gate.addChild(self.legend_switch)
+        guard = coin.SoCallback()
+        guard.setCallback(_gate_for_picking, self._legend_gate)
         skip = coin.SoType.fromName(coin.SbName("SoSkipBoundingGroup")).createInstance()
-        skip.addChild(unpickable)
-        skip.addChild(self.legend_switch)
+        skip.addChild(guard)
+        skip.addChild(self._legend_gate)
 
         for node in (self.surface, self.markers_switch, self.labels_switch, self.flags, skip):
             self.root.addChild(node)
