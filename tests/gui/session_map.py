@@ -3,6 +3,7 @@
 # tolerance and warning bands, steps, shared range, stacking, navigation cube), the
 # histogram panel, the point readout and flags, save and reopen.
 import Path
+import PathGui  # noqa: F401  (the view provider that draws a Path::Feature)
 
 doc = FreeCAD.newDocument("Map")
 nominal, meas = load_example(doc)
@@ -148,19 +149,22 @@ tool_path = doc.addObject("Path::Feature", "ToolPath")
 tool_path.Path = Path.Path([Path.Command("G0", {"X": x0 - 10.0, "Y": y0, "Z": z0 + 5.0}),
                             Path.Command("G1", {"X": x0 + 10.0, "Y": y0, "Z": z0 + 5.0})])
 doc.recompute()
-Gui.updateGui()
+view_top()                            # the view volume takes the path in
+px_path = project(view, [[x0, y0, z0 + 5.0]])[0]
+RESULTS["path_pixel_is_the_node's"] = px_path == project(view, nodes[[k2]])[0]
 Gui.Selection.clearSelection()
-mouse("press", px)
-mouse("release", px)
+mouse("press", px_path)
+mouse("release", px_path)
 RESULTS["click_path_without_readout"] = selection()
 Gui.Selection.clearSelection()
 readout.install()
-mouse("press", px)
-mouse("release", px)
+mouse("press", px_path)
+mouse("release", px_path)
 RESULTS["click_over_path"] = {"selection": selection(),
                               "flags": list(vobj.Flags), "node": readout.LAST.get("node")}
 doc.removeObject(tool_path.Name)
-Gui.updateGui()
+view_top()
+px, xy = project(view, nodes[[k2, k]])
 # click the same node again: the flag goes; once more: it stays
 mouse("press", px)
 mouse("release", px)

@@ -219,6 +219,7 @@ def test_click_flags_the_point_and_removes_it(session):
     (name, subs), = session["click_without_readout"]
     assert name == "Compensation" and subs and subs[0].startswith(("Vertex", "Face"))
     # a tool path drawn in front takes a click on its line while the readout is off ...
+    assert session["path_pixel_is_the_node's"] is True
     assert [name for name, _subs in session["click_path_without_readout"]] == ["ToolPath"]
     click = session["click_over_path"]
     assert click["selection"] == [["Compensation", []]]    # ... the map takes it while shown
