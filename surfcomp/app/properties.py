@@ -164,7 +164,7 @@ COMPENSATION_PROPERTIES = (
      False, 0),
     ("App::PropertyInteger", "Refine", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
-                                        "step"),
+                                        "step at most (one where that meets the limits)"),
      4, 0),
     ("App::PropertyEnumeration", "Output", _IN,
      QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"

@@ -74,7 +74,9 @@ def add_method_options(p):
                         "filter's place (the wavelength damped to half; default chosen by "
                         "generalized cross-validation)")
     p.add_argument("--refine", type=int, default=4, metavar="K",
-                   help="knot spans of the corrected surface per measurement grid step (default 4)")
+                   help="knot spans of the corrected surface per measurement grid step at most "
+                        "(default 4): a grid along the face's parameter lines first gets one "
+                        "span per step, kept when it meets the 0.1 um / 1 um limits")
 
 
 def job_from_args(args, command):

@@ -42,7 +42,9 @@ class Options:
     Lengths in mm. ``mask_size``/``weights``/``mask_kind``/``sigma``/``edge`` define the
     filter (:mod:`surfcomp.core.filters`); ``stock`` is the mirror method's semi-finishing
     allowance; ``max_offset`` the largest accepted distance of a point from the face;
-    ``refine`` the knot spans per measurement grid step of the corrected surface;
+    ``refine`` the knot spans per measurement grid step of the corrected surface at most
+    (grids along the parameter lines first get one, kept when it meets the limits; see
+    :func:`surfcomp.core.corrected.construct`);
     ``tip_radius`` the stylus ball radius when the measured points are tip centres
     (the contact point is the centre moved by it against the outward normal);
     ``layout`` one of :data:`LAYOUTS`; ``smoothing`` the smoothing length (mm) of the

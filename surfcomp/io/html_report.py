@@ -249,7 +249,7 @@ def _section_method(report):
             ("Edge handling", _e(m.get("edge"))),
             ("Stock (mirror)",
              _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
-            ("Refinement", _e("%s knot spans per grid step" % m.get("refine"))),
+            ("Refinement", _e("at most %s knot spans per grid step" % m.get("refine"))),
             ("Layout", _e(layout))]
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
 
