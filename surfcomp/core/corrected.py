@@ -76,7 +76,8 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
     near = np.zeros(lines.size, dtype=bool)
     for k in own[(own > lo) & (own < hi)]:
         i = np.argmin(np.abs(lines - k))
-        near[i] |= abs(lines[i] - k) <= keep_off * step
+        # 1e-6: a knot halfway between two lines (up to rounding) replaces one of them
+        near[i] |= abs(lines[i] - k) <= (keep_off + 1e-6) * step
     return lines[(lines > lo) & (lines < hi) & ~near]
 
 
@@ -201,7 +202,8 @@ class Construction:
 
 
 def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
-              refine=DEFAULT_REFINE, field_factory=GridField, grid_shape=None, progress=None):
+              refine=DEFAULT_REFINE, field_factory=GridField, grid_shape=None, progress=None,
+              lean=True):
     """Build the corrected surface for node corrections ``delta`` and check it.
 
     The one entry point for the pipeline and the document objects. A grid along the
@@ -222,6 +224,9 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     grid_shape : tuple, optional
         Shape of the measurement grid for the density of the dense check grid
         (default ``U.shape``; give a shape for scattered nodes).
+    lean : bool
+        False: no lean space below the dense limit, ``refine`` spans per step as before it
+        (documents made before it recompute to the face they saved).
 
     Returns
     -------
@@ -231,6 +236,8 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     report(progress, 0.0, "sampling the nominal")
     args = (nominal, U, V, delta, outward, grid_shape or U.shape)
     lines = grid_lines(U, V) if field_factory is GridField else None
+    if not lean:
+        lines = aligned_lines(U, V, refine) if lines is not None else None
     lean = None
     if lines is not None:
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, lines)

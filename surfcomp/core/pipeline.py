@@ -44,7 +44,8 @@ class Options:
     allowance; ``max_offset`` the largest accepted distance of a point from the face;
     ``refine`` the knot spans per measurement grid step of the corrected surface at most
     (grids along the parameter lines first get one, kept when it meets the limits; see
-    :func:`surfcomp.core.corrected.construct`);
+    :func:`surfcomp.core.corrected.construct`; ``lean`` False: ``refine`` spans per step
+    as before, for documents made before);
     ``tip_radius`` the stylus ball radius when the measured points are tip centres
     (the contact point is the centre moved by it against the outward normal);
     ``layout`` one of :data:`LAYOUTS`; ``smoothing`` the smoothing length (mm) of the
@@ -65,6 +66,7 @@ class Options:
     tip_radius: float = 0.0
     layout: str = "auto"
     smoothing: float = None
+    lean: bool = True
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -436,7 +438,8 @@ def build_surface(result, surface, outward, delta, progress=None):
         du, dv = grid_spacing(prepared)
         factory, shape = GridField, None
     built = construct(surface, U, V, delta, outward, du, dv, result.options.refine,
-                      field_factory=factory, grid_shape=shape, progress=progress)
+                      field_factory=factory, grid_shape=shape, progress=progress,
+                      lean=result.options.lean)
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
