@@ -62,8 +62,9 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
     lie near the nodes, where the correction must be met exactly.
 
     Each of the nominal's own knots (which stay, so the space still contains the
-    nominal) takes the place of the node line nearest to it when that is at most
-    ``keep_off`` of a step away, so the spans stay about one step long. Beyond
+    nominal) takes the place of the node line nearest to it (beyond the outermost lines
+    when that is at most ``keep_off`` of a step away), so the spans stay about one step
+    long. Beyond
     the outermost lines, where the field levels off within about a grid step (see
     :mod:`surfcomp.core.field`), the first span is one step and the next ones grow
     fourfold (1, 4, 16, ... steps out, none within half a step of the border).
@@ -71,13 +72,15 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
     lines = np.sort(np.asarray(lines, dtype=float))
     step = np.median(np.diff(lines))
     own = np.unique(np.asarray(knots, dtype=float))
-    lines = np.concatenate([lines[0] - _strip(lines[0] - lo, step)[::-1], lines,
-                            lines[-1] + _strip(hi - lines[-1], step)])
+    first, last = lines[0], lines[-1]
+    lines = np.concatenate([first - _strip(first - lo, step)[::-1], lines,
+                            last + _strip(hi - last, step)])
     near = np.zeros(lines.size, dtype=bool)
     for k in own[(own > lo) & (own < hi)]:
         i = np.argmin(np.abs(lines - k))
-        # 1e-6: a knot halfway between two lines (up to rounding) replaces one of them
-        near[i] |= abs(lines[i] - k) <= (keep_off + 1e-6) * step
+        # between the outermost lines the nearest is at most half a (local) step away; a
+        # knot halfway between two lines replaces one of them whatever the rounding
+        near[i] |= first <= k <= last or abs(lines[i] - k) <= keep_off * step
     return lines[(lines > lo) & (lines < hi) & ~near]
 
 

@@ -67,3 +67,9 @@ def test_nominal_knot_replaces_its_nearest_node_line():
     np.testing.assert_allclose(k[:2], [0.01 - 4 * step, 0.01 - step])
     np.testing.assert_allclose(k[-2:], [0.99 + step, 0.99 + 4 * step])
     assert np.min(np.abs(k - 0.25)) > 0.4 * step     # no line left right next to 0.25
+    # 0.5 lies halfway between two lines whose gap is a little wider than the median step
+    # (rounded coordinates): it still replaces one of them
+    lines[500:] += 2e-8
+    assert 0.5 < np.min(np.abs(lines - 0.5)) / step < 0.5001
+    k = node_line_knots([0, 0, 0, 0, 0.25, 0.5, 1, 1, 1, 1], 0.0, 1.0, lines)
+    assert k.size == 1000 - 2 + 4
