@@ -329,6 +329,9 @@ def _section_checks(report):
                 rows.append((text, '<span class="num">%.4f %s</span>' % (val * f, unit)))
             else:
                 rows.append((key.replace("_", " "), _e(val)))
+        size = (report.get("output_shape") or {}).get("file_bytes")
+        if size is not None:
+            rows.append(("Written file size", '<span class="num">%d bytes</span>' % size))
         body = _kv_table(rows)
     return '<section id="checks"><h2>Corrected face checks</h2>%s</section>' % body
 
