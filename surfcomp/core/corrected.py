@@ -64,8 +64,8 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
     Each of the nominal's own knots (which stay, so the space still contains the
     nominal) takes the place of the node line nearest to it (beyond the outermost lines
     when that is at most ``keep_off`` of a step away), so the spans stay about one step
-    long. Beyond
-    the outermost lines, where the field levels off within about a grid step (see
+    long; lines within 1/20 of a step of the border are left out. Beyond the outermost
+    lines, where the field levels off within about a grid step (see
     :mod:`surfcomp.core.field`), the first span is one step and the next ones grow
     fourfold (1, 4, 16, ... steps out, none within half a step of the border).
     """
@@ -81,7 +81,9 @@ def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
         # between the outermost lines the nearest is at most half a (local) step away; a
         # knot halfway between two lines replaces one of them whatever the rounding
         near[i] |= first <= k <= last or abs(lines[i] - k) <= keep_off * step
-    return lines[(lines > lo) & (lines < hi) & ~near]
+    # a line on the border (up to rounding) would make a span of almost no length
+    inside = (lines > lo + 0.05 * step) & (lines < hi - 0.05 * step)
+    return lines[inside & ~near]
 
 
 def _strip(width, step):

@@ -73,3 +73,14 @@ def test_nominal_knot_replaces_its_nearest_node_line():
     assert 0.5 < np.min(np.abs(lines - 0.5)) / step < 0.5001
     k = node_line_knots([0, 0, 0, 0, 0.25, 0.5, 1, 1, 1, 1], 0.0, 1.0, lines)
     assert k.size == 1000 - 2 + 4
+
+
+def test_lines_on_the_border_make_no_empty_span():
+    """A grid up to the face's border (parameters rounded to 3.9e-33 off it, as on the pipe
+    quarter) gives no knot next to the border; one 1/10 step inside stays."""
+    lines = np.linspace(0.0, 1.0, 9)
+    lines[0] = 3.9e-33
+    k = node_line_knots([0, 0, 1, 1], 0.0, 1.0, lines)
+    np.testing.assert_allclose(k, lines[1:-1])
+    lines[0] = 0.0125                               # a tenth of the 0.125 step
+    assert node_line_knots([0, 0, 1, 1], 0.0, 1.0, lines)[0] == 0.0125
