@@ -102,6 +102,9 @@ class Options:
             if getattr(self, name) not in choices:
                 raise InputError("%s %r: expected one of %s"
                                  % (option, getattr(self, name), ", ".join(choices)))
+        if not isinstance(self.lean, (bool, np.bool_)):
+            raise InputError("lean %r: expected true or false (Lean in the document)"
+                             % (self.lean,))
         if self.method == "mirror" and self.stock is None:
             raise InputError("--method mirror needs --stock (the semi-finishing allowance in "
                              "mm; DH = stock / 2)")

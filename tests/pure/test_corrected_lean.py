@@ -84,3 +84,18 @@ def test_lines_on_the_border_make_no_empty_span():
     np.testing.assert_allclose(k, lines[1:-1])
     lines[0] = 0.0125                               # a tenth of the 0.125 step
     assert node_line_knots([0, 0, 1, 1], 0.0, 1.0, lines)[0] == 0.0125
+
+
+def test_lean_off_builds_refine_spans_per_step():
+    """``lean=False`` (documents made before the lean face, job files) skips the lean space:
+    4 spans per grid step as before; the option takes true or false only."""
+    from surfcomp.core.pipeline import Options
+    from surfcomp.errors import InputError
+
+    surf = bicubic()
+    U, V, delta, step = case(45, 0.0)
+    built = construct(surf, U, V, delta, 1, step, step, refine=4, lean=False)
+    assert built.checks.poles_shape[0] >= 4 * 44 + 3 and meets_limits(built.checks)
+    Options(lean=False).validate()
+    with pytest.raises(InputError, match="lean 'no': expected true or false"):
+        Options(lean="no").validate()
