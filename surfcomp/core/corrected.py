@@ -28,8 +28,8 @@ DEFAULT_REFINE = 4
 #: target of the residual iteration at the measured points (mm)
 MATCH_TOL = 2e-5
 MATCH_ITERATIONS = 8
-#: a dense grid's one-span-per-step surface is kept when it meets the points this well
-#: (the pipeline's requirement, 0.1 um) even if the iteration has not reached MATCH_TOL
+#: a lean or capped surface is kept when it meets the points this well (the pipeline's
+#: requirement, 0.1 um) even if the iteration has not reached MATCH_TOL (see meets_limits)
 ACCEPT_TOL = 1e-4
 #: poles of the finer space a dense grid across the parameter lines falls back to (two
 #: spans per grid step, fewer (at least 1.25) where that would exceed this)
@@ -243,18 +243,18 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     lines = grid_lines(U, V) if field_factory is GridField else None
     if not lean:
         lines = aligned_lines(U, V, refine) if lines is not None else None
-    lean = None
+    first = None    # the lean construction
     if lines is not None:
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, lines)
-        lean = _checked(smp, *_match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
-                                     field_factory, sub(progress, 0.05, 0.4)), *args)
+        first = _checked(smp, *_match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
+                                      field_factory, sub(progress, 0.05, 0.4)), *args)
         # a dense grid has no finer space within MAX_SPANS
-        if meets_limits(lean.checks) or aligned_lines(U, V, refine) is not None:
+        if meets_limits(first.checks) or aligned_lines(U, V, refine) is not None:
             report(progress, 1.0, "corrected surface checked")
-            return lean
+            return first
     capped = [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)] != \
         [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine, per_step=1)]
-    part = sub(progress, 0.0 if lean is None else 0.4, 1.0)
+    part = sub(progress, 0.0 if first is None else 0.4, 1.0)
     if not capped:
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
         fine = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
@@ -265,8 +265,8 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     report(part, 0.75, "checking the corrected surface")
     built = _checked(smp, *fine, *args)
     report(progress, 1.0, "corrected surface checked")
-    if lean is not None and _excess(lean.checks) <= _excess(built.checks):
-        return lean
+    if first is not None and _excess(first.checks) <= _excess(built.checks):
+        return first
     return built
 
 
