@@ -216,6 +216,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     comp.MaxOffset = float(options.max_offset)
     comp.Flip = bool(options.flip_normals)
     comp.Refine = int(options.refine)
+    comp.Lean = bool(options.lean)
     return comp, meas
 
 

@@ -241,6 +241,11 @@ class CompensationFeature(_Proxy):
     PROPERTIES = COMPENSATION_PROPERTIES
     RENAMED = RENAMED
 
+    def onDocumentRestored(self, obj):
+        added = _migrate(obj, self.PROPERTIES, self.VERSION, self.RENAMED)
+        if "Lean" in added:     # made before the lean face: recompute to the saved face
+            obj.Lean = False
+
     def execute(self, obj):
         result = _compute(obj)
         _write_results(obj, result)
@@ -259,7 +264,8 @@ def options_of(obj):
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
                    max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
-                   refine=int(obj.Refine), layout=obj.Layout,
+                   refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
+                   layout=obj.Layout,
                    smoothing=(float(obj.Smoothing.Value) or None),
                    tip_radius=float(obj.TipRadius.Value))
 

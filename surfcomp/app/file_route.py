@@ -124,6 +124,19 @@ def run_job(job, progress=None):
                                  output_shape=output.as_dict() if output else None)
     if build and job.curves:
         shapes["curves"] = curve_net(comp)
+    with Transaction(outputs, inputs) as tx:
+        for attr, shape in shapes.items():
+            tmp = tx.write(getattr(job, attr), lambda tmp, shape=shape: write_face(tmp, shape))
+            if attr == "output":        # the report states the size of the written face
+                rep["output_shape"]["file_bytes"] = os.path.getsize(tmp)
+        for attr, text in _texts(job, comp, rep).items():
+            tx.stage_text(getattr(job, attr), text)
+        tx.commit()
+    return comp, rep
+
+
+def _texts(job, comp, rep):
+    """The text outputs of ``job`` (points CSV, JSON report, HTML report) by attribute."""
     texts = {}
     if job.points:
         texts["points"] = corrected_points_csv(comp)
@@ -131,13 +144,7 @@ def run_job(job, progress=None):
         texts["report"] = report_io.dumps(rep)
     if job.html:
         texts["html"] = render_html(rep)
-    with Transaction(outputs, inputs) as tx:
-        for attr, shape in shapes.items():
-            tx.write(getattr(job, attr), lambda tmp, shape=shape: write_face(tmp, shape))
-        for attr, text in texts.items():
-            tx.stage_text(getattr(job, attr), text)
-        tx.commit()
-    return comp, rep
+    return texts
 
 
 def _warn_outside_trim(nominal, prepared):

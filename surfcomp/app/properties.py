@@ -164,8 +164,13 @@ COMPENSATION_PROPERTIES = (
      False, 0),
     ("App::PropertyInteger", "Refine", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
-                                        "step"),
+                                        "step at most (one where that meets the limits)"),
      4, 0),
+    ("App::PropertyBool", "Lean", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Grids along the face's parameter lines: one knot span "
+                                        "per grid step first, kept when it meets the limits "
+                                        "(off in documents made before it: Refine spans)"),
+     True, 0),
     ("App::PropertyEnumeration", "Output", _IN,
      QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
                                         " the face replaced and its neighbours re-trimmed to meet"

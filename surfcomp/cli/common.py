@@ -74,7 +74,9 @@ def add_method_options(p):
                         "filter's place (the wavelength damped to half; default chosen by "
                         "generalized cross-validation)")
     p.add_argument("--refine", type=int, default=4, metavar="K",
-                   help="knot spans of the corrected surface per measurement grid step (default 4)")
+                   help="knot spans of the corrected surface per measurement grid step at most "
+                        "(default 4): a grid along the face's parameter lines first gets one "
+                        "span per step, kept when it meets the 0.1 um / 1 um limits")
 
 
 def job_from_args(args, command):
@@ -190,15 +192,16 @@ def output_lines(shape):
     """What the written shape is: the report's ``output_shape``, as summary lines."""
     if not shape:
         return []
+    size = ["  file size %d bytes" % shape["file_bytes"]] if "file_bytes" in shape else []
     if shape["kind"] == "face":
         return ["Output:       the corrected face alone (largest edge tolerance %.2g mm)"
                 % shape["max_edge_tolerance_mm"],
                 "  the correction integrates to %.4f mm^3 over it (positive = material removed)"
-                % shape["correction_integral_mm3"]]
+                % shape["correction_integral_mm3"]] + size
     lines = ["Output:       the nominal's shape with the face replaced (%d faces, %d solids; "
              "re-trimmed neighbours: %s; largest edge tolerance of the face %.2g mm)"
              % (shape["faces"], shape["solids"], ", ".join(shape["retrimmed_faces"]) or "none",
-                shape["max_edge_tolerance_mm"])]
+                shape["max_edge_tolerance_mm"])] + size
     if shape["volume_change_mm3"] is not None:
         mismatch = shape["volume_change_vs_integral"]
         lines.append("  volume change %.4f mm^3; the correction integrates to %.4f mm^3 "

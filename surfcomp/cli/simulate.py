@@ -139,7 +139,8 @@ def add_parser(subparsers):
                    help="allowance the semi-finishing pass leaves, and the mirror method's stock "
                         "(default 0.3 mm, or the preset's)")
     g.add_argument("--refine", type=int, default=4, metavar="K",
-                   help="knot spans of the corrected surface per grid step (default 4)")
+                   help="knot spans of the corrected surface per grid step at most "
+                        "(default 4; one where that meets the limits)")
     g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     m = p.add_argument_group("machining-process model (mm)")
     for name, metavar, text, _, _ in _MODEL_OPTIONS:

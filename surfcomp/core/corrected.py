@@ -4,8 +4,10 @@
 Construction (why not the papers' interpolation through the corrected points:
 on coarse grids such as 7 x 10 points on a bicubic face with interior knots that
 misses the nominal shape by ~100 um between points): the nominal's knot vectors
-are refined until every knot span is at most ``1/refine`` of the measurement grid
-spacing, the nominal is sampled at the Greville abscissae of the refined space,
+are refined, for a grid along the parameter lines first by knots on its node lines
+(one span per grid step, see :func:`construct`), else or where that misses the limits
+until every knot span is at most ``1/refine`` of the measurement grid spacing; the
+nominal is sampled at the Greville abscissae of the refined space,
 each sample is displaced by the correction field along the nominal's outward
 normal, ``S_c(u, v) = S(u, v) - delta(u, v) n(u, v)``, and the refined space
 interpolates these samples. The refined space contains the nominal exactly
@@ -26,8 +28,8 @@ DEFAULT_REFINE = 4
 #: target of the residual iteration at the measured points (mm)
 MATCH_TOL = 2e-5
 MATCH_ITERATIONS = 8
-#: a dense grid's one-span-per-step surface is kept when it meets the points this well
-#: (the pipeline's requirement, 0.1 um) even if the iteration has not reached MATCH_TOL
+#: a lean or capped surface is kept when it meets the points this well (the pipeline's
+#: requirement, 0.1 um) even if the iteration has not reached MATCH_TOL (see meets_limits)
 ACCEPT_TOL = 1e-4
 #: poles of the finer space a dense grid across the parameter lines falls back to (two
 #: spans per grid step, fewer (at least 1.25) where that would exceed this)
@@ -54,30 +56,46 @@ def refinement_knots(knots, degree, lo, hi, spacing):
     return np.asarray(new, dtype=float)
 
 
-def node_line_knots(knots, lo, hi, lines, keep_off=0.25):
-    """Knots at the measurement grid's node lines (one span per grid step), for dense
-    grids whose rows and columns run along parameter lines: the space's Greville
-    samples then fall on the nodes, where the correction must be met exactly.
+def node_line_knots(knots, lo, hi, lines, keep_off=0.5):
+    """Knots at the measurement grid's node lines (one span per grid step), for grids
+    whose rows and columns run along parameter lines: the space's Greville samples then
+    lie near the nodes, where the correction must be met exactly.
 
-    Node lines closer than ``keep_off`` of their step to one of the nominal's own
-    knots (which stay, so the space still contains the nominal) are left out; beyond
-    the outermost lines the spans are split to the same step.
+    Each of the nominal's own knots (which stay, so the space still contains the
+    nominal) takes the place of the node line nearest to it (beyond the outermost lines
+    when that is at most ``keep_off`` of a step away), so the spans stay about one step
+    long; lines within 1/20 of a step of the border are left out. Beyond the outermost
+    lines, where the field levels off within about a grid step (see
+    :mod:`surfcomp.core.field`), the first span is one step and the next ones grow
+    fourfold (1, 4, 16, ... steps out, none within half a step of the border).
     """
     lines = np.sort(np.asarray(lines, dtype=float))
     step = np.median(np.diff(lines))
     own = np.unique(np.asarray(knots, dtype=float))
-    lines = np.concatenate([lines[0] - step * np.arange(int((lines[0] - lo) / step), 0, -1),
-                            lines,
-                            lines[-1] + step * np.arange(1, int((hi - lines[-1]) / step) + 1)])
-    near = np.min(np.abs(lines[:, None] - own[None, :]), axis=1) < keep_off * step
-    return lines[(lines > lo) & (lines < hi) & ~near]
+    first, last = lines[0], lines[-1]
+    lines = np.concatenate([first - _strip(first - lo, step)[::-1], lines,
+                            last + _strip(hi - last, step)])
+    near = np.zeros(lines.size, dtype=bool)
+    for k in own[(own > lo) & (own < hi)]:
+        i = np.argmin(np.abs(lines - k))
+        # between the outermost lines the nearest is at most half a (local) step away; a
+        # knot halfway between two lines replaces one of them whatever the rounding
+        near[i] |= first <= k <= last or abs(lines[i] - k) <= keep_off * step
+    # a line on the border (up to rounding) would make a span of almost no length
+    inside = (lines > lo + 0.05 * step) & (lines < hi - 0.05 * step)
+    return lines[inside & ~near]
 
 
-def aligned_lines(U, V, refine, tol=0.02):
-    """The grid's u per row and v per column when nodes lie on parameter lines within
-    ``tol`` of a grid step and the grid is dense enough that :data:`MAX_SPANS` caps the
-    refinement; else None (the general construction applies)."""
-    if U.ndim != 2 or min(U.shape) < 4 or refine * (max(U.shape) - 1) <= MAX_SPANS:
+def _strip(width, step):
+    """Offsets of the knots in a strip ``width`` wide beyond the outermost node line."""
+    out = step * 4.0 ** np.arange(max(0, int(np.log(max(width, step) / step) / np.log(4)) + 2))
+    return out[out <= width - 0.5 * step]
+
+
+def grid_lines(U, V, tol=0.02):
+    """The grid's u per row and v per column when its nodes lie on parameter lines
+    within ``tol`` of a grid step; else None."""
+    if U.ndim != 2 or min(U.shape) < 2:
         return None
     lu, lv = np.median(U, axis=1), np.median(V, axis=0)
     du, dv = np.diff(lu), np.diff(lv)
@@ -87,6 +105,14 @@ def aligned_lines(U, V, refine, tol=0.02):
             or np.max(np.abs(V - lv[None, :])) > tol * np.min(np.abs(dv))):
         return None
     return lu, lv
+
+
+def aligned_lines(U, V, refine, tol=0.02):
+    """:func:`grid_lines` for grids dense enough that :data:`MAX_SPANS` caps the
+    refinement (their only space is the node-line one); else None."""
+    if U.ndim != 2 or min(U.shape) < 4 or refine * (max(U.shape) - 1) <= MAX_SPANS:
+        return None
+    return grid_lines(U, V, tol)
 
 
 def _span(width, spacing, refine, per_step=2):
@@ -181,20 +207,31 @@ class Construction:
 
 
 def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
-              refine=DEFAULT_REFINE, field_factory=GridField, grid_shape=None, progress=None):
+              refine=DEFAULT_REFINE, field_factory=GridField, grid_shape=None, progress=None,
+              lean=True):
     """Build the corrected surface for node corrections ``delta`` and check it.
 
-    The one entry point for the pipeline and the document objects: the refined
-    space is sampled once and serves the matching surface (:func:`build_matching_surface`),
-    the zero-field surface (the construction's self-check) and the check figures.
+    The one entry point for the pipeline and the document objects. A grid along the
+    parameter lines first gets the lean space (:func:`node_line_knots`: the nominal's
+    knots and one span per grid step); it is kept when it meets the limits
+    (:func:`meets_limits`). Otherwise, and for other layouts, the space has ``refine``
+    spans per grid step (see :func:`_span`; dense grids fewer); when neither meets the
+    limits the one closer to them is kept. Each space is sampled once and serves the
+    matching surface (:func:`build_matching_surface`), the zero-field surface (the
+    construction's self-check) and the check figures.
 
     Parameters
     ----------
     U, V, delta : array_like, shape (n, m) (grids) or (N,) (scattered ``field_factory``)
         Node parameters and intended corrections (mm).
+    refine : int
+        Knot spans per grid step at most (the space the lean one falls back to).
     grid_shape : tuple, optional
         Shape of the measurement grid for the density of the dense check grid
         (default ``U.shape``; give a shape for scattered nodes).
+    lean : bool
+        False: no lean space below the dense limit, ``refine`` spans per step as before it
+        (documents made before it recompute to the face they saved).
 
     Returns
     -------
@@ -202,23 +239,60 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     """
     U, V = np.asarray(U, dtype=float), np.asarray(V, dtype=float)
     report(progress, 0.0, "sampling the nominal")
-    lines = aligned_lines(U, V, refine) if field_factory is GridField else None
-    capped = lines is None and (
-        [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)]
-        != [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine, per_step=1)])
-    if not capped:
+    args = (nominal, U, V, delta, outward, grid_shape or U.shape)
+    lines = grid_lines(U, V) if field_factory is GridField else None
+    if not lean:
+        lines = aligned_lines(U, V, refine) if lines is not None else None
+    first = None    # the lean construction
+    if lines is not None:
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine, lines)
-        surf, field, k, real = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
-                                      field_factory, sub(progress, 0.1, 0.75))
+        first = _checked(smp, *_match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
+                                      field_factory, sub(progress, 0.05, 0.4)), *args)
+        # a dense grid has no finer space within MAX_SPANS
+        if meets_limits(first.checks) or aligned_lines(U, V, refine) is not None:
+            report(progress, 1.0, "corrected surface checked")
+            return first
+    capped = [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)] != \
+        [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine, per_step=1)]
+    part = sub(progress, 0.0 if first is None else 0.4, 1.0)
+    if not capped:
+        smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
+        fine = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS,
+                      field_factory, sub(part, 0.1, 0.75))
     else:
-        smp, surf, field, k, real = _dense_across(nominal, outward, U, V, delta, spacing_u,
-                                                  spacing_v, refine, field_factory, progress)
-    report(progress, 0.75, "checking the corrected surface")
+        smp, *fine = _dense_across(nominal, outward, U, V, delta, spacing_u, spacing_v,
+                                   refine, field_factory, part)
+    report(part, 0.75, "checking the corrected surface")
+    built = _checked(smp, *fine, *args)
+    report(progress, 1.0, "corrected surface checked")
+    if first is not None and _excess(first.checks) <= _excess(built.checks):
+        return first
+    return built
+
+
+def _checked(smp, surf, field, k, real, nominal, U, V, delta, outward, shape):
+    """The :class:`Construction` of a matched surface on the sampled space ``smp``."""
     zero = smp.build(np.zeros((smp.us.size, smp.vs.size)))
     checks = check_figures(nominal, surf, zero, U.ravel(), V.ravel(), np.ravel(delta), outward,
-                           grid_shape or U.shape, realised=real.ravel())
-    report(progress, 1.0, "corrected surface checked")
+                           shape, realised=real.ravel())
     return Construction(surf, zero, field, k, checks)
+
+
+#: the limits a corrected surface is held to (mm): realised - intended correction at the
+#: points and the zero field's deviation from the nominal at most ACCEPT_TOL, the largest
+#: realised correction on the dense check grid at most the largest intended + OVERSHOOT_TOL
+OVERSHOOT_TOL = 1e-3
+
+
+def _excess(checks):
+    """How far ``checks`` exceed the limits: the largest ratio figure / limit."""
+    return max(checks.max_error_at_points / ACCEPT_TOL, checks.max_zero_deviation / ACCEPT_TOL,
+               (checks.max_realised - checks.max_intended) / OVERSHOOT_TOL)
+
+
+def meets_limits(checks):
+    """True when the :class:`CheckFigures` meet the limits (see :data:`OVERSHOOT_TOL`)."""
+    return _excess(checks) <= 1.0
 
 
 def _dense_across(nominal, outward, U, V, delta, spacing_u, spacing_v, refine, field_factory,

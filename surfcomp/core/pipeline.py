@@ -42,7 +42,10 @@ class Options:
     Lengths in mm. ``mask_size``/``weights``/``mask_kind``/``sigma``/``edge`` define the
     filter (:mod:`surfcomp.core.filters`); ``stock`` is the mirror method's semi-finishing
     allowance; ``max_offset`` the largest accepted distance of a point from the face;
-    ``refine`` the knot spans per measurement grid step of the corrected surface;
+    ``refine`` the knot spans per measurement grid step of the corrected surface at most
+    (grids along the parameter lines first get one, kept when it meets the limits; see
+    :func:`surfcomp.core.corrected.construct`; ``lean`` False: ``refine`` spans per step
+    as before, for documents made before);
     ``tip_radius`` the stylus ball radius when the measured points are tip centres
     (the contact point is the centre moved by it against the outward normal);
     ``layout`` one of :data:`LAYOUTS`; ``smoothing`` the smoothing length (mm) of the
@@ -63,6 +66,7 @@ class Options:
     tip_radius: float = 0.0
     layout: str = "auto"
     smoothing: float = None
+    lean: bool = True
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -98,6 +102,9 @@ class Options:
             if getattr(self, name) not in choices:
                 raise InputError("%s %r: expected one of %s"
                                  % (option, getattr(self, name), ", ".join(choices)))
+        if not isinstance(self.lean, (bool, np.bool_)):
+            raise InputError("lean %r: expected true or false (Lean in the document)"
+                             % (self.lean,))
         if self.method == "mirror" and self.stock is None:
             raise InputError("--method mirror needs --stock (the semi-finishing allowance in "
                              "mm; DH = stock / 2)")
@@ -434,7 +441,8 @@ def build_surface(result, surface, outward, delta, progress=None):
         du, dv = grid_spacing(prepared)
         factory, shape = GridField, None
     built = construct(surface, U, V, delta, outward, du, dv, result.options.refine,
-                      field_factory=factory, grid_shape=shape, progress=progress)
+                      field_factory=factory, grid_shape=shape, progress=progress,
+                      lean=result.options.lean)
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks

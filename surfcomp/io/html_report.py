@@ -249,7 +249,7 @@ def _section_method(report):
             ("Edge handling", _e(m.get("edge"))),
             ("Stock (mirror)",
              _e("%s mm" % m["stock_mm"] if m.get("stock_mm") is not None else "-")),
-            ("Refinement", _e("%s knot spans per grid step" % m.get("refine"))),
+            ("Refinement", _e("at most %s knot spans per grid step" % m.get("refine"))),
             ("Layout", _e(layout))]
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
 
@@ -329,6 +329,9 @@ def _section_checks(report):
                 rows.append((text, '<span class="num">%.4f %s</span>' % (val * f, unit)))
             else:
                 rows.append((key.replace("_", " "), _e(val)))
+        size = (report.get("output_shape") or {}).get("file_bytes")
+        if size is not None:
+            rows.append(("Written file size", '<span class="num">%d bytes</span>' % size))
         body = _kv_table(rows)
     return '<section id="checks"><h2>Corrected face checks</h2>%s</section>' % body
 

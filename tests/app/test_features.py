@@ -135,7 +135,8 @@ def test_compensation_matches_the_pipeline(doc):
     assert stats["deviation"]["max_positive"] == pytest.approx(0.04713, abs=5e-6)  # CLI test
     assert stats["deviation"] == comp.statistics["deviation"].as_dict()
     checks = json.loads(c.Checks)
-    assert checks["max_error_at_points_mm"] < 1e-4 and checks["poles"] == [183, 183]
+    # the lean space: 45 node lines, three of them replaced by the nominal's knots
+    assert checks["max_error_at_points_mm"] < 1e-4 and checks["poles"] == [49, 49]
     assert c.Round == 1
     # the realised correction of the document's face at the nodes is the Correction
     U, V = np.reshape(c.U, g.shape), np.reshape(c.V, g.shape)

@@ -192,3 +192,14 @@ def test_preset_simulation_shows_the_papers_table_and_the_parts_maps():
         assert img.format == "PNG" and img.size[0] > 300
     # without maps (the JSON alone) the section has the tables but no map block
     assert 'id="simulated-maps"' not in render_html(_report(), res.as_dict())
+
+
+def test_checks_state_the_poles_and_the_written_file_size():
+    """The corrected face's checks give its poles, and the written file's size when there
+    is one (``output_shape.file_bytes``, set when the job writes the face)."""
+    rep = _report()
+    checks = render_html(rep).split('<section id="checks">')[1].split("</section>")[0]
+    assert "poles" in checks and "Written file size" not in checks
+    rep["output_shape"] = {"kind": "face", "file_bytes": 238855}
+    checks = render_html(rep).split('<section id="checks">')[1].split("</section>")[0]
+    assert "Written file size" in checks and "238855 bytes" in checks

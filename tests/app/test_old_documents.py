@@ -42,6 +42,7 @@ out = {"aliased": aliased, "unimportable": unimportable, "branches": cam.branche
        "versions": {n: doc.getObject(n).Version for n in ("Meas1", "Round1", "Round2",
                                                           "DressupAxisErrors")},
        "saved_poles": [poles(doc.getObject(n).Shape, 1) for n in ("Round1", "Round2")],
+       "lean": {n: doc.getObject(n).Lean for n in ("Round1", "Round2")},
        "renamed": {n: {p: (len(getattr(doc.getObject(n), p)) if p == "Nodes" else True)
                        for p in ("Flip", "EdgeTol", "Nodes", "FlipNormals", "EdgeTolerance",
                                  "NominalPoints") if p in doc.getObject(n).PropertiesList}
@@ -123,7 +124,9 @@ def test_recomputes_to_what_0_20_computed(reopened):
     r, expected = reopened
     assert r["invalid"] == []
     # the saved shapes are 0.20's; recomputed here with this numpy/scipy/OCCT they are the
-    # same to 1e-9 mm
+    # same to 1e-9 mm: made before the lean face (one span per grid step), the objects come
+    # back with Lean off and keep the 123 x 123 poles of Refine spans per step
+    assert r["lean"] == {"Round1": False, "Round2": False}
     for saved, now, shape in zip(r["saved_poles"], r["poles"], expected["poles_shape"]):
         assert np.shape(saved) == np.shape(now) == tuple(shape)
         np.testing.assert_allclose(now, saved, atol=1e-9)

@@ -9,6 +9,7 @@ Requirements checked on several faces (bicubic with interior knots, rational, a 
 * raw noisy data does not overshoot: |realised| <= max|intended| + 1 um anywhere.
 """
 
+import json
 import os
 
 import numpy as np
@@ -127,7 +128,18 @@ def test_example_job_matches_werner_table_form(tmp_path):
     pts = rep["points"]
     cor = np.array(pts["nominal"]) - np.array(pts["correction"])[:, None] * np.array(pts["normal"])
     assert_allclose(np.array(pts["corrected"]), cor, atol=2e-9)
-    assert os.path.getsize(tmp_path / "c.step") > 10000
+    # the lean face: one knot span per grid step (45 node lines, three of them replaced by
+    # the nominal's knots 0.25, 0.5, 0.75) meets the limits, so 49 x 49 poles (183 x 183
+    # with 4 spans per step) and a STEP file of about 0.24 MB (3.1 MB before)
+    face = rep["corrected_face"]
+    assert face["poles"] == [49, 49]
+    assert face["max_deviation_from_nominal_with_zero_correction_mm"] < 0.1 * UM
+    assert face["max_abs_realised_correction_on_face_mm"] <= (
+        face["max_abs_intended_correction_mm"] + 1 * UM)
+    size = os.path.getsize(tmp_path / "c.step")
+    assert rep["output_shape"]["file_bytes"] == size
+    assert 10000 < size <= 400000
+    assert json.loads((tmp_path / "r.json").read_text())["output_shape"]["file_bytes"] == size
 
 
 def test_mirror_and_offset_methods(tmp_path):

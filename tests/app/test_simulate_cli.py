@@ -15,6 +15,7 @@ import surfcomp.cli
 from surfcomp.app.nominal import load_nominal
 from surfcomp.core import presets
 from surfcomp.core import simulate as sm
+from surfcomp.core.corrected import MATCH_TOL
 from tests.app.helpers import EXAMPLE_STEP, ROOT
 
 #: until the command is listed in surfcomp.cli.COMMANDS the tests register it for the child
@@ -61,7 +62,8 @@ def test_simulate_example_writes_json_with_every_replica(tmp_path):
 
 
 def test_model_options_reach_the_model(tmp_path):
-    """Only a constant 10 um error, no noise: before mean 10 um, offset removes it exactly."""
+    """Only a constant 10 um error, no noise: before mean 10 um, offset removes it to the
+    construction's precision."""
     out = run_cli(EXAMPLE_STEP, "--grid", "7x7", "--replicas", "1", "--methods", "none,offset,raw",
                   "--offset", "0.01", "--slope-gain", "0", "--abs-slope-gain", "0", "--tilt", "0,0",
                   "--bow", "0,0", "--sigma", "0", "--probe-sigma", "0",
@@ -73,8 +75,14 @@ def test_model_options_reach_the_model(tmp_path):
     assert_allclose([before["mean"], before["max_negative"], before["max_positive"]], 0.01,
                     atol=1e-9)
     for m in d["methods"][1:]:
-        r = m["replicas"][0]["all"]
-        assert max(abs(r["max_negative"]), abs(r["max_positive"])) < 2e-6, m["label"]
+        r = m["replicas"][0]
+        # at the nodes within the residual iteration's target MATCH_TOL (0.02 um; measured
+        # 0.0095 um); between them the lean face (one knot span per grid step) carries the
+        # constant offset of the curved face within 0.017 um (measured; 4 spans per step
+        # gave 0.002 um), well inside the 0.1 um limit
+        grid, every = r["grid"], r["all"]
+        assert max(abs(grid["max_negative"]), abs(grid["max_positive"])) < MATCH_TOL, m["label"]
+        assert max(abs(every["max_negative"]), abs(every["max_positive"])) < 3e-5, m["label"]
 
 
 def _bad(tmp_path, *args):

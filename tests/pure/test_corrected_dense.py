@@ -82,7 +82,7 @@ def test_node_line_knots_keep_the_nominal_knots_and_fill_the_ends():
     own = [0, 0, 0, 0, 0.3, 0.55, 0.8, 1, 1, 1, 1]
     lines = np.linspace(0.1, 0.9, 17)  # step 0.05
     k = node_line_knots(own, 0.0, 1.0, lines)
-    # lines within a quarter step of 0.3, 0.55, 0.8 are left out (0.3, 0.55, 0.8 are lines)
+    # the lines nearest to 0.3, 0.55, 0.8 are left out (0.3, 0.55, 0.8 are lines)
     assert not np.any(np.isclose(k, 0.3)) and not np.any(np.isclose(k, 0.8))
     np.testing.assert_allclose(k[:2], [0.05, 0.1])     # continued to the border
     assert k.max() == pytest.approx(0.95) and np.all(np.diff(k) > 0)
