@@ -21,6 +21,9 @@ from ..core import bspline
 from ..core.trimmed import correction_integral, domain_integral, knots_of
 from .nominal import boundary_polylines
 
+#: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
+_trapezoid = getattr(np, "trapezoid", None) or np.trapz
+
 #: knots per direction above which the volume change's panels ignore them
 _MAX_KNOTS = 400
 
@@ -65,7 +68,7 @@ def _strip_flux(p, centre):
         across = -across
     move = np.einsum("ij,ij->i", new - old, across)
     density = np.einsum("ij,ij->i", (old - centre) / 3.0, normals)
-    return -float(np.trapz(density * move * speed, ts))
+    return -float(_trapezoid(density * move * speed, ts))
 
 
 def volume_change(nominal, corrected, new_face, plan):
