@@ -154,10 +154,21 @@ def to_bspline_face(face):
                             % (converted, exc)) from exc
 
 
+#: share of the face's UV range the work surface keeps beyond the face's UV bounds (where
+#: the underlying surface extends that far): the edges of a neighbour re-trimmed to meet the
+#: corrected face can leave the face's UV box by the correction's slope, and their 2D curves
+#: must stay on the surface (else a STEP reader that rebuilds them, OCCT 7.7 and later,
+#: widens the edge's tolerance to the gap)
+WORK_MARGIN = 0.05
+
+
 def work_surface(bface):
     """The B-spline surface of ``bface`` made non-periodic and cut to the face's UV bounds
-    (same parametrisation): the surface the compensation works on."""
+    widened by :data:`WORK_MARGIN` (same parametrisation): the surface the compensation
+    works on."""
     u0, u1, v0, v1 = bface.ParameterRange
+    du, dv = WORK_MARGIN * (u1 - u0), WORK_MARGIN * (v1 - v0)
+    u0, u1, v0, v1 = u0 - du, u1 + du, v0 - dv, v1 + dv
     bs = bface.Surface.copy()
     if bs.isUPeriodic():
         bs.setUNotPeriodic()
