@@ -20,27 +20,11 @@ import tempfile
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from tests.gui.harness import run_gui  # noqa: E402
+from tests.gui.harness import run_gui, with_common  # noqa: E402
 
 BODY = r'''
-import time
-import numpy as np
-from surfcomp.gui import dialogs, panels
-Gui = FreeCADGui
-root = os.environ["SURFCOMP_ROOT"]
-files = [os.path.join(root, "examples", "nominal.step"),
-         os.path.join(root, "examples", "measurements.csv")]
-dialogs.ask_open_file = lambda *a: files.pop(0)
-dialogs.run_dialog = lambda dlg: True
-Gui.activateWorkbench("SurfCompWorkbench")
 doc = FreeCAD.newDocument("Bench")
-Gui.runCommand("SurfComp_LoadNominal")
-Gui.runCommand("SurfComp_ImportMeasurements")
-Gui.Selection.addSelection(doc.Name, "Nominal", "Face1")
-Gui.Selection.addSelection(doc.Name, "Measurement")
-Gui.runCommand("SurfComp_DeviationMap")
-comp = doc.getObject("Compensation")
-Gui.Selection.clearSelection()
+comp = make_map(doc, *load_example(doc))
 Gui.Selection.addSelection(doc.Name, comp.Name)
 Gui.runCommand("SurfComp_Filter")
 panel = panels.FilterPanel.instance
@@ -95,7 +79,7 @@ panel.reject()
 
 def main():
     with tempfile.TemporaryDirectory() as tmp:
-        res, _out = run_gui(BODY, pathlib.Path(tmp))
+        res, _out = run_gui(with_common(BODY), pathlib.Path(tmp))
     if res["errors"]:
         print("\n".join(res["errors"]))
         raise SystemExit(1)

@@ -105,14 +105,20 @@ def read_image(path):
     return img[..., :3]
 
 
+def with_common(body):
+    """``body`` after the shared prologue ``gui_common.py`` (dialog recorders,
+    ``load_example``, ``make_map``, ...), for :func:`run_gui`."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    with open(os.path.join(here, "gui_common.py"), encoding="utf-8") as f:
+        return f.read() + "\n" + body
+
+
 def run_session(name, tmp_path, home=None, timeout=300):
     """Run ``tests/gui/session_<name>.py`` after the shared prologue ``gui_common.py``;
     return the results dict with the process output under ``'output'``."""
     here = os.path.dirname(os.path.abspath(__file__))
-    parts = []
-    for fname in ("gui_common.py", "session_%s.py" % name):
-        with open(os.path.join(here, fname), encoding="utf-8") as f:
-            parts.append(f.read())
-    results, output = run_gui("\n".join(parts), tmp_path, home=home, timeout=timeout)
+    with open(os.path.join(here, "session_%s.py" % name), encoding="utf-8") as f:
+        body = f.read()
+    results, output = run_gui(with_common(body), tmp_path, home=home, timeout=timeout)
     results["output"] = output
     return results
