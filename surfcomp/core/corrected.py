@@ -142,8 +142,10 @@ def _added_knots(nominal, spacing_u, spacing_v, refine, lines=None, per_step=2):
 class _Sampling:
     """The refined space of the nominal and its samples (computed once per construction)."""
 
-    def __init__(self, nominal, outward, spacing_u, spacing_v, refine, lines=None, per_step=2):
-        new_u, new_v = _added_knots(nominal, spacing_u, spacing_v, refine, lines, per_step)
+    def __init__(self, nominal, outward, spacing_u, spacing_v, refine, lines=None, per_step=2,
+                 added=None):
+        new_u, new_v = added or _added_knots(nominal, spacing_u, spacing_v, refine, lines,
+                                             per_step)
         self.nominal = nominal
         self.fine = bspline.insert_knots(nominal, new_u, new_v)
         self.us = bspline.greville(self.fine.knots_u, self.fine.degree_u)
@@ -268,6 +270,69 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     if first is not None and _excess(first.checks) <= _excess(built.checks):
         return first
     return built
+
+
+#: knot spans of the smooth route's space per span of the union of the nominal's and the
+#: field's knots, tried in turn until the limits are met
+SMOOTH_PARTS = (1, 2, 4, 8)
+#: the smooth route stops refining beyond this many poles
+SMOOTH_POLE_BUDGET = 1.1e6
+
+
+def smooth_knots(knots, lo, hi, field_knots, parts):
+    """Knots to add to the nominal's (flat ``knots``) within [lo, hi]: the field's knots
+    (those within 1/10 of a field span of one of the nominal's knots left out, the
+    nominal's knot stands in), then every span of the union split into ``parts`` (spans
+    up to 1.2 field spans long count as one)."""
+    own = np.unique(np.asarray(knots, dtype=float))
+    field_knots = np.asarray(field_knots, dtype=float)
+    h = float(np.median(np.diff(field_knots))) if field_knots.size > 1 else hi - lo
+    inside = field_knots[(field_knots > lo + 0.1 * h) & (field_knots < hi - 0.1 * h)]
+    gap = np.min(np.abs(inside[:, None] - own[None, :]), axis=1) if inside.size else inside
+    first = inside[gap > 0.1 * h]
+    union = np.union1d(own, first)
+    # (a span that lost a field knot to a nominal one is up to 1.1 field spans long)
+    return np.sort(np.concatenate([first, refinement_knots(union, 0, lo, hi, h / parts * 1.2)]))
+
+
+def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
+    """The corrected surface for a correction that is a smooth field known everywhere
+    (the scattered layouts' P-spline fit, :class:`surfcomp.core.spline_field.SplineField`,
+    whose values at the points are ``delta``): the space holds the nominal's knots and
+    the field's (:func:`smooth_knots`), split into 1, 2, 4, 8 parts until the limits are
+    met (:func:`meets_limits`); no residual iteration (the field is met everywhere, not
+    only at the points). The check grid has four points per knot span.
+
+    Returns
+    -------
+    Construction
+        The first that meets the limits, else the one closest to them.
+    """
+    U, V, delta = np.ravel(U).astype(float), np.ravel(V).astype(float), np.ravel(delta)
+    (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
+    best = None
+    for k, parts in enumerate(SMOOTH_PARTS):
+        added = (smooth_knots(nominal.knots_u, u0, u1, field.knots(0), parts),
+                 smooth_knots(nominal.knots_v, v0, v1, field.knots(1), parts))
+        poles = np.prod([len(a) + len(own) - d - 1 for a, own, d in
+                         zip(added, (nominal.knots_u, nominal.knots_v),
+                             (nominal.degree_u, nominal.degree_v))])
+        if best is not None and poles > SMOOTH_POLE_BUDGET:
+            break
+        report(progress, k / len(SMOOTH_PARTS), "building the corrected surface (%d poles)"
+               % poles)
+        smp = _Sampling(nominal, outward, None, None, 1, added=added)
+        uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")
+        surf = smp.build(field(uu, vv))
+        real = realised_correction(nominal, surf, U, V, outward, guess=delta)
+        built = _checked(smp, surf, field, 0, real, nominal, U, V, delta, outward,
+                         (smp.us.size, smp.vs.size))
+        if best is None or _excess(built.checks) < _excess(best.checks):
+            best = built
+        if meets_limits(built.checks):
+            break
+    report(progress, 1.0, "corrected surface checked")
+    return best
 
 
 def _checked(smp, surf, field, k, real, nominal, U, V, delta, outward, shape):

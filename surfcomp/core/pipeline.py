@@ -14,9 +14,8 @@ from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
 from . import bspline, plausibility
-from .corrected import DEFAULT_REFINE, construct
+from .corrected import DEFAULT_REFINE, construct, construct_smooth
 from .deviations import deviation_components, statistics
-from .field import GridField
 from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
 from .methods import METHODS, compute_correction
@@ -30,6 +29,12 @@ NORMAL_WARNING_DEG = 5.0
 MISS_WARNING = 1e-4
 #: ... and one that moves more than the largest intended correction plus this anywhere
 OVERSHOOT_WARNING = 1e-3
+#: a scattered layout's corrected face is built from its smoothing fit's spline when the
+#: intended corrections are the spline's values at the points within this (mm)
+SMOOTH_MATCH = 1e-9
+#: the median nearest-neighbour distance of a scattered layout is taken over this many
+#: points at most (its sampling error is well under 1 %)
+SPACING_SAMPLE = 50000
 #: how the points are arranged: found automatically (a complete grid, else scattered),
 #: or forced
 LAYOUTS = ("auto", "grid", "scattered")
@@ -352,7 +357,7 @@ class Compensation:
     zero: object = None         # Surface built with a zero field (construction check)
     checks: object = None       # corrected.CheckFigures
     spacing: tuple = None
-    field: object = None        # field.GridField of the intended correction
+    field: object = None        # the field of the intended correction (GridField, ...)
     iterations: int = 0         # residual iterations of the construction
     fit: object = None          # scattered.SmoothFit (scattered layouts only)
     scale: tuple = None         # mm per unit parameter along u and v at the points
@@ -430,19 +435,7 @@ def build_surface(result, surface, outward, delta, progress=None):
     prepared = result.prepared
     g = prepared.grid
     U, V = g.take(prepared.u), g.take(prepared.v)
-    if prepared.scattered:
-        scale = result.scale or parameter_scale(surface, prepared)
-        du, dv = scattered_spacing(prepared, scale)
-        factory = functools.partial(ScatteredField, scale=scale,
-                                    box=(surface.u_range, surface.v_range))
-        (u0, u1), (v0, v1) = surface.u_range, surface.v_range
-        shape = (int(np.ceil((u1 - u0) / du)) + 1, int(np.ceil((v1 - v0) / dv)) + 1)
-    else:
-        du, dv = grid_spacing(prepared)
-        factory, shape = GridField, None
-    built = construct(surface, U, V, delta, outward, du, dv, result.options.refine,
-                      field_factory=factory, grid_shape=shape, progress=progress,
-                      lean=result.options.lean)
+    built, (du, dv) = _construction(result, surface, outward, U, V, delta, progress)
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
@@ -463,6 +456,29 @@ def build_surface(result, surface, outward, delta, progress=None):
     return result
 
 
+def _construction(result, surface, outward, U, V, delta, progress):
+    """The :class:`~surfcomp.core.corrected.Construction` of ``build_surface`` and the
+    parameter spacing it used: from the smoothing fit's spline where ``delta`` is its
+    values at the points (scattered layouts, ``filtered``), else through the values."""
+    prepared = result.prepared
+    if not prepared.scattered:
+        du, dv = grid_spacing(prepared)
+        return construct(surface, U, V, delta, outward, du, dv, result.options.refine,
+                         progress=progress, lean=result.options.lean), (du, dv)
+    scale = result.scale or parameter_scale(surface, prepared)
+    du, dv = scattered_spacing(prepared, scale)
+    spline = getattr(result.fit, "field", None)
+    if spline is not None and np.max(np.abs(spline(U, V) - delta)) <= SMOOTH_MATCH:
+        return construct_smooth(surface, U, V, delta, spline, outward, progress), (du, dv)
+    factory = functools.partial(ScatteredField, scale=scale,
+                                box=(surface.u_range, surface.v_range))
+    (u0, u1), (v0, v1) = surface.u_range, surface.v_range
+    shape = (int(np.ceil((u1 - u0) / du)) + 1, int(np.ceil((v1 - v0) / dv)) + 1)
+    return construct(surface, U, V, delta, outward, du, dv, result.options.refine,
+                     field_factory=factory, grid_shape=shape, progress=progress,
+                     lean=result.options.lean), (du, dv)
+
+
 def parameter_scale(surface, prepared):
     """Median length per unit parameter (mm) along u and along v at the measured points,
     so that fits over (u, v) are isotropic on the face."""
@@ -472,9 +488,13 @@ def parameter_scale(surface, prepared):
 
 def scattered_spacing(prepared, scale):
     """Parameter spacing (du, dv) of a scattered layout: the median distance (mm) from
-    each point to its nearest neighbour, in parameter units along u and v."""
+    each point to its nearest neighbour, in parameter units along u and v (estimated from
+    a seeded sample of :data:`SPACING_SAMPLE` points on larger sets)."""
     x = np.stack([prepared.u * scale[0], prepared.v * scale[1]], axis=1)
-    dist, _ = cKDTree(x).query(x, k=2)
+    query = x
+    if x.shape[0] > SPACING_SAMPLE:
+        query = x[np.random.default_rng(0).choice(x.shape[0], SPACING_SAMPLE, replace=False)]
+    dist, _ = cKDTree(x).query(query, k=2)
     h = float(np.median(dist[:, 1]))
     if not h > 0:
         raise InputError("the measured points coincide: no spacing between them",

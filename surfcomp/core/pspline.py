@@ -33,6 +33,7 @@ from scipy import linalg as sla
 from scipy import sparse
 
 from . import bspline
+from .spline_field import CellSpline, powers, uniform_locate
 
 #: largest number of tensor B-spline coefficients of the large-N smoothing fit
 PSPLINE_MAX_COEFFS = 1100
@@ -84,22 +85,6 @@ def span_polynomials(knots, spans):
     return np.transpose(ders * fac[:, :, None], (1, 0, 2))
 
 
-def _locate(knots, spans, t):
-    """Span index and local coordinate in [0, 1] of parameters on a uniform knot grid."""
-    lo, hi = knots[3], knots[3 + spans]
-    i = np.clip(np.floor((t - lo) * (spans / (hi - lo))).astype(np.intp), 0, spans - 1)
-    s = (t - knots[3 + i]) / (knots[4 + i] - knots[3 + i])
-    return i, s
-
-
-def _powers(s, count):
-    out = np.empty((count, s.size))
-    out[0] = 1.0
-    for k in range(1, count):
-        out[k] = out[k - 1] * s
-    return out
-
-
 class PSplineSolver:
     """The P-spline fit of values ``d`` at points ``x`` (N, 2) in the box ``lo``..``hi``,
     decomposed once for all smoothing parameters (see the module docstring).
@@ -136,8 +121,8 @@ class PSplineSolver:
 
     # ------------------------------------------------------------------ assembly
     def _cells(self, x):
-        iu, s = _locate(self.ku, self.nsu, x[:, 0])
-        iv, t = _locate(self.kv, self.nsv, x[:, 1])
+        iu, s = uniform_locate(self.ku[3], self.ku[3 + self.nsu], self.nsu, x[:, 0])
+        iv, t = uniform_locate(self.kv[3], self.kv[3 + self.nsv], self.nsv, x[:, 1])
         return iu, iv, s, t
 
     def _normal_equations(self, x, d):
@@ -149,7 +134,7 @@ class PSplineSolver:
         for a in range(0, x.shape[0], CHUNK):
             iu, iv, s, t = self._cells(x[a:a + CHUNK])
             cell = iu * nsv + iv
-            sp, tp = _powers(s, _POW), _powers(t, _POW)
+            sp, tp = powers(s, _POW), powers(t, _POW)
             dc = d[a:a + CHUNK]
             for k in range(_POW):
                 for m in range(_POW):
@@ -203,27 +188,14 @@ class PSplineSolver:
         """Spline coefficients (nu * nv,) of the fit at ``rho``."""
         return self.V @ (self._f(rho) * self.y)
 
+    def spline(self, c):
+        """The fitted spline with coefficients ``c`` (:class:`CellSpline`)."""
+        return CellSpline(self.cu, self.cv, c.reshape(self.nu, self.nv),
+                          (self.ku[3], self.kv[3]), (self.ku[3 + self.nsu], self.kv[3 + self.nsv]))
+
     def values(self, c, x):
         """The spline with coefficients ``c`` at points x (M, 2)."""
-        C = c.reshape(self.nu, self.nv)
-        i = np.arange(self.nsu)[:, None] + np.arange(4)
-        j = np.arange(self.nsv)[:, None] + np.arange(4)
-        net = C[i[:, None, :, None], j[None, :, None, :]]           # (nsu, nsv, 4, 4)
-        # bicubic power coefficients of every cell: P[i, j, k, l] (s^k t^l)
-        P = np.einsum("ika,ijab,jlb->ijkl", self.cu, net, self.cv, optimize=True)
-        P = P.reshape(self.nsu * self.nsv, 4, 4)
-        out = np.empty(x.shape[0])
-        for a in range(0, x.shape[0], CHUNK):
-            iu, iv, s, t = self._cells(x[a:a + CHUNK])
-            Q = P[iu * self.nsv + iv]                                # (m, 4, 4)
-            r = Q[:, :, 3]
-            for m in (2, 1, 0):
-                r = r * t[:, None] + Q[:, :, m]
-            val = r[:, 3]
-            for k in (2, 1, 0):
-                val = val * s + r[:, k]
-            out[a:a + CHUNK] = val
-        return out
+        return self.spline(c).values(x)
 
     def solve(self, rho, rng_seed=0):
         """Residuals ``d - f`` (N,), leave-one-out residuals at the sample, ``tr(H)``."""
@@ -239,8 +211,8 @@ class PSplineSolver:
         iu, iv, su, tv = self._cells(self.x[idx])
         rows = self._block_index()[iu * self.nsv + iv]                 # (m, 16)
         Z = (self.V * f) @ self.V.T
-        bu = np.einsum("mk,mka->ma", _powers(su, 4).T, self.cu[iu])
-        bv = np.einsum("mk,mkb->mb", _powers(tv, 4).T, self.cv[iv])
+        bu = np.einsum("mk,mka->ma", powers(su, 4).T, self.cu[iu])
+        bv = np.einsum("mk,mkb->mb", powers(tv, 4).T, self.cv[iv])
         w = (bu[:, :, None] * bv[:, None, :]).reshape(-1, 16)
         Hkk = np.einsum("ma,mab,mb->m", w, Z[rows[:, :, None], rows[:, None, :]], w)
         loo = resid[idx] / np.maximum(1.0 - Hkk, 1e-12)

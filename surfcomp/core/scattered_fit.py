@@ -48,6 +48,7 @@ from scipy.spatial.distance import cdist
 from ..errors import InputError
 from .progress import report
 from .pspline import PSplineSolver
+from .spline_field import SplineField
 from .uvpoints import check_duplicates, check_spread, scaled_points
 
 #: largest number of points fitted with the exact thin-plate smoothing spline
@@ -87,6 +88,9 @@ class SmoothFit:
         Noise estimate ``sqrt(RSS / tr(I - H))`` (Wahba's variance estimate).
     field_error_rms : float
         Estimated RMS error of the field itself, ``sqrt(max(loo_rms^2 - noise_rms^2, 0))``.
+    field : SplineField or None
+        The fitted field over face parameters (``"pspline"`` fits; None for ``"tps"``),
+        equal to ``determined`` at the points.
     """
 
     determined: np.ndarray
@@ -102,6 +106,7 @@ class SmoothFit:
     dof: float
     noise_rms: float
     field_error_rms: float
+    field: object = None
 
     def as_dict(self):
         """The scalar figures (for reports)."""
@@ -236,6 +241,10 @@ def smooth(u, v, d, smoothing=None, scale=(1.0, 1.0), method="auto", progress=No
     if method == "tps" and ell == 0:
         resid = np.zeros(n)
     determined = d - resid
+    field = None
+    if method == "pspline":
+        top = float(np.max(np.abs(determined)))
+        field = SplineField(solver.spline(solver.coefficients(par)), scale, (-top, top))
     noise2 = float(resid @ resid) / max(n - dof, 1e-12) if n - dof > 1e-9 else 0.0
     loo_rms = float(np.sqrt(np.mean(loo ** 2)))
     report(progress, 1.0, "smoothing done")
@@ -244,7 +253,8 @@ def smooth(u, v, d, smoothing=None, scale=(1.0, 1.0), method="auto", progress=No
                      fit_max=float(np.max(np.abs(resid))), loo_rms=loo_rms,
                      loo_max=float(np.max(np.abs(loo))), loo_points=int(loo.size),
                      dof=float(dof), noise_rms=float(np.sqrt(noise2)),
-                     field_error_rms=float(np.sqrt(max(loo_rms ** 2 - noise2, 0.0))))
+                     field_error_rms=float(np.sqrt(max(loo_rms ** 2 - noise2, 0.0))),
+                     field=field)
 
 
 def loo_residuals(u, v, d, smoothing=0.0, scale=(1.0, 1.0)):
