@@ -40,10 +40,11 @@ def test_example_sized_grid_gets_one_span_per_step(noise):
     assert ch.max_realised <= ch.max_intended + 1 * UM
 
 
-def test_lean_space_missing_the_limits_falls_back_to_refine():
+def test_lean_space_missing_the_limits_falls_back_to_a_finer_one():
     """15 x 15 raw points with 2 um noise: one span per step overshoots between the nodes
-    (1.5 um over max|intended|, measured), so the refined space (at least MIN_SPANS spans)
-    is built and kept; it meets the limits."""
+    (1.5 um over max|intended|, measured), so the next spaces of the ladder (1.5 and 2
+    spans per step) are tried: the first that meets the limits is kept (27 x 27 poles,
+    against 123 x 123 for ``refine`` spans per step with at least MIN_SPANS)."""
     surf = bicubic()
     U, V, delta, step = case(15, 0.002)
     lines = grid_lines(U, V)
@@ -53,8 +54,11 @@ def test_lean_space_missing_the_limits_falls_back_to_refine():
                               surf, U, V, delta, 1, U.shape)
     assert lean.checks.poles_shape[0] <= 15 + 4 and not meets_limits(lean.checks)
     built = construct(surf, U, V, delta, 1, step, step, refine=4)
-    assert built.checks.poles_shape[0] >= corrected.MIN_SPANS + 3
+    assert 15 + 4 < built.checks.poles_shape[0] <= 2 * 14 + 8
     assert meets_limits(built.checks)
+    # without the ladder (documents made before it): the refined space
+    old = construct(surf, U, V, delta, 1, step, step, refine=4, lean=False)
+    assert old.checks.poles_shape[0] >= corrected.MIN_SPANS + 3 and meets_limits(old.checks)
 
 
 def test_nominal_knot_replaces_its_nearest_node_line():
