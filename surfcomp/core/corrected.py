@@ -262,12 +262,13 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     capped = [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine)] != \
         [len(k) for k in _added_knots(nominal, spacing_u, spacing_v, refine, per_step=1)]
     part = sub(progress, 0.0 if first is None else 0.4, 1.0)
+    tried = [] if first is None else [first]
     if lean:
-        built = _ladder(nominal, outward, spacing_u, spacing_v, refine, field_factory, args,
-                        sub(part, 0.0, 0.5))
-        if built is not None:
+        tried += _ladder(nominal, outward, spacing_u, spacing_v, refine, field_factory, args,
+                         sub(part, 0.0, 0.5))
+        if tried and meets_limits(tried[-1].checks):
             report(progress, 1.0, "corrected surface checked")
-            return built
+            return tried[-1]
         part = sub(part, 0.5, 1.0)
     if not capped:
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
@@ -279,9 +280,7 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
     report(part, 0.75, "checking the corrected surface")
     built = _checked(smp, *fine, *args)
     report(progress, 1.0, "corrected surface checked")
-    if first is not None and _excess(first.checks) <= _excess(built.checks):
-        return first
-    return built
+    return min(tried + [built], key=lambda c: _excess(c.checks))
 
 
 #: knot spans of the smooth route's space per span of the union of the nominal's and the
@@ -352,15 +351,18 @@ def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
 #: also on grids across the parameter lines (a 100 x 100 grid turned by 20 degrees: 163 x
 #: 163 poles, 0.05 um at the points, against 639 x 639 with four); raw noisy ones need two
 LADDER = (1.0, 1.5, 2.0)
+#: the residual iteration on the ladder's spaces stops at half the limit (on one span per
+#: step it converges slowly: 8 steps to 0.03 um on a 200 x 200 turned grid)
+LADDER_TOL = ACCEPT_TOL / 2
 
 
 def _ladder(nominal, outward, spacing_u, spacing_v, refine, field_factory, args, progress):
-    """The first space of :data:`LADDER` spans per grid step (fewer than ``refine``, at
-    most :data:`POLE_BUDGET` poles) whose surface meets the limits, as a
-    :class:`Construction`; None when none does."""
+    """The :class:`Construction` on each space of :data:`LADDER` spans per grid step
+    (fewer than ``refine``, at most :data:`POLE_BUDGET` poles) up to the first that meets
+    the limits (then the last of the list)."""
     _, U, V, delta, _, _ = args
     rungs = [r for r in LADDER if r < refine]
-    seen = set()
+    seen, tried = set(), []
     for k, per_step in enumerate(rungs):
         added = _added_knots(nominal, spacing_u, spacing_v, per_step, per_step=per_step,
                              min_spans=1)
@@ -371,12 +373,12 @@ def _ladder(nominal, outward, spacing_u, spacing_v, refine, field_factory, args,
             continue
         seen.add(size)
         smp = _Sampling(nominal, outward, spacing_u, spacing_v, per_step, added=added)
-        fine = _match(smp, U, V, delta, outward, MATCH_TOL, MATCH_ITERATIONS, field_factory,
+        fine = _match(smp, U, V, delta, outward, LADDER_TOL, MATCH_ITERATIONS, field_factory,
                       sub(progress, k / len(rungs), (k + 1) / len(rungs)))
-        built = _checked(smp, *fine, *args)
-        if meets_limits(built.checks):
-            return built
-    return None
+        tried.append(_checked(smp, *fine, *args))
+        if meets_limits(tried[-1].checks):
+            break
+    return tried
 
 
 def _checked(smp, surf, field, k, real, nominal, U, V, delta, outward, shape):
@@ -477,17 +479,43 @@ def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
     nodes = _NodeFrame(smp.nominal, U.ravel(), V.ravel(), outward)
     values = delta.copy()
     current = field
+    xs, fs, best = [], [], None
     k = 0
     while True:
         report(progress, k / (iterations + 1), "building the corrected surface")
         surf = smp.build(current.at_index(*loc).reshape(uu.shape))
         real = nodes.realised(surf, guess=values.ravel()).reshape(delta.shape)
         miss = delta - real
-        if np.max(np.abs(miss)) <= tol or k >= iterations:
-            return surf, field, k, real
-        values = values + miss
+        worst = float(np.max(np.abs(miss)))
+        if best is None or worst < best[0]:
+            best = (worst, surf, k, real)
+        if worst <= tol or k >= iterations:
+            return best[1], field, best[2], best[3]
+        xs, fs = (xs + [values.ravel()])[-ANDERSON - 1:], (fs + [miss.ravel()])[-ANDERSON - 1:]
+        values = anderson_step(xs, fs).reshape(delta.shape)
         current = field.with_values(values)
         k += 1
+
+
+#: the residual iteration mixes this many previous steps into the next (Anderson)
+ANDERSON = 4
+
+
+def anderson_step(xs, fs):
+    """Next iterate of the fixed-point iteration ``x <- x + f(x)`` by Anderson mixing over
+    the stored iterates ``xs`` and their residuals ``fs`` (lists of (N,) arrays, newest
+    last; Walker & Ni 2011, "Anderson acceleration for fixed-point iterations"): the
+    combination of the last steps whose residual is least, which removes the slowly
+    decaying components a plain iteration leaves (one knot span per grid step across the
+    parameter lines: 0.20 um to 0.085 um in 8 plain steps)."""
+    x, f = xs[-1], fs[-1]
+    if len(xs) < 2:
+        return x + f
+    dX, dF = np.diff(np.array(xs), axis=0), np.diff(np.array(fs), axis=0)
+    A = dF @ dF.T
+    A[np.diag_indices_from(A)] += 1e-12 * np.trace(A) + 1e-300
+    gamma = np.linalg.solve(A, dF @ f)
+    return x + f - (dX + dF).T @ gamma
 
 
 class _NodeFrame:

@@ -38,9 +38,10 @@ def grid(n, rotated):
 
 @pytest.mark.parametrize("rotated,noise", [(False, 0.002), (True, 0.002), (True, 0.0)])
 def test_dense_grid_paths_meet_the_requirements(monkeypatch, rotated, noise):
-    """Along parameter lines: knots on the node lines. Across them: the capped space
-    (here 1.3 spans per step) for smooth corrections, two spans per step for raw noisy
-    ones (tried in that order)."""
+    """Along parameter lines: knots on the node lines. Across them the ladder: one span
+    per grid step for smooth corrections; raw noisy ones overshoot beyond the turned grid
+    on every space (measured 8.4, 4.7 and 1.9 um with 1, 1.5 and 2 spans per step, 6.0 um
+    on the capped space), so the one closest to the limits is kept: two spans per step."""
     monkeypatch.setattr(corrected, "MAX_SPANS", 80)
     surf = bicubic()
     n = 41
@@ -55,9 +56,9 @@ def test_dense_grid_paths_meet_the_requirements(monkeypatch, rotated, noise):
     if not rotated:
         assert spans <= n + 4                         # one per step (+ the nominal's knots)
     elif noise:
-        assert spans >= 2 * (1 / step) - 2            # two spans per grid step
+        assert 2 * (1 / step) - 2 <= spans <= 2 * (1 / step) + 4
     else:
-        assert spans <= 80 + 4 < 2 * (1 / step) - 2   # the capped space (1.3 spans per step)
+        assert spans <= (1 / step) + 4                # one span per grid step
     assert ch.max_error_at_points < 0.1 * UM
     assert ch.max_zero_deviation < 0.1 * UM
     # no overshoot inside the measured region; beyond it (the rotated grid leaves wide
