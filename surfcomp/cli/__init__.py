@@ -22,7 +22,9 @@ from ..errors import SurfcompError
 COMMANDS = ("compensate", "inspect", "simulate", "gcode")
 
 
-def build_parser():
+def build_parser(only=None):
+    """The argument parser; with ``only`` (a command name) just that command's subparser,
+    so a run imports one command module (and its dependencies), not all of them."""
     parser = argparse.ArgumentParser(
         prog="python3 -m surfcomp",
         description="Compensate machining errors of free-form B-spline surfaces "
@@ -30,7 +32,7 @@ def build_parser():
     parser.add_argument("--version", action="version", version="surfcomp " + __version__)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
-    for name in COMMANDS:
+    for name in (only,) if only in COMMANDS else COMMANDS:
         module = importlib.import_module("." + name, __name__)
         module.add_parser(subparsers)
     return parser
@@ -63,8 +65,9 @@ def _handle_signals():
 
 def main(argv=None):
     """Run the command line; return the process exit code."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = sys.argv[1:] if argv is None else list(argv)
+    parser = build_parser(args[0] if args else None)
+    args = parser.parse_args(args)
     _handle_signals()
     try:
         return int(args.run(args) or 0)

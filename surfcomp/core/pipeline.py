@@ -32,8 +32,8 @@ OVERSHOOT_WARNING = 1e-3
 #: a scattered layout's corrected face is built from its smoothing fit's spline when the
 #: intended corrections are the spline's values at the points within this (mm)
 SMOOTH_MATCH = 1e-9
-#: the median nearest-neighbour distance of a scattered layout is taken over this many
-#: points at most (its sampling error is well under 1 %)
+#: the median nearest-neighbour distance of a scattered layout and the median tangent
+#: lengths are taken over about this many points at most (sampling error well under 1 %)
 SPACING_SAMPLE = 50000
 #: how the points are arranged: found automatically (a complete grid, else scattered),
 #: or forced
@@ -480,9 +480,11 @@ def _construction(result, surface, outward, U, V, delta, progress):
 
 
 def parameter_scale(surface, prepared):
-    """Median length per unit parameter (mm) along u and along v at the measured points,
-    so that fits over (u, v) are isotropic on the face."""
-    lu, lv = tangent_lengths(surface, prepared.u, prepared.v)
+    """Median length per unit parameter (mm) along u and along v at the measured points
+    (every k-th of them on sets above :data:`SPACING_SAMPLE`), so that fits over (u, v) are
+    isotropic on the face."""
+    k = max(1, prepared.u.size // SPACING_SAMPLE)
+    lu, lv = tangent_lengths(surface, prepared.u[::k], prepared.v[::k])
     return float(np.median(lu)) or 1.0, float(np.median(lv)) or 1.0
 
 

@@ -161,8 +161,13 @@ def inside(polylines, u, v, buckets=256):
     band = np.floor((v.ravel() - v0) / width).astype(int)
     flat = out.ravel()
     uf, vf = u.ravel(), v.ravel()
-    for k in np.unique(band[(band >= 0) & (band < buckets)]):
-        pts = np.nonzero(band == k)[0]
+    # the points of each band: one sort instead of a pass over all points per band
+    order = np.argsort(band, kind="stable")
+    starts = np.searchsorted(band[order], np.arange(buckets + 1))
+    for k in range(buckets):
+        pts = order[starts[k]:starts[k + 1]]
+        if not pts.size:
+            continue
         sel = segs[(hi >= v0 + k * width) & (lo <= v0 + (k + 1) * width)]
         a, b = sel[:, 0], sel[:, 1]
         vv = vf[pts, None]
