@@ -312,7 +312,8 @@ def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
     whose values at the points are ``delta``): the space holds the nominal's knots and
     the field's (:func:`smooth_knots`), split into 1, 2, 4, 8 parts until the limits are
     met (:func:`meets_limits`); no residual iteration (the field is met everywhere, not
-    only at the points). The check grid has four points per knot span.
+    only at the points). The check grid has four points per knot span (at least 201 x
+    201).
 
     Returns
     -------
@@ -337,7 +338,7 @@ def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
         surf = smp.build(field(uu, vv))
         real = realised_correction(nominal, surf, U, V, outward, guess=delta)
         built = _checked(smp, surf, field, 0, real, nominal, U, V, delta, outward,
-                         (smp.us.size, smp.vs.size))
+                         (max(smp.us.size, 51), max(smp.vs.size, 51)))
         if best is None or _excess(built.checks) < _excess(best.checks):
             best = built
         if meets_limits(built.checks):

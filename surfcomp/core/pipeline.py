@@ -22,6 +22,7 @@ from .methods import METHODS, compute_correction
 from .progress import report, sub
 from .projection import project, tangent_lengths
 from .scattered import ScatteredField, smooth
+from .spline_field import ConstantField
 
 #: a given normal more than this many degrees off the face normal is reported
 NORMAL_WARNING_DEG = 5.0
@@ -458,9 +459,16 @@ def build_surface(result, surface, outward, delta, progress=None):
 
 def _construction(result, surface, outward, U, V, delta, progress):
     """The :class:`~surfcomp.core.corrected.Construction` of ``build_surface`` and the
-    parameter spacing it used: from the smoothing fit's spline where ``delta`` is its
-    values at the points (scattered layouts, ``filtered``), else through the values."""
+    parameter spacing it used: for a uniform ``delta`` (``offset``) on the nominal's knots,
+    from the smoothing fit's spline where ``delta`` is its values at the points (scattered
+    layouts, ``filtered``), else through the values."""
     prepared = result.prepared
+    flat = np.ravel(delta)
+    if flat.size and np.all(flat == flat[0]):        # a uniform offset: no knots of its own
+        spacing = grid_spacing(prepared) if not prepared.scattered else \
+            scattered_spacing(prepared, result.scale or parameter_scale(surface, prepared))
+        return construct_smooth(surface, U, V, delta, ConstantField(flat[0]), outward,
+                                progress), spacing
     if not prepared.scattered:
         du, dv = grid_spacing(prepared)
         return construct(surface, U, V, delta, outward, du, dv, result.options.refine,

@@ -153,3 +153,19 @@ def soft_limit(f, lo, hi, width=SOFT_LIMIT):
     out[above] = hi + width * np.tanh((f[above] - hi) / width)
     out[below] = lo - width * np.tanh((lo - f[below]) / width)
     return out
+
+
+class ConstantField:
+    """A uniform correction (the ``offset`` method, a constant ``delta``) as a field with
+    no knots of its own, for :func:`surfcomp.core.corrected.construct_smooth`: the face is
+    the nominal's space, split only where the offset surface needs it."""
+
+    def __init__(self, value):
+        self.value = float(value)
+
+    def knots(self, axis):
+        return np.empty(0)
+
+    def __call__(self, u, v):
+        return np.full(np.shape(u), self.value)
+

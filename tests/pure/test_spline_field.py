@@ -12,7 +12,7 @@ from examples.make_example import deviation_field, example_surface
 from surfcomp.core import bspline, corrected
 from surfcomp.core.pipeline import SMOOTH_MATCH, Options, compensate
 from surfcomp.core.scattered import ScatteredField, smooth
-from surfcomp.core.spline_field import SOFT_LIMIT, SplineField, soft_limit
+from surfcomp.core.spline_field import SOFT_LIMIT, ConstantField, SplineField, soft_limit
 
 SCALE = (45.0, 45.0)   # mm per unit parameter of the example face (45 x 45 mm)
 
@@ -155,3 +155,29 @@ def _prepared(nominal, u, v, d):
     N = bspline.normals(nominal, u, v)
     ms = MeasurementSet(measured=P + d[:, None] * N, source="scattered.xyz")
     return prepare(nominal, 1, ms, Options())
+
+
+@pytest.mark.parametrize("layout", ["grid", "scattered"])
+def test_uniform_offset_keeps_the_nominal_knots(layout):
+    """``offset`` (one value everywhere) has no knots of its own: the face is the nominal's
+    space split until the offset surface meets the limits (the example: 11 x 11 poles,
+    against 49 x 49 on the grid's node lines and about 1100 x 1100 through 250 000
+    scattered values)."""
+    nominal = example_surface()
+    if layout == "grid":
+        t = np.linspace(0.01, 0.99, 45)
+        uu, vv = np.meshgrid(t, t, indexing="ij")
+        u, v = uu.ravel(), vv.ravel()
+        S = bspline.evaluate(nominal, u, v)
+        d = deviation_field(S[:, 0], S[:, 1])
+    else:
+        u, v, d = scattered_set(1500)
+    prepared = _prepared(nominal, u, v, d)
+    assert prepared.scattered == (layout == "scattered")
+    comp = compensate(nominal, 1, prepared, Options(method="offset"))
+    assert isinstance(comp.field, ConstantField)
+    assert_allclose(comp.correction.delta, np.mean(d), atol=1e-12)
+    ch = comp.checks
+    assert ch.poles_shape == (11, 11)
+    assert corrected.meets_limits(ch) and ch.max_error_at_points < 2e-5
+
