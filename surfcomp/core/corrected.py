@@ -294,10 +294,14 @@ def smooth_knots(knots, lo, hi, field_knots, parts):
     """Knots to add to the nominal's (flat ``knots``) within [lo, hi]: the field's knots
     (those within 1/10 of a field span of one of the nominal's knots left out, the
     nominal's knot stands in), then every span of the union split into ``parts`` (spans
-    up to 1.2 field spans long count as one)."""
+    up to 1.2 field spans long count as one; without field knots, the nominal's longest
+    span in [lo, hi] stands for a field span)."""
     own = np.unique(np.asarray(knots, dtype=float))
     field_knots = np.asarray(field_knots, dtype=float)
-    h = float(np.median(np.diff(field_knots))) if field_knots.size > 1 else hi - lo
+    if field_knots.size > 1:
+        h = float(np.median(np.diff(field_knots)))
+    else:   # a field without knots (a constant): the nominal's longest span in [lo, hi]
+        h = float(np.max(np.diff(np.clip(own, lo, hi))))
     inside = field_knots[(field_knots > lo + 0.1 * h) & (field_knots < hi - 0.1 * h)]
     gap = np.min(np.abs(inside[:, None] - own[None, :]), axis=1) if inside.size else inside
     first = inside[gap > 0.1 * h]
@@ -311,9 +315,9 @@ def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
     (the scattered layouts' P-spline fit, :class:`surfcomp.core.spline_field.SplineField`,
     whose values at the points are ``delta``): the space holds the nominal's knots and
     the field's (:func:`smooth_knots`), split into 1, 2, 4, 8 parts until the limits are
-    met (:func:`meets_limits`); no residual iteration (the field is met everywhere, not
-    only at the points). The check grid has four points per knot span (at least 201 x
-    201).
+    met (:func:`meets_limits`) and the field is met within MATCH_TOL at the points and
+    on a 101 x 101 grid between them (:func:`_field_miss`); no residual iteration. The
+    check grid has four points per knot span (at least 201 x 201).
 
     Returns
     -------
@@ -341,10 +345,24 @@ def construct_smooth(nominal, U, V, delta, field, outward=1, progress=None):
                          (max(smp.us.size, 51), max(smp.vs.size, 51)))
         if best is None or _excess(built.checks) < _excess(best.checks):
             best = built
-        if meets_limits(built.checks):
+        if meets_limits(built.checks) and _field_miss(nominal, surf, field, outward,
+                                                       real - delta) <= MATCH_TOL:
             break
     report(progress, 1.0, "corrected surface checked")
     return best
+
+
+def _field_miss(nominal, surf, field, outward, at_points, size=101):
+    """How far (mm) the surface's realised correction misses a field known everywhere: at
+    the points (``at_points``, realised - intended) and on a ``size`` x ``size`` grid
+    over the field's ``box`` (where it is smooth: a spline field is only C1 beyond its
+    knots, and the check figures' overshoot limit holds there), else the work area."""
+    (u0, u1), (v0, v1) = field.box or (nominal.u_range, nominal.v_range)
+    uu, vv = (a.ravel() for a in np.meshgrid(np.linspace(u0, u1, size),
+                                             np.linspace(v0, v1, size), indexing="ij"))
+    want = field(uu, vv)
+    real = realised_correction(nominal, surf, uu, vv, outward, guess=want)
+    return max(float(np.max(np.abs(at_points))), float(np.max(np.abs(real - want))))
 
 
 #: spans per grid step tried in turn (lean faces) before ``refine`` per step: the first

@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import GridError, InputError, MeasurementFileError
 from . import bspline, plausibility
-from .corrected import DEFAULT_REFINE, construct, construct_smooth
+from .corrected import DEFAULT_REFINE, construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
 from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
@@ -459,16 +459,21 @@ def build_surface(result, surface, outward, delta, progress=None):
 
 def _construction(result, surface, outward, U, V, delta, progress):
     """The :class:`~surfcomp.core.corrected.Construction` of ``build_surface`` and the
-    parameter spacing it used: for a uniform ``delta`` (``offset``) on the nominal's knots,
+    parameter spacing it used: for a uniform ``delta`` (``offset``) on the nominal's knots
+    where that meets the limits,
     from the smoothing fit's spline where ``delta`` is its values at the points (scattered
     layouts, ``filtered``), else through the values."""
     prepared = result.prepared
     flat = np.ravel(delta)
     if flat.size and np.all(flat == flat[0]):        # a uniform offset: no knots of its own
-        spacing = grid_spacing(prepared) if not prepared.scattered else \
-            scattered_spacing(prepared, result.scale or parameter_scale(surface, prepared))
-        return construct_smooth(surface, U, V, delta, ConstantField(flat[0]), outward,
-                                progress), spacing
+        built = construct_smooth(surface, U, V, delta, ConstantField(flat[0]), outward,
+                                 sub(progress, 0.0, 0.5))
+        if meets_limits(built.checks):
+            spacing = grid_spacing(prepared) if not prepared.scattered else \
+                scattered_spacing(prepared, result.scale or parameter_scale(surface, prepared))
+            return built, spacing
+        # (e.g. a rational sphere patch near its pole: its offset needs more than 8 splits)
+        progress = sub(progress, 0.5, 1.0)
     if not prepared.scattered:
         du, dv = grid_spacing(prepared)
         return construct(surface, U, V, delta, outward, du, dv, result.options.refine,

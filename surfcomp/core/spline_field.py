@@ -128,6 +128,13 @@ class SplineField:
         """The spline's distinct knots along u (0) or v (1) in face parameters."""
         return self.spline.knots(axis) / self.scale[axis]
 
+    @property
+    def box(self):
+        """``((u0, u1), (v0, v1))``: the knot box in face parameters (the field is a cubic
+        spline inside, C1 beyond)."""
+        return tuple((self.spline.lo[k] / self.scale[k], self.spline.hi[k] / self.scale[k])
+                     for k in (0, 1))
+
     def __call__(self, u, v):
         shape = np.shape(u)
         x = np.stack([np.ravel(u) * self.scale[0], np.ravel(v) * self.scale[1]], axis=1)
@@ -159,6 +166,9 @@ class ConstantField:
     """A uniform correction (the ``offset`` method, a constant ``delta``) as a field with
     no knots of its own, for :func:`surfcomp.core.corrected.construct_smooth`: the face is
     the nominal's space, split only where the offset surface needs it."""
+
+    #: smooth everywhere: checked over the whole work area
+    box = None
 
     def __init__(self, value):
         self.value = float(value)
