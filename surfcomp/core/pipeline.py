@@ -460,12 +460,13 @@ def build_surface(result, surface, outward, delta, progress=None):
 def _construction(result, surface, outward, U, V, delta, progress):
     """The :class:`~surfcomp.core.corrected.Construction` of ``build_surface`` and the
     parameter spacing it used: for a uniform ``delta`` (``offset``) on the nominal's knots
-    where that meets the limits,
-    from the smoothing fit's spline where ``delta`` is its values at the points (scattered
-    layouts, ``filtered``), else through the values."""
+    where that meets the limits, from the smoothing fit's spline where ``delta`` is its
+    values at the points (scattered layouts, ``filtered``), else through the values; the
+    first two only for lean faces (``Options.lean``)."""
     prepared = result.prepared
+    lean = result.options.lean      # False: a document made before these routes
     flat = np.ravel(delta)
-    if flat.size and np.all(flat == flat[0]):        # a uniform offset: no knots of its own
+    if lean and flat.size and np.all(flat == flat[0]):   # a uniform offset: no knots of its own
         built = construct_smooth(surface, U, V, delta, ConstantField(flat[0]), outward,
                                  sub(progress, 0.0, 0.5))
         if meets_limits(built.checks):
@@ -477,11 +478,11 @@ def _construction(result, surface, outward, U, V, delta, progress):
     if not prepared.scattered:
         du, dv = grid_spacing(prepared)
         return construct(surface, U, V, delta, outward, du, dv, result.options.refine,
-                         progress=progress, lean=result.options.lean), (du, dv)
+                         progress=progress, lean=lean), (du, dv)
     scale = result.scale or parameter_scale(surface, prepared)
     du, dv = scattered_spacing(prepared, scale)
     spline = getattr(result.fit, "field", None)
-    if spline is not None and np.max(np.abs(spline(U, V) - delta)) <= SMOOTH_MATCH:
+    if lean and spline is not None and np.max(np.abs(spline(U, V) - delta)) <= SMOOTH_MATCH:
         return construct_smooth(surface, U, V, delta, spline, outward, progress), (du, dv)
     factory = functools.partial(ScatteredField, scale=scale,
                                 box=(surface.u_range, surface.v_range))
@@ -489,7 +490,7 @@ def _construction(result, surface, outward, U, V, delta, progress):
     shape = (int(np.ceil((u1 - u0) / du)) + 1, int(np.ceil((v1 - v0) / dv)) + 1)
     return construct(surface, U, V, delta, outward, du, dv, result.options.refine,
                      field_factory=factory, grid_shape=shape, progress=progress,
-                     lean=result.options.lean), (du, dv)
+                     lean=lean), (du, dv)
 
 
 def parameter_scale(surface, prepared):

@@ -143,6 +143,10 @@ def test_pipeline_uses_the_field_for_filtered_only():
     raw = compensate(nominal, 1, prepared, Options(method="raw"))
     assert isinstance(raw.field, ScatteredField)
     assert raw.checks.max_error_at_points < corrected.ACCEPT_TOL
+    # a document made before the lean faces (Lean false) recomputes as it did then
+    old = compensate(nominal, 1, prepared, Options(method="filtered", lean=False))
+    assert isinstance(old.field, ScatteredField)
+    assert old.corrected.shape[0] >= corrected.MIN_SPANS + 3
 
 
 def _prepared(nominal, u, v, d):
@@ -180,4 +184,6 @@ def test_uniform_offset_keeps_the_nominal_knots(layout):
     ch = comp.checks
     assert ch.poles_shape == (11, 11)
     assert corrected.meets_limits(ch) and ch.max_error_at_points < 2e-5
+    old = compensate(nominal, 1, prepared, Options(method="offset", lean=False))
+    assert not isinstance(old.field, ConstantField) and old.corrected.shape[0] > 11
 
