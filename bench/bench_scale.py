@@ -103,19 +103,29 @@ def _child(args):
 
 def inspect_case(meas, command="inspect", out_dir=None):
     """``python3 -m surfcomp inspect NOMINAL MEAS`` (or ``compensate ... -o OUT.step``) in
-    a fresh process: wall seconds, CPU seconds, peak RSS (MB), exit status."""
+    a fresh process: wall seconds, CPU seconds, peak RSS (MB), its standard output."""
     cmd = [sys.executable, "-m", "surfcomp", command, NOMINAL, meas, "--quiet"]
     if command == "compensate":
         cmd += ["-o", os.path.join(out_dir or tempfile.gettempdir(), "bench_scale.step")]
+    return timed(cmd)
+
+
+def timed(cmd):
+    """Run ``cmd`` in the repository: wall and CPU seconds, peak RSS (MB) and its standard
+    output; a failure raises with the end of its standard error."""
     t = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t
-    err = proc.stderr.read().decode()
-    proc.stderr.close()
+    with tempfile.TemporaryFile("w+") as out:
+        proc = subprocess.Popen(cmd, cwd=ROOT, stdout=out, stderr=subprocess.PIPE)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t
+        err = proc.stderr.read().decode()
+        proc.stderr.close()
+        out.seek(0)
+        text = out.read()
     if status:
         raise RuntimeError("%s failed:\n%s" % (" ".join(cmd), err[-3000:]))
-    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime, "peak_mb": usage.ru_maxrss / 1024}
+    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime,
+            "peak_mb": usage.ru_maxrss / 1024, "stdout": text}
 
 
 def freecad_inspection(X):

@@ -104,7 +104,7 @@ def _run_child(kind, *args):
     else:  # the whole compensate job; poles, error and file size from its summary
         cmd = [sys.executable, "-m", "surfcomp", "compensate", NOMINAL, args[0], "-o",
                os.path.join(args[1], "run.step"), "--quiet"]
-        out = _timed(cmd)
+        out = bench_scale.timed(cmd)
         text = out.pop("stdout")
         poles = re.search(r"Corrected face: (\d+) x (\d+) poles", text).groups()
         err = re.search(r"measured points: max ([0-9.e+-]+) um", text).group(1)
@@ -112,23 +112,6 @@ def _run_child(kind, *args):
         out["note"] = "%s x %s poles, %s um at the points, STEP %.2f MB" % (
             poles + (err, size / 1e6))
     print(json.dumps(out))
-
-
-def _timed(cmd):
-    """Run ``cmd``: wall and CPU seconds, peak RSS (MB) and its standard output."""
-    t = time.perf_counter()
-    with tempfile.TemporaryFile("w+") as out:
-        proc = subprocess.Popen(cmd, cwd=ROOT, stdout=out, stderr=subprocess.PIPE)
-        _, status, usage = os.wait4(proc.pid, 0)
-        wall = time.perf_counter() - t
-        err = proc.stderr.read().decode()
-        proc.stderr.close()
-        out.seek(0)
-        text = out.read()
-    if status:
-        raise RuntimeError("%s failed:\n%s" % (" ".join(cmd), err[-3000:]))
-    return {"wall": wall, "cpu": usage.ru_utime + usage.ru_stime,
-            "peak_mb": usage.ru_maxrss / 1024, "stdout": text}
 
 
 def row(case, n, ours, reference="", ref_s=None, ratio=None, note=""):
