@@ -31,7 +31,7 @@ MISS_WARNING = 1e-4
 #: ... and one that moves more than the largest intended correction plus this anywhere
 OVERSHOOT_WARNING = 1e-3
 #: a scattered layout's corrected face is built from its smoothing fit's spline when the
-#: intended corrections are the spline's values at the points within this (mm)
+#: intended corrections are the fit's values at the points within this (mm)
 SMOOTH_MATCH = 1e-9
 #: the median nearest-neighbour distance of a scattered layout and the median tangent
 #: lengths are taken over about this many points at most (sampling error well under 1 %)
@@ -481,9 +481,11 @@ def _construction(result, surface, outward, U, V, delta, progress):
                          progress=progress, lean=lean), (du, dv)
     scale = result.scale or parameter_scale(surface, prepared)
     du, dv = scattered_spacing(prepared, scale)
-    spline = getattr(result.fit, "field", None)
-    if lean and spline is not None and np.max(np.abs(spline(U, V) - delta)) <= SMOOTH_MATCH:
-        return construct_smooth(surface, U, V, delta, spline, outward, progress), (du, dv)
+    fit = result.fit
+    # the fit's field equals fit.determined at the points (tests/pure/test_spline_field.py)
+    if lean and fit is not None and fit.field is not None and \
+            np.max(np.abs(fit.determined - np.ravel(delta))) <= SMOOTH_MATCH:
+        return construct_smooth(surface, U, V, delta, fit.field, outward, progress), (du, dv)
     factory = functools.partial(ScatteredField, scale=scale,
                                 box=(surface.u_range, surface.v_range))
     (u0, u1), (v0, v1) = surface.u_range, surface.v_range
