@@ -497,12 +497,15 @@ def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
         loc = field.locate(uu.ravel(), vv.ravel())
     nodes = _NodeFrame(smp.nominal, U.ravel(), V.ravel(), outward)
     values = delta.copy()
-    current = field
+    base = samples = field.at_index(*loc)
+    # the steps only move the node values by the misses left, so a linear interpolant of
+    # the change (where the field has one) stands in for a new field through them
+    linear = field.linear_at(*loc) if hasattr(field, "linear_at") else None
     xs, fs, best = [], [], None
     k = 0
     while True:
         report(progress, k / (iterations + 1), "building the corrected surface")
-        surf = smp.build(current.at_index(*loc).reshape(uu.shape))
+        surf = smp.build(samples.reshape(uu.shape))
         real = nodes.realised(surf, guess=values.ravel()).reshape(delta.shape)
         miss = delta - real
         worst = float(np.max(np.abs(miss)))
@@ -512,7 +515,8 @@ def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
             return best[1], field, best[2], best[3]
         xs, fs = (xs + [values.ravel()])[-ANDERSON - 1:], (fs + [miss.ravel()])[-ANDERSON - 1:]
         values = anderson_step(xs, fs).reshape(delta.shape)
-        current = field.with_values(values)
+        samples = (base + linear @ (values - delta).ravel() if linear is not None
+                   else field.with_values(values).at_index(*loc))
         k += 1
 
 
@@ -547,12 +551,16 @@ class _NodeFrame:
         self.P, Su, Sv = bspline.derivatives(nominal, self.u, self.v, order=1)
         n = np.cross(Su, Sv)
         self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
+        self._last = None
 
     def realised(self, corrected, guess=None, iterations=20):
         """See :func:`realised_correction`."""
         u, v, P, n = self.u, self.v, self.P, self.n
         t = np.zeros(u.size) if guess is None else np.ravel(guess).astype(float).copy()
-        a, b = u.copy(), v.copy()
+        # the residual iteration's surfaces differ by fractions of a um: each starts from
+        # where the line met the one before
+        a, b = (u.copy(), v.copy()) if self._last is None else (self._last[0].copy(),
+                                                                  self._last[1].copy())
         (ua, ub), (va, vb) = corrected.u_range, corrected.v_range
         act = np.arange(u.size)  # only the points whose intersection has not converged
         for _ in range(iterations):
@@ -567,6 +575,7 @@ class _NodeFrame:
             a[act] = np.clip(a[act] + step[:, 0], ua, ub)
             b[act] = np.clip(b[act] + step[:, 1], va, vb)
             t[act] += step[:, 2]
+        self._last = (a, b)
         return t
 
 

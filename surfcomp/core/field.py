@@ -321,6 +321,23 @@ class GridField:
         val = np.clip(val, self._lo, self._hi)
         return val[:, 0] if self._scalar else val
 
+    def linear_at(self, s, t):
+        """The bilinear interpolant in index space at (s, t) as a sparse (N, n * m) matrix
+        (clamped to the grid outside it): a linear stand-in for :meth:`with_values` in
+        the residual iteration, which only moves the node values by the small misses
+        left (``base + linear_at(s, t) @ change`` instead of a new Hermite field)."""
+        from scipy.sparse import csr_matrix
+
+        n, m = self.shape
+        s, t = self._clamped(np.ravel(s).astype(float), np.ravel(t).astype(float))
+        i = np.minimum(np.floor(s).astype(np.int64), n - 2)
+        j = np.minimum(np.floor(t).astype(np.int64), m - 2)
+        a, b = s - i, t - j
+        cols = np.stack([i * m + j, i * m + j + 1, (i + 1) * m + j, (i + 1) * m + j + 1], 1)
+        w = np.stack([(1 - a) * (1 - b), (1 - a) * b, a * (1 - b), a * b], 1)
+        rows = np.repeat(np.arange(s.size), 4)
+        return csr_matrix((w.ravel(), (rows, cols.ravel())), shape=(s.size, n * m))
+
     def __call__(self, u, v):
         """Field values at face parameters (u, v) (arrays of equal shape)."""
         shape = np.shape(u)
