@@ -16,6 +16,7 @@ import numpy as np
 from ..errors import GeometryError
 from .bspline_basis import basis_functions, basis_matrix, find_spans, greville
 from .bspline_fit import fit_grid_lsq, interpolate_grid, refine_knots
+from .chunks import for_chunks
 
 __all__ = ["Surface", "CHUNK_VALUES", "evaluate", "derivatives", "normals", "evaluate_grid",
            "insert_knots", "find_spans", "basis_functions", "basis_matrix", "greville",
@@ -169,12 +170,12 @@ def _all_ders(surf, u, v, order):
     keys = _ORDER_KEYS[order]
     out = [np.empty((uf.size, 3)) for _ in keys]
     Pw = _homogeneous(surf) if surf.weights is not None else surf.poles
-    step = _chunk_size(surf.degree_u, surf.degree_v, order + 1)
-    for start in range(0, uf.size, step):
-        sl = slice(start, start + step)
+    def job(sl):
         res = _ders_chunk(surf, Pw, uf[sl], vf[sl], order)
         for arr, key in zip(out, keys):
             arr[sl] = res[key]
+
+    for_chunks(job, uf.size, _chunk_size(surf.degree_u, surf.degree_v, order + 1))
     return [arr.reshape(shape + (3,)) for arr in out]
 
 

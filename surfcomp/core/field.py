@@ -26,10 +26,10 @@ the border value, and clipped to the node value range like the inside.
 """
 
 import numpy as np
-from scipy.interpolate import PchipInterpolator
 from scipy.spatial import cKDTree
 
 from ..errors import ComputationError
+from .chunks import for_chunks
 
 _L = 0.5  # damping length of the outside continuation, in grid steps
 
@@ -39,6 +39,10 @@ _HERMITE = np.array([[1.0, 0.0, -3.0, 2.0],
                      [0.0, 0.0, 3.0, -2.0],
                      [0.0, 1.0, -2.0, 1.0],
                      [0.0, 0.0, -1.0, 1.0]])
+
+
+#: C[i, j] = sum_kl H[k, i] M[k, l] H[l, j] on flattened (k, l) and (i, j)
+_HERMITE_2D = np.kron(_HERMITE, _HERMITE)
 
 
 def _powers(a):
@@ -58,12 +62,28 @@ def _solve2(ds, dt, r):
 
 
 def _pchip_slopes(F, axis):
-    n = F.shape[axis]
-    x = np.arange(n, dtype=float)
-    if n == 2:
-        d = np.diff(F, axis=axis)
-        return np.concatenate([d, d], axis=axis)
-    return PchipInterpolator(x, F, axis=axis).derivative()(x)
+    """PCHIP node slopes along ``axis`` of values at unit spacing (Fritsch & Carlson;
+    the slopes of ``scipy.interpolate.PchipInterpolator``, without building its spline):
+    inside, the harmonic mean of the neighbouring secants, zero where they differ in
+    sign or one is zero; at the ends the one-sided three-point slope, zero when its
+    sign differs from the first secant's and at most 3 times that secant when the first
+    two secants differ in sign."""
+    F = np.moveaxis(F, axis, 0)
+    m = np.diff(F, axis=0)
+    if F.shape[0] == 2:
+        return np.moveaxis(np.concatenate([m, m], axis=0), 0, axis)
+    d = np.empty_like(F)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mean = 2.0 / (1.0 / m[:-1] + 1.0 / m[1:])
+    flat = (np.sign(m[:-1]) != np.sign(m[1:])) | (m[:-1] == 0) | (m[1:] == 0)
+    d[1:-1] = np.where(flat, 0.0, mean)
+    for end, m0, m1 in ((0, m[0], m[1]), (-1, m[-1], m[-2])):
+        e = (3.0 * m0 - m1) / 2.0
+        e = np.where(np.sign(e) != np.sign(m0), 0.0,
+                     np.where((np.sign(m0) != np.sign(m1)) & (np.abs(e) > 3.0 * np.abs(m0)),
+                              3.0 * m0, e))
+        d[end] = e
+    return np.moveaxis(d, 0, axis)
 
 
 class GridField:
@@ -142,7 +162,8 @@ class GridField:
                     M[..., p, q] = F[p:n - 1 + p, q:m - 1 + q]
                     M[..., 2 + p, q] = Fs[p:n - 1 + p, q:m - 1 + q]
                     M[..., p, 2 + q] = Ft[p:n - 1 + p, q:m - 1 + q]
-            C = _HERMITE.T @ M @ _HERMITE  # (.., c, i, j): power coefficients
+            # power coefficients H^T M H of every patch as one product with kron(H, H)
+            C = (M.reshape(-1, 16) @ _HERMITE_2D).reshape(n - 1, m - 1, c, 16)
             cache[key] = np.ascontiguousarray(
                 np.moveaxis(C, 2, -1).reshape((n - 1) * (m - 1), 16, c))
         return cache[key]
@@ -156,8 +177,8 @@ class GridField:
         val = np.empty((N, c))
         ds = np.empty((N, c)) if deriv else 0.0
         dt = np.empty((N, c)) if deriv else 0.0
-        for k in range(0, N, block):
-            sl = slice(k, k + block)
+
+        def job(sl):
             i = np.clip(np.floor(s[sl]).astype(np.int64), 0, n - 2)
             j = np.clip(np.floor(t[sl]).astype(np.int64), 0, m - 2)
             a, b = s[sl] - i, t[sl] - j
@@ -170,6 +191,8 @@ class GridField:
                                    (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
                 dt[sl] = np.einsum("nk,nkc->nc",
                                    (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
+
+        for_chunks(job, N, block)
         return val, ds, dt
 
     def _clamped(self, s, t):

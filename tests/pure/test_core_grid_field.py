@@ -184,3 +184,41 @@ def test_locate_beyond_a_distorted_border():
     back = f._map(s[inside], t[inside], deriv=False)[0]
     # within the tensor-grid locator's 1e-7 grid cells (cells ~0.1 wide here)
     assert_allclose(back, np.stack([uu.ravel()[inside], vv.ravel()[inside]], axis=1), atol=5e-8)
+
+
+@pytest.mark.parametrize("axis", [0, 1])
+def test_pchip_slopes_are_scipys(axis):
+    """The field's own node slopes equal PchipInterpolator's (monotone runs, sign
+    changes, flat stretches, zero secants, both ends), to rounding."""
+    from scipy.interpolate import PchipInterpolator
+
+    from surfcomp.core.field import _pchip_slopes
+
+    rng = np.random.default_rng(3)
+    cases = [rng.normal(size=(40, 30, 3)), np.round(rng.normal(size=(25, 20, 2))),
+             np.cumsum(rng.random((20, 12, 1)), axis=axis), rng.normal(size=(3, 3, 1))]
+    for F in cases:
+        x = np.arange(F.shape[axis], dtype=float)
+        ref = PchipInterpolator(x, F, axis=axis).derivative()(x)
+        assert_allclose(_pchip_slopes(F, axis), ref, rtol=0, atol=1e-14)
+    # two nodes: the secant at both
+    F = rng.normal(size=(2, 5, 1)) if axis == 0 else rng.normal(size=(5, 2, 1))
+    secant = np.diff(F, axis=axis)
+    assert_allclose(_pchip_slopes(F, axis), np.concatenate([secant, secant], axis=axis))
+
+
+def test_linear_update_is_the_bilinear_interpolant():
+    """``linear_at`` (the residual iteration's update) reproduces node values at the
+    nodes, is bilinear inside a cell and holds the border value outside the grid."""
+    U, V = _uv_grid(6, 5)
+    f = GridField(U, V, np.zeros(U.shape))
+    rng = np.random.default_rng(4)
+    change = rng.normal(size=U.shape)
+    s = np.array([0.0, 2.0, 2.5, 2.25, -1.0, 7.0])
+    t = np.array([0.0, 3.0, 3.0, 1.75, 2.0, 4.5])
+    got = f.linear_at(s, t) @ change.ravel()
+    want = [change[0, 0], change[2, 3], 0.5 * (change[2, 3] + change[3, 3]),
+            0.75 * 0.25 * change[2, 1] + 0.75 * 0.75 * change[2, 2]
+            + 0.25 * 0.25 * change[3, 1] + 0.25 * 0.75 * change[3, 2],
+            change[0, 2], change[5, 4]]
+    assert_allclose(got, want, rtol=0, atol=1e-15)

@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Chunked evaluation on several threads gives the serial result bit for bit."""
+
+import numpy as np
+import pytest
+
+from surfcomp.core import bspline, chunks
+from surfcomp.core.corrected import _solve3
+
+
+def _surface(n=40, seed=0):
+    rng = np.random.default_rng(seed)
+    knots = np.r_[[0.0] * 3, np.linspace(0, 1, n - 2), [1.0] * 3]
+    return bspline.Surface(rng.random((n, n, 3)), knots, knots, 3, 3, None, (0, 1), (0, 1))
+
+
+def test_threaded_derivatives_equal_serial(monkeypatch):
+    surf = _surface()
+    rng = np.random.default_rng(1)
+    u, v = rng.random(300_000), rng.random(300_000)   # several chunks
+    monkeypatch.setenv("SURFCOMP_THREADS", "1")
+    serial = bspline.derivatives(surf, u, v, order=2)
+    monkeypatch.setenv("SURFCOMP_THREADS", "3")
+    assert chunks.threads() == 3
+    threaded = bspline.derivatives(surf, u, v, order=2)
+    for a, b in zip(serial, threaded):
+        assert np.array_equal(a, b)
+
+
+def test_an_error_in_one_chunk_is_raised(monkeypatch):
+    monkeypatch.setenv("SURFCOMP_THREADS", "2")
+    done = np.zeros(10, dtype=bool)
+
+    def job(sl):
+        if sl.start == 6:
+            raise ValueError("chunk 6")
+        done[sl] = True
+
+    with pytest.raises(ValueError, match="chunk 6"):
+        chunks.for_chunks(job, 10, 2)
+    # the other chunks ran; nested calls inside a chunk run serially (no deadlock)
+    assert done[[0, 1, 2, 3, 4, 5, 8, 9]].all()
+    inner = np.zeros(12)
+
+    def outer(sl):
+        def fill(s2):
+            inner[s2] = 1.0
+        chunks.for_chunks(fill, 12, 3)
+
+    chunks.for_chunks(outer, 4, 1)
+    assert inner.sum() == 12
+
+
+def test_solve3_matches_lu():
+    rng = np.random.default_rng(2)
+    a, b, c, r = (rng.normal(size=(1000, 3)) for _ in range(4))
+    want = np.linalg.solve(np.stack([a, b, c], axis=2), r[..., None])[..., 0]
+    np.testing.assert_allclose(np.stack(_solve3(a, b, c, r), axis=1), want, rtol=1e-9,
+                               atol=1e-9)
