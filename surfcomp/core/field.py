@@ -168,15 +168,17 @@ class GridField:
                 np.moveaxis(C, 2, -1).reshape((n - 1) * (m - 1), 16, c))
         return cache[key]
 
-    def _eval(self, s, t, channels=slice(None), deriv=False, block=32768):
-        """Values (and d/ds, d/dt) at index coordinates inside [0, n-1] x [0, m-1]
-        (in blocks that stay in cache: several times faster on millions of points)."""
+    def _eval(self, s, t, channels=slice(None), deriv=False, block=32768, cross=False):
+        """Values (and d/ds, d/dt; with ``cross`` also d2/dsdt as a fourth array) at index
+        coordinates inside [0, n-1] x [0, m-1] (in blocks that stay in cache: several
+        times faster on millions of points)."""
         C = self._coefficients(channels)
         n, m = self.shape
         N, c = s.size, C.shape[2]
         val = np.empty((N, c))
         ds = np.empty((N, c)) if deriv else 0.0
         dt = np.empty((N, c)) if deriv else 0.0
+        dst = np.empty((N, c)) if cross else None
 
         def job(sl):
             i = np.clip(np.floor(s[sl]).astype(np.int64), 0, n - 2)
@@ -191,9 +193,12 @@ class GridField:
                                    (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
                 dt[sl] = np.einsum("nk,nkc->nc",
                                    (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
+                if cross:
+                    dst[sl] = np.einsum("nk,nkc->nc",
+                                        (dA[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
 
         for_chunks(job, N, block)
-        return val, ds, dt
+        return (val, ds, dt, dst) if cross else (val, ds, dt)
 
     def _clamped(self, s, t):
         n, m = self.shape
@@ -204,9 +209,13 @@ class GridField:
         Without ``deriv`` only the (u, v) (the Jacobian is None)."""
         sc, tc = self._clamped(s, t)
         if deriv:
-            val, ds, dt = self._eval(sc, tc, slice(0, 2), deriv=True)
+            val, ds, dt, dst = self._eval(sc, tc, slice(0, 2), deriv=True, cross=True)
             es, et = (s - sc)[:, None], (t - tc)[:, None]
-            return val + ds * es + dt * et, ds, dt
+            # beyond one border only, the base point slides along it: its slope's change
+            # along the border times the distance out belongs to the Jacobian (without it
+            # Newton crawls on points many cells out: 30 steps on a turned grid)
+            return (val + ds * es + dt * et, ds + dst * np.where(es == 0, et, 0.0),
+                    dt + dst * np.where(et == 0, es, 0.0))
         val = self._eval(sc, tc, slice(0, 2))[0]
         out = np.nonzero((s != sc) | (t != tc))[0]
         if out.size:
