@@ -619,3 +619,29 @@ def test_project_generic_evaluator_fallback_agrees(monkeypatch):
     assert_allclose(b.distance, a.distance, atol=1e-9, rtol=0)
     assert_allclose(b.foot, a.foot, atol=1e-8, rtol=0)
     assert b.converged.all()
+
+
+def test_band_factor_equals_sparse_lu_and_names_a_singular_matrix():
+    """Collocation matrices are solved as band matrices (many right-hand sides); the
+    result is SuperLU's to rounding, a wide matrix still goes to SuperLU, and a zero
+    pivot raises the Schoenberg-Whitney message."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from surfcomp.core import bspline_fit
+    from surfcomp.core.bspline_basis import basis_matrix, greville
+
+    n = 300
+    knots = np.r_[[0.0] * 4, np.linspace(0, 1, n - 2)[1:-1], [1.0] * 4]
+    M = sp.csr_matrix(basis_matrix(knots, 3, n, greville(knots, 3)))
+    B = np.random.default_rng(6).normal(size=(n, 7))
+    want = spla.splu(sp.csc_matrix(M)).solve(B)
+    np.testing.assert_allclose(bspline_fit._factor(M, "test")(B), want, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(bspline_fit._factor(M, "test")(B[:, 0]), want[:, 0], atol=1e-12)
+    wide = sp.random(40, 40, density=0.5, random_state=1) + 10 * sp.eye(40)
+    np.testing.assert_allclose(bspline_fit._factor(wide, "test")(B[:40]),
+                               spla.splu(sp.csc_matrix(wide)).solve(B[:40]), atol=1e-12)
+    sites = greville(knots, 3)
+    sites[10] = sites[11]                                  # two equal rows
+    with pytest.raises(GridError, match="singular.*Schoenberg-Whitney"):
+        bspline_fit._factor(sp.csr_matrix(basis_matrix(knots, 3, n, sites)), "u matrix")
