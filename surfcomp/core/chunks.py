@@ -13,7 +13,7 @@ import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 
-_POOL = None
+_POOL = (0, None)   # (threads, executor)
 _LOCK = threading.Lock()
 _INSIDE = threading.local()
 
@@ -29,9 +29,11 @@ def threads():
 def _pool(workers):
     global _POOL
     with _LOCK:
-        if _POOL is None or _POOL._max_workers != workers:
-            _POOL = ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk")
-        return _POOL
+        if _POOL[0] != workers:
+            if _POOL[1] is not None:
+                _POOL[1].shutdown(wait=False)
+            _POOL = (workers, ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk"))
+        return _POOL[1]
 
 
 def _guarded(job):
