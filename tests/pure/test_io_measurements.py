@@ -555,3 +555,27 @@ def test_round_trip_200k_rows():
     assert_allclose(ms.normal, nrm, atol=1e-12, rtol=0)
     assert_allclose(ms.deviation, dev, atol=1e-12, rtol=0)
     assert_array_equal(ms.lines, lines)
+
+
+@pytest.mark.parametrize("body, lines", [
+    ("A\nB\n", [2, 3]),                      # plain: one scan of the text, no row tests
+    ("A\nB", [2, 3]),                        # no newline at the end
+    ("A\nB\n , ,\n\n  \n", [2, 3]),          # blank tails, separators only
+    ("\nA\nB\n", [3, 4]),                    # a blank row first
+    ("A\n ,\t,\nB\n", [2, 4]),               # a blank row inside
+    ("A\n# note\nB\n", [2, 4]),              # a comment row
+    ("A\n  // note\nB\n", [2, 4]),
+    ("A\nB,\n", None),                       # a separator too many on the last row
+])
+def test_data_rows_with_and_without_blank_or_comment_rows(body, lines):
+    """The rows after the header: blank rows (blanks and separators only) and comments are
+    skipped whether the text is scanned once (none of them) or row by row."""
+    text = "x_nom,y_nom,z_nom,x_meas,y_meas,z_meas\n" + body.replace(
+        "A", "0,0,0,0,0,0.001").replace("B", "5,0,0,5,0,0.002")
+    if lines is None:
+        with pytest.raises(MeasurementFileError, match="has 7 fields.*ends with a separator"):
+            parse_measurements(text)
+        return
+    ms = parse_measurements(text)
+    assert ms.lines.tolist() == lines
+    assert_allclose(ms.measured[:, 2], [0.001, 0.002])
