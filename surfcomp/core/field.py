@@ -26,6 +26,7 @@ the border value, and clipped to the node value range like the inside.
 """
 
 import numpy as np
+from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
 from ..errors import ComputationError
@@ -358,8 +359,6 @@ class GridField:
         (clamped to the grid outside it): a linear stand-in for :meth:`with_values` in
         the residual iteration, which only moves the node values by the small misses
         left (``base + linear_at(s, t) @ change`` instead of a new Hermite field)."""
-        from scipy.sparse import csr_matrix
-
         n, m = self.shape
         s, t = self._clamped(np.ravel(s).astype(float), np.ravel(t).astype(float))
         i = np.minimum(np.floor(s).astype(np.int64), n - 2)
