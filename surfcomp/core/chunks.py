@@ -11,7 +11,7 @@ them serially (no nested waiting on the same pool).
 
 import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, wait
 
 _POOL = (0, None)   # (threads, executor)
 _LOCK = threading.Lock()
@@ -20,20 +20,11 @@ _INSIDE = threading.local()
 
 def threads():
     """Threads a chunked call uses (``SURFCOMP_THREADS``, else the cores, at most 4)."""
-    env = os.environ.get("SURFCOMP_THREADS", "").strip()
-    if env.isdigit() and int(env) > 0:
-        return int(env)
-    return max(1, min(4, os.cpu_count() or 1))
-
-
-def _pool(workers):
-    global _POOL
-    with _LOCK:
-        if _POOL[0] != workers:
-            if _POOL[1] is not None:
-                _POOL[1].shutdown(wait=False)
-            _POOL = (workers, ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk"))
-        return _POOL[1]
+    try:
+        env = int(os.environ.get("SURFCOMP_THREADS", ""))
+    except ValueError:
+        env = 0
+    return env if env > 0 else max(1, min(4, os.cpu_count() or 1))
 
 
 def _guarded(job):
@@ -46,15 +37,36 @@ def _guarded(job):
     return run
 
 
+def _submit(workers, run, slices):
+    """Submit the slices to the pool of ``workers`` threads (replaced, under the lock,
+    when the number changed: a call never submits to a pool being shut down)."""
+    global _POOL
+    with _LOCK:
+        if _POOL[0] != workers:
+            if _POOL[1] is not None:
+                _POOL[1].shutdown(wait=False)     # its submitted slices still run
+            _POOL = (workers, ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk"))
+        return [_POOL[1].submit(run, sl) for sl in slices]
+
+
 def for_chunks(job, n, step):
     """Call ``job(slice)`` for the slices of ``range(n)`` ``step`` long, on several
     threads when there are several slices. ``job`` writes its results into arrays it
-    shares with the caller (each slice its own part); an exception in any slice is
-    raised here after all have finished."""
+    shares with the caller (each slice its own part). Returns when every slice has
+    finished; then the first failed slice's exception is raised. An interrupt while
+    waiting cancels the slices not started yet."""
     slices = [slice(k, min(k + step, n)) for k in range(0, n, step)]
     workers = threads()
     if len(slices) < 2 or workers < 2 or getattr(_INSIDE, "active", False):
         for sl in slices:
             job(sl)
         return
-    list(_pool(workers).map(_guarded(job), slices))   # raises the first slice's error
+    futures = _submit(workers, _guarded(job), slices)
+    try:
+        wait(futures)
+    except BaseException:
+        for fut in futures:
+            fut.cancel()
+        raise
+    for fut in futures:
+        fut.result()

@@ -584,19 +584,30 @@ class _NodeFrame:
             act = act[~np.all(np.abs(F) < FINAL_STEP, axis=1)]
             if act.size == 0:
                 break
-        self._last = (a, b)
+        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+            self._last = (a, b)
         return t
 
 
 def _solve3(a, b, c, r):
     """Solve ``[a b c] x = r`` for each row (3 x 3 systems by columns, (N, 3) each) by
     Cramer's rule (a batched LU costs several times more for millions of 3 x 3 systems);
-    returns the three components of x."""
+    returns the three components of x. Rows whose system is singular or nearly so (a
+    collapsed edge: a zero column) get the least-squares step of the smallest length
+    (pseudo-inverse) instead: never NaN."""
     bc = np.cross(b, c)
     det = np.einsum("ij,ij->i", a, bc)
-    return (np.einsum("ij,ij->i", r, bc) / det,
-            np.einsum("ij,ij->i", a, np.cross(r, c)) / det,
-            np.einsum("ij,ij->i", a, np.cross(b, r)) / det)
+    size = (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
+            * np.linalg.norm(c, axis=1))
+    bad = ~(np.abs(det) > 1e-12 * size)
+    det = np.where(bad, 1.0, det)
+    x = np.stack([np.einsum("ij,ij->i", r, bc) / det,
+                  np.einsum("ij,ij->i", a, np.cross(r, c)) / det,
+                  np.einsum("ij,ij->i", a, np.cross(b, r)) / det])
+    if bad.any():
+        J = np.stack([a[bad], b[bad], c[bad]], axis=2)
+        x[:, bad] = (np.linalg.pinv(J) @ r[bad][..., None])[..., 0].T
+    return x[0], x[1], x[2]
 
 
 def realised_correction(nominal, corrected, u, v, outward=1, guess=None, iterations=20):

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Chunked evaluation on several threads gives the serial result bit for bit."""
 
+import os
+
 import numpy as np
 import pytest
 
@@ -38,7 +40,8 @@ def test_an_error_in_one_chunk_is_raised(monkeypatch):
 
     with pytest.raises(ValueError, match="chunk 6"):
         chunks.for_chunks(job, 10, 2)
-    # the other chunks ran; nested calls inside a chunk run serially (no deadlock)
+    # every other chunk ran before the error came back; nested calls inside a chunk run
+    # serially (no deadlock)
     assert done[[0, 1, 2, 3, 4, 5, 8, 9]].all()
     inner = np.zeros(12)
 
@@ -57,3 +60,20 @@ def test_solve3_matches_lu():
     want = np.linalg.solve(np.stack([a, b, c], axis=2), r[..., None])[..., 0]
     np.testing.assert_allclose(np.stack(_solve3(a, b, c, r), axis=1), want, rtol=1e-9,
                                atol=1e-9)
+
+
+def test_solve3_singular_rows_get_the_least_squares_step():
+    """A zero column (the surface's Su on a collapsed edge) gives the minimum-norm
+    least-squares step for that row, never NaN; the other rows keep Cramer's result."""
+    a = np.array([[1.0, 0, 0], [0, 0, 0]])
+    b = np.array([[0.0, 1, 0], [0, 1, 0]])
+    c = np.array([[0.0, 0, 1], [0, 0, 1]])
+    r = np.array([[1.0, 2, 3], [1, 2, 3]])
+    got = np.stack(_solve3(a, b, c, r), axis=1)
+    np.testing.assert_allclose(got, [[1, 2, 3], [0, 2, 3]], atol=1e-12)
+
+
+@pytest.mark.parametrize("value", ["", "0", "-2", "abc", "\u00b2", "2.5"])
+def test_unusable_thread_settings_fall_back_to_the_cores(monkeypatch, value):
+    monkeypatch.setenv("SURFCOMP_THREADS", value)
+    assert chunks.threads() == max(1, min(4, os.cpu_count() or 1))

@@ -566,6 +566,9 @@ def test_round_trip_200k_rows():
     ("A\n# note\nB\n", [2, 4]),              # a comment row
     ("A\n  // note\nB\n", [2, 4]),
     ("A\nB,\n", None),                       # a separator too many on the last row
+    ("A\r\r\nB\r\r\n\r\r\n", [2, 3]),           # doubled CRs: rows of a lone CR are blank
+    ("A\n\u00a0\nB\n", [2, 4]),               # a row of a no-break space is blank
+    ("A\n#\u00a0\nB\n", [2, 4]),
 ])
 def test_data_rows_with_and_without_blank_or_comment_rows(body, lines):
     """The rows after the header: blank rows (blanks and separators only) and comments are
