@@ -155,7 +155,7 @@ _HINTS = {"x": _AMBIGUOUS, "y": _AMBIGUOUS, "z": _AMBIGUOUS,
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _NONFINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
 #: white space other than blanks, tabs and newlines (ASCII; str.isspace's others)
-_OTHER_SPACE = re.compile(r"[\r\x0b\x0c\x1c-\x1f]")
+_OTHER_SPACE = "\r\x0b\x0c\x1c\x1d\x1e\x1f"
 _SEP_NAMES = {",": "','", ";": "';'", "\t": "tabs", None: "blanks"}
 _UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
@@ -447,7 +447,7 @@ class _Parser:
         # (only blanks, tabs and newlines as white space: a row of other white space,
         # such as a CR left by doubled line ends, is blank to the row by row test)
         if ("#" not in body and "//" not in body and body.isascii()
-                and not _OTHER_SPACE.search(body)):
+                and not any(ch in body for ch in _OTHER_SPACE)):
             body = body.rstrip(blank + "\n")
             if not body:
                 return range(h + 1, h + 1)
