@@ -13,7 +13,7 @@ import os
 import threading
 from concurrent.futures import ThreadPoolExecutor, wait
 
-_POOL = (0, None)   # (threads, executor)
+_POOLS = {}          # threads -> executor (one per thread count, kept for the process)
 _LOCK = threading.Lock()
 _INSIDE = threading.local()
 
@@ -38,35 +38,40 @@ def _guarded(job):
 
 
 def _submit(workers, run, slices):
-    """Submit the slices to the pool of ``workers`` threads (replaced, under the lock,
-    when the number changed: a call never submits to a pool being shut down)."""
-    global _POOL
+    """Submit the slices to the pool of ``workers`` threads (made on first use)."""
     with _LOCK:
-        if _POOL[0] != workers:
-            if _POOL[1] is not None:
-                _POOL[1].shutdown(wait=False)     # its submitted slices still run
-            _POOL = (workers, ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk"))
-        return [_POOL[1].submit(run, sl) for sl in slices]
+        if workers not in _POOLS:
+            _POOLS[workers] = ThreadPoolExecutor(workers, thread_name_prefix="surfcomp-chunk")
+        return [_POOLS[workers].submit(run, sl) for sl in slices]
 
 
-def for_chunks(job, n, step):
-    """Call ``job(slice)`` for the slices of ``range(n)`` ``step`` long, on several
-    threads when there are several slices. ``job`` writes its results into arrays it
-    shares with the caller (each slice its own part). Returns when every slice has
-    finished; then the first failed slice's exception is raised. An interrupt while
-    waiting cancels the slices not started yet."""
+def for_chunks(job, n, step, workers=None, done=None):
+    """Call ``job(slice)`` for the slices of ``range(n)`` ``step`` long, on ``workers``
+    threads (default :func:`threads`) when there are several slices. ``job`` writes its
+    results into arrays it shares with the caller (each slice its own part).
+
+    ``done(k, count)``, if given, is called in the caller's thread once slice ``k`` has
+    finished, in slice order (progress); when it raises (a cancel), or the wait is
+    interrupted, the slices not started are cancelled and the running ones waited for.
+    Returns when every slice has finished; then the first failed slice's exception is
+    raised."""
     slices = [slice(k, min(k + step, n)) for k in range(0, n, step)]
-    workers = threads()
+    workers = workers or threads()
     if len(slices) < 2 or workers < 2 or getattr(_INSIDE, "active", False):
-        for sl in slices:
+        for k, sl in enumerate(slices):
             job(sl)
+            if done is not None:
+                done(k, len(slices))
         return
     futures = _submit(workers, _guarded(job), slices)
     try:
-        wait(futures)
+        for k, fut in enumerate(futures):
+            if fut.exception() is None and done is not None:
+                done(k, len(slices))
     except BaseException:
         for fut in futures:
             fut.cancel()
+        wait(futures)
         raise
     for fut in futures:
         fut.result()

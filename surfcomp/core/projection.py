@@ -23,7 +23,6 @@ Evaluation and the Newton iterations are in :mod:`surfcomp.core.projection_newto
 import itertools
 import os
 import threading
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,6 +30,7 @@ from scipy.spatial import cKDTree
 
 from ..errors import GeometryError, InputError
 from . import bspline
+from .chunks import for_chunks
 from .progress import report
 from .projection_newton import GenericEval, Newton, SpanTable, dot
 from .projection_regions import Regions, principal_curvatures
@@ -225,24 +225,11 @@ class Projector:
         # blocks are independent (disjoint result rows): one thread each; two per thread
         # at most (each ends with a tail of iterations on its few slow points)
         block = max(CHUNK * 2, -(-good.size // (2 * self.workers)))
-        blocks = [good[s_:s_ + block] for s_ in range(0, good.size, block)]
-        job = lambda idx: self._project_block(P[idx], idx, res, max_distance)  # noqa: E731
-        if self.workers == 1 or len(blocks) == 1:
-            for k, idx in enumerate(blocks):
-                job(idx)
-                report(progress, (k + 1) / len(blocks), "projecting points")
-        else:
-            with ThreadPoolExecutor(self.workers) as pool:
-                futures = [pool.submit(job, idx) for idx in blocks]
-                try:
-                    for k, fut in enumerate(futures):
-                        fut.result()
-                        report(progress, (k + 1) / len(blocks), "projecting points")
-                except BaseException:
-                    for fut in futures:
-                        fut.cancel()
-                    raise
-        if not blocks:
+        for_chunks(lambda sl: self._project_block(P[good[sl]], good[sl], res, max_distance),
+                   good.size, block, workers=self.workers,
+                   done=lambda k, count: report(progress, (k + 1) / count,
+                                                "projecting points"))
+        if not good.size:
             report(progress, 1.0, "projecting points")
         return Projection(**res)
 
