@@ -77,3 +77,31 @@ def test_solve3_singular_rows_get_the_least_squares_step():
 def test_unusable_thread_settings_fall_back_to_the_cores(monkeypatch, value):
     monkeypatch.setenv("SURFCOMP_THREADS", value)
     assert chunks.threads() == max(1, min(4, os.cpu_count() or 1))
+
+
+def test_progress_in_order_and_a_cancel_stops_the_rest(monkeypatch):
+    """``done`` reports the slices in order in the caller's thread; when it raises (Esc in
+    FreeCAD's progress) the slices not started are cancelled and the error comes back."""
+    import threading
+    import time
+
+    seen, ran = [], np.zeros(40, dtype=bool)
+    caller = threading.get_ident()
+
+    def job(sl):
+        time.sleep(0.01)
+        ran[sl] = True
+
+    def done(k, count):
+        assert threading.get_ident() == caller
+        seen.append((k, count))
+        if k == 2:
+            raise KeyboardInterrupt("cancelled")
+
+    with pytest.raises(KeyboardInterrupt):
+        chunks.for_chunks(job, 40, 1, workers=2, done=done)
+    assert seen == [(0, 40), (1, 40), (2, 40)]
+    assert 3 <= ran.sum() < 40                  # the slices not started never ran
+    full = []
+    chunks.for_chunks(job, 40, 1, workers=2, done=lambda k, c: full.append(k))
+    assert full == list(range(40)) and ran.all()
