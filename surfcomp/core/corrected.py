@@ -589,21 +589,29 @@ class _NodeFrame:
         return t
 
 
+def _cross(p, q):
+    """Cross products of vectors given as three component arrays (tuples or (3, N))."""
+    return (p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0])
+
+
+def _dot(p, q):
+    return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
+
+
 def _solve3(a, b, c, r):
     """Solve ``[a b c] x = r`` for each row (3 x 3 systems by columns, (N, 3) each) by
-    Cramer's rule (a batched LU costs several times more for millions of 3 x 3 systems);
-    returns the three components of x. Rows whose system is singular or nearly so (a
-    collapsed edge: a zero column) get the least-squares step of the smallest length
-    (pseudo-inverse) instead: never NaN."""
-    bc = np.cross(b, c)
-    det = np.einsum("ij,ij->i", a, bc)
-    size = (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
-            * np.linalg.norm(c, axis=1))
+    Cramer's rule on the components (a batched LU costs several times more for millions of
+    3 x 3 systems); returns the three components of x. Rows whose system is singular or
+    nearly so (a collapsed edge: a zero column) get the least-squares step of the smallest
+    length (pseudo-inverse) instead: never NaN."""
+    A, B, C, R = a.T, b.T, c.T, r.T
+    bc = _cross(B, C)
+    det = _dot(A, bc)
+    size = np.sqrt(_dot(A, A) * _dot(B, B) * _dot(C, C))
     bad = ~(np.abs(det) > 1e-12 * size)
     det = np.where(bad, 1.0, det)
-    x = np.stack([np.einsum("ij,ij->i", r, bc) / det,
-                  np.einsum("ij,ij->i", a, np.cross(r, c)) / det,
-                  np.einsum("ij,ij->i", a, np.cross(b, r)) / det])
+    # x_k = det of the matrix with column k replaced by r: triple products with r
+    x = np.stack([_dot(R, bc), _dot(R, _cross(C, A)), _dot(R, _cross(A, B))]) / det
     if bad.any():
         J = np.stack([a[bad], b[bad], c[bad]], axis=2)
         x[:, bad] = (np.linalg.pinv(J) @ r[bad][..., None])[..., 0].T
