@@ -30,7 +30,7 @@ from scipy.sparse import csr_matrix
 from scipy.spatial import cKDTree
 
 from ..errors import ComputationError
-from .chunks import for_chunks
+from .chunks import for_chunks, threads
 
 _L = 0.5  # damping length of the outside continuation, in grid steps
 
@@ -125,9 +125,12 @@ class GridField:
         ss, tt = np.meshgrid(np.linspace(0, n - 1, k * (n - 1) + 1),
                              np.linspace(0, m - 1, k * (m - 1) + 1), indexing="ij")
         self._seed_st = np.stack([ss.ravel(), tt.ravel()], axis=1)
-        uv = self._eval(self._seed_st[:, 0], self._seed_st[:, 1], channels=slice(0, 2))[0]
+        # one seed per node on dense grids: the map passes through the nodes
+        uv = F[..., :2].reshape(-1, 2) if k == 1 else \
+            self._eval(self._seed_st[:, 0], self._seed_st[:, 1], channels=slice(0, 2))[0]
         self._scale = np.array([np.ptp(U) or 1.0, np.ptp(V) or 1.0])
-        self._tree = cKDTree(uv / self._scale)
+        # (a sliding-midpoint tree: built and queried faster than a balanced one on grids)
+        self._tree = cKDTree(uv / self._scale, balanced_tree=False)
 
     def with_values(self, values):
         """A field with the same grid positions and new node values (reuses the
@@ -219,8 +222,9 @@ class GridField:
                     dt + dst * np.where(et == 0, es, 0.0))
         val = self._eval(sc, tc, slice(0, 2))[0]
         out = np.nonzero((s != sc) | (t != tc))[0]
-        if out.size:
-            val[out] = self._map(s[out], t[out])[0]
+        if out.size:    # the linear continuation (no cross derivative needed)
+            _, ds, dt = self._eval(sc[out], tc[out], slice(0, 2), deriv=True)
+            val[out] += ds * (s - sc)[out, None] + dt * (t - tc)[out, None]
         return val, None, None
 
     # -- public ---------------------------------------------------------------------------
@@ -237,9 +241,16 @@ class GridField:
             May lie outside [0, n-1] x [0, m-1] for points outside the measured region.
         """
         uv = np.stack([np.ravel(u), np.ravel(v)], axis=1).astype(float)
-        _, k = self._tree.query(uv / self._scale)
-        return self._newton(uv, self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy(),
-                            iterations, tol)
+        _, k = self._tree.query(uv / self._scale, workers=threads())
+        s, t = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
+        # points nearest a border sample may lie many cells beyond it, where Newton's
+        # limited steps would need ~log2(distance) more iterations: they start one linear
+        # step out (along the border at most one cell)
+        n, m = self.shape
+        out = np.flatnonzero((s == 0) | (s == n - 1) | (t == 0) | (t == m - 1))
+        if out.size:
+            s[out], t[out] = self._step_out(uv[out], s[out], t[out], along=1.0)
+        return self._newton(uv, s, t, iterations, tol)
 
     def locate_grid(self, us, vs, stride=4):
         """:meth:`locate` for the tensor grid ``us x vs`` (``meshgrid(..., indexing="ij")``
@@ -313,20 +324,27 @@ class GridField:
         placed by one linear step from the nearest border sample, so the bounded outside
         continuation applies. Points that have a sample inside the grid nearest raise."""
         n, m = self.shape
-        _, k = self._tree.query(uv / self._scale)
+        _, k = self._tree.query(uv / self._scale, workers=threads())
         s0, t0 = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
         border = (s0 == 0) | (s0 == n - 1) | (t0 == 0) | (t0 == m - 1)
         if not np.all(border):
             bad = int(np.argmin(border))
             raise ComputationError("could not locate (u, v) = (%g, %g) on the measurement grid"
                                    % tuple(uv[bad]))
+        return self._step_out(uv, s0, t0)
+
+    def _step_out(self, uv, s0, t0, along=0.0):
+        """One linear step from border samples (s0, t0) towards ``uv``: outward only (the
+        point stays beyond the border it is nearest to), along a border at most ``along``
+        cells."""
+        n, m = self.shape
         val, ds, dt = self._map(s0, t0)
-        r = uv - val
-        dS, dT = _solve2(ds, dt, r)
-        # only outward steps: the point stays beyond the border it is nearest to
-        dS = np.where(s0 == 0, np.minimum(dS, 0), np.where(s0 == n - 1, np.maximum(dS, 0), 0))
-        dT = np.where(t0 == 0, np.minimum(dT, 0), np.where(t0 == m - 1, np.maximum(dT, 0), 0))
-        return s0 + dS, t0 + dT
+        dS, dT = _solve2(ds, dt, uv - val)
+
+        def part(d, x, last):
+            return np.where(x == 0, np.minimum(d, 0), np.where(x == last, np.maximum(d, 0),
+                                                               np.clip(d, -along, along)))
+        return s0 + part(dS, s0, n - 1), t0 + part(dT, t0, m - 1)
 
     def at_index(self, s, t):
         """Field values at index coordinates (continued outside, clipped to the node range)."""

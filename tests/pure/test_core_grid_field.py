@@ -253,3 +253,29 @@ def test_locate_far_beyond_a_noisy_border():
     miss = np.abs(f._map(s, t, deriv=False)[0] - np.stack([uu.ravel(), vv.ravel()], 1))
     # every point but the fallbacks within locate_grid's tolerance (1e-7 cells)
     assert np.sum(miss.max(axis=1) > 1e-7 / (n - 1)) <= sum(fallback)
+
+
+def test_locate_starts_points_beyond_the_border_one_linear_step_out():
+    """Points nearest a border sample start Newton one linear step out, not at the
+    sample: on a turned (affine) grid points up to 60 cells beyond a border are located
+    exactly (the continuation is affine there too) in at most three passes; from the
+    border sample, with steps limited to the distance out plus one cell, they took seven."""
+    n = 40
+    t = np.linspace(0.3, 0.7, n)
+    S, T = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float), indexing="ij")
+    a, h = np.radians(20.0), t[1] - t[0]
+    U = 0.3 + h * (S * np.cos(a) - T * np.sin(a))
+    V = 0.3 + h * (S * np.sin(a) + T * np.cos(a))
+    f = GridField(U, V, np.zeros(U.shape))
+    passes = []
+    mapping = f._map
+    f._map = lambda s, t, deriv=True: (passes.append(deriv), mapping(s, t, deriv))[1]
+    rng = np.random.default_rng(2)
+    s_true = rng.uniform(-60, n + 60, 400)
+    t_true = rng.uniform(-10, n + 10, 400)
+    u = 0.3 + h * (s_true * np.cos(a) - t_true * np.sin(a))
+    v = 0.3 + h * (s_true * np.sin(a) + t_true * np.cos(a))
+    s, t = f.locate(u, v)
+    assert_allclose(s, s_true, rtol=0, atol=1e-9)
+    assert_allclose(t, t_true, rtol=0, atol=1e-9)
+    assert passes.count(False) <= 3
