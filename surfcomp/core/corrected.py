@@ -502,17 +502,27 @@ def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
     # the change (where the field has one) stands in for a new field through them
     linear = field.linear_at(*loc) if hasattr(field, "linear_at") else None
     xs, fs, best = [], [], None
+    exact = None    # the first surface and its realised correction by Newton
     k = 0
     while True:
         report(progress, k / (iterations + 1), "building the corrected surface")
         surf = smp.build(samples.reshape(uu.shape))
-        real = nodes.realised(surf, guess=values.ravel()).reshape(delta.shape)
+        # the later surfaces differ from the first by fractions of a um: their realised
+        # corrections follow from its intersections to first order (one evaluation)
+        real = None if exact is None else nodes.realised_change(exact[0], surf, exact[1])
+        if real is None:
+            real = nodes.realised(surf, guess=values.ravel())
+            exact = (surf, real)
+        real = real.reshape(delta.shape)
         miss = delta - real
         worst = float(np.max(np.abs(miss)))
         if best is None or worst < best[0]:
             best = (worst, surf, k, real)
         if worst <= tol or k >= iterations:
-            return best[1], field, best[2], best[3]
+            _, surf, k, real = best
+            if surf is not exact[0]:     # the kept surface's own intersections
+                real = nodes.realised(surf, guess=real.ravel()).reshape(delta.shape)
+            return surf, field, k, real
         xs, fs = (xs + [values.ravel()])[-ANDERSON - 1:], (fs + [miss.ravel()])[-ANDERSON - 1:]
         values = anderson_step(xs, fs).reshape(delta.shape)
         samples = (base + linear @ (values - delta).ravel() if linear is not None
@@ -557,10 +567,28 @@ class _NodeFrame:
         self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
         self._last = None
 
+    def realised_change(self, before, after, real):
+        """The realised correction on ``after`` from the one on ``before`` (``real``, from
+        :meth:`realised` on ``before``), to first order in the surfaces' difference D
+        (same knots and weights): the intersection moves by -D . N / (n . N) along the
+        line, N the normal of ``before`` where the line met it. The residual iteration's
+        surfaces differ by fractions of a um and the correction's slopes are ~1e-3, so
+        what is left is ~1e-6 of the change (tested against :meth:`realised`). None when
+        :meth:`realised` left no intersection to start from."""
+        if self._last is None:
+            return None
+        a, b, W = self._last
+        diff = bspline.Surface(after.poles - before.poles, after.knots_u, after.knots_v,
+                               after.degree_u, after.degree_v, after.weights,
+                               after.u_range, after.v_range)
+        D = bspline.evaluate(diff, a, b)
+        return np.ravel(real) - np.einsum("ij,ij->i", D, W)
+
     def realised(self, corrected, guess=None, iterations=20):
         """See :func:`realised_correction`."""
         u, v, P, n = self.u, self.v, self.P, self.n
         t = np.zeros(u.size) if guess is None else np.ravel(guess).astype(float).copy()
+        W = np.full((u.size, 3), np.nan)    # N / (n . N) at the last step (realised_change)
         # the residual iteration's surfaces differ by fractions of a um: each starts from
         # where the line met the one before
         a, b = (u.copy(), v.copy()) if self._last is None else (self._last[0].copy(),
@@ -570,11 +598,11 @@ class _NodeFrame:
         for _ in range(iterations):
             C, Cu, Cv = bspline.derivatives(corrected, a[act], b[act], order=1)
             F = C + t[act, None] * n[act] - P[act]
+            da, db, dt, W[act] = _solve3(Cu, Cv, n[act], -F, weights=True)
             keep = ~np.all(np.abs(F) < 1e-12, axis=1)
-            act, F, Cu, Cv = act[keep], F[keep], Cu[keep], Cv[keep]
+            act, F, da, db, dt = act[keep], F[keep], da[keep], db[keep], dt[keep]
             if act.size == 0:
                 break
-            da, db, dt = _solve3(Cu, Cv, n[act], -F)
             a[act] = np.clip(a[act] + da, ua, ub)
             b[act] = np.clip(b[act] + db, va, vb)
             t[act] += dt
@@ -584,8 +612,8 @@ class _NodeFrame:
             act = act[~np.all(np.abs(F) < FINAL_STEP, axis=1)]
             if act.size == 0:
                 break
-        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
-            self._last = (a, b)
+        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(W)):
+            self._last = (a, b, W)
         return t
 
 
@@ -598,24 +626,29 @@ def _dot(p, q):
     return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
 
 
-def _solve3(a, b, c, r):
+def _solve3(a, b, c, r, weights=False):
     """Solve ``[a b c] x = r`` for each row (3 x 3 systems by columns, (N, 3) each) by
     Cramer's rule on the components (a batched LU costs several times more for millions of
     3 x 3 systems); returns the three components of x. Rows whose system is singular or
     nearly so (a collapsed edge: a zero column) get the least-squares step of the smallest
-    length (pseudo-inverse) instead: never NaN."""
+    length (pseudo-inverse) instead: never NaN. With ``weights`` also the (N, 3) rows
+    ``a x b / det`` (x[2] = r . them; NaN on the singular rows)."""
     A, B, C, R = a.T, b.T, c.T, r.T
-    bc = _cross(B, C)
+    bc, ab = _cross(B, C), _cross(A, B)
     det = _dot(A, bc)
     size = np.sqrt(_dot(A, A) * _dot(B, B) * _dot(C, C))
     bad = ~(np.abs(det) > 1e-12 * size)
     det = np.where(bad, 1.0, det)
     # x_k = det of the matrix with column k replaced by r: triple products with r
-    x = np.stack([_dot(R, bc), _dot(R, _cross(C, A)), _dot(R, _cross(A, B))]) / det
+    x = np.stack([_dot(R, bc), _dot(R, _cross(C, A)), _dot(R, ab)]) / det
     if bad.any():
         J = np.stack([a[bad], b[bad], c[bad]], axis=2)
         x[:, bad] = (np.linalg.pinv(J) @ r[bad][..., None])[..., 0].T
-    return x[0], x[1], x[2]
+    if not weights:
+        return x[0], x[1], x[2]
+    w = np.stack(ab, axis=1) / det[:, None]
+    w[bad] = np.nan
+    return x[0], x[1], x[2], w
 
 
 def realised_correction(nominal, corrected, u, v, outward=1, guess=None, iterations=20):
