@@ -320,12 +320,23 @@ def evaluate_grid(surf, us, vs, order=0):
     dim = Pw.shape[2]
     Bu = [basis_matrix(surf.knots_u, surf.degree_u, nu, us, k) for k in range(order + 1)]
     Bv = [basis_matrix(surf.knots_v, surf.degree_v, nv, vs, k) for k in range(order + 1)]
-    # first contract along v: (nv, nu*dim) -> (Mv, nu, dim)
-    flat = np.ascontiguousarray(Pw.transpose(1, 0, 2)).reshape(nv, nu * dim)
-    Tv = [(Bv[kv] @ flat).reshape(vs.size, nu, dim).transpose(1, 0, 2).reshape(nu, vs.size * dim)
-          for kv in range(order + 1)]
-    A = {(k, kv): (Bu[k] @ Tv[kv]).reshape(us.size * vs.size, dim)
-         for (k, kv) in _ORDER_KEYS[order]}
+    if us.size * (nv + vs.size) < vs.size * nu:
+        # few rows (a block of a check grid): contract along u first, (nu, nv*dim) ->
+        # (Mu, nv, dim), then along v; the intermediate has Mu rows, not all nu (two
+        # transposed copies, so only where they cost less than the nu x Mv intermediate)
+        flat = Pw.reshape(nu, nv * dim)
+        Tu = [np.ascontiguousarray((Bu[k] @ flat).reshape(us.size, nv, dim).transpose(1, 0, 2))
+              .reshape(nv, us.size * dim) for k in range(order + 1)]
+        A = {(k, kv): np.ascontiguousarray((Bv[kv] @ Tu[k]).reshape(vs.size, us.size, dim)
+                                           .transpose(1, 0, 2)).reshape(-1, dim)
+             for (k, kv) in _ORDER_KEYS[order]}
+    else:
+        # first contract along v: (nv, nu*dim) -> (Mv, nu, dim)
+        flat = np.ascontiguousarray(Pw.transpose(1, 0, 2)).reshape(nv, nu * dim)
+        Tv = [(Bv[kv] @ flat).reshape(vs.size, nu, dim).transpose(1, 0, 2)
+              .reshape(nu, vs.size * dim) for kv in range(order + 1)]
+        A = {(k, kv): (Bu[k] @ Tv[kv]).reshape(us.size * vs.size, dim)
+             for (k, kv) in _ORDER_KEYS[order]}
     if surf.weights is None:
         res = {key: val for key, val in A.items()}
     else:
