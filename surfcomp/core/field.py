@@ -384,8 +384,9 @@ class GridField:
         a, b = s - i, t - j
         cols = np.stack([i * m + j, i * m + j + 1, (i + 1) * m + j, (i + 1) * m + j + 1], 1)
         w = np.stack([(1 - a) * (1 - b), (1 - a) * b, a * (1 - b), a * b], 1)
-        rows = np.repeat(np.arange(s.size), 4)
-        return csr_matrix((w.ravel(), (rows, cols.ravel())), shape=(s.size, n * m))
+        # four distinct columns per row, in order: the CSR arrays directly (no COO sort)
+        return csr_matrix((w.ravel(), cols.ravel(), np.arange(0, 4 * s.size + 1, 4)),
+                          shape=(s.size, n * m))
 
     def __call__(self, u, v):
         """Field values at face parameters (u, v) (arrays of equal shape)."""
