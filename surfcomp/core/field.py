@@ -152,7 +152,7 @@ class GridField:
 
     # -- Hermite patches in index space -------------------------------------------------
     def _coefficients(self, channels):
-        """Per-cell power-basis coefficients ((n-1)(m-1), 16, c) of the bicubic Hermite
+        """Per-cell power-basis coefficients ((n-1)(m-1), c, 16) of the bicubic Hermite
         patches of a channel group (``sum_ij C[ij] a^i b^j``), built once per group."""
         key = (channels.start, channels.stop)
         cache = self.__dict__.setdefault("_coeffs", {})
@@ -167,9 +167,7 @@ class GridField:
                     M[..., 2 + p, q] = Fs[p:n - 1 + p, q:m - 1 + q]
                     M[..., p, 2 + q] = Ft[p:n - 1 + p, q:m - 1 + q]
             # power coefficients H^T M H of every patch as one product with kron(H, H)
-            C = (M.reshape(-1, 16) @ _HERMITE_2D).reshape(n - 1, m - 1, c, 16)
-            cache[key] = np.ascontiguousarray(
-                np.moveaxis(C, 2, -1).reshape((n - 1) * (m - 1), 16, c))
+            cache[key] = (M.reshape(-1, 16) @ _HERMITE_2D).reshape((n - 1) * (m - 1), c, 16)
         return cache[key]
 
     def _eval(self, s, t, channels=slice(None), deriv=False, block=32768, cross=False):
@@ -178,7 +176,7 @@ class GridField:
         times faster on millions of points)."""
         C = self._coefficients(channels)
         n, m = self.shape
-        N, c = s.size, C.shape[2]
+        N, c = s.size, C.shape[1]
         val = np.empty((N, c))
         ds = np.empty((N, c)) if deriv else 0.0
         dt = np.empty((N, c)) if deriv else 0.0
@@ -190,15 +188,15 @@ class GridField:
             a, b = s[sl] - i, t[sl] - j
             G = C[i * (m - 1) + j]
             A, B = _powers(a), _powers(b)
-            val[sl] = np.einsum("nk,nkc->nc", (A[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
+            val[sl] = np.einsum("nk,nck->nc", (A[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
             if deriv:
                 dA, dB = _dpowers(a), _dpowers(b)
-                ds[sl] = np.einsum("nk,nkc->nc",
+                ds[sl] = np.einsum("nk,nck->nc",
                                    (dA[:, :, None] * B[:, None, :]).reshape(-1, 16), G)
-                dt[sl] = np.einsum("nk,nkc->nc",
+                dt[sl] = np.einsum("nk,nck->nc",
                                    (A[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
                 if cross:
-                    dst[sl] = np.einsum("nk,nkc->nc",
+                    dst[sl] = np.einsum("nk,nck->nc",
                                         (dA[:, :, None] * dB[:, None, :]).reshape(-1, 16), G)
 
         for_chunks(job, N, block)
