@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..core.memory import return_free_memory
 from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import report as report_progress
 from ..core.progress import sub
@@ -124,6 +125,7 @@ def run_job(job, progress=None):
                                  output_shape=output.as_dict() if output else None)
     if build and job.curves:
         shapes["curves"] = curve_net(comp)
+    return_free_memory()    # the shape's conversions, before the CAD writer's gigabyte
     with Transaction(outputs, inputs) as tx:
         for attr, shape in shapes.items():
             tmp = tx.write(getattr(job, attr), lambda tmp, shape=shape: write_face(tmp, shape))

@@ -18,6 +18,7 @@ from .corrected import DEFAULT_REFINE, construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
 from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
+from .memory import return_free_memory
 from .methods import METHODS, compute_correction
 from .progress import report, sub
 from .projection import project, tangent_lengths
@@ -437,6 +438,7 @@ def build_surface(result, surface, outward, delta, progress=None):
     g = prepared.grid
     U, V = g.take(prepared.u), g.take(prepared.v)
     built, (du, dv) = _construction(result, surface, outward, U, V, delta, progress)
+    return_free_memory()     # the construction's temporaries, before the CAD export
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
