@@ -501,6 +501,8 @@ def _match(smp, U, V, delta, outward, tol, iterations, field_factory, progress):
     # the steps only move the node values by the misses left, so a linear interpolant of
     # the change (where the field has one) stands in for a new field through them
     linear = field.linear_at(*loc) if hasattr(field, "linear_at") else None
+    if linear is not None:    # the field itself is not evaluated again here
+        field.drop_caches()
     xs, fs, best = [], [], None
     exact = None    # the first surface and its realised correction by Newton
     k = 0

@@ -42,6 +42,9 @@ _HERMITE = np.array([[1.0, 0.0, -3.0, 2.0],
                      [0.0, 0.0, -1.0, 1.0]])
 
 
+#: points per block of :meth:`GridField.locate_grid`'s Newton iteration
+_BLOCK = 1 << 18
+
 #: C[i, j] = sum_kl H[k, i] M[k, l] H[l, j] on flattened (k, l) and (i, j)
 _HERMITE_2D = np.kron(_HERMITE, _HERMITE)
 
@@ -116,21 +119,38 @@ class GridField:
         # channels: u, v, then the values
         F = np.concatenate([U[..., None], V[..., None], vals], axis=2)
         self._F = F
-        self._Fs = _pchip_slopes(F, 0)
-        self._Ft = _pchip_slopes(F, 1)
         self._lo = vals.reshape(-1, vals.shape[2]).min(axis=0)
         self._hi = vals.reshape(-1, vals.shape[2]).max(axis=0)
-        n, m = self.shape
-        k = max(1, min(4, int(np.sqrt(1e6 / (n * m)))))  # seeds per cell side (<= ~1M seeds)
-        ss, tt = np.meshgrid(np.linspace(0, n - 1, k * (n - 1) + 1),
-                             np.linspace(0, m - 1, k * (m - 1) + 1), indexing="ij")
-        self._seed_st = np.stack([ss.ravel(), tt.ravel()], axis=1)
-        # one seed per node on dense grids: the map passes through the nodes
-        uv = F[..., :2].reshape(-1, 2) if k == 1 else \
-            self._eval(self._seed_st[:, 0], self._seed_st[:, 1], channels=slice(0, 2))[0]
         self._scale = np.array([np.ptp(U) or 1.0, np.ptp(V) or 1.0])
-        # (a sliding-midpoint tree: built and queried faster than a balanced one on grids)
-        self._tree = cKDTree(uv / self._scale, balanced_tree=False)
+
+    def _slopes(self):
+        """PCHIP node slopes (d/ds, d/dt) of every channel, made on first use."""
+        got = self.__dict__.get("_slope_cache")
+        if got is None:
+            got = self._slope_cache = (_pchip_slopes(self._F, 0), _pchip_slopes(self._F, 1))
+        return got
+
+    def _kd(self):
+        """Seeds in index space and the KD-tree of their (u, v), made on first use."""
+        got = self.__dict__.get("_kd_cache")
+        if got is None:
+            n, m = self.shape
+            k = max(1, min(4, int(np.sqrt(1e6 / (n * m)))))  # seeds per cell side (<= ~1M)
+            ss, tt = np.meshgrid(np.linspace(0, n - 1, k * (n - 1) + 1),
+                                 np.linspace(0, m - 1, k * (m - 1) + 1), indexing="ij")
+            seed_st = np.stack([ss.ravel(), tt.ravel()], axis=1)
+            # one seed per node on dense grids: the map passes through the nodes
+            uv = self._F[..., :2].reshape(-1, 2) if k == 1 else \
+                self._eval(seed_st[:, 0], seed_st[:, 1], channels=slice(0, 2))[0]
+            # (a sliding-midpoint tree: built and queried faster than a balanced one here)
+            got = self._kd_cache = (seed_st, cKDTree(uv / self._scale, balanced_tree=False))
+        return got
+
+    def _seed(self, uv):
+        """Index coordinates of the seed nearest each (u, v) (copies)."""
+        seed_st, tree = self._kd()
+        _, k = tree.query(uv / self._scale, workers=threads())
+        return seed_st[k, 0].copy(), seed_st[k, 1].copy()
 
     def with_values(self, values):
         """A field with the same grid positions and new node values (reuses the
@@ -144,11 +164,17 @@ class GridField:
         F = np.concatenate([self._F[..., :2], vals], axis=2)
         other._F = F
         other._coeffs = {k: v for k, v in self.__dict__.get("_coeffs", {}).items() if k == (0, 2)}
-        other._Fs = _pchip_slopes(F, 0)
-        other._Ft = _pchip_slopes(F, 1)
+        other.__dict__.pop("_slope_cache", None)
         other._lo = vals.reshape(-1, vals.shape[2]).min(axis=0)
         other._hi = vals.reshape(-1, vals.shape[2]).max(axis=0)
         return other
+
+    def drop_caches(self):
+        """Free what is made again when next needed: the per-cell patch coefficients (16
+        numbers per cell and channel: 380 MB for a 1000 x 1000 grid), the node slopes and
+        the seeds' KD-tree."""
+        for name in ("_coeffs", "_slope_cache", "_kd_cache"):
+            self.__dict__.pop(name, None)
 
     # -- Hermite patches in index space -------------------------------------------------
     def _coefficients(self, channels):
@@ -158,7 +184,8 @@ class GridField:
         cache = self.__dict__.setdefault("_coeffs", {})
         if key not in cache:
             n, m = self.shape
-            F, Fs, Ft = self._F[..., channels], self._Fs[..., channels], self._Ft[..., channels]
+            Fs, Ft = (x[..., channels] for x in self._slopes())
+            F = self._F[..., channels]
             c = F.shape[2]
             M = np.zeros((n - 1, m - 1, c, 4, 4))  # M[..., k, l] multiplies h_k(a) h_l(b)
             for p in (0, 1):
@@ -239,8 +266,7 @@ class GridField:
             May lie outside [0, n-1] x [0, m-1] for points outside the measured region.
         """
         uv = np.stack([np.ravel(u), np.ravel(v)], axis=1).astype(float)
-        _, k = self._tree.query(uv / self._scale, workers=threads())
-        s, t = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
+        s, t = self._seed(uv)
         # points nearest a border sample may lie many cells beyond it, where Newton's
         # limited steps would need ~log2(distance) more iterations: they start one linear
         # step out (along the border at most one cell)
@@ -284,7 +310,12 @@ class GridField:
         # a miss of 1e-7 grid cells moves a field value by less than 1e-7 of the value
         # step between neighbouring nodes (1e-5 um for 100 um steps)
         cells = max(self.shape) - 1
-        return self._newton(uv, seeds[0], seeds[1], tol=1e-7 / cells)
+        # in blocks: the iteration's temporaries stay ~100 MB (960 MB at once for 1599^2)
+        for k in range(0, uv.shape[0], _BLOCK):
+            sl = slice(k, k + _BLOCK)
+            seeds[0][sl], seeds[1][sl] = self._newton(uv[sl], seeds[0][sl], seeds[1][sl],
+                                                      tol=1e-7 / cells)
+        return seeds[0], seeds[1]
 
     def _newton(self, uv, s, t, iterations=30, tol=1e-13):
         """Solve map(s, t) = uv from the given starting points (Newton, steps limited to
@@ -322,8 +353,7 @@ class GridField:
         placed by one linear step from the nearest border sample, so the bounded outside
         continuation applies. Points that have a sample inside the grid nearest raise."""
         n, m = self.shape
-        _, k = self._tree.query(uv / self._scale, workers=threads())
-        s0, t0 = self._seed_st[k, 0].copy(), self._seed_st[k, 1].copy()
+        s0, t0 = self._seed(uv)
         border = (s0 == 0) | (s0 == n - 1) | (t0 == 0) | (t0 == m - 1)
         if not np.all(border):
             bad = int(np.argmin(border))

@@ -279,3 +279,32 @@ def test_locate_starts_points_beyond_the_border_one_linear_step_out():
     assert_allclose(s, s_true, rtol=0, atol=1e-9)
     assert_allclose(t, t_true, rtol=0, atol=1e-9)
     assert passes.count(False) <= 3
+
+
+def test_locate_grid_in_blocks_and_dropped_caches_give_the_same_field(monkeypatch):
+    """locate_grid's Newton runs in blocks of points (bounded temporaries) and the
+    field's caches (patch coefficients, slopes, seed tree) can be dropped after the
+    samples are placed: both leave every located point and field value as they were."""
+    from surfcomp.core import field as field_module
+
+    n = 30
+    t = np.linspace(0.01, 0.99, n)
+    U, V = np.meshgrid(t, t, indexing="ij")
+    a, c = np.radians(20.0), 0.5
+    U, V = (c + 0.68 * ((U - c) * np.cos(a) - (V - c) * np.sin(a)),
+            c + 0.68 * ((U - c) * np.sin(a) + (V - c) * np.cos(a)))
+    vals = np.random.default_rng(9).normal(size=U.shape)
+    us = np.linspace(0, 1, 47)
+    whole = GridField(U, V, vals)
+    s0, t0 = whole.locate_grid(us, us)
+    monkeypatch.setattr(field_module, "_BLOCK", 100)
+    blocks = GridField(U, V, vals)
+    s1, t1 = blocks.locate_grid(us, us)
+    assert_allclose(s1, s0, rtol=0, atol=0)
+    assert_allclose(t1, t0, rtol=0, atol=0)
+    before = whole.at_index(s0, t0)
+    whole.drop_caches()
+    assert not {"_coeffs", "_slope_cache", "_kd_cache"} & set(whole.__dict__)
+    assert_allclose(whole.at_index(s0, t0), before, rtol=0, atol=0)
+    assert_allclose(np.stack(whole.locate(U.ravel() + 1e-3, V.ravel()), 1),
+                    np.stack(blocks.locate(U.ravel() + 1e-3, V.ravel()), 1), rtol=0, atol=0)
