@@ -577,7 +577,7 @@ class _NodeFrame:
         surfaces differ by fractions of a um and the correction's slopes are ~1e-3, so
         what is left is ~1e-6 of the change (tested against :meth:`realised`). None when
         :meth:`realised` left no intersection to start from."""
-        if self._last is None:
+        if self._last is None or self._last[2] is None:
             return None
         a, b, W = self._last
         diff = bspline.Surface(after.poles - before.poles, after.knots_u, after.knots_v,
@@ -614,8 +614,9 @@ class _NodeFrame:
             act = act[~np.all(np.abs(F) < FINAL_STEP, axis=1)]
             if act.size == 0:
                 break
-        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)) and np.all(np.isfinite(W)):
-            self._last = (a, b, W)
+        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+            # (no first-order updates where a system was singular: a collapsed edge)
+            self._last = (a, b, W if np.all(np.isfinite(W)) else None)
         return t
 
 
