@@ -137,7 +137,16 @@ def test_reopen_in_a_fresh_freecadcmd(saved, tmp_path):
         assert lines[k + 1].startswith("G0 Z")
         return lines[:k + 1] + lines[k + 2:]
 
-    assert program(r["gcode"]) == program(before["gcode"])
+    # (a coordinate on a rounding boundary, e.g. 4.95495, may print one unit of the last
+    # digit apart when the face differs by 1e-12 mm: numbers agree within that unit)
+    got, want = program(r["gcode"]), program(before["gcode"])
+    assert len(got) == len(want)
+    for a, b in zip(got, want):
+        wa, wb = a.split(), b.split()
+        assert len(wa) == len(wb) and [w[0] for w in wa] == [w[0] for w in wb], (a, b)
+        for x, y in zip(wa, wb):
+            if x != y:
+                assert abs(float(x[1:]) - float(y[1:])) <= 1.0001e-4, (a, b)
     assert r["gcode"].count("\nG1 ") == before["gcode"].count("\nG1 ") > 50
 
 
