@@ -15,6 +15,15 @@ def _uv_grid(n=7, m=10, skew=0.01):
     return s + skew * np.sin(3 * t), t + skew * s ** 2
 
 
+def _turned_grid(n):
+    """An n x n grid turned by 20 degrees in the parameter plane (the bench's layout)."""
+    t = np.linspace(0.01, 0.99, n)
+    U, V = np.meshgrid(t, t, indexing="ij")
+    a, c = np.radians(20.0), 0.5
+    return (c + 0.68 * ((U - c) * np.cos(a) - (V - c) * np.sin(a)),
+            c + 0.68 * ((U - c) * np.sin(a) + (V - c) * np.cos(a)))
+
+
 def test_grid_from_uv_serpentine_shuffled_rows():
     U, V = _uv_grid()
     rng = np.random.default_rng(0)
@@ -231,11 +240,7 @@ def test_locate_far_beyond_a_noisy_border():
     Jacobian holds the border slope's change along the border): 0.4 % of the samples
     fall back to the one-step placement (``_beyond``), 7 % without that term."""
     n = 60
-    t = np.linspace(0.01, 0.99, n)
-    U, V = np.meshgrid(t, t, indexing="ij")
-    a, c = np.radians(20.0), 0.5
-    U, V = (c + 0.68 * ((U - c) * np.cos(a) - (V - c) * np.sin(a)),
-            c + 0.68 * ((U - c) * np.sin(a) + (V - c) * np.cos(a)))
+    U, V = _turned_grid(n)
     step = 0.68 * 0.98 / (n - 1)
     rng = np.random.default_rng(7)
     U = U + rng.normal(0, 0.01 * step, U.shape)
@@ -288,11 +293,7 @@ def test_locate_grid_in_blocks_and_dropped_caches_give_the_same_field(monkeypatc
     from surfcomp.core import field as field_module
 
     n = 30
-    t = np.linspace(0.01, 0.99, n)
-    U, V = np.meshgrid(t, t, indexing="ij")
-    a, c = np.radians(20.0), 0.5
-    U, V = (c + 0.68 * ((U - c) * np.cos(a) - (V - c) * np.sin(a)),
-            c + 0.68 * ((U - c) * np.sin(a) + (V - c) * np.cos(a)))
+    U, V = _turned_grid(n)
     vals = np.random.default_rng(9).normal(size=U.shape)
     us = np.linspace(0, 1, 47)
     whole = GridField(U, V, vals)
