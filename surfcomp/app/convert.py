@@ -6,7 +6,7 @@ from contextlib import contextmanager
 
 import numpy as np
 
-from ..core.bspline import Surface
+from ..core.bspline import Surface, compress_knots
 
 
 @contextmanager
@@ -55,23 +55,12 @@ def surface_from_part(bs, u_range=None, v_range=None):
     return Surface(poles, ku, kv, bs.UDegree, bs.VDegree, weights, u_range, v_range)
 
 
-def _compress(flat):
-    knots, mults = [], []
-    for k in flat:
-        if knots and abs(k - knots[-1]) <= 1e-15 * max(1.0, abs(k)):
-            mults[-1] += 1
-        else:
-            knots.append(float(k))
-            mults.append(1)
-    return knots, mults
-
-
 def surface_to_part(surf):
     """Return a new ``Part.BSplineSurface`` with the geometry of ``surf``."""
     import Part
 
-    ku, mu = _compress(surf.knots_u)
-    kv, mv = _compress(surf.knots_v)
+    ku, mu = compress_knots(surf.knots_u)
+    kv, mv = compress_knots(surf.knots_v)
     out = Part.BSplineSurface()
     with gc_paused():
         # nested [x, y, z] lists: 20x faster than Vectors for 4M poles

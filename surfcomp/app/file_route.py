@@ -21,6 +21,7 @@ from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.html_report import render_html
 from ..io.readers import read_any
+from ..io.step_face import write_natural_face
 from . import fcenv
 
 
@@ -128,7 +129,9 @@ def run_job(job, progress=None):
     return_free_memory()    # the shape's conversions, before the CAD writer's gigabyte
     with Transaction(outputs, inputs) as tx:
         for attr, shape in shapes.items():
-            tmp = tx.write(getattr(job, attr), lambda tmp, shape=shape: write_face(tmp, shape))
+            tmp = tx.write(getattr(job, attr),
+                           lambda tmp, shape=shape, attr=attr:
+                           write_face(tmp, shape, output if attr == "output" else None))
             if attr == "output":        # the report states the size of the written face
                 rep["output_shape"]["file_bytes"] = os.path.getsize(tmp)
         for attr, text in _texts(job, comp, rep).items():
@@ -213,10 +216,18 @@ def cad_format(path, option="output"):
     return CAD_FORMATS[ext]
 
 
-def write_face(path, shape):
-    """Write a shape as STEP, IGES or BREP, chosen by the file extension of ``path``."""
+def write_face(path, shape, output=None):
+    """Write a shape as STEP, IGES or BREP, chosen by the file extension of ``path``.
+
+    ``output``: the :class:`surfcomp.app.shapes.Output` of ``shape``; a face bounded by its
+    surface's knot domain (``output.natural``) goes to STEP from its pole net
+    (:mod:`surfcomp.io.step_face`, 4x faster than OpenCASCADE's writer).
+    """
     fmt = cad_format(path)
-    if fmt == "step":
+    if fmt == "step" and output is not None and output.natural is not None:
+        write_natural_face(path, output.natural, shape.Orientation == "Reversed",
+                           output.edge_tolerance)
+    elif fmt == "step":
         shape.exportStep(path)
     elif fmt == "iges":
         shape.exportIges(path)

@@ -47,6 +47,9 @@ class Output:
     correction_volume: float = 0.0
     volume_change: float = None
     retrimmed: list = field(default_factory=list)
+    #: the corrected surface (surfcomp.core.bspline.Surface) when ``shape`` is the face
+    #: bounded by its knot domain, which surfcomp.io.step_face writes from the pole net
+    natural: object = None
 
     def volume_mismatch(self):
         """``volume_change / -correction_volume - 1`` (None without a volume change)."""
@@ -122,6 +125,30 @@ def rebuild_face(face, bs, pcurves=None):
                             "edges instead of %d, %d)" % (len(out.Wires), len(out.Edges),
                                                           len(face.Wires), len(face.Edges)))
     return out
+
+
+def natural_face(face, surf, samples=5):
+    """True when ``face`` is the face bounded by the knot domain of ``surf`` (the Surface
+    of ``face.Surface``; polynomial and clamped): one wire of four edges, each running
+    along its own side of the domain."""
+    ends = [surf.degree_u + 1, surf.degree_v + 1]
+    if surf.weights is not None or len(face.Wires) != 1 or len(face.Edges) != 4 or \
+            any(np.ptp(k[:n]) or np.ptp(k[-n:])
+                for k, n in zip((surf.knots_u, surf.knots_v), ends)):
+        return False
+    domain = np.array([surf.knots_u[0], surf.knots_u[-1], surf.knots_v[0], surf.knots_v[-1]])
+    tol = 1e-12 * max(1.0, float(np.max(np.abs(domain))))
+    if np.max(np.abs(np.array(face.ParameterRange) - domain)) > tol:
+        return False
+    sides = set()
+    for e in face.Edges:
+        c2d, a, b = face.curveOnSurface(e)[:3]
+        uv = np.array([[c2d.value(t).x, c2d.value(t).y] for t in np.linspace(a, b, samples)])
+        side = [k for k in range(4) if np.max(np.abs(uv[:, k // 2] - domain[k])) <= tol]
+        if len(side) != 1:
+            return False
+        sides.add(side[0])
+    return len(sides) == 4
 
 
 def _valid(shape):
@@ -269,7 +296,8 @@ def corrected_shape(nominal, corrected, output="face", label="compensation"):
     idx = int(nominal.face_name[4:]) - 1
     if output == "face" or shape is None or not has_neighbours(shape, shape.Faces[idx]):
         new = rebuild_face(nominal.bspline_face, bs)
-        return Output(new, "face", _tolerance(new), integral)
+        return Output(new, "face", _tolerance(new), integral,
+                      natural=corrected if natural_face(new, corrected) else None)
     pface = to_bspline_face(shape.Faces[idx])[0]
     out, plan = replace_face(shape, idx, pface, bs, label)
     change = None

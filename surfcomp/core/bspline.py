@@ -101,6 +101,19 @@ class Surface:
 CHUNK_VALUES = 4_000_000
 
 
+def compress_knots(flat):
+    """Distinct knots and their multiplicities of a flat knot vector (knots within 1e-15
+    relative are one)."""
+    knots, mults = [], []
+    for k in flat:
+        if knots and abs(k - knots[-1]) <= 1e-15 * max(1.0, abs(k)):
+            mults[-1] += 1
+        else:
+            knots.append(float(k))
+            mults.append(1)
+    return knots, mults
+
+
 def _chunk_size(degree_u, degree_v, extra=1):
     return max(1024, CHUNK_VALUES // ((degree_u + 1) * (degree_v + 1) * 4 * max(1, extra)))
 

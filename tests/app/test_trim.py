@@ -405,6 +405,8 @@ def test_face_of_a_solid_on_the_command_line(circle_solid):
     assert out.returncode == 0, out.stderr
     alone = Part.read(str(tmp / "face.step"))
     assert len(alone.Faces) == 1 and not alone.Solids and len(alone.Faces[0].Edges) == 1
+    # a trimmed face: OpenCASCADE's writer, not the pole-net one of natural faces
+    assert b"Open CASCADE" in (tmp / "face.step").read_bytes()[:1000]
 
 
 def test_face_of_a_solid_in_the_document(circle_solid):
