@@ -31,6 +31,7 @@ import argparse
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -91,11 +92,35 @@ def face_build(meas):
     ref.interpolate(rows)
     ref_s = time.perf_counter() - t
     ch = comp.checks
+    ref_poles = ref.NbUPoles, ref.NbVPoles
+    del rows, ref
     return {"wall": ours[0], "cpu": ours[1], "ref": ref_s,
             "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
             "note": "%d x %d poles (interpolate: %d x %d), %.4f um at the points"
-                    % (ch.poles_shape + (ref.NbUPoles, ref.NbVPoles)
-                       + (ch.max_error_at_points * 1e3,))}
+                    % (ch.poles_shape + ref_poles
+                       + (ch.max_error_at_points * 1e3,)),
+            "step": step_writers(nom, comp.corrected)}
+
+
+def step_writers(nom, corrected):
+    """Seconds and bytes of the corrected face's STEP: ours from the pole net
+    (surfcomp.io.step_face) and OpenCASCADE's ``exportStep`` of the same face."""
+    from surfcomp.app.shapes import corrected_shape
+    from surfcomp.io.step_face import write_natural_face
+
+    out = corrected_shape(nom, corrected, "face")
+    folder = tempfile.mkdtemp(prefix="surfcomp-bench-")
+    ours, occt = os.path.join(folder, "ours.step"), os.path.join(folder, "occt.step")
+    t = time.perf_counter()
+    write_natural_face(ours, out.natural, out.shape.Orientation == "Reversed",
+                       out.edge_tolerance)
+    t_ours = time.perf_counter() - t
+    t = time.perf_counter()
+    out.shape.exportStep(occt)
+    t_occt = time.perf_counter() - t
+    sizes = [os.path.getsize(ours), os.path.getsize(occt)]
+    shutil.rmtree(folder)
+    return {"wall": t_ours, "ref": t_occt, "mb": [b / 1e6 for b in sizes]}
 
 
 def _run_child(kind, *args):
@@ -186,6 +211,10 @@ def _grid(n, turned, folder):
     build = _child("build", meas)
     row("face build, " + name, n * n, build, "Part BSplineSurface.interpolate", build["ref"],
         build["ref"] / build["wall"])
+    step = build["step"]
+    print(ROW % ("STEP of the face, " + name, "", "%.2f" % step["wall"], "", "",
+                 "OCCT exportStep", "%.3g" % step["ref"], "%.2fx" % (step["ref"] / step["wall"]),
+                 "%.1f MB (OCCT %.1f MB)" % tuple(step["mb"])), flush=True)
     row("compensate, " + name, n * n, _child("job", meas, folder))
 
 
