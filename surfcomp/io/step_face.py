@@ -23,6 +23,7 @@ import os
 import numpy as np
 
 from ..core.bspline import compress_knots
+from ..core.chunks import for_chunks
 from ..errors import InputError
 
 #: poles per line of a B_SPLINE_SURFACE_WITH_KNOTS list of references
@@ -80,36 +81,51 @@ def _right_aligned(digits, keep, mark):
     return out
 
 
+def _layout(top):
+    """(whole digits, decimals) of the fixed-point numbers up to ``top`` in magnitude."""
+    whole = max(1, int(np.floor(np.log10(top))) + 1) if top >= 1 else 1
+    while whole <= DIGITS:
+        decimals = max(0, min(DECIMALS, DIGITS - whole))
+        if np.rint(top * 10.0 ** decimals) < 10.0 ** (whole + decimals):
+            return whole, decimals
+        whole += 1          # top rounds up to one more whole digit
+    raise ValueError("coordinates of %g are too large for a STEP file in mm" % top)
+
+
+def _fixed(x, whole, decimals):
+    """The ASCII array (len(x), whole + decimals + 2) of :func:`fixed_point`."""
+    scaled = np.rint(np.abs(x) * 10.0 ** decimals)
+    digits = _digit_columns(scaled, whole + decimals)
+    sign = np.where(np.signbit(x) & (scaled > 0), 45, 32).astype(np.uint8)
+    head = _right_aligned(digits[:, :whole], 1, sign)
+    point = np.full((x.size, 1), 46, dtype=np.uint8)
+    return np.hstack([head, point, digits[:, whole:]])
+
+
+def _finite_top(x):
+    if x.size and not np.all(np.isfinite(x)):
+        raise ValueError("a STEP file cannot hold non-finite coordinates")
+    return float(np.max(np.abs(x), initial=0.0))
+
+
+def _rounding(top, decimals):
+    """Half a unit of the last decimal, and the doubles' own rounding of x * 10^decimals."""
+    return 0.5 * 10.0 ** -decimals + 2 * float(np.spacing(top))
+
+
 def fixed_point(x):
     """Fixed-width fixed-point STEP REALs for the array ``x``: (ASCII array (len(x), width),
     a bound on the rounding error in units of ``x``). As many decimals as keep 15
     significant digits for the largest number, at most 12."""
     x = np.ravel(np.asarray(x, dtype=float))
-    if x.size and not np.all(np.isfinite(x)):
-        raise ValueError("a STEP file cannot hold non-finite coordinates")
-    top = float(np.max(np.abs(x), initial=0.0))
-    whole = max(1, int(np.floor(np.log10(top))) + 1) if top >= 1 else 1
-    if whole > DIGITS:
-        raise ValueError("coordinates of %g are too large for a STEP file in mm" % top)
-    while True:
-        decimals = max(0, min(DECIMALS, DIGITS - whole))
-        scaled = np.rint(np.abs(x) * 10.0 ** decimals)
-        if not scaled.size or scaled.max() < 10.0 ** (whole + decimals):
-            break
-        whole += 1
-    digits = _digit_columns(scaled, whole + decimals)
-    sign = np.where(np.signbit(x) & (scaled > 0), 45, 32).astype(np.uint8)
-    head = _right_aligned(digits[:, :whole], 1, sign)
-    point = np.full((x.size, 1), 46, dtype=np.uint8)
-    # half a unit of the last decimal, and the doubles' own rounding of x * 10^decimals
-    return np.hstack([head, point, digits[:, whole:]]), \
-        0.5 * 10.0 ** -decimals + 2 * float(np.spacing(top))
+    top = _finite_top(x)
+    whole, decimals = _layout(top)
+    return _fixed(x, whole, decimals), _rounding(top, decimals)
 
 
-def _names(ids):
-    """Entity names ``#id`` right-aligned to one width, as an ASCII array."""
+def _names(ids, width):
+    """Entity names ``#id`` right-aligned to ``width`` digits, as an ASCII array."""
     ids = np.asarray(ids, dtype=np.int64)
-    width = len(str(int(ids.max())))
     return _right_aligned(_digit_columns(ids, width), 1, 35)
 
 
@@ -259,32 +275,57 @@ def natural_face_step(surface, reversed_face=False, tolerance=1e-7, name="surfco
     ent.add("PRODUCT_RELATED_PRODUCT_CATEGORY('part',$,(#7))")
     # the surface: its list of pole references, then the poles, row by row along u
     first = ent.reserve(nu * nv)
-    ids = np.arange(first, first + nu * nv)
-    refs = _names(ids)          # right-aligned by spaces, which go before the text is joined
-    sep = np.full((ids.size, 1), 44, dtype=np.uint8)                    # ','
-    sep[nv - 1::nv] = 41                                                 # ')' ends a row
-    brk = np.full((ids.size, 1), 32, dtype=np.uint8)
-    brk[(np.arange(ids.size) % nv) % REFS_PER_LINE == REFS_PER_LINE - 1] = 10
-    brk[nv - 1::nv] = 44                                                 # '),' between rows
-    brk[-1] = 32
-    lead = np.full((ids.size, 2), 32, dtype=np.uint8)
-    lead[::nv, 1] = 40                                                   # '(' opens a row
-    lead[nv::nv, 0] = 10                                                 # on a line of its own
+    top = _finite_top(P)
+    whole, decimals = _layout(top)
+    refs, poles = _pole_texts(P.reshape(-1, 3), first, nv, whole, decimals)
     ku_k, ku_m = compress_knots(ku)
     kv_k, kv_m = compress_knots(kv)
     surface_text = b"".join([
         ("#%d = B_SPLINE_SURFACE_WITH_KNOTS('',%d,%d,(\n" % (surf, p, q)).encode("ascii"),
-        _compact(_text(lead, refs, sep, brk)),
+        *refs,
         ("),.UNSPECIFIED.,.F.,.F.,.F.,\n(%s),\n(%s),\n(%s),\n(%s),\n.UNSPECIFIED.);\n"
          % (_ints(ku_m), _ints(kv_m), _reals(ku_k), _reals(kv_k))).encode("ascii")])
-    coords, rounding = fixed_point(P.reshape(-1))
-    coords = coords.reshape(nu * nv, -1)
-    width = coords.shape[1] // 3
-    poles_text = _compact(_text(refs, b"=CARTESIAN_POINT('',(", coords[:, :width], b",",
-                                coords[:, width:2 * width], b",", coords[:, 2 * width:],
-                                b"));\n"))
-    return b"".join([_header(name), *ent.lines, surface_text, poles_text,
-                     b"ENDSEC;\nEND-ISO-10303-21;\n"]), rounding
+    return b"".join([_header(name), *ent.lines, surface_text, *poles,
+                     b"ENDSEC;\nEND-ISO-10303-21;\n"]), _rounding(top, decimals)
+
+
+#: pole rows formatted per block (one block per thread at a time)
+BLOCK_POLES = 1 << 18
+
+
+def _pole_texts(P, first, nv, whole, decimals):
+    """The surface's nested list of pole references and the poles' CARTESIAN_POINT
+    entities (names from ``first`` on, numbers in the :func:`_layout` ``whole``,
+    ``decimals``) for the poles ``P`` (nu * nv, 3), in blocks of whole rows on the cores:
+    (list of bytes, list of bytes)."""
+    rows = P.shape[0] // nv
+    per = max(1, BLOCK_POLES // nv)
+    blocks = [slice(k, min(k + per, rows)) for k in range(0, rows, per)]
+    refs, poles = [None] * len(blocks), [None] * len(blocks)
+
+    def block(k):
+        a, b = blocks[k].start * nv, blocks[k].stop * nv
+        ids = np.arange(first + a, first + b)
+        names = _names(ids, len(str(first + P.shape[0])))   # right-aligned by spaces
+        col = np.arange(ids.size) % nv
+        sep = np.where(col == nv - 1, 41, 44).astype(np.uint8)[:, None]     # ')' ends a row
+        brk = np.where(col % REFS_PER_LINE == REFS_PER_LINE - 1, 10, 32).astype(np.uint8)
+        brk[col == nv - 1] = 44                                            # '),' between rows
+        if b == P.shape[0]:
+            brk[-1] = 32
+        lead = np.full((ids.size, 2), 32, dtype=np.uint8)
+        lead[col == 0, 1] = 40                                             # '(' opens a row
+        lead[col == 0, 0] = 10                                             # on its own line
+        if a == 0:
+            lead[0, 0] = 32
+        refs[k] = _compact(_text(lead, names, sep, brk[:, None]))
+        coords = _fixed(P[a:b].reshape(-1), whole, decimals).reshape(b - a, -1)
+        w = coords.shape[1] // 3
+        poles[k] = _compact(_text(names, b"=CARTESIAN_POINT('',(", coords[:, :w], b",",
+                                  coords[:, w:2 * w], b",", coords[:, 2 * w:], b"));\n"))
+
+    for_chunks(lambda sl: [block(k) for k in range(sl.start, sl.stop)], len(blocks), 1)
+    return refs, poles
 
 
 def _string(text):

@@ -119,6 +119,16 @@ def test_surface_poles_knots_and_topology_come_back(reverse):
     assert "SI_UNIT(.MILLI.,.METRE.)" in data.decode("ascii")
 
 
+def test_blocks_on_threads_write_the_file_one_block_writes(monkeypatch):
+    s = random_surface(np.random.default_rng(8), nu=37, nv=29)
+    whole, _ = step_face.natural_face_step(s, name="x")
+    monkeypatch.setattr(step_face, "BLOCK_POLES", 60)        # two rows a block, 19 blocks
+    blocks, _ = step_face.natural_face_step(s, name="x")
+    cut = whole.index(b"DATA;")
+    assert blocks[cut:] == whole[cut:]
+    assert read_surface(blocks)[0].shape == (37, 29, 3)
+
+
 def test_lines_stay_short():
     s = random_surface(np.random.default_rng(3), nu=300, nv=40)
     data, _ = step_face.natural_face_step(s)
