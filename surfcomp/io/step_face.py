@@ -344,9 +344,10 @@ def _header(name):
             % (_string(name), stamp, __version__)).encode("ascii")
 
 
-def write_natural_face(path, surface, reversed_face=False, tolerance=1e-7):
-    """Write :func:`natural_face_step` to ``path`` (the product named after the file)."""
-    name = os.path.splitext(os.path.basename(path))[0]
+def write_natural_face(path, surface, reversed_face=False, tolerance=1e-7, name=None):
+    """Write :func:`natural_face_step` to ``path``; the product is ``name``, by default
+    the file's name without its extension."""
+    name = name or os.path.splitext(os.path.basename(path))[0]
     data, _ = natural_face_step(surface, reversed_face, tolerance, name)
     try:
         with open(path, "wb") as fh:

@@ -99,6 +99,7 @@ def test_the_job_writes_the_example_face_from_its_poles(tmp_path):
     comp, rep = run_job(job)
     data = (tmp_path / "c.step").read_bytes()
     assert b"'surfcomp " in data[:400] and b"Open CASCADE" not in data
+    assert b"PRODUCT('c','c'" in data           # the file's name, not the staged file's
     assert rep["output_shape"]["file_bytes"] == len(data)
     face = Part.read(str(tmp_path / "c.step")).Faces[0]
     got = surface_from_part(face.Surface)
