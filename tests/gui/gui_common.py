@@ -141,6 +141,9 @@ def mouse(kind, xy, button=None):
     b = QtCore.Qt.LeftButton if button is None else button
     btn = QtCore.Qt.NoButton if kind == "move" else b
     btns = QtCore.Qt.NoButton if kind in ("move", "release") else b
+    # pending events first (a redraw, the viewport's last resize): on FreeCAD 1.1 / Qt6 an
+    # event sent before them reached Coin's callbacks in some runs and not in others
+    Gui.updateGui()
     ev = QtGui.QMouseEvent(types[kind], pos, glob, btn, btns, QtCore.Qt.NoModifier)
     QtGui.QApplication.sendEvent(w, ev)
     Gui.updateGui()
