@@ -130,9 +130,11 @@ def rebuild_face(face, bs, pcurves=None):
 def natural_face(face, surf, samples=5):
     """True when ``face`` is the face bounded by the knot domain of ``surf`` (the Surface
     of ``face.Surface``; polynomial and clamped): one wire of four edges, each running
-    along its own side of the domain."""
+    along its own side of the domain. A side collapsed to a point (a degenerated edge,
+    which OpenCASCADE leaves out of the STEP loop) is not one."""
     ends = [surf.degree_u + 1, surf.degree_v + 1]
     if surf.weights is not None or len(face.Wires) != 1 or len(face.Edges) != 4 or \
+            any(e.Degenerated for e in face.Edges) or \
             any(np.ptp(k[:n]) or np.ptp(k[-n:])
                 for k, n in zip((surf.knots_u, surf.knots_v), ends)):
         return False
@@ -142,7 +144,10 @@ def natural_face(face, surf, samples=5):
         return False
     sides = set()
     for e in face.Edges:
-        c2d, a, b = face.curveOnSurface(e)[:3]
+        pcurve = face.curveOnSurface(e)
+        if not pcurve:
+            return False
+        c2d, a, b = pcurve[:3]
         uv = np.array([[c2d.value(t).x, c2d.value(t).y] for t in np.linspace(a, b, samples)])
         side = [k for k in range(4) if np.max(np.abs(uv[:, k // 2] - domain[k])) <= tol]
         if len(side) != 1:

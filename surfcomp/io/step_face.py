@@ -83,7 +83,7 @@ def _right_aligned(digits, keep, mark):
 
 def _layout(top):
     """(whole digits, decimals) of the fixed-point numbers up to ``top`` in magnitude."""
-    whole = max(1, int(np.floor(np.log10(top))) + 1) if top >= 1 else 1
+    whole = len("%d" % top) if top >= 1 else 1
     while whole <= DIGITS:
         decimals = max(0, min(DECIMALS, DIGITS - whole))
         if np.rint(top * 10.0 ** decimals) < 10.0 ** (whole + decimals):
@@ -188,7 +188,15 @@ def _curve(ent, poles, knots, degree):
 
 
 def natural_face_step(surface, reversed_face=False, tolerance=1e-7, name="surfcomp"):
-    """The STEP text (bytes) of the face bounded by ``surface``'s knot domain.
+    """The STEP text (bytes) of the face bounded by ``surface``'s knot domain and the
+    largest rounding of a pole (mm); see :func:`natural_face_parts`."""
+    parts, rounding = natural_face_parts(surface, reversed_face, tolerance, name)
+    return b"".join(parts), rounding
+
+
+def natural_face_parts(surface, reversed_face=False, tolerance=1e-7, name="surfcomp"):
+    """The STEP text of the face bounded by ``surface``'s knot domain, in parts (the pole
+    text is most of a large file: no joined copy of it).
 
     Parameters
     ----------
@@ -203,8 +211,8 @@ def natural_face_step(surface, reversed_face=False, tolerance=1e-7, name="surfco
 
     Returns
     -------
-    (bytes, float)
-        The file and the largest rounding of a pole (mm).
+    (list of bytes, float)
+        The file's parts in order and the largest rounding of a pole (mm).
     """
     s = surface
     p, q = s.degree_u, s.degree_v
@@ -285,8 +293,8 @@ def natural_face_step(surface, reversed_face=False, tolerance=1e-7, name="surfco
         *refs,
         ("),.UNSPECIFIED.,.F.,.F.,.F.,\n(%s),\n(%s),\n(%s),\n(%s),\n.UNSPECIFIED.);\n"
          % (_ints(ku_m), _ints(kv_m), _reals(ku_k), _reals(kv_k))).encode("ascii")])
-    return b"".join([_header(name), *ent.lines, surface_text, *poles,
-                     b"ENDSEC;\nEND-ISO-10303-21;\n"]), _rounding(top, decimals)
+    return [_header(name), *ent.lines, surface_text, *poles,
+            b"ENDSEC;\nEND-ISO-10303-21;\n"], _rounding(top, decimals)
 
 
 #: pole rows formatted per block (one block per thread at a time)
@@ -329,9 +337,22 @@ def _pole_texts(P, first, nv, whole, decimals):
 
 
 def _string(text):
-    """A STEP string (quotes doubled, ASCII only)."""
-    text = str(text).encode("ascii", "replace").decode("ascii")
-    return "'%s'" % text.replace("\\", "\\\\").replace("'", "''")
+    """A STEP string: quotes and backslashes doubled, characters beyond ASCII as Part 21's
+    ``\\X2\\hhhh\\X0\\`` (``\\X4\\`` with eight digits beyond the first plane),
+    control characters as ``?``."""
+    out = []
+    for ch in str(text):
+        if ch in "'\\":
+            out.append(ch * 2)
+        elif ord(ch) < 32 or ord(ch) == 127:
+            out.append("?")
+        elif ord(ch) < 127:
+            out.append(ch)
+        elif ord(ch) <= 0xFFFF:
+            out.append("\\X2\\%04X\\X0\\" % ord(ch))
+        else:
+            out.append("\\X4\\%08X\\X0\\" % ord(ch))
+    return "'%s'" % "".join(out)
 
 
 def _header(name):
@@ -348,9 +369,9 @@ def write_natural_face(path, surface, reversed_face=False, tolerance=1e-7, name=
     """Write :func:`natural_face_step` to ``path``; the product is ``name``, by default
     the file's name without its extension."""
     name = name or os.path.splitext(os.path.basename(path))[0]
-    data, _ = natural_face_step(surface, reversed_face, tolerance, name)
+    parts, _ = natural_face_parts(surface, reversed_face, tolerance, name)
     try:
         with open(path, "wb") as fh:
-            fh.write(data)
+            fh.writelines(parts)
     except OSError as exc:
         raise InputError("cannot write the STEP file: %s" % exc, file=path) from exc

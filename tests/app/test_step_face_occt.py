@@ -63,12 +63,17 @@ def test_freecad_import_names_the_object_after_the_file(tmp_path):
     s = random_surface(np.random.default_rng(5))
     path = tmp_path / "corrected blade.step"
     write_natural_face(str(path), s)
+    named = tmp_path / "named.step"
+    write_natural_face(str(named), s, name="Schaufel \u00e4 '3'")
+    assert rb"PRODUCT('Schaufel \X2\00E4\X0\ ''3'''" in named.read_bytes()
     doc = FreeCAD.newDocument("stepface")
     try:
         Import.insert(str(path), doc.Name)
         objs = [o for o in doc.Objects if hasattr(o, "Shape") and not o.Shape.isNull()]
         assert [o.Label for o in objs] == ["corrected blade"]
         assert abs(objs[0].Shape.Area / surface_to_part(s).toShape().Area - 1) < 1e-12
+        Import.insert(str(named), doc.Name)      # the encoded name comes back decoded
+        assert doc.Objects[-1].Label == "Schaufel \u00e4 '3'"
     finally:
         FreeCAD.closeDocument(doc.Name)
 
@@ -85,6 +90,10 @@ def test_natural_face_only_for_the_face_bounded_by_its_knot_domain():
     holed = whole.copy()
     holed = holed.cutHoles([Part.Wire(circle.toShape(bs))]) or holed
     assert len(holed.Wires) == 2 and not natural_face(holed, s)
+    collapsed = Surface(s.poles.copy(), s.knots_u, s.knots_v, 3, 2)
+    collapsed.poles[0, :] = collapsed.poles[0, 0]        # the side u = u0 is one point
+    face = surface_to_part(collapsed).toShape()
+    assert sum(e.Degenerated for e in face.Edges) == 1 and not natural_face(face, collapsed)
     rational = quarter_cylinder()
     assert not natural_face(surface_to_part(rational).toShape(), rational)
     ku = s.knots_u.copy()

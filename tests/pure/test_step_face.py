@@ -145,10 +145,19 @@ def test_only_polynomial_clamped_surfaces():
         step_face.natural_face_step(Surface(s.poles, ku, s.knots_v, 3, 2))
 
 
+def test_strings_escape_quotes_and_encode_beyond_ascii():
+    assert step_face._string("it's a\\b") == r"'it''s a\\b'"
+    assert step_face._string("Bl\u00e4tt\t\U0001F600") == r"'Bl\X2\00E4\X0\tt?\X4\0001F600\X0\'"
+
+
 def test_write_names_the_product_after_the_file_and_reports_a_failed_write(tmp_path):
     s = random_surface(np.random.default_rng(2))
     path = tmp_path / "corrected part.step"
     step_face.write_natural_face(str(path), s)
     assert b"PRODUCT('corrected part','corrected part'" in path.read_bytes()
+    # written in parts: the same bytes as the joined text
+    data, _ = step_face.natural_face_step(s, name="corrected part")
+    cut = data.index(b"DATA;")
+    assert path.read_bytes()[cut:] == data[cut:]
     with pytest.raises(Exception, match="cannot write the STEP file"):
         step_face.write_natural_face(str(tmp_path / "missing" / "x.step"), s)
