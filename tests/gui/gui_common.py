@@ -77,11 +77,28 @@ def make_map(doc, nominal, meas, command="SurfComp_DeviationMap"):
     return [o for o in doc.Objects if o.Name.startswith("Compensation")][-1]
 
 
+def settle(view, rounds=40, calm=3):
+    """Process pending events until the 3D view's size and camera have stayed the same for
+    ``calm`` rounds 50 ms apart: Qt6 layouts resize the view over several event loops and
+    FreeCAD 1.x animates camera changes, so a pixel projected before they end is not
+    where a later screenshot or mouse event finds the point."""
+    last, same = None, 0
+    for _ in range(rounds):
+        Gui.updateGui()
+        state = (tuple(view.getSize()), view.getCamera())
+        same = same + 1 if state == last else 0
+        if same >= calm:
+            return
+        last = state
+        time.sleep(0.05)
+
+
 def view_top():
     view = Gui.ActiveDocument.ActiveView
+    settle(view)
     view.viewTop()
     view.fitAll()
-    Gui.updateGui()
+    settle(view)
     return view
 
 

@@ -128,8 +128,14 @@ k = int(np.flatnonzero(fin)[1000])
 xy = project(view, nodes[[k]])[0]
 fcgui.show_status("")
 readout.LAST.clear()
-mouse("move", xy)
+# a real mouse sends many moves; on FreeCAD 1.1 / Qt6 a lone synthetic one sometimes does
+# not reach Coin (2 of 9 runs): up to three, each after the pending events
+hover_tries = 0
+while not readout.LAST and hover_tries < 3:
+    hover_tries += 1
+    mouse("move", xy)
 RESULTS["hover"] = {"status": fcgui.status_text(), "node": readout.LAST.get("node"),
+                    "tries": hover_tries,
                     "want_node": k, "deviation": float(dev[k]),
                     "preselection": str(Gui.Selection.getPreselection().ObjectName)
                     if hasattr(Gui.Selection, "getPreselection") else ""}
