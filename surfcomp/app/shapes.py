@@ -19,6 +19,7 @@ import FreeCAD  # noqa: F401  (Part needs FreeCAD imported first)
 import numpy as np
 import Part
 
+from ..core.bspline import clamped
 from ..errors import GeometryError
 from . import retrim
 from .convert import surface_to_part
@@ -132,11 +133,8 @@ def natural_face(face, surf, samples=5):
     of ``face.Surface``; polynomial and clamped): one wire of four edges, each running
     along its own side of the domain. A side collapsed to a point (a degenerated edge,
     which OpenCASCADE leaves out of the STEP loop) is not one."""
-    ends = [surf.degree_u + 1, surf.degree_v + 1]
-    if surf.weights is not None or len(face.Wires) != 1 or len(face.Edges) != 4 or \
-            any(e.Degenerated for e in face.Edges) or \
-            any(np.ptp(k[:n]) or np.ptp(k[-n:])
-                for k, n in zip((surf.knots_u, surf.knots_v), ends)):
+    if surf.weights is not None or not clamped(surf) or len(face.Wires) != 1 or \
+            len(face.Edges) != 4 or any(e.Degenerated for e in face.Edges):
         return False
     domain = np.array([surf.knots_u[0], surf.knots_u[-1], surf.knots_v[0], surf.knots_v[-1]])
     tol = 1e-12 * max(1.0, float(np.max(np.abs(domain))))

@@ -101,6 +101,13 @@ class Surface:
 CHUNK_VALUES = 4_000_000
 
 
+def clamped(surf):
+    """True when each end knot of ``surf`` is repeated ``degree + 1`` times (the border
+    pole rows are then the border curves)."""
+    return not any(np.ptp(k[:d + 1]) or np.ptp(k[-d - 1:])
+                   for k, d in ((surf.knots_u, surf.degree_u), (surf.knots_v, surf.degree_v)))
+
+
 def compress_knots(flat):
     """Distinct knots and their multiplicities of a flat knot vector (knots within 1e-15
     relative are one)."""

@@ -22,7 +22,7 @@ import os
 
 import numpy as np
 
-from ..core.bspline import compress_knots
+from ..core.bspline import clamped, compress_knots
 from ..core.chunks import for_chunks
 from ..errors import InputError
 
@@ -221,7 +221,7 @@ def natural_face_parts(surface, reversed_face=False, tolerance=1e-7, name="surfc
     if s.weights is not None:
         raise ValueError("natural_face_step writes polynomial surfaces only")
     ku, kv = np.asarray(s.knots_u), np.asarray(s.knots_v)
-    if np.ptp(ku[:p + 1]) or np.ptp(ku[-p - 1:]) or np.ptp(kv[:q + 1]) or np.ptp(kv[-q - 1:]):
+    if not clamped(s):
         raise ValueError("natural_face_step writes clamped surfaces only")
     u0, u1, v0, v1 = ku[0], ku[-1], kv[0], kv[-1]
     ent = _Entities()
@@ -288,13 +288,12 @@ def natural_face_parts(surface, reversed_face=False, tolerance=1e-7, name="surfc
     refs, poles = _pole_texts(P.reshape(-1, 3), first, nv, whole, decimals)
     ku_k, ku_m = compress_knots(ku)
     kv_k, kv_m = compress_knots(kv)
-    surface_text = b"".join([
-        ("#%d = B_SPLINE_SURFACE_WITH_KNOTS('',%d,%d,(\n" % (surf, p, q)).encode("ascii"),
-        *refs,
-        ("),.UNSPECIFIED.,.F.,.F.,.F.,\n(%s),\n(%s),\n(%s),\n(%s),\n.UNSPECIFIED.);\n"
-         % (_ints(ku_m), _ints(kv_m), _reals(ku_k), _reals(kv_k))).encode("ascii")])
-    return [_header(name), *ent.lines, surface_text, *poles,
-            b"ENDSEC;\nEND-ISO-10303-21;\n"], _rounding(top, decimals)
+    surface_head = ("#%d = B_SPLINE_SURFACE_WITH_KNOTS('',%d,%d,(\n" % (surf, p, q))
+    surface_tail = ("),.UNSPECIFIED.,.F.,.F.,.F.,\n(%s),\n(%s),\n(%s),\n(%s),\n"
+                    ".UNSPECIFIED.);\n" % (_ints(ku_m), _ints(kv_m), _reals(ku_k), _reals(kv_k)))
+    return [_header(name), *ent.lines, surface_head.encode("ascii"), *refs,
+            surface_tail.encode("ascii"), *poles, b"ENDSEC;\nEND-ISO-10303-21;\n"], \
+        _rounding(top, decimals)
 
 
 #: pole rows formatted per block (one block per thread at a time)
