@@ -10,3 +10,17 @@ if ROOT not in sys.path:
 
 #: public CAD, QIF and G-code files copied into the repository (see its README.md)
 REALDATA = os.path.join(ROOT, "tests", "data", "real")
+
+
+def default_signals():
+    """``preexec_fn`` for a subprocess that a test signals: SIGINT, SIGTERM and SIGHUP at
+    their default dispositions in the child.
+
+    A runner started in the background or under ``nohup`` hands on ignored SIGINT/SIGHUP,
+    and Python keeps an inherited ignore (rightly: the program does too), so without this a
+    test that sends the signal would see it ignored and fail on the machine's mood.
+    """
+    import signal
+
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)

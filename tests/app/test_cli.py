@@ -12,7 +12,7 @@ import pytest
 
 from surfcomp.app.nominal import load_nominal
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
-from tests.conftest import REALDATA
+from tests.conftest import REALDATA, default_signals
 
 
 def run_cli(*args, cwd=None):
@@ -337,7 +337,8 @@ def test_interrupt_leaves_no_outputs(tmp_path, signame, code):
     write_cmm_csv(tmp_path / "m.csv", P, N, 0.02 * np.sin(U / U.max() * 3))
     proc = subprocess.Popen([sys.executable, "-c", HOLD_IN_BUILD, "compensate", EXAMPLE_STEP,
                              tmp_path / "m.csv", "-o", tmp_path / "c.step", "--report",
-                             tmp_path / "r.json"], cwd=ROOT, stderr=subprocess.PIPE, text=True)
+                             tmp_path / "r.json"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=default_signals)
     seen = []
     for line in proc.stderr:
         seen.append(line)

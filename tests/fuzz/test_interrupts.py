@@ -14,6 +14,8 @@ import sys
 
 import pytest
 
+from tests.conftest import default_signals
+
 from . import inputs as I
 from .harness import EXAMPLE_STEP, check_tree, snapshot, subprocess_env
 
@@ -93,7 +95,8 @@ def test_signal_while_writing(tmp_path, name, argv, setup, where, signame):
     before = snapshot(sandbox)
     proc = subprocess.Popen([sys.executable, "-c", HELD_CLI] + list(argv),
                             cwd=str(sandbox), stderr=subprocess.PIPE, stdout=subprocess.PIPE,
-                            text=True, env=subprocess_env({"SURFCOMP_FUZZ_HOLD": where}))
+                            text=True, env=subprocess_env({"SURFCOMP_FUZZ_HOLD": where}),
+                            preexec_fn=default_signals)
     seen = []
     for line in proc.stderr:
         seen.append(line)
