@@ -1,8 +1,31 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp``: the batch command line."""
 
+import importlib.util
 import sys
 
-from .cli import main
 
-sys.exit(main())
+def _missing():
+    """The numeric packages this Python lacks (another Python first on ``PATH``, such as a
+    pyenv or a venv, usually has neither FreeCAD nor Debian's numpy and scipy)."""
+    out = []
+    for name in ("numpy", "scipy"):
+        try:
+            found = importlib.util.find_spec(name) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            out.append(name)
+    return out
+
+
+if __name__ == "__main__":
+    lacking = _missing()
+    if lacking:
+        print("surfcomp: error: this Python (%s) has no %s; run 'surfcomp' or "
+              "'/usr/bin/python3 -m surfcomp' (Debian's Python, set up by tools/install.sh)"
+              % (sys.executable or "python3", " or ".join(lacking)), file=sys.stderr)
+        sys.exit(2)
+    from surfcomp.cli import main
+
+    sys.exit(main())

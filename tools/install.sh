@@ -95,6 +95,23 @@ else
   echo "surfcomp setup: already linked into $mod_dir"
 fi
 
+# The command line as a command on PATH, run by Debian's Python (which has FreeCAD, numpy
+# and scipy) whatever python3 comes first on PATH, with this checkout's package
+launcher=/usr/local/bin/surfcomp
+want="#!/bin/sh
+# surfcomp's command line (written by $repo/tools/install.sh)
+PYTHONPATH=\"$repo\${PYTHONPATH:+:\$PYTHONPATH}\" exec /usr/bin/python3 -m surfcomp \"\$@\""
+if [ "$(cat "$launcher" 2>/dev/null)" != "$want" ]; then
+  if [ -e "$launcher" ] && ! grep -q "^# surfcomp's command line" "$launcher"; then
+    echo "surfcomp setup: $launcher exists and is not surfcomp's; leaving it alone" >&2
+  else
+    printf '%s\n' "$want" >"$launcher.new" && chmod 755 "$launcher.new" && mv "$launcher.new" "$launcher"
+    echo "surfcomp setup: installed the command $launcher"
+  fi
+else
+  echo "surfcomp setup: the command $launcher is installed"
+fi
+
 # What was found: the versions every result depends on
 /usr/bin/python3 "$repo/tools/versions.py" --prefix "surfcomp setup: found "
 echo "surfcomp setup: found $(ruff --version)"
