@@ -210,7 +210,8 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     comp = features.make_compensation(
         doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
         weights=options.weights if isinstance(options.weights, str) else "",
-        edge=options.edge, stock=options.stock or 0.0, output=output)
+        edge=options.edge, stock=options.stock or 0.0, output=output,
+        accept_stock=bool(options.accept_stock))
     comp.MaskKind = options.mask_kind
     comp.Sigma = float(options.sigma or 0.0)
     comp.MaxOffset = float(options.max_offset)

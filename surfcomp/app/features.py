@@ -263,6 +263,7 @@ def options_of(obj):
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
+                   accept_stock=bool(getattr(obj, "AcceptStock", False)),
                    max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
                    refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
                    layout=obj.Layout,
@@ -454,7 +455,7 @@ def _write_results(obj, r):
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
                       weights="", edge="renormalize", stock=0.0, base=None,
-                      name="Compensation", output="face"):
+                      name="Compensation", output="face", accept_stock=False):
     """Create a ``SurfComp_Compensation`` feature (recompute the document to compute it).
 
     Parameters
@@ -464,8 +465,9 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     face : str
         ``FaceN`` of ``nominal`` (None: the only B-spline face).
     measurement : ``SurfComp_Measurement`` object
-    method, mask_size, weights, edge, stock
-        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method).
+    method, mask_size, weights, edge, stock, accept_stock
+        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method;
+        ``accept_stock`` uses a stock inconsistent with the measured mean).
     base : ``SurfComp_Compensation``, optional
         The previous round of an iteration.
     output : {'face', 'solid'}
@@ -497,6 +499,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     obj.Weights = weights or ""
     obj.Edge = edge
     obj.Stock = float(stock or 0.0)
+    obj.AcceptStock = bool(accept_stock)
     obj.Output = output
     if not obj.FaceName:
         from .nominal import pick_face
