@@ -154,7 +154,7 @@ COMPENSATION_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
                                         "Stock / 2)"),
      0.0, 0),
-    ("App::PropertyBool", "AcceptStock", _IN,
+    ("App::PropertyBool", "StockOk", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Use a mirror Stock although it does not fit the "
                                         "measured mean deviation (a part measured with stock s "
                                         "has its mean near s); false refuses such a stock"),

@@ -114,7 +114,7 @@ class Options:
                 raise InputError("%s %r: expected one of %s"
                                  % (option, getattr(self, name), ", ".join(choices)))
         for name, flag, prop in (("lean", "lean", "Lean"),
-                                 ("accept_stock", "--accept-stock", "AcceptStock")):
+                                 ("accept_stock", "--accept-stock", "StockOk")):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise InputError("%s %r: expected true or false (%s in the document)"
                                  % (flag, getattr(self, name), prop))
@@ -454,7 +454,7 @@ def check_stock(deviation, options):
             "the stock %g mm (option --stock, Stock in the document) does not fit the "
             "measured deviations: %s. Was the part measured after finishing, or with another "
             "stock? Give the stock the measured part carries, or use this one anyway with "
-            "--accept-stock (AcceptStock = true in the document)"
+            "--accept-stock (StockOk = true in the document)"
             % (check.stock, check.describe()))
     return check
 

@@ -2,7 +2,7 @@
 """The mirror stock check on the command line and in the document object (issue 24, item
 4): the example is a finished part (mean deviation 15.7 um), so the default stock 0.1 mm
 is refused with the measured mean, exit 2 and nothing written, unless confirmed with
---accept-stock / AcceptStock; the predicted residual says what it assumes."""
+--accept-stock / StockOk; the predicted residual says what it assumes."""
 
 import json
 import os
@@ -41,7 +41,7 @@ def test_cli_refuses_the_default_stock_on_a_finished_part(tmp_path):
                           "document) does not fit the measured deviations")
     assert "measured mean deviation 15.7 um (spread 19.1 um)" in msg
     assert "a mean of 0.1 mm +- 57.2 um" in msg
-    assert "--accept-stock (AcceptStock = true in the document)" in msg
+    assert "--accept-stock (StockOk = true in the document)" in msg
     assert os.listdir(tmp_path) == []      # nothing written, no temporary file left
 
 
@@ -91,18 +91,18 @@ def test_document_object_refuses_until_accept_stock(doc):
     nom.Shape = Part.read(EXAMPLE_STEP)
     m = features.make_measurement(doc, EXAMPLE_CSV)
     c = features.make_compensation(doc, nom, "Face1", m, method="mirror", stock=0.1)
-    assert c.AcceptStock is False
+    assert c.StockOk is False
     doc.recompute()
     assert "Invalid" in c.State
-    with pytest.raises(InputError, match=r"measured mean deviation 15\.7 um .*AcceptStock = "
+    with pytest.raises(InputError, match=r"measured mean deviation 15\.7 um .*StockOk = "
                                          r"true in the document"):
         features.compensation_result(c)
-    c.AcceptStock = True
+    c.StockOk = True
     doc.recompute()
     assert "Invalid" not in c.State and not c.Shape.isNull()
     assert_allclose(c.Correction, np.asarray(c.Deviation) - 0.1, atol=1e-15)
     # a stock within the part's scatter is used without confirmation
-    c.AcceptStock, c.Stock = False, 0.02
+    c.StockOk, c.Stock = False, 0.02
     doc.recompute()
     assert "Invalid" not in c.State
     assert_allclose(c.Correction, np.asarray(c.Deviation) - 0.02, atol=1e-15)

@@ -127,9 +127,15 @@ with open(far, "w") as f:
         if parts[0].startswith("P"):
             parts[3] = "%.6f" % (float(parts[3]) + 5.0)
         f.write(",".join(parts) + "\n")
+# the preview locates the points on the nominal face: refused there, nothing added
+n_before = len(doc.Objects)
 FILES.append(far)
 Gui.runCommand("SurfComp_ImportMeasurements")
-far_meas = doc.Objects[-1]
+RESULTS["far_preview"] = [PREVIEWS[-1], len(doc.Objects) - n_before]
+# made by script, the map refuses it before any object is made
+from surfcomp.app import features
+
+far_meas = features.make_measurement(doc, far)
 names_before = sorted(o.Name for o in doc.Objects)
 del ERRORS[:]
 Gui.Selection.clearSelection()

@@ -109,7 +109,7 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
     msg = str(err.value)
     assert "the stock 0.1 mm (option --stock, Stock in the document)" in msg
     assert "measured mean deviation 15.7 um" in msg
-    assert "--accept-stock (AcceptStock = true in the document)" in msg
+    assert "--accept-stock (StockOk = true in the document)" in msg
     # confirmed: used as given, delta = d - s (mirror paper eq. 1-2)
     comp = compensate(surf, 1, prep, Options(method="mirror", stock=0.1, accept_stock=True),
                       build=False)
@@ -120,5 +120,5 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
 
 def test_accept_stock_is_a_boolean():
     with pytest.raises(InputError, match=r"--accept-stock 'yes': expected true or false "
-                                         r"\(AcceptStock in the document\)"):
+                                         r"\(StockOk in the document\)"):
         Options(method="mirror", stock=0.1, accept_stock="yes").validate()
