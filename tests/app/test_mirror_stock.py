@@ -9,7 +9,6 @@ import os
 import subprocess
 import sys
 
-import FreeCAD
 import numpy as np
 import Part
 import pytest
@@ -79,14 +78,8 @@ def test_cli_a_stock_that_fits_needs_no_confirmation(tmp_path):
            "(the larger of stock/2 and 3 x the spread): consistent" in out.stdout
 
 
-@pytest.fixture
-def doc():
-    d = FreeCAD.newDocument("mirrorstock")
-    yield d
-    FreeCAD.closeDocument(d.Name)
-
-
-def test_document_object_refuses_until_accept_stock(doc):
+def test_document_object_refuses_until_accept_stock(fresh_doc):
+    doc = fresh_doc
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)
     m = features.make_measurement(doc, EXAMPLE_CSV)

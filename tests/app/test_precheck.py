@@ -4,21 +4,14 @@ the deviation map's own location checks, before the measurement enters the docum
 
 import FreeCAD
 import Part
-import pytest
 
 from surfcomp.app import features, precheck
 from surfcomp.io.readers import read_any
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
 
 
-@pytest.fixture
-def doc():
-    d = FreeCAD.newDocument("precheck")
-    yield d
-    FreeCAD.closeDocument(d.Name)
-
-
-def test_points_on_the_face_and_off_it(doc):
+def test_points_on_the_face_and_off_it(fresh_doc):
+    doc = fresh_doc
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)
     assert precheck.nominal_candidate(doc) == (nom, "Face1")
@@ -33,7 +26,8 @@ def test_points_on_the_face_and_off_it(doc):
     assert len(errors) == 1 and "is 4.9999 mm from the face" in errors[0]  # along the normal
 
 
-def test_the_candidate_is_the_only_plain_object_with_a_bspline_face(doc):
+def test_the_candidate_is_the_only_plain_object_with_a_bspline_face(fresh_doc):
+    doc = fresh_doc
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)
     meas = features.make_measurement(doc, EXAMPLE_CSV)

@@ -70,6 +70,20 @@ def load_example(doc):
     return doc.getObject("Nominal"), meas
 
 
+def deviations_in_um(path):
+    """The example's measurements with the deviation column in um, its name without a unit
+    (the coordinates stay in mm); returns the lines of the example."""
+    with open(MEAS) as f:
+        rows = f.read().splitlines()
+    with open(path, "w") as f:
+        for line in rows:
+            parts = line.split(",")
+            if parts[0].startswith("P"):
+                parts[7] = "%.1f" % (float(parts[7]) * 1000.0)
+            f.write(",".join(parts) + "\n")
+    return rows
+
+
 def make_map(doc, nominal, meas, command="SurfComp_DeviationMap"):
     Gui.Selection.clearSelection()
     Gui.Selection.addSelection(doc.Name, nominal.Name, "Face1")

@@ -50,14 +50,7 @@ RESULTS["preview"] = PREVIEWS[:]
 
 # the um file read as mm (issue 13): deviations in um, no unit in the column name
 um = os.path.join(TMP, "deviations_in_um.csv")
-with open(MEAS) as f:
-    rows = f.read().splitlines()
-with open(um, "w") as f:
-    for line in rows:
-        parts = line.split(",")
-        if parts[0].startswith("P"):
-            parts[7] = "%.1f" % (float(parts[7]) * 1000.0)
-        f.write(",".join(parts) + "\n")
+rows = deviations_in_um(um)
 n_before = len(doc.Objects)
 del PREVIEWS[:]
 state = {}

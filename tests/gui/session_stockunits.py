@@ -60,14 +60,7 @@ RESULTS["example_preview"] = PREVIEWS[-1]
 
 # -- the import preview: deviations in um, coordinates in mm (the file) ----------------
 um = os.path.join(TMP, "deviations_in_um.csv")
-with open(MEAS) as f:
-    rows = f.read().splitlines()
-with open(um, "w") as f:
-    for line in rows:
-        parts = line.split(",")
-        if parts[0].startswith("P"):
-            parts[7] = "%.1f" % (float(parts[7]) * 1000.0)
-        f.write(",".join(parts) + "\n")
+deviations_in_um(um)
 state = {}
 
 

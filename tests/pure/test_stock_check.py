@@ -13,6 +13,7 @@ from surfcomp.core import plausibility as pl
 from surfcomp.core import simulate as sm
 from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.errors import InputError
+from tests.pure.surfaces import wavy_patch
 
 #: mirror paper Tab. 3, mirror compensation "before" (semi-finished parts, stock 0.2 mm,
 #: Sec. 2.6): mean and standard deviation of the error beyond the stock (um), 280, 196
@@ -80,16 +81,8 @@ def test_the_residual_says_what_it_assumes():
     assert pl.residual_assumption("filtered", 0.1) == ""
 
 
-def _surface():
-    x = np.linspace(0.0, 30.0, 5)
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    Z = 2.0 * np.sin(X / 12.0) * np.cos(Y / 15.0)
-    k = np.array([0, 0, 0, 0, 0.5, 1, 1, 1, 1.0])
-    return bspline.Surface(np.stack([X, Y, Z], axis=-1), k, k, 3, 3)
-
-
 def _prepared(d, n):
-    surf = _surface()
+    surf = wavy_patch()
     us = np.linspace(0.02, 0.98, n)
     S, Su, Sv = bspline.evaluate_grid(surf, us, us, order=1)
     nrm = np.cross(Su, Sv)
