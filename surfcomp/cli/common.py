@@ -31,6 +31,10 @@ def add_input_options(p):
     p.add_argument("--units", choices=("mm", "um", "in"), default=None,
                    help="units of values that carry no unit of their own (column suffix, "
                         "XYZIJK METRIC, QIF FileUnits); default mm")
+    p.add_argument("--deviation-units", choices=("mm", "um", "in"), default=None,
+                   help="unit of a deviation column without a unit of its own, when it is "
+                        "not the coordinates' (--units): a CMM report in mm with deviations "
+                        "in um; default the same as --units")
     p.add_argument("--format", dest="fmt", choices=FORMATS, default="auto",
                    help="measurement file format (default auto: detected from the content)")
     p.add_argument("--sample", metavar="N|ID",
@@ -91,7 +95,8 @@ def job_from_args(args, command):
 
     outputs = {k: getattr(args, k, None) for k in ("output", "report", "points", "curves", "html")}
     return Job(nominal=args.nominal, measurements=args.measurements, command=command,
-               face=args.face, object=args.object, units=args.units, fmt=args.fmt,
+               face=args.face, object=args.object, units=args.units,
+               deviation_units=args.deviation_units, fmt=args.fmt,
                sample=args.sample, face_only=bool(getattr(args, "face_only", False)),
                options=options_from_args(args), **outputs)
 
