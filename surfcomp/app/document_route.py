@@ -76,7 +76,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
                      gcode=None, post="linuxcnc", post_args="--no-show-editor", job_name=None,
                      units="mm", options=None, output=None, overwrite_input=False,
                      fmt="auto", sample=None,
-                     progress=None):
+                     progress=None, deviation_units=None):
     """Compensate face ``face`` of ``object_name`` in the FreeCAD document ``document``.
 
     Parameters
@@ -103,6 +103,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Which Job to post when several use the compensation.
     units : str
         Units of measurement columns without a unit suffix.
+    deviation_units : str, optional
+        Unit of a deviation column without a suffix when it is not ``units``.
     options : surfcomp.core.pipeline.Options, optional
         Method, mask, edge, stock, refine (default: Werner's filtered 5x5).
     output : {'face', 'solid'}, optional
@@ -145,8 +147,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
                              % (len(problems), "; ".join(problems), why), file=document)
         nominal = _find_object(doc, object_name, document)
         report(progress, 0.1, "reading the measurements")
-        comp, meas = _add_compensation(doc, nominal, face, measurements, units, fmt, sample,
-                                       options, output)
+        comp, meas = _add_compensation(doc, nominal, face, measurements,
+                                       (units, deviation_units), fmt, sample, options, output)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
         # computed once outside the recompute so bad input raises with file and line
         features.compensation_result(comp)
@@ -204,13 +206,17 @@ def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
 
 
 def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output):
+    """The measurement (``units``: the coordinates' and the deviation column's, or None)
+    and the compensation objects of a document job."""
     if output is None:
         output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
-    meas = features.make_measurement(doc, measurements, units=units, fmt=fmt, sample=sample)
+    meas = features.make_measurement(doc, measurements, units=units[0], fmt=fmt, sample=sample,
+                                     deviation_units=units[1])
     comp = features.make_compensation(
         doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
         weights=options.weights if isinstance(options.weights, str) else "",
-        edge=options.edge, stock=options.stock or 0.0, output=output)
+        edge=options.edge, stock=options.stock or 0.0, output=output,
+        accept_stock=bool(options.accept_stock))
     comp.MaskKind = options.mask_kind
     comp.Sigma = float(options.sigma or 0.0)
     comp.MaxOffset = float(options.max_offset)

@@ -172,7 +172,8 @@ def measurement_set(obj):
                           warnings=list(obj.ReadWarnings))
 
 
-def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample=None):
+def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample=None,
+                     deviation_units=None):
     """Read a measurement file into a new ``SurfComp_Measurement`` object of ``doc``.
 
     Parameters
@@ -182,6 +183,8 @@ def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample
         Any format :func:`surfcomp.io.readers.read_any` reads.
     units : {'mm', 'um', 'in'}
         Units of columns without a unit suffix.
+    deviation_units : {'mm', 'um', 'in'}, optional
+        Unit of a deviation column without a suffix when it differs from ``units``.
     fmt : str, optional
         One of :data:`surfcomp.io.readers.FORMATS` (default: detected).
     sample : int or str, optional
@@ -194,7 +197,8 @@ def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample
     fmt = fmt or "auto"
     if fmt not in FORMATS:
         raise InputError("unknown format %r (expected one of %s)" % (fmt, ", ".join(FORMATS)))
-    ms = read_any(os.fspath(path), units=units, fmt=fmt, sample=sample)
+    ms = read_any(os.fspath(path), units=units, fmt=fmt, sample=sample,
+                  deviation_units=deviation_units)
     return make_measurement_from_set(doc, ms, name)
 
 
@@ -263,6 +267,7 @@ def options_of(obj):
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
                    edge=obj.Edge, stock=float(obj.Stock.Value),
+                   accept_stock=bool(getattr(obj, "StockOk", False)),
                    max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
                    refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
                    layout=obj.Layout,
@@ -339,25 +344,32 @@ class _Result:
 def nominal_of(obj):
     """The :class:`~surfcomp.app.nominal.Nominal` of a compensation object, in the
     nominal object's own coordinates (its Shape without its Placement), and that Placement."""
-    from .nominal import nominal_from_face, pick_face
-
-    nom_obj = obj.Nominal
-    if nom_obj is None:
+    if obj.Nominal is None:
         raise InputError("%s has no Nominal (link the object holding the nominal face)"
                          % obj.Label)
+    return nominal_in(obj.Nominal, obj.FaceName or None, obj.Label)
+
+
+def nominal_in(nom_obj, face_name=None, label=None):
+    """The :class:`~surfcomp.app.nominal.Nominal` of face ``face_name`` (None: the only
+    B-spline face) of a document object, in its own coordinates, and its Placement;
+    ``label`` names the asking object in messages."""
+    from .nominal import nominal_from_face, pick_face
+
     shape = getattr(nom_obj, "Shape", None)
     if shape is None or shape.isNull() or not shape.Faces:
-        raise GeometryError("%s: the nominal %s has no faces" % (obj.Label, nom_obj.Label))
+        raise GeometryError("%s: the nominal %s has no faces" % (label or nom_obj.Label,
+                                                                nom_obj.Label))
     local = shape.copy()
     placement = local.Placement
     local.Placement = FreeCAD.Placement()
-    face, name = pick_face(local, obj.FaceName or None, source=nom_obj.Label)
+    face, name = pick_face(local, face_name, source=nom_obj.Label)
     nominal = nominal_from_face(face, source=nom_obj.Label, face_name=name,
                                 object_name=nom_obj.Name, shape=local)
     return nominal, placement
 
 
-def _local_measurements(ms, placement):
+def local_measurements(ms, placement):
     """The measurement set in the nominal object's own coordinates."""
     if placement.isIdentity():
         return ms
@@ -379,7 +391,7 @@ def _compute(obj):
     if obj.Output not in OUTPUTS:
         raise InputError("%s: unknown Output %r (expected face or solid)" % (obj.Label, obj.Output))
     nominal, placement = nominal_of(obj)
-    ms = _local_measurements(measurement_set(obj.Measurement), placement)
+    ms = local_measurements(measurement_set(obj.Measurement), placement)
     options = options_of(obj)
     base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
@@ -454,7 +466,7 @@ def _write_results(obj, r):
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
                       weights="", edge="renormalize", stock=0.0, base=None,
-                      name="Compensation", output="face"):
+                      name="Compensation", output="face", accept_stock=False):
     """Create a ``SurfComp_Compensation`` feature (recompute the document to compute it).
 
     Parameters
@@ -464,8 +476,9 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     face : str
         ``FaceN`` of ``nominal`` (None: the only B-spline face).
     measurement : ``SurfComp_Measurement`` object
-    method, mask_size, weights, edge, stock
-        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method).
+    method, mask_size, weights, edge, stock, accept_stock
+        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method;
+        ``accept_stock`` uses a stock inconsistent with the measured mean).
     base : ``SurfComp_Compensation``, optional
         The previous round of an iteration.
     output : {'face', 'solid'}
@@ -497,6 +510,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
     obj.Weights = weights or ""
     obj.Edge = edge
     obj.Stock = float(stock or 0.0)
+    obj.StockOk = bool(accept_stock)
     obj.Output = output
     if not obj.FaceName:
         from .nominal import pick_face

@@ -45,6 +45,7 @@ class Job:
     face: str = None
     object: str = None
     units: str = None
+    deviation_units: str = None
     fmt: str = "auto"
     sample: str = None
     face_only: bool = False
@@ -101,7 +102,8 @@ def run_job(job, progress=None):
     from .nominal import load_nominal
 
     nominal = load_nominal(job.nominal, job.face, job.object)
-    ms = read_any(job.measurements, job.units, job.fmt, job.sample)
+    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
+                  deviation_units=job.deviation_units)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
     _warn_outside_trim(nominal, prepared)

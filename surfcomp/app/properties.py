@@ -154,6 +154,11 @@ COMPENSATION_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
                                         "Stock / 2)"),
      0.0, 0),
+    ("App::PropertyBool", "StockOk", _IN,
+     QT_TRANSLATE_NOOP("App::Property", "Use a mirror Stock although it does not fit the "
+                                        "measured mean deviation (a part measured with stock s "
+                                        "has its mean near s); false refuses such a stock"),
+     False, 0),
     ("App::PropertyLength", "MaxOffset", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
                                         "face"),

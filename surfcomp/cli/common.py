@@ -4,6 +4,7 @@
 import sys
 import time
 
+from ..core import plausibility
 from ..core.deviations import format_table
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
@@ -30,6 +31,10 @@ def add_input_options(p):
     p.add_argument("--units", choices=("mm", "um", "in"), default=None,
                    help="units of values that carry no unit of their own (column suffix, "
                         "XYZIJK METRIC, QIF FileUnits); default mm")
+    p.add_argument("--deviation-units", choices=("mm", "um", "in"), default=None,
+                   help="unit of a deviation column without a unit of its own, when it is "
+                        "not the coordinates' (--units): a CMM report in mm with deviations "
+                        "in um; default the same as --units")
     p.add_argument("--format", dest="fmt", choices=FORMATS, default="auto",
                    help="measurement file format (default auto: detected from the content)")
     p.add_argument("--sample", metavar="N|ID",
@@ -68,7 +73,12 @@ def add_method_options(p):
                    help="filter edge handling (default renormalize: divide by the weights on "
                         "measured points)")
     p.add_argument("--stock", type=float, metavar="MM",
-                   help="semi-finishing allowance for --method mirror (DH = stock / 2)")
+                   help="semi-finishing allowance for --method mirror (DH = stock / 2); a "
+                        "stock that does not fit the measured mean deviation is refused")
+    p.add_argument("--accept-stock", action="store_true",
+                   help="use the --stock although the measured mean deviation does not fit it "
+                        "(a part measured with stock s has its mean within max(s/2, 3 x the "
+                        "spread) of s; see docs/method.md)")
     p.add_argument("--smoothing", type=float, metavar="MM",
                    help="scattered layouts: smoothing length of the fit that takes the mask "
                         "filter's place (the wavelength damped to half; default chosen by "
@@ -85,7 +95,8 @@ def job_from_args(args, command):
 
     outputs = {k: getattr(args, k, None) for k in ("output", "report", "points", "curves", "html")}
     return Job(nominal=args.nominal, measurements=args.measurements, command=command,
-               face=args.face, object=args.object, units=args.units, fmt=args.fmt,
+               face=args.face, object=args.object, units=args.units,
+               deviation_units=args.deviation_units, fmt=args.fmt,
                sample=args.sample, face_only=bool(getattr(args, "face_only", False)),
                options=options_from_args(args), **outputs)
 
@@ -111,7 +122,8 @@ def options_from_args(args):
                    max_offset=args.max_offset, flip_normals=args.flip_normals,
                    tip_radius=args.tip_radius, layout=args.layout,
                    smoothing=getattr(args, "smoothing", None),
-                   refine=getattr(args, "refine", 4))
+                   refine=getattr(args, "refine", 4),
+                   accept_stock=bool(getattr(args, "accept_stock", False)))
 
 
 class ProgressLine:
@@ -167,12 +179,19 @@ def print_summary(comp, rep, out=sys.stdout):
     if comp.corrected is None:
         return
     extra = ""
+    notes = []
     if o.method == "mirror":
         extra = ", stock %g mm (DH = %g mm)" % (o.stock, o.stock / 2)
+        check = plausibility.stock_check(p.deviation, o.stock)
+        notes = ["  stock check: %s: %s" % (check.describe(), "consistent" if check.consistent
+                                            else "INCONSISTENT, used by --accept-stock"),
+                 "  " + plausibility.residual_assumption(o.method, o.stock)]
     print("", file=out)
     print("Correction:   method %s%s; applied along the normal: %.2f .. %.2f um (mean %.2f um)"
           % (o.method, extra, st["correction"].max_negative * 1e3,
              st["correction"].max_positive * 1e3, st["correction"].mean * 1e3), file=out)
+    for line in notes:
+        print(line, file=out)
     ch = comp.checks
     print("Corrected face: %d x %d poles, degree %d x %d%s"
           % (ch.poles_shape + (comp.corrected.degree_u, comp.corrected.degree_v,

@@ -81,7 +81,8 @@ def run_document(args):
                            units=args.units or "mm", options=options_from_args(args),
                            output="face" if args.face_only else None,
                            overwrite_input=args.overwrite_input, fmt=args.fmt,
-                           sample=args.sample, progress=ProgressLine(args.quiet))
+                           sample=args.sample, progress=ProgressLine(args.quiet),
+                           deviation_units=args.deviation_units)
     for line in summary_lines(res):
         print(line)
     return 0

@@ -57,7 +57,10 @@ class Options:
     (the contact point is the centre moved by it against the outward normal);
     ``layout`` one of :data:`LAYOUTS`; ``smoothing`` the smoothing length (mm) of the
     scattered layouts' fit (None: chosen by generalized cross-validation, see
-    :func:`surfcomp.core.scattered.smooth`), their counterpart of the mask filter.
+    :func:`surfcomp.core.scattered.smooth`), their counterpart of the mask filter;
+    ``accept_stock`` True uses a mirror stock that
+    :func:`surfcomp.core.plausibility.stock_check` finds inconsistent with the measured
+    mean (else it is refused).
     """
 
     method: str = "filtered"
@@ -74,6 +77,7 @@ class Options:
     layout: str = "auto"
     smoothing: float = None
     lean: bool = True
+    accept_stock: bool = False
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -109,9 +113,11 @@ class Options:
             if getattr(self, name) not in choices:
                 raise InputError("%s %r: expected one of %s"
                                  % (option, getattr(self, name), ", ".join(choices)))
-        if not isinstance(self.lean, (bool, np.bool_)):
-            raise InputError("lean %r: expected true or false (Lean in the document)"
-                             % (self.lean,))
+        for name, flag, prop in (("lean", "lean", "Lean"),
+                                 ("accept_stock", "--accept-stock", "StockOk")):
+            if not isinstance(getattr(self, name), (bool, np.bool_)):
+                raise InputError("%s %r: expected true or false (%s in the document)"
+                                 % (flag, getattr(self, name), prop))
         if self.method == "mirror" and self.stock is None:
             raise InputError("--method mirror needs --stock (the semi-finishing allowance in "
                              "mm; DH = stock / 2)")
@@ -405,6 +411,7 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     Compensation
     """
     options = (options or Options()).validate()
+    check_stock(prepared.deviation, options)
     g = prepared.grid
     d = g.take(prepared.deviation)
     scale = parameter_scale(surface, prepared)
@@ -427,6 +434,29 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
     report(progress, 1.0, "done")
     return result
+
+
+def check_stock(deviation, options):
+    """Refuse a mirror stock inconsistent with the measured deviations (mm) unless
+    ``options.accept_stock`` (:func:`surfcomp.core.plausibility.stock_check`); returns the
+    check (None for other methods).
+
+    Raises
+    ------
+    InputError
+        Naming the measured mean, the option and its document property.
+    """
+    if options.method != "mirror" or options.stock is None:
+        return None
+    check = plausibility.stock_check(deviation, options.stock)
+    if not check.consistent and not options.accept_stock:
+        raise InputError(
+            "the stock %g mm (option --stock, Stock in the document) does not fit the "
+            "measured deviations: %s. Was the part measured after finishing, or with another "
+            "stock? Give the stock the measured part carries, or use this one anyway with "
+            "--accept-stock (StockOk = true in the document)"
+            % (check.stock, check.describe()))
+    return check
 
 
 def build_surface(result, surface, outward, delta, progress=None):

@@ -15,7 +15,24 @@ and the GUI's import preview:
   +-0.5 mm). A file whose deviations are *all* larger than :data:`UNITS_FACTOR` times
   that tolerance describes no part that passed a machining process: its deviations are
   almost certainly in another unit. :func:`units_warning` says so.
+- **mirror stock** (refused unless confirmed): the mirror method measures the part after
+  a semi-finishing pass that left the stock ``s``, so in surfcomp's sign convention
+  (deviation along the outward normal, + = material left) every measured deviation is
+  ``d = s + e`` with ``e`` the semi-finishing error (Huang et al. 2019, Sec. 2.4; the
+  mirror surface lies at ``s/2``, half-way between the ideal semi-finished and finished
+  surfaces). The measured mean is therefore expected near ``s``, not near ``s/2``
+  (``mean - s/2`` is the mean distance from the mirror surface, ``s/2 + mean(e)`` for a
+  right stock). :func:`stock_check` calls a stock *inconsistent* when the mean deviation
+  lies farther from ``s`` than the larger of ``s/2`` (beyond the mirror surface: nearer
+  the finished than the semi-finished surface, or as far on the other side) and
+  :data:`STOCK_SPREADS` times the spread (sample standard deviation) of the
+  deviations (small stocks, where the error is as large as the stock). The paper's
+  semi-finished parts (stock 0.2 mm, mean error 15.1-17.2 um, spread 3.1-6.2 um, Tab. 3)
+  pass; a finished part (mean 15.7 um, spread 19.1 um) with the default stock 0.1 mm
+  does not: its face would move out by up to 0.13 mm.
 """
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,6 +45,9 @@ UNITS_FACTOR = 100.0
 DEFAULT_MAX_OFFSET = 1.0
 #: lines named one by one before "and N more"
 MAX_LISTED = 20
+#: a stock is consistent while the mean deviation is within this many spreads of it
+#: (or within half the stock, whichever is larger)
+STOCK_SPREADS = 3.0
 
 
 def size_tolerance(largest_dimension):
@@ -119,3 +139,60 @@ def value_ranges(columns):
         if a.size:
             out[name] = (float(a.min()), float(a.max()))
     return out
+
+
+@dataclass
+class StockCheck:
+    """The mirror method's stock against the measured deviations (mm), see module doc.
+
+    ``mean`` and ``spread`` (sample standard deviation, ddof=1; 0 for one point) of the
+    finite deviations; a part measured with ``stock`` should have its mean within
+    ``tolerance`` = max(stock/2, :data:`STOCK_SPREADS` x spread) of ``stock``.
+    """
+
+    stock: float
+    mean: float
+    spread: float
+    tolerance: float
+    consistent: bool
+
+    def describe(self):
+        """One line: the measured mean and spread against what the stock expects (um)."""
+        return ("measured mean deviation %.1f um (spread %.1f um); a part measured with the "
+                "stock %g mm should have a mean of %g mm +- %.1f um (the larger of stock/2 and "
+                "%g x the spread)" % (1e3 * self.mean, 1e3 * self.spread, self.stock,
+                                      self.stock, 1e3 * self.tolerance, STOCK_SPREADS))
+
+
+def stock_check(deviation, stock, spreads=STOCK_SPREADS):
+    """Is ``stock`` (mm) consistent with the measured ``deviation`` (mm, NaN ignored)?
+
+    Returns
+    -------
+    StockCheck
+        ``consistent`` is False when ``|mean(d) - stock| > max(stock / 2, spreads *
+        std(d))`` (module doc: a semi-finished part measures ``d = stock + e``); True
+        when there is no finite deviation.
+    """
+    d = np.asarray(deviation, dtype=float).ravel()
+    d = d[np.isfinite(d)]
+    s = float(stock)
+    if not d.size:
+        return StockCheck(stock=s, mean=float("nan"), spread=float("nan"), tolerance=s / 2,
+                          consistent=True)
+    mean = float(d.mean())
+    spread = float(d.std(ddof=1)) if d.size > 1 else 0.0
+    tol = max(s / 2.0, spreads * spread)
+    return StockCheck(stock=s, mean=mean, spread=spread, tolerance=tol,
+                      consistent=bool(abs(mean - s) <= tol))
+
+
+def residual_assumption(method, stock=None):
+    """What the predicted residual ``d_f - stock - delta`` of ``method`` assumes (one
+    sentence), or "" where it assumes nothing beyond the method."""
+    if method != "mirror":
+        return ""
+    return ("the mirror method's predicted residual assumes the measured part carries the "
+            "stock %g mm (d = stock + e): it is -(the random part) whatever the stock, so "
+            "it cannot show a wrong stock; the stock check against the measured mean can"
+            % float(stock or 0.0))

@@ -124,7 +124,8 @@ def method_specs(methods=("none", "offset", "raw", "filtered", "mirror"), masks=
             if stock is not None and not (np.isfinite(stock) and stock >= 0):
                 raise InputError("the mirror method needs a stock >= 0 mm, got %r" % (stock,))
             specs.append(MethodSpec("mirror", "mirror",
-                                    Options(method="mirror",
+                                    # the simulated part carries its stock by construction
+                                    Options(method="mirror", accept_stock=True,
                                             stock=None if stock is None else float(stock),
                                             mask_kind=mask_kind, edge=edge, **kw)))
         else:

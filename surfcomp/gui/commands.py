@@ -181,6 +181,17 @@ class Command:
         return [o for o in doc.Objects if o.Name not in before]
 
 
+def _check_on_face(nom, face, meas):
+    """Refuse, before any object is made, a measurement whose points the new compensation
+    could not locate on the face (off the face, beyond its border, beyond the max offset):
+    the message in a dialog and the Report view, not a failed recompute's tracebacks."""
+    from ..app import precheck
+
+    errors = precheck.check_on_face(nom, face, features.measurement_set(meas))[0]
+    if errors:
+        raise InputError("%s: %s" % (meas.Label, errors[0]))
+
+
 def create_compensation(label, display="Map", quantity="deviation"):
     """Macro: a compensation of the selected face and measurement with the preferences'
     method, mask and edge handling; computed and shown. Returns the new object.
@@ -194,6 +205,7 @@ def create_compensation(label, display="Map", quantity="deviation"):
     if sel is None or meas is None:
         raise InputError("select the nominal face (one face) and a measurement object")
     nom, face = sel
+    _check_on_face(nom, face, meas)
     before = {o.Name for o in doc.Objects}
     lines = ["_doc = App.ActiveDocument",
              "_comp = surfcomp.app.features.make_compensation(_doc, _doc.getObject(%r), %r, "
@@ -267,17 +279,37 @@ class ImportMeasurements(Command):
         if not path:
             return
         ms = read_any(path, units=prefs.file_units())
-        dlg = PreviewDialog(ms, reader=lambda units: read_any(path, units=units))
-        # a file with implausible deviations never reaches the document
+        face, face_name = _preview_face()
+        dlg = PreviewDialog(ms, reader=lambda units, dev: read_any(path, units=units,
+                                                                   deviation_units=dev),
+                            face=face, face_name=face_name)
+        # a file with implausible deviations or points off the face never reaches the document
         if not dialogs.run_dialog(dlg) or not dlg.accepted_ok():
             return
-        units = dlg.units()
+        units, dev = dlg.units(), dlg.deviation_units()
         self.macro(translate("SurfComp", "Import measurements"), [
-            "_meas = surfcomp.app.features.make_measurement(App.ActiveDocument, %r, units=%r)"
-            % (path, units),
+            "_meas = surfcomp.app.features.make_measurement(App.ActiveDocument, %r, units=%r%s)"
+            % (path, units, "" if dev == units else ", deviation_units=%r" % dev),
             "surfcomp.gui.viewproviders.attach(_meas)",
             "App.ActiveDocument.recompute()"],
             modules=("surfcomp.app.features", "surfcomp.gui.viewproviders"))
+
+
+def _preview_face():
+    """``(check, 'Label.FaceN')`` of the nominal face the import preview checks the points
+    against (the selected face, else the document's only object with one B-spline face),
+    or ``(None, '')``."""
+    from ..app import precheck
+
+    found = selected_face() or precheck.nominal_candidate(FreeCAD.ActiveDocument)
+    if found is None:
+        return None, ""
+    obj, face = found
+
+    def check(ms):
+        return precheck.check_on_face(obj, face, ms)
+
+    return check, "%s.%s" % (obj.Label, face)
 
 
 class _MapCommand(Command):
@@ -370,14 +402,17 @@ class Mirror(_CompensationCommand):
     ID = "SurfComp_Mirror"
 
     def apply(self, comp):
-        stock = dialogs.ask_stock(self.MENU, float(comp.Stock.Value) or 0.1)
-        if stock is None:
+        deviation = [float(x) for x in comp.Deviation] or None
+        answer = dialogs.ask_stock(self.MENU, float(comp.Stock.Value) or 0.1, deviation)
+        if answer is None:
             return
+        stock, confirmed = answer
         doc = FreeCAD.ActiveDocument
         self.macro(self.MENU, [
             "_comp = App.ActiveDocument.getObject(%r)" % comp.Name,
             "_comp.Method = 'mirror'",
             "_comp.Stock = %r" % stock,
+            "_comp.StockOk = %r" % bool(confirmed),
             "_comp.ViewObject.Map = 'correction'",
             "App.ActiveDocument.recompute()"])
         if "Invalid" in comp.State or "Error" in comp.State:

@@ -46,12 +46,15 @@ def ask_float(title, label, value, minimum, maximum, decimals=4):
     return float(val) if ok else None
 
 
-def ask_stock(title, value):
-    """The mirror method's stock (mm) from the explained stock dialog, or None."""
+def ask_stock(title, value, deviation=None):
+    """The mirror method's stock from the explained stock dialog, checked against the
+    measured ``deviation`` (mm): ``(stock in mm, confirmed)``, or None when cancelled.
+    ``confirmed`` is True when the user confirmed a stock that does not fit the measured
+    mean."""
     from .panels import StockDialog
 
-    dlg = StockDialog(title, value, _parent())
-    return dlg.value() if run_dialog(dlg) else None
+    dlg = StockDialog(title, value, deviation, _parent())
+    return dlg.answer() if run_dialog(dlg) else None
 
 
 def run_dialog(dialog):

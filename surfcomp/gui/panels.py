@@ -15,7 +15,7 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from ..app import reports
 from ..app.undo import UndoStep
-from ..core import colormap
+from ..core import colormap, plausibility
 from ..core.deviations import Statistics, format_table
 from ..core.filters import EDGE_MODES
 from ..errors import SurfcompError
@@ -76,6 +76,11 @@ class ReportDialog(QtGui.QDialog):
         lay.addWidget(QtGui.QLabel(translate("SurfComp", "Deviations in %s")
                                    % colormap.UNIT_TEXT[self.unit]))
         lay.addWidget(self.table)
+        assumes = plausibility.residual_assumption(obj.Method, float(obj.Stock.Value))
+        self.assumes = QtGui.QLabel(translate("SurfComp", "Predicted residual: %s.") % assumes
+                                    if assumes else "")
+        self.assumes.setWordWrap(True)
+        lay.addWidget(self.assumes)
         box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Close)
         copy = box.addButton(translate("SurfComp", "Copy"), QtGui.QDialogButtonBox.ActionRole)
         copy.clicked.connect(self.copy)
@@ -354,11 +359,16 @@ class StockDrawing(QtGui.QWidget):
 
 
 class StockDialog(QtGui.QDialog):
-    """The mirror method's stock, explained: tooltip, text and drawing."""
+    """The mirror method's stock, explained: tooltip, text and drawing; checked against
+    the measured deviations (:func:`surfcomp.core.plausibility.stock_check`). OK refuses
+    an inconsistent stock, showing the measured mean, and offers a button that confirms
+    it; :meth:`answer` is ``(stock, confirmed)``."""
 
-    def __init__(self, title, value, parent=None):
+    def __init__(self, title, value, deviation=None, parent=None):
         super().__init__(parent or FreeCADGui.getMainWindow())
         self.setWindowTitle(title)
+        self.deviation = deviation
+        self.confirmed = False
         lay = QtGui.QVBoxLayout(self)
         text = QtGui.QLabel(translate("SurfComp", STOCK_TIP))
         text.setWordWrap(True)
@@ -375,10 +385,65 @@ class StockDialog(QtGui.QDialog):
         self.spin.setToolTip(translate("SurfComp", STOCK_TIP))
         row.addRow(translate("SurfComp", "Stock (semi-finishing allowance)"), self.spin)
         lay.addLayout(row)
+        self.check_text = QtGui.QLabel("")
+        self.check_text.setWordWrap(True)
+        lay.addWidget(self.check_text)
         box = QtGui.QDialogButtonBox(QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel)
+        self.confirm = box.addButton(translate("SurfComp", "Use this stock anyway"),
+                                     QtGui.QDialogButtonBox.ActionRole)
+        self.confirm.setVisible(False)
+        self.confirm.clicked.connect(self.accept_anyway)
         box.accepted.connect(self.accept)
         box.rejected.connect(self.reject)
+        self.buttons = box
         lay.addWidget(box)
+        self.spin.valueChanged.connect(self.show_check)
+        self.show_check()
 
     def value(self):
         return float(self.spin.value())
+
+    def check(self):
+        """The stock check of the current value, or None without deviations."""
+        if self.deviation is None:
+            return None
+        return plausibility.stock_check(self.deviation, self.value())
+
+    def show_check(self, *_args, refused=False):
+        """The measured mean against the stock under the spin box; a new value withdraws
+        the confirmation button."""
+        self.confirm.setVisible(refused)
+        c = self.check()
+        if c is None:
+            self.check_text.setText("")
+            return
+        if refused:
+            head = translate("SurfComp", "Refused: the stock does not fit the measured "
+                                         "deviations.")
+        elif c.consistent:
+            head = translate("SurfComp", "The stock fits the measured deviations.")
+        else:
+            head = translate("SurfComp", "The stock does not fit the measured deviations.")
+        what = c.describe().replace("um", "µm").replace("+-", "±")
+        self.check_text.setText("%s %s%s." % (head, what[0].upper(), what[1:]))
+        self.check_text.setStyleSheet("" if c.consistent else "color: #c53030;%s"
+                                      % (" font-weight: bold;" if refused else ""))
+
+    def accept(self):
+        """OK: an inconsistent stock is refused (the dialog stays, the confirmation button
+        appears)."""
+        c = self.check()
+        if c is not None and not c.consistent and not self.confirmed:
+            self.show_check(refused=True)
+            return
+        super().accept()
+
+    def accept_anyway(self):
+        self.confirmed = True
+        super().accept()
+
+    def answer(self):
+        """``(stock in mm, confirmed)``: confirmed is True when the user chose a stock
+        that does not fit the measured mean."""
+        c = self.check()
+        return self.value(), bool(self.confirmed and c is not None and not c.consistent)

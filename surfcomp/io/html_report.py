@@ -305,6 +305,17 @@ def _section_statistics(report, arrays):
         note = ("<p>Expected RMS of the next part (predicted residual plus a new random scatter "
                 'like this one): <span class="num">%.2f µm</span>.</p>'
                 % (1e3 * float(np.hypot(rms_res, rms_rnd))))
+    assumes = report.get("method", {}).get("residual_assumes")
+    if assumes:
+        note += "<p>Predicted residual: %s.</p>" % _e(assumes)
+    check = report.get("method", {}).get("stock_check")
+    if check:
+        note += ("<p>Stock check: mean deviation %.1f µm, spread %.1f µm, a part measured with "
+                 "this stock should lie within %.1f µm of it: %s.</p>"
+                 % (1e3 * check["mean_mm"], 1e3 * check["spread_mm"],
+                    1e3 * check["tolerance_mm"],
+                    "consistent" if check["consistent"] else
+                    "<strong>inconsistent</strong>, used as confirmed (--accept-stock)"))
     return ('<section id="statistics"><h2>Statistics</h2><p>Werner 2022 Tab. 1 and 3 form; '
             'standard deviation with ddof=%s.</p>%s%s</section>'
             % (_e(report.get("statistics_ddof", 1)), _stat_table(cols), note))

@@ -7,14 +7,17 @@ table with a header (:mod:`surfcomp.io.measurements`), and, when its header name
 none of the table's columns, as plain measured XYZ points.
 """
 
+import dataclasses
+
 from ..errors import InputError, MeasurementFileError
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
+from .units import unit_factor
 
 FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")
 
 
-def read_any(path, units="mm", fmt="auto", sample=None):
+def read_any(path, units="mm", fmt="auto", sample=None, deviation_units=None):
     """Read a measurement file of any supported format.
 
     Parameters
@@ -22,6 +25,9 @@ def read_any(path, units="mm", fmt="auto", sample=None):
     path : str
     units : {'mm', 'um', 'in'} or None
         Units of values without a unit of their own (default mm).
+    deviation_units : {'mm', 'um', 'in'}, optional
+        Unit of a deviation column without a unit of its own, when it differs from the
+        coordinates' (``units``); a deviation computed from the points keeps theirs.
     fmt : str
         One of :data:`FORMATS`; ``auto`` detects it.
     sample : int or str, optional
@@ -31,6 +37,18 @@ def read_any(path, units="mm", fmt="auto", sample=None):
     -------
     surfcomp.io.measurements.MeasurementSet
     """
+    ms = _read_any(path, units, fmt, sample)
+    if (deviation_units is None or ms.deviation is None or "dev" not in (ms.columns or {})
+            or unit_factor(deviation_units) == unit_factor(units or "mm")):
+        return ms
+    # the file again with the deviation's unit: the dev column as the reader scales it
+    # (one with a unit of its own keeps it), the coordinates of the first reading
+    dev = _read_any(path, deviation_units, fmt, sample).deviation
+    return dataclasses.replace(ms, deviation=dev, units="%s, deviation %s"
+                               % (ms.units or units or "mm", deviation_units))
+
+
+def _read_any(path, units, fmt, sample):
     if fmt not in FORMATS:
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)

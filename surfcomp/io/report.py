@@ -10,6 +10,7 @@ import json
 import numpy as np
 
 from .. import __version__
+from ..core import plausibility
 
 SCHEMA = "surfcomp-report/1"
 
@@ -22,6 +23,15 @@ def _list(a, digits=9):
     with np.errstate(over="ignore", invalid="ignore"):
         r = np.round(a, digits)
     return np.where(np.isfinite(r) | ~np.isfinite(a), r, a).tolist()
+
+
+def _stock_check(deviation, options):
+    """The mirror stock against the measured mean (mm), None for other methods."""
+    if options.method != "mirror" or options.stock is None:
+        return None
+    c = plausibility.stock_check(deviation, options.stock)
+    return {"mean_mm": c.mean, "spread_mm": c.spread, "tolerance_mm": c.tolerance,
+            "consistent": c.consistent, "accepted": bool(options.accept_stock)}
 
 
 def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
@@ -61,6 +71,8 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
             "mask_kind": "custom" if o.weights is not None else o.mask_kind,
             "edge": o.edge,
             "stock_mm": o.stock,
+            "stock_check": _stock_check(p.deviation, o),
+            "residual_assumes": plausibility.residual_assumption(o.method, o.stock) or None,
             "refine": o.refine,
             "tip_radius_mm": o.tip_radius,
         },

@@ -25,19 +25,12 @@ from surfcomp.io.html_report import (
     simulation_maps,
     write_html_report,
 )
-
-
-def _surface():
-    x = np.linspace(0.0, 30.0, 5)
-    X, Y = np.meshgrid(x, x, indexing="ij")
-    Z = 2.0 * np.sin(X / 12.0) * np.cos(Y / 15.0)
-    k = np.array([0, 0, 0, 0, 0.5, 1, 1, 1, 1.0])
-    return bspline.Surface(np.stack([X, Y, Z], axis=-1), k, k, 3, 3)
+from tests.pure.surfaces import wavy_patch
 
 
 def _report(method="filtered", stock=None, n=11, build=True, seed=1):
     """A compensation report of a synthetic smooth field + noise on an n x n grid."""
-    surf = _surface()
+    surf = wavy_patch()
     us = np.linspace(0.02, 0.98, n)
     S, Su, Sv = bspline.evaluate_grid(surf, us, us, order=1)
     nrm = np.cross(Su, Sv)
@@ -61,7 +54,7 @@ def _report(method="filtered", stock=None, n=11, build=True, seed=1):
 def rendered(tmp_path_factory):
     """A filtered compensation with a simulation, written and opened in headless Chromium."""
     folder = tmp_path_factory.mktemp("html")
-    sim = sm.simulate(_surface(), 1, sm.MachiningModel(), grid=(9, 9), replicas=2, seed=3,
+    sim = sm.simulate(wavy_patch(), 1, sm.MachiningModel(), grid=(9, 9), replicas=2, seed=3,
                       specs=sm.method_specs(["none", "offset", "raw", "filtered"])).as_dict()
     rep = _report()
     path = str(folder / "report.html")

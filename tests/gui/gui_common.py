@@ -35,7 +35,10 @@ STOCKS = [0.1]
 dialogs.show_error = lambda title, message: ERRORS.append([title, message])
 dialogs.show_info = lambda title, message: INFOS.append([title, message])
 dialogs.ask_open_file = lambda title, filters: FILES.pop(0)
-dialogs.ask_stock = lambda title, value: STOCKS[0]
+#: the replaced dialogs, for sessions that drive the real one with input events
+REAL_DIALOGS = {"ask_stock": dialogs.ask_stock}
+# the scripted user confirms the stock (a stock that does not fit the measured mean too)
+dialogs.ask_stock = lambda title, value, deviation=None: (STOCKS[0], True)
 dialogs.ask_save_file = lambda title, filters, default="": os.path.join(TMP, "report.html")
 #: what a dialog does when it is "run": a function(dialog) -> accepted
 ON_DIALOG = []
@@ -65,6 +68,20 @@ def load_example(doc):
     Gui.runCommand("SurfComp_ImportMeasurements")
     meas = [o for o in doc.Objects if o.Name.startswith("Measurement")][-1]
     return doc.getObject("Nominal"), meas
+
+
+def deviations_in_um(path):
+    """The example's measurements with the deviation column in um, its name without a unit
+    (the coordinates stay in mm); returns the lines of the example."""
+    with open(MEAS) as f:
+        rows = f.read().splitlines()
+    with open(path, "w") as f:
+        for line in rows:
+            parts = line.split(",")
+            if parts[0].startswith("P"):
+                parts[7] = "%.1f" % (float(parts[7]) * 1000.0)
+            f.write(",".join(parts) + "\n")
+    return rows
 
 
 def make_map(doc, nominal, meas, command="SurfComp_DeviationMap"):

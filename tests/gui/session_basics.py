@@ -50,14 +50,7 @@ RESULTS["preview"] = PREVIEWS[:]
 
 # the um file read as mm (issue 13): deviations in um, no unit in the column name
 um = os.path.join(TMP, "deviations_in_um.csv")
-with open(MEAS) as f:
-    rows = f.read().splitlines()
-with open(um, "w") as f:
-    for line in rows:
-        parts = line.split(",")
-        if parts[0].startswith("P"):
-            parts[7] = "%.1f" % (float(parts[7]) * 1000.0)
-        f.write(",".join(parts) + "\n")
+rows = deviations_in_um(um)
 n_before = len(doc.Objects)
 del PREVIEWS[:]
 state = {}
@@ -127,9 +120,15 @@ with open(far, "w") as f:
         if parts[0].startswith("P"):
             parts[3] = "%.6f" % (float(parts[3]) + 5.0)
         f.write(",".join(parts) + "\n")
+# the preview locates the points on the nominal face: refused there, nothing added
+n_before = len(doc.Objects)
 FILES.append(far)
 Gui.runCommand("SurfComp_ImportMeasurements")
-far_meas = doc.Objects[-1]
+RESULTS["far_preview"] = [PREVIEWS[-1], len(doc.Objects) - n_before]
+# made by script, the map refuses it before any object is made
+from surfcomp.app import features
+
+far_meas = features.make_measurement(doc, far)
 names_before = sorted(o.Name for o in doc.Objects)
 del ERRORS[:]
 Gui.Selection.clearSelection()

@@ -75,8 +75,10 @@ def test_import_preview_sample_rows_ranges_and_units(session):
     text = session["preview"][0]
     assert "Points: 2025" in text and "nominal+normal+deviation" in text
     assert "Problems found: none" in text
-    assert "First 6 rows (mm):" in text and "Value ranges (mm):" in text
-    assert "deviation" in text.split("Value ranges (mm):")[1]
+    assert "First 6 rows (coordinates in mm, deviation in mm):" in text
+    assert "Value ranges (coordinates in mm, deviation in mm):" in text
+    assert "deviation" in text.split("Value ranges (coordinates in mm, deviation in mm):")[1]
+    assert "Checked against the nominal face: nominal.Face1" in text
 
 
 def test_deviations_in_um_read_as_mm_are_refused_before_the_document(session):
@@ -88,13 +90,14 @@ def test_deviations_in_um_read_as_mm_are_refused_before_the_document(session):
     assert "deviations_in_um.csv:4: deviation" in text     # the line is named
     assert "are the deviations in um?" in text
     assert status.startswith("Cannot import:") and "larger than the max offset 1 mm" in status
-    # the unit selector reads the file again: in um it is plausible
+    # the deviation's unit selector reads the file again: in um it is plausible, and the
+    # coordinates stay in mm (their own selector)
     text, status, ok, unit = session["um_file"]["um"]
-    assert unit == "um" and ok is True and "ERRORS" not in text
-    assert "Value ranges (µm):" in text
+    assert unit == "mm" and ok is True and "ERRORS" not in text
+    assert "Value ranges (coordinates in mm, deviation in µm):" in text
     assert session["um_file_objects_added"] == 0
     name, units, largest = session["um_file_as_um"]
-    assert name.startswith("Measurement") and units == "um" and largest < 0.1
+    assert name.startswith("Measurement") and units == "mm, deviation um" and largest < 0.1
 
 
 def test_deviations_far_beyond_the_size_tolerance_are_flagged(session):
@@ -111,6 +114,10 @@ def test_unreadable_file_error_dialog_has_the_cli_message(session):
 
 
 def test_measurement_off_the_face_error_dialog_document_unchanged(session):
+    text, added = session["far_preview"]
+    assert added == 0 and "Checked against the nominal face: nominal.Face1" in text
+    assert "ERRORS (1)" in text and "far.csv:973: nominal point (21.1601, 21.8314, 14.0338) " \
+        "is 4.9999 mm from the face" in text
     (title, message), = session["far_errors"]
     assert "Deviation map" in title
     assert "far.csv:" in message and "mm from the face" in message
