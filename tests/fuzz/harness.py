@@ -156,11 +156,19 @@ def subprocess_env(extra=None):
     return env
 
 
+def default_signals():
+    """``preexec_fn`` of a child: SIGINT, SIGTERM and SIGHUP at their defaults, also when
+    the test runner has them ignored (``nohup``, a background job)."""
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
+
+
 def run_subprocess(argv, cwd, timeout=300):
     """``python3 -m surfcomp argv`` with ``cwd`` as working directory (so that it is on
     ``sys.path``, as for a user), surfcomp found through PYTHONPATH."""
     proc = subprocess.run([sys.executable, "-m", "surfcomp"] + [str(a) for a in argv], cwd=cwd,
-                          env=subprocess_env(), capture_output=True, text=True, timeout=timeout)
+                          env=subprocess_env(), capture_output=True, text=True, timeout=timeout,
+                          preexec_fn=default_signals)
     return Result(proc.returncode, proc.stdout, proc.stderr)
 
 

@@ -99,15 +99,18 @@ CLOBBER = [
 ALL_OR_NOTHING = [
     comp("report-is-an-existing-folder", "--report", "rdir", setup=I.setup(BASE, I.folder("rdir")),
          file="rdir", says=("--report is a folder",)),
-    comp("curves-on-a-scattered-layout", "--curves", "new/b/net.step", setup=with_meas(_scattered),
+    comp("curves-on-a-scattered-layout", "--curves", "new/b/net.step",
+         setup=I.setup(with_meas(_scattered), I.folder("new/a"), I.folder("new/b")),
          out=("-o", "new/a/c.step"), says=("--curves needs a measurement grid",)),
     comp("o-in-proc", out=("-o", "/proc/c.step"), file="/proc/c.step"),
     comp("html-in-proc", "--html", "/proc/r.html", file="/proc/r.html"),
     insp("inspect-report-in-proc", "--report", "/proc/r.json", file="/proc/r.json"),
     comp("o-under-a-file", out=("-o", "m.csv/c.step"), file="m.csv/c.step",
-         says=("cannot create the folder",)),
+         says=("m.csv is not a folder",)),
+    comp("outputs-in-missing-folders", "--report", "out/r.json", out=("-o", "out/c.step"),
+         file="out/c.step", says=("its folder out cannot be reached", "No such file")),
     comp("o-is-a-device", out=("-o", "/dev/null"), file="/dev/null",
-         says=("not a regular file",)),
+         says=("is in /dev, a folder of devices",)),
     comp("o-is-a-broken-link", setup=I.setup(BASE, I.link("dangling.step", "gone/x.step")),
          out=("-o", "dangling.step"), file="dangling.step", says=("not a regular file",)),
     comp("o-unsupported-type", out=("-o", "c.txt"), file="c.txt",
@@ -188,8 +191,9 @@ OPTIONS_OK = [
     comp("mirror-stock=10", "--method", "mirror", "--stock", "10", rc=0, writes=("c.step",)),
     insp("inspect-max-offset=100", "--max-offset", "100", rc=0),
     insp("inspect-smoothing-bounds", "--layout", "scattered", "--smoothing", "1e4", rc=0),
-    comp("outputs-in-new-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
-         out=("-o", "out/c.step"), rc=0, writes=("out/c.step", "out/r.json", "out/deep/p.csv")),
+    comp("outputs-in-existing-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
+         setup=I.setup(BASE, I.folder("out/deep")), out=("-o", "out/c.step"), rc=0,
+         writes=("out/c.step", "out/r.json", "out/deep/p.csv")),
 ]
 
 
