@@ -22,25 +22,13 @@ def _main():
     root = os.path.dirname(here)
     if root not in sys.path:
         sys.path.insert(0, root)
-    from surfcomp.app.file_route import declared_outputs, load_job_file, run_job
-    from surfcomp.cli import runner
-    from surfcomp.cli.common import ProgressLine, print_summary, print_written
+    from surfcomp.cli.jobfile import run_job_file
 
     path = os.environ.get("SURFCOMP_JOB")
     if not path:
         print("surfcomp: error: set SURFCOMP_JOB to the job file (JSON)", file=sys.stderr)
         return 2
-
-    def body():
-        job = load_job_file(path)
-        to_stdout = any(p == "-" for _o, p in declared_outputs(job))
-        with contextlib.redirect_stdout(sys.stderr if to_stdout else sys.stdout):
-            comp, rep = run_job(job, progress=ProgressLine(), inputs=[("job file", path)])
-            print_summary(comp, rep)
-            print_written(job)
-        return 0
-
-    return runner.run(body)
+    return run_job_file(path)
 
 
 _code = _main()
