@@ -101,6 +101,8 @@ def snapshot(root):
                                 sha256(path) if os.path.isfile(path) else None)
             elif os.path.isdir(path):
                 entries[rel] = ("dir",)
+            elif not os.path.isfile(path):      # a FIFO or socket: never opened
+                entries[rel] = ("special",)
             else:
                 entries[rel] = ("file", sha256(path))
     return entries

@@ -258,3 +258,37 @@ def test_job_file_dotdot_after_a_link(tmp_path, cad_cache):
     assert res.rc == 0, res.err
     assert "wrote vlink/../nominal.step" in res.out.replace(str(sandbox) + "/", "")
     check_tree(before, snapshot(sandbox), writes=("v/nominal.step", "v/job.json"))
+
+
+FREECADCMD = [
+    ({"command": "bogus"}, 2, '"command": "bogus": a job file runs "compensate" or "inspect"'),
+    ({"command": "simulate"}, 2, '"command": "simulate": a job file runs'),
+    ({"command": "inspect", "output": "c.step"}, 2,
+     '"output": does nothing for "command": "inspect"'),
+    ({"report": "job.json"}, 2, "--report would overwrite the input job file job.json"),
+    ({"output": "nope/../nominal.step"}, 2, "-o cannot be written: its folder"),
+    ({"output": "vlink/../nominal.step", "method": "raw"}, 0, "wrote "),
+]
+
+
+@pytest.mark.parametrize("keys, rc, says", FREECADCMD,
+                         ids=["%s" % (sorted(k.items()),) for k, _r, _s in FREECADCMD])
+def test_freecadcmd_job(keys, rc, says, tmp_path):
+    """The same through ``freecadcmd macros/surfcomp_job.py`` itself."""
+    import subprocess
+
+    from .harness import ROOT, default_signals
+
+    sandbox = tmp_path / BOX
+    sandbox.mkdir()
+    INPUTS(str(sandbox))
+    _job(str(sandbox), **keys)
+    before = snapshot(str(sandbox))
+    proc = subprocess.run(["freecadcmd", os.path.join(ROOT, "macros", "surfcomp_job.py")],
+                          cwd=str(sandbox), env=dict(os.environ, SURFCOMP_JOB="job.json"),
+                          capture_output=True, text=True, timeout=300,
+                          preexec_fn=default_signals)
+    assert proc.returncode == rc, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert says in (proc.stdout if rc == 0 else proc.stderr), proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr
+    check_tree(before, snapshot(str(sandbox)), writes=("v/nominal.step",) if rc == 0 else ())
