@@ -107,8 +107,8 @@ ALL_OR_NOTHING = [
     insp("inspect-report-in-proc", "--report", "/proc/r.json", file="/proc/r.json"),
     comp("o-under-a-file", out=("-o", "m.csv/c.step"), file="m.csv/c.step",
          says=("m.csv is not a folder",)),
-    comp("outputs-in-missing-folders", "--report", "out/r.json", out=("-o", "out/c.step"),
-         file="out/c.step", says=("its folder out cannot be reached", "No such file")),
+    comp("output-past-a-missing-folder", "--report", "out/r.json", out=("-o", "out/../c.step"),
+         file="out/../c.step", says=("its folder out/.. cannot be reached", "No such file")),
     comp("o-is-a-device", out=("-o", "/dev/null"), file="/dev/null",
          says=("is in /dev, a folder of devices",)),
     comp("o-is-a-broken-link", setup=I.setup(BASE, I.link("dangling.step", "gone/x.step")),
@@ -194,6 +194,10 @@ OPTIONS_OK = [
     comp("outputs-in-existing-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
          setup=I.setup(BASE, I.folder("out/deep")), out=("-o", "out/c.step"), rc=0,
          writes=("out/c.step", "out/r.json", "out/deep/p.csv")),
+    comp("outputs-in-new-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
+         "--html", "vlink/new/r.html", setup=I.setup(BASE, I.folder("v"), I.link("vlink", "v")),
+         out=("-o", "out/c.step"), rc=0,
+         writes=("out/c.step", "out/r.json", "out/deep/p.csv", "v/new/r.html")),
 ]
 
 

@@ -59,9 +59,8 @@ ALL_OR_NOTHING = [
        file="rdir", says=("--report is a folder",)),
     gc("o-in-proc", out=("-o", "/proc/out.ngc"), file="/proc/out.ngc"),
     gc("o-under-a-file", out=("-o", "e.csv/out.ngc"), file="e.csv/out.ngc"),
-    # refused after the program was read and planned: nothing may stay behind
-    gc("refused-late-in-folders", "--report", "new/b/r.json", "--max-error", "0.001",
-       setup=I.setup(BASE, I.folder("new/a"), I.folder("new/b")),
+    # refused after the program was read and planned: no folder may stay behind
+    gc("refused-late-in-new-folders", "--report", "new/b/r.json", "--max-error", "0.001",
        out=("-o", "new/a/out.ngc"), file="e.csv", line=3, says=("--max-error",)),
 ]
 

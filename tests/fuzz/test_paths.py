@@ -54,6 +54,13 @@ ONTO = ("./{x}", ".//{x}", "v/../{x}", "v/sub/../../{x}", "vlink/../../{x}",
 #: spellings whose folder the kernel cannot reach (a missing folder, a file) before ..
 UNREACHABLE = ("nope/../{x}", "nope/./../{x}", "nope//../{x}", "afile/../{x}", "{x}/../{x}",
                "v/nope/../../{x}", "vlink/nope/../../{x}")
+#: new folders named plainly are made; the rest of the path resolved by the kernel
+NEW_FOLDERS = [
+    ("compensate", "--report", "new/r.json", "new/r.json"),
+    ("compensate", "-o", "vlink/../new/a/c.step", "v/new/a/c.step"),
+    ("gcode", "--report", "v/sub/../new//r.json", "v/new/r.json"),
+    ("simulate", "--json", ".//new/s.json", "new/s.json"),
+]
 #: spellings that name a folder
 FOLDERS = ("{x}/", "{x}//", "./{x}/", "{x}/.", "v/..", "vlink/.")
 
@@ -125,6 +132,16 @@ def test_dotdot_after_a_link_writes_where_the_kernel_says(command, option, path,
         request.getfixturevalue("cad_cache")
     run_case(Case(path, _argv(command, option, path), _setup(command), rc=0,
                   writes=(written,)), tmp_path / BOX)
+
+
+@pytest.mark.parametrize("command, option, path, written", NEW_FOLDERS,
+                         ids=["-".join(c[:3]) for c in NEW_FOLDERS])
+def test_new_folders_named_plainly(command, option, path, written, tmp_path, request):
+    if command != "gcode":
+        request.getfixturevalue("cad_cache")
+    run_case(Case(path, _argv(command, option, path), _setup(command), rc=0,
+                  writes=(written,) + (("out.ngc",) if command == "gcode" else ())),
+             tmp_path / BOX)
 
 
 # --------------------------------------------------------------------- every input guarded
