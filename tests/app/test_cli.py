@@ -133,7 +133,6 @@ def test_missing_nominal(tmp_path):
 
 def test_freecadcmd_job_route(tmp_path):
     job = tmp_path / "job.json"
-    (tmp_path / "out").mkdir()
     job.write_text(json.dumps({"command": "compensate", "nominal": EXAMPLE_STEP,
                                "measurements": EXAMPLE_CSV, "output": "out/c.step",
                                "report": "out/r.json", "method": "raw"}))
