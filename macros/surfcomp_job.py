@@ -14,7 +14,13 @@ temporary file left).
 
 import contextlib
 import os
+import signal
 import sys
+
+# Ctrl-C while surfcomp is still being imported: FreeCAD's own SIGINT handling would end the
+# process with exit 0 (signal.signal puts Python's handler back; the run installs its own)
+if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _main():
@@ -31,7 +37,11 @@ def _main():
     return run_job_file(path)
 
 
-_code = _main()
+try:
+    _code = _main()
+except KeyboardInterrupt:
+    print("surfcomp: interrupted; nothing was written", file=sys.stderr)
+    _code = 130
 for _stream in (sys.stdout, sys.stderr):
     with contextlib.suppress(OSError, ValueError):
         _stream.flush()
