@@ -162,7 +162,7 @@ def check_outputs(outputs, inputs=()):
                              % (seen[dest.key], option,
                                 "standard output" if dest.stdout else "file"), file=path)
         seen[dest.key] = option
-        dests[path] = dest
+        dests[os.fspath(path)] = dest
     return dests
 
 
