@@ -239,3 +239,17 @@ def test_250_character_corrected_face(tmp_path, cad_cache):
     run_case(Case("long-step", ("compensate", "n.step", "m.csv", "-o", name, "--quiet"),
                   I.setup(I.copy("n.step", EXAMPLE_STEP), I.put("m.csv", I.csv)), rc=0,
                   writes=(name,)), tmp_path / "box")
+
+
+def test_255_byte_name_replaced(tmp_path):
+    """An existing output with a name of 255 bytes is replaced (its backup during the
+    commit fits the file system too); nothing else is left."""
+    box = tmp_path / "box"
+    box.mkdir()
+    BASE(str(box))
+    name = _name(255)
+    (box / name).write_text("old program\n")
+    res = run_cli(GCODE + ("-o", name), str(box))
+    assert res.rc == 0, res.err
+    assert "G1" in (box / name).read_text()
+    assert sorted(os.listdir(str(box))) == sorted(["e.csv", "in.ngc", name])
