@@ -37,7 +37,7 @@ def build_parser(only=None):
     subparsers.required = True
     for name in (only,) if only in COMMANDS else COMMANDS:
         module = importlib.import_module("." + name, __name__)
-        module.add_parser(subparsers)
+        registry.add_plain_options(module.add_parser(subparsers), name)
     return parser
 
 

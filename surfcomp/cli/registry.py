@@ -6,7 +6,8 @@ and the name messages use for it. The commands add their options from this table
 (:func:`add_options`) and :func:`declared` turns a parsed command line into the outputs and
 inputs :func:`surfcomp.io.atomic.check_outputs` compares, so an input option added here is
 guarded against every output without further code. Options that name no file may be added
-with the role ``option``.
+with the role ``option``: :func:`add_plain_options` adds them to each command's parser after
+the command's own options, so one entry here is all such an option needs.
 """
 
 from dataclasses import dataclass, field
@@ -112,13 +113,19 @@ def entries(command, role=None):
 
 
 def add_options(parser, command, groups=None, flags=None):
-    """Add ``command``'s options of the table to ``parser`` (``groups``: argument groups by
-    title; ``flags``: only the entries whose first flag is among them)."""
+    """Add ``command``'s file options of the table to ``parser`` (``groups``: argument groups
+    by title; ``flags``: only the entries whose first flag is among them)."""
     groups = groups or {}
     for e in entries(command):
-        if flags is not None and e.flags[0] not in flags:
+        if e.role == "option" or flags is not None and e.flags[0] not in flags:
             continue
         groups.get(e.group, parser).add_argument(*e.flags, **e.kwargs)
+
+
+def add_plain_options(parser, command):
+    """Add ``command``'s entries with the role ``option`` (no file) to its parser."""
+    for e in entries(command, "option"):
+        parser.add_argument(*e.flags, **e.kwargs)
 
 
 def declared(args, command=None):
