@@ -6,13 +6,21 @@
 The job file is a JSON object with the same names as the CLI (README, "freecadcmd"):
 ``{"command": "compensate", "nominal": "nominal.step", "measurements": "meas.csv",
 "output": "out/corrected.step", "report": "out/report.json", "method": "filtered",
-"mask_size": 5}``; relative paths are relative to the job file. Exit code as the CLI:
-0 ok, 2 bad input (nothing written), 1 internal error.
+"mask_size": 5}``; relative paths are relative to the job file. Exit codes, messages and
+signals as the CLI (:mod:`surfcomp.cli.runner`): 0 ok, 2 bad input (nothing written), 1
+internal error, 130/143/129 interrupted, terminated or hung up (nothing written, no
+temporary file left).
 """
 
+import contextlib
 import os
+import signal
 import sys
-import traceback
+
+# Ctrl-C while surfcomp is still being imported: FreeCAD's own SIGINT handling would end the
+# process with exit 0 (signal.signal puts Python's handler back; the run installs its own)
+if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _main():
@@ -20,31 +28,21 @@ def _main():
     root = os.path.dirname(here)
     if root not in sys.path:
         sys.path.insert(0, root)
-    from surfcomp.app.file_route import load_job_file, run_job
-    from surfcomp.cli.common import ProgressLine, print_summary
-    from surfcomp.errors import SurfcompError
+    from surfcomp.cli.jobfile import run_job_file
 
     path = os.environ.get("SURFCOMP_JOB")
     if not path:
         print("surfcomp: error: set SURFCOMP_JOB to the job file (JSON)", file=sys.stderr)
         return 2
-    try:
-        job = load_job_file(path)
-        comp, rep = run_job(job, progress=ProgressLine())
-        print_summary(comp, rep)
-        for key in ("output", "points", "curves", "report"):
-            if getattr(job, key):
-                print("wrote %s" % getattr(job, key))
-        return 0
-    except SurfcompError as exc:
-        print("surfcomp: error: %s" % exc, file=sys.stderr)
-        return exc.exit_code
-    except Exception:  # internal error: traceback, exit 1
-        traceback.print_exc()
-        return 1
+    return run_job_file(path)
 
 
-_code = _main()
-sys.stdout.flush()
-sys.stderr.flush()
+try:
+    _code = _main()
+except KeyboardInterrupt:
+    print("surfcomp: interrupted; nothing was written", file=sys.stderr)
+    _code = 130
+for _stream in (sys.stdout, sys.stderr):
+    with contextlib.suppress(OSError, ValueError):
+        _stream.flush()
 os._exit(_code)

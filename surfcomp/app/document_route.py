@@ -27,6 +27,7 @@ from ..core.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
+from ..io.outpath import shown
 from . import cam, cam_job, features
 from .documents import open_document, restore_failures
 
@@ -186,9 +187,9 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
 
 def _declared(document, measurements, save, gcode, overwrite_input):
     """(outputs, inputs) for :class:`surfcomp.io.atomic.Transaction`."""
-    inputs = [("MEASUREMENTS", measurements)]
-    if not overwrite_input:
-        inputs.append(("document (--overwrite-input allows it)", document))
+    inputs = [("MEASUREMENTS", measurements),
+              ("document", document, ("--save",)) if overwrite_input else
+              ("document (--overwrite-input allows it)", document)]
     return [("--save", save), ("--gcode", gcode)], inputs
 
 
@@ -255,7 +256,7 @@ def _write(doc, result, save, gcode, text, declared):
             result.saved = os.path.abspath(save)
         if text is not None:
             tx.stage_text(gcode, text)
-            result.gcode = os.path.abspath(gcode)
+            result.gcode = shown(gcode)
             result.gcode_lines = text.count("\n")
         tx.commit()
 

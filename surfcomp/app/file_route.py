@@ -20,6 +20,7 @@ from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.html_report import render_html
+from ..io.outpath import shown
 from ..io.readers import read_any
 from ..io.step_face import write_natural_face
 from . import fcenv
@@ -53,46 +54,70 @@ class Job:
 
     @classmethod
     def from_dict(cls, data, base_dir="."):
-        """A job from a JSON job file's dict; relative paths are relative to ``base_dir``."""
+        """A job from a JSON job file's dict; relative paths are relative to ``base_dir``.
+
+        Unknown keys and commands, and keys that do nothing for the job's command, are
+        refused."""
         known = {f.name for f in fields(cls)} - {"options"}
         opt_names = {f.name for f in fields(Options)}
         unknown = set(data) - known - opt_names
         if unknown:
             raise InputError("unknown job file keys: %s (expected some of %s)"
                              % (", ".join(sorted(unknown)), ", ".join(sorted(known | opt_names))))
+        command = data.get("command", "compensate")
+        if command not in JOB_COMMANDS:
+            raise InputError("\"command\": %s: a job file runs %s (simulate and gcode are "
+                             "command-line only)" % (json.dumps(command), " or ".join(
+                                 '"%s"' % c for c in JOB_COMMANDS)))
+        inert = sorted(set(data) & set(INERT_KEYS.get(command, ())))
+        if inert:
+            raise InputError("%s: does nothing for \"command\": \"%s\" (it builds no face); "
+                             "remove %s or use \"command\": \"compensate\""
+                             % (", ".join('"%s"' % k for k in inert), command,
+                                "it" if len(inert) == 1 else "them"))
         for key in ("nominal", "measurements"):
             if key not in data:
                 raise InputError("the job file needs %r" % key)
         kw = {k: data[k] for k in known if k in data}
-        for k in ("nominal", "measurements", "output", "report", "points", "curves", "html"):
-            if kw.get(k):
+        for k, _role, _label in JOB_FILES:
+            if kw.get(k) and kw[k] != "-":
                 kw[k] = os.path.join(base_dir, kw[k])
         kw["options"] = Options(**{k: data[k] for k in opt_names if k in data})
         return cls(**kw)
 
 
+#: the commands a job file runs
+JOB_COMMANDS = ("compensate", "inspect")
+#: the files of a job: (attribute of :class:`Job`, role, name in messages); the command
+#: line's are in :mod:`surfcomp.cli.registry`
+JOB_FILES = (("nominal", "input", "NOMINAL"), ("measurements", "input", "MEASUREMENTS"),
+             ("output", "output", "-o"), ("report", "output", "--report"),
+             ("points", "output", "--points"), ("curves", "output", "--curves"),
+             ("html", "output", "--html"))
 #: the outputs of a job: (attribute of :class:`Job`, command-line option)
-OUTPUT_OPTIONS = (("output", "-o"), ("report", "--report"), ("points", "--points"),
-                  ("curves", "--curves"), ("html", "--html"))
+OUTPUT_OPTIONS = tuple((attr, label) for attr, role, label in JOB_FILES if role == "output")
+#: job keys that do nothing for a command (refused)
+INERT_KEYS = {"inspect": ("output", "points", "curves", "face_only", "refine", "lean")}
 
 
 def declared_outputs(job):
     """``(option, path)`` of every output the job writes."""
     return [(option, getattr(job, attr)) for attr, option in OUTPUT_OPTIONS
-            if getattr(job, attr)]
+            if getattr(job, attr) is not None]
 
 
 def declared_inputs(job):
-    return [("NOMINAL", job.nominal), ("MEASUREMENTS", job.measurements)]
+    return [(label, getattr(job, attr)) for attr, role, label in JOB_FILES if role == "input"]
 
 
-def run_job(job, progress=None):
+def run_job(job, progress=None, inputs=()):
     """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs.
 
-    The outputs are checked against the inputs and each other before anything is read, and
-    written together at the end (:class:`surfcomp.io.atomic.Transaction`).
+    The outputs are checked against the inputs (the job's and ``inputs``, e.g. the job
+    file) and each other before anything is read, and written together at the end
+    (:class:`surfcomp.io.atomic.Transaction`).
     """
-    outputs, inputs = declared_outputs(job), declared_inputs(job)
+    outputs, inputs = declared_outputs(job), declared_inputs(job) + list(inputs)
     check_outputs(outputs, inputs)
     job.options.validate()
     for attr in ("output", "curves"):
@@ -122,7 +147,7 @@ def run_job(job, progress=None):
         shapes["output"] = output.shape
     rep = report_io.build_report(job.command, _inputs_record(job, nominal, ms), comp,
                                  prepared.warnings,
-                                 {attr: os.path.abspath(getattr(job, attr))
+                                 {attr: shown(getattr(job, attr))
                                   for attr, _opt in OUTPUT_OPTIONS if getattr(job, attr)},
                                  points=bool(job.report or job.html),
                                  output_shape=output.as_dict() if output else None)
@@ -270,4 +295,9 @@ def load_job_file(path):
                          file=path, line=exc.lineno, column=exc.colno) from exc
     if not isinstance(data, dict):
         raise InputError("the job file must hold a JSON object", file=path)
-    return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))
+    try:
+        return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))
+    except InputError as exc:
+        if exc.file is None:            # about the job file's keys: name the job file
+            exc.file = path
+        raise

@@ -2,21 +2,24 @@
 """Command-line front end: ``python3 -m surfcomp <command> ...``.
 
 Each subcommand lives in its own module of this package with two functions,
-``add_parser(subparsers)`` and ``run(args) -> int``. Exit codes: 0 ok, 2 bad input
-(stderr says why, nothing written), 1 internal error, 130 interrupted (Ctrl-C), 143
-terminated (SIGTERM), 129 hung up (SIGHUP). An interrupted command removes its temporary
-files and writes nothing.
+``add_parser(subparsers)`` and ``run(args) -> int``; the options naming files are in
+:mod:`surfcomp.cli.registry`, and every output is checked against every input and every
+other output (:func:`surfcomp.io.atomic.check_outputs`) before the command starts. Exit
+codes (:mod:`surfcomp.cli.runner`): 0 ok (the outputs are complete), 2 bad input (stderr
+says why, nothing written), 1 internal error, 130 interrupted (Ctrl-C), 143 terminated
+(SIGTERM), 129 hung up (SIGHUP). An interrupted command removes its temporary files and
+writes nothing; a signal after the outputs were committed exits 0 and names them.
 """
 
 import argparse
 import importlib
-import signal
 import sys
-import threading
-import traceback
 
 from .. import __version__
 from ..errors import SurfcompError
+from ..io import atomic
+from . import registry, runner
+from .runner import Terminated  # noqa: F401  (the signal exception, for callers)
 
 #: subcommand modules, in the order ``--help`` lists them
 COMMANDS = ("compensate", "inspect", "simulate", "gcode")
@@ -34,7 +37,7 @@ def build_parser(only=None):
     subparsers.required = True
     for name in (only,) if only in COMMANDS else COMMANDS:
         module = importlib.import_module("." + name, __name__)
-        module.add_parser(subparsers)
+        registry.add_plain_options(module.add_parser(subparsers), name)
     return parser
 
 
@@ -42,45 +45,14 @@ class ArgumentError(SurfcompError):
     exit_code = 2
 
 
-class Terminated(KeyboardInterrupt):
-    """SIGTERM or SIGHUP: unwinds like Ctrl-C (temporary files removed, nothing written)."""
-
-    def __init__(self, signum):
-        super().__init__(signum)
-        self.exit_code = 128 + signum
-
-
-def _terminate(signum, _frame):
-    raise Terminated(signum)
-
-
-def _handle_signals():
-    if threading.current_thread() is not threading.main_thread():
-        return
-    for name in ("SIGTERM", "SIGHUP"):
-        sig = getattr(signal, name, None)
-        if sig is not None and signal.getsignal(sig) is not signal.SIG_IGN:
-            signal.signal(sig, _terminate)
-
-
 def main(argv=None):
-    """Run the command line; return the process exit code."""
+    """Run the command line; return the process exit code (:mod:`surfcomp.cli.runner`)."""
     args = sys.argv[1:] if argv is None else list(argv)
     parser = build_parser(args[0] if args else None)
     args = parser.parse_args(args)
-    _handle_signals()
-    try:
-        return int(args.run(args) or 0)
-    except SurfcompError as exc:
-        print("surfcomp: error: %s" % exc, file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt as exc:
-        print("surfcomp: %s; nothing was written"
-              % ("interrupted" if not isinstance(exc, Terminated) else
-                 "terminated by signal %d" % (exc.exit_code - 128)), file=sys.stderr)
-        return getattr(exc, "exit_code", 130)
-    except Exception:  # an internal error: show the traceback, exit 1
-        traceback.print_exc()
-        print("surfcomp: internal error (please report it with the traceback above)",
-              file=sys.stderr)
-        return 1
+
+    def body():
+        atomic.check_outputs(*registry.declared(args))
+        return args.run(args)
+
+    return runner.run(body, data_to_stdout=registry.wants_stdout(args))

@@ -10,21 +10,19 @@ from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
 from ..core.pipeline import Options
 from ..io.readers import FORMATS
+from . import registry
 
 
 def add_job_parser(subparsers, name, summary, description):
     """The parser of a job command (``compensate``, ``inspect``) with its input options."""
     p = subparsers.add_parser(name, help=summary, description=description)
-    add_input_options(p)
+    add_input_options(p, name)
     return p
 
 
-def add_input_options(p):
+def add_input_options(p, command):
     """NOMINAL MEASUREMENTS, face choice, units, and the measurement checks."""
-    p.add_argument("nominal", metavar="NOMINAL",
-                   help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)")
-    p.add_argument("measurements", metavar="MEASUREMENTS",
-                   help="measurement file (CSV/text; see README 'Measurement files')")
+    registry.add_options(p, command, flags=("nominal", "measurements"))
     p.add_argument("--face", metavar="FaceN",
                    help="the nominal face (default: the only B-spline face)")
     p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
@@ -53,7 +51,7 @@ def add_input_options(p):
                    help="stylus ball radius when the measured points are tip centres (probe "
                         "logs): each contact point is the centre moved by it against the "
                         "outward normal (default 0)")
-    p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
+    registry.add_options(p, command, flags=("--report",))
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
 
 
@@ -106,12 +104,25 @@ def run_job_command(args, command):
     from ..app.file_route import run_job
 
     job = job_from_args(args, command)
-    comp, rep = run_job(job, progress=ProgressLine(args.quiet))
+    comp, rep = run_job(job, progress=ProgressLine(args.quiet),
+                        inputs=registry.declared(args, command)[1])
     print_summary(comp, rep)
-    for key in ("output", "points", "curves", "report", "html"):
-        if getattr(job, key):
-            print("wrote %s" % getattr(job, key))
+    print_written(job)
     return 0
+
+
+def print_written(job, out=None):
+    """The ``wrote ...`` lines of a job's outputs."""
+    from ..app.file_route import OUTPUT_OPTIONS
+
+    for attr, _option in OUTPUT_OPTIONS:
+        if getattr(job, attr) is not None:
+            print(wrote(getattr(job, attr)), file=out or sys.stdout)
+
+
+def wrote(path):
+    """``wrote PATH`` (``-``: standard output)."""
+    return "wrote %s" % ("- (standard output)" if path == "-" else path)
 
 
 def options_from_args(args):

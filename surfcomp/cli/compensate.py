@@ -2,6 +2,7 @@
 """``python3 -m surfcomp compensate``: nominal + measurements -> corrected face."""
 
 from ..errors import InputError
+from . import registry
 from .common import (
     ProgressLine,
     add_job_parser,
@@ -17,30 +18,21 @@ def add_parser(subparsers):
         "build the corrected face that pre-compensates the systematic error",
         "Build a corrected B-spline face from a nominal face and a measurement file (Werner "
         "2022 raw/filtered, mirror method, uniform offset).")
-    p.add_argument("-o", "--output", metavar="OUT.step",
-                   help="the nominal's shape with the face replaced by the corrected face (its "
-                        "neighbours re-trimmed), or the corrected face when the nominal is a "
-                        "lone face (STEP; .iges/.brep by extension)")
+    registry.add_options(p, "compensate", flags=("-o",))
     p.add_argument("--face-only", action="store_true",
                    help="write the corrected face alone, also when it is a face of a solid or "
                         "shell")
     add_method_options(p)
-    p.add_argument("--points", metavar="OUT.csv", help="also write the corrected points (CSV)")
-    p.add_argument("--curves", metavar="OUT.step",
-                   help="also write the curve net through the corrected points (Werner Fig. 3b)")
-    p.add_argument("--html", metavar="OUT.html",
-                   help="also write the self-contained HTML inspection report")
+    registry.add_options(p, "compensate", flags=("--points", "--curves", "--html"))
     doc = p.add_argument_group(
-        "shop document (NOMINAL is an .FCStd)",
+        registry.DOCUMENT,
         "Add the compensation to the document, put it in the nominal's place so Path "
         "regenerates the tool paths, save a copy and post the program. The input document "
         "is never overwritten unless --overwrite-input is given.")
     doc.add_argument("--replace", action="store_true",
                      help="rebind every user of the nominal (Path Job models, operations, "
                           "links) to the compensation and recompute")
-    doc.add_argument("--save", metavar="OUT.FCStd", help="save the updated document here")
-    doc.add_argument("--gcode", metavar="OUT.ngc",
-                     help="post the regenerated program of the Job using the compensation")
+    registry.add_options(p, "compensate", {registry.DOCUMENT: doc}, flags=("--save", "--gcode"))
     doc.add_argument("--post", default="linuxcnc", metavar="NAME",
                      help="Path post-processor for --gcode (default linuxcnc)")
     doc.add_argument("--post-args", default="--no-show-editor", metavar="ARGS",

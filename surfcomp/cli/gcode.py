@@ -21,6 +21,9 @@ from ..io.axis_csv import read_axis_errors
 from ..io.gcode import compensate_gcode, parse_gcode, read_gcode
 from ..io.gcode.interpreter import MAX_POSITION
 from ..io.hashing import sha256_file
+from ..io.outpath import shown
+from . import registry
+from .common import wrote
 
 SCHEMA = "surfcomp-gcode-report/1"
 
@@ -32,12 +35,7 @@ def add_parser(subparsers):
                     "geometric axis errors (Dobariya 2015: scale, straightness, flatness, "
                     "squareness; linear or quadratic per axis) lands on the programmed "
                     "points. Lines that need no change are kept byte for byte.")
-    p.add_argument("program", metavar="IN.ngc", help="G-code program (G0/G1/G2/G3, 3 axes)")
-    p.add_argument("--axis-errors", required=True, metavar="ERR.csv",
-                   help="per-axis error measurements: 'axis,position,ex,ey,ez' rows or "
-                        "'X EXX EYX EZX' tables (docs/axis_errors.md)")
-    p.add_argument("-o", "--output", required=True, metavar="OUT.ngc",
-                   help="compensated program (written atomically)")
+    registry.add_options(p, "gcode", flags=("program", "--axis-errors", "-o"))
     p.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
                    help="longest piece of a split G1 move or of an arc turned into G1 "
                         "segments (default 2 mm; at least %g mm, and at most %d segments "
@@ -45,7 +43,7 @@ def add_parser(subparsers):
     p.add_argument("--model", choices=MODEL_CHOICES, default="auto",
                    help="degree of every error function, or auto: quadratic where the "
                         "F-test of the quadratic term is significant at 5%% (default auto)")
-    p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
+    registry.add_options(p, "gcode", flags=("--report",))
     p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
                    help="units of error-file columns without a unit suffix (default mm)")
     p.add_argument("--max-error", type=float, default=1.0, metavar="MM",
@@ -113,14 +111,8 @@ def _outside_travel(model, points):
     return int((dist > 1e-9).sum()), float(dist.max())
 
 
-def _declared(args):
-    """(outputs, inputs) of the command, checked before any work and at the commit."""
-    return ([("-o", args.output), ("--report", args.report)],
-            [("IN.ngc", args.program), ("--axis-errors", args.axis_errors)])
-
-
 def run(args):
-    check_outputs(*_declared(args))
+    check_outputs(*registry.declared(args, "gcode"))
     seg = _positive(args.segment_length, "--segment-length", MIN_SEGMENT_LENGTH)
     tol = _positive(args.tolerance, "--tolerance")
     arc_tol = _positive(args.arc_tolerance, "--arc-tolerance")
@@ -160,20 +152,20 @@ def run(args):
                         "%.3f um: are the tables measured from the same reference (--reference)?"
                         % _um(spread.max()))
 
-    outputs = {"program": os.path.abspath(args.output)}
-    with Transaction(*_declared(args)) as tr:
+    outputs = {"program": shown(args.output)}
+    with Transaction(*registry.declared(args, "gcode")) as tr:
         tr.stage_bytes(args.output, res.output)
         if args.report:
-            outputs["report"] = os.path.abspath(args.report)
+            outputs["report"] = shown(args.report)
             rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,
                                outputs, seg, tol, arc_tol, reference, offset, start)
             tr.stage_text(args.report, json.dumps(rep, indent=1, allow_nan=False) + "\n")
         tr.commit()
 
     print_summary(args, table, model, res, pred, vmap, warnings)
-    print("wrote %s" % args.output)
-    if args.report:
-        print("wrote %s" % args.report)
+    for path in (args.output, args.report):
+        if path is not None:
+            print(wrote(path))
     return 0
 
 

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp inspect``: deviations and statistics only."""
 
+from . import registry
 from .common import add_job_parser, run_job_command
 
 
@@ -14,7 +15,7 @@ def add_parser(subparsers):
     p.add_argument("--weights", metavar="W", help="custom mask weights (see compensate)")
     p.add_argument("--smoothing", type=float, metavar="MM",
                    help="scattered layouts: smoothing length of the fit (default: GCV)")
-    p.add_argument("--html", metavar="OUT.html", help="also write the HTML inspection report")
+    registry.add_options(p, "inspect", flags=("--html",))
     p.set_defaults(run=run)
     return p
 

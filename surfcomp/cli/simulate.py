@@ -61,7 +61,9 @@ from ..core.progress import sub
 from ..errors import InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
-from .common import ProgressLine
+from ..io.outpath import shown
+from . import registry
+from .common import ProgressLine, wrote
 
 _DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
 #: model options: (option name, metavar, help, values per option, may be negative)
@@ -106,9 +108,7 @@ def add_parser(subparsers):
                "= position over the half extent along/across the feed, a = depth the pass "
                "removes: semi-engagement, then stock + the semi-finishing error). Presets: %s. "
                "See README 'Virtual machining'." % ", ".join(presets_.PRESETS))
-    p.add_argument("nominal", metavar="NOMINAL", nargs="?",
-                   help="nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd); "
-                        "optional with --preset (the preset's own surface)")
+    registry.add_options(p, "simulate", flags=("nominal",))
     p.add_argument("--face", metavar="FaceN",
                    help="the nominal face (default: the only B-spline face)")
     p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
@@ -142,14 +142,12 @@ def add_parser(subparsers):
                    help="knot spans of the corrected surface per grid step at most "
                         "(default 4; one where that meets the limits)")
     g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
-    m = p.add_argument_group("machining-process model (mm)")
+    m = p.add_argument_group(registry.SIM_MODEL)
     for name, metavar, text, _, _ in _MODEL_OPTIONS:
         key = name.replace("-", "_")
         m.add_argument("--" + name, dest=key, metavar=metavar, default=None,
                        help="%s (default %s, or the preset's)" % (text, _fmt(_DEFAULTS[key])))
-    m.add_argument("--axis-errors", metavar="ERR.csv",
-                   help="per-axis error measurements (as for the gcode command); the fitted "
-                        "Dobariya 2015 model adds its error along the normal")
+    registry.add_options(p, "simulate", {registry.SIM_MODEL: m}, flags=("--axis-errors",))
     m.add_argument("--axis-units", choices=("mm", "um", "in"), default="mm",
                    help="units of the axis error file without unit suffixes (default mm)")
     m.add_argument("--max-error", type=float, default=1.0, metavar="MM",
@@ -157,12 +155,8 @@ def add_parser(subparsers):
                         "refused as a likely unit mistake (default 1 mm, as for gcode)")
     m.add_argument("--reference", default="0,0,0", metavar="X,Y,Z",
                    help="reference point of the axis error measurements (default 0,0,0)")
-    o = p.add_argument_group("output")
-    o.add_argument("--json", metavar="OUT.json", help="write every replica's statistics (JSON)")
-    o.add_argument("--html", metavar="OUT.html",
-                   help="write the HTML report of the first replica's compensation with the "
-                        "--report-method, the before/after table, the paper's table beside the "
-                        "simulated one (--preset) and the simulated parts' maps")
+    o = p.add_argument_group(registry.SIM_OUTPUT)
+    registry.add_options(p, "simulate", {registry.SIM_OUTPUT: o}, flags=("--json", "--html"))
     o.add_argument("--report-method", metavar="LABEL",
                    help="method of the HTML report (default filtered, else the first compensation)")
     o.add_argument("--quiet", action="store_true", help="print no progress lines")
@@ -319,7 +313,7 @@ def run(args):
 
 def _declared(args):
     """(outputs, inputs) of the command, checked before any work and at the commit."""
-    return [("--json", args.json), ("--html", args.html)], [("NOMINAL", args.nominal)]
+    return registry.declared(args, "simulate")
 
 
 def _write(args, res, data, inputs, report_label):
@@ -338,7 +332,7 @@ def _write(args, res, data, inputs, report_label):
                     "columns": {}, "ignored_columns": []}
             rep = report_io.build_report("simulate", dict(inputs, measurements=meas), comp,
                                          comp.prepared.warnings,
-                                         {"html": os.path.abspath(args.html)})
+                                         {"html": shown(args.html)})
             tx.stage_text(args.html, render_html(rep, dict(data, maps=simulation_maps(res))))
         tx.commit()
 
@@ -360,8 +354,8 @@ def _print(args, res, grid, name, preset):
         print("")
         print(res.side_table())
     for out in (args.json, args.html):
-        if out:
-            print("wrote %s" % out)
+        if out is not None:
+            print(wrote(out))
 
 
 def _array_sha256(a):

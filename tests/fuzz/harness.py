@@ -26,6 +26,8 @@ import sys
 import warnings
 from dataclasses import dataclass
 
+from tests.conftest import default_signals  # noqa: F401  (re-exported for the fuzz tests)
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EXAMPLE_STEP = os.path.join(ROOT, "examples", "nominal.step")
 EXAMPLE_CSV = os.path.join(ROOT, "examples", "measurements.csv")
@@ -101,6 +103,8 @@ def snapshot(root):
                                 sha256(path) if os.path.isfile(path) else None)
             elif os.path.isdir(path):
                 entries[rel] = ("dir",)
+            elif not os.path.isfile(path):      # a FIFO or socket: never opened
+                entries[rel] = ("special",)
             else:
                 entries[rel] = ("file", sha256(path))
     return entries
@@ -160,7 +164,8 @@ def run_subprocess(argv, cwd, timeout=300):
     """``python3 -m surfcomp argv`` with ``cwd`` as working directory (so that it is on
     ``sys.path``, as for a user), surfcomp found through PYTHONPATH."""
     proc = subprocess.run([sys.executable, "-m", "surfcomp"] + [str(a) for a in argv], cwd=cwd,
-                          env=subprocess_env(), capture_output=True, text=True, timeout=timeout)
+                          env=subprocess_env(), capture_output=True, text=True, timeout=timeout,
+                          preexec_fn=default_signals)
     return Result(proc.returncode, proc.stdout, proc.stderr)
 
 

@@ -57,6 +57,7 @@ CASES = [
     doc("save-is-an-existing-folder", setup=I.setup(BASE, I.folder("out.FCStd")),
         file="out.FCStd", says=("--save is a folder",)),
     doc("gcode-without-a-path-job", "--gcode", "new/o.ngc", save=("--save", "new/out.FCStd"),
+        setup=I.setup(BASE, I.folder("new")),
         says=("no Path jobs use the compensation",)),
     doc("save-in-proc", save=("--save", "/proc/out.FCStd"), file="/proc/out.FCStd"),
     doc("save-not-an-fcstd", save=("--save", "out.txt"), file="out.txt",

@@ -32,6 +32,7 @@ OUTPUTS = [
         file="d", says=("--json is a folder",)),
     sim("json-in-proc", "--json", "/proc/s.json", file="/proc/s.json"),
     sim("html-without-a-compensating-method", "--html", "new/r.html",
+        setup=I.setup(NOM, I.folder("new")),
         small=("--grid", "5x5", "--replicas", "1", "--methods", "none"),
         says=("--html needs a compensating method",)),
     sim("report-method-unknown", "--html", "r.html", "--report-method", "magic",
@@ -125,7 +126,8 @@ NOMINAL = [
 ]
 
 OK = [
-    sim("small-run-with-outputs", "--json", "out/s.json", rc=0, writes=("out/s.json",)),
+    sim("small-run-with-outputs", "--json", "out/s.json", setup=I.setup(NOM, I.folder("out")),
+        rc=0, writes=("out/s.json",)),
     sim("preset-with-explicit-options", nominal=(),
         small=("--preset", "mirror2019-s3", "--replicas", "1", "--methods", "none,offset"),
         rc=0),
