@@ -244,14 +244,16 @@ def _check_restored(doc, comp):
     for job in cam_job.jobs_of(doc):
         if job.Name in users:
             users.update((o.Name, o) for o in job.OutListRecursive)
-    lost = toolpaths.lost_proxies(sorted(users.values(), key=lambda o: o.Name))
+    lost = toolpaths.lost_labels(sorted(users.values(), key=lambda o: o.Name))
     if lost:
-        raise InputError("%d object(s) that use %s did not restore when the document was "
-                         "opened, so their tool paths cannot follow the corrected face and "
-                         "saving would lose them: %s. Nothing was replaced. Close the document "
-                         "without saving, make the missing module importable (the 3D Surface "
-                         "operation needs OpenCamLib: tools/install.sh) and open it again"
-                         % (len(lost), comp.Nominal.Label, "; ".join(lost)))
+        raise InputError("%d object(s) that use %s lost their Python objects when the document "
+                         "was opened (a module they need could not be imported): %s. Their "
+                         "tool paths cannot follow the corrected face, and saving would lose "
+                         "them, so nothing was replaced. Close the document without saving, "
+                         "make the modules importable (OpenCamLib for the 3D Surface "
+                         "operation: tools/install.sh; FreeCAD 0.20's CAM modules resolve on "
+                         "1.x when surfcomp is installed before FreeCAD starts) and open it "
+                         "again" % (len(lost), comp.Nominal.Label, "; ".join(lost)))
 
 
 def replace(doc, comp):

@@ -74,6 +74,13 @@ def lost_proxies(objs):
             "not be imported)" % (o.Name, o.TypeId, o.Label) for o in objs if has_lost_proxy(o)]
 
 
+def lost_labels(objs):
+    """``Name (TypeId, label 'Label')`` of the objects of ``objs`` that lost their Python
+    object (short, for a list in one message)."""
+    return ["%s (%s, label %r)" % (o.Name, o.TypeId, o.Label) for o in objs
+            if has_lost_proxy(o)]
+
+
 def _is_path_feature(obj):
     return obj is not None and hasattr(obj, "PropertiesList") and "Path" in obj.PropertiesList
 
@@ -100,7 +107,11 @@ def _setup_objects(job):
     for tc in getattr(tools, "Group", []) or []:
         objs.append(tc)
         objs.extend(o for o in getattr(tc, "OutList", []) if "Python" in o.TypeId)
-    return objs
+    unique = []
+    for o in objs:
+        if all(o is not u for u in unique):
+            unique.append(o)
+    return unique
 
 
 def _commands(op):
@@ -223,5 +234,6 @@ def as_dicts(reports):
              "operations": [vars(op).copy() for op in j.operations]} for j in reports]
 
 
-__all__ = ["snapshot", "compare", "describe", "as_dicts", "lost_proxies", "has_lost_proxy",
+__all__ = ["snapshot", "compare", "describe", "as_dicts", "lost_proxies", "lost_labels",
+           "has_lost_proxy",
            "operations", "OperationReport", "JobReport", "STATUSES"]

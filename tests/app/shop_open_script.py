@@ -2,8 +2,9 @@
 # Run by tests/app/test_toolpath_report.py in a fresh `freecadcmd` whose user home links this
 # checkout: FreeCAD opens the 0.20 shop document itself (as File > Open does; surfcomp's
 # Init.py has run, nothing else of surfcomp), then Restore and Replace of Round2 with what
-# each did to the tool paths. SURFCOMP_BLOCK_OCL=1: OpenCamLib is unimportable while the
-# document opens (a machine without it).
+# each did to the tool paths. SURFCOMP_BLOCK=ocl: OpenCamLib is unimportable while the
+# document opens (a machine without it); SURFCOMP_BLOCK=cam: so are the CAM modules the
+# document names (a FreeCAD that cannot resolve 0.20's names).
 import importlib.abc
 import json
 import os
@@ -16,14 +17,20 @@ out = {"loaded_before_open": sorted(m for m in sys.modules
                                     or m.startswith(("Path.", "surfcomp.gui")))}
 
 
-class NoOpenCamLib(importlib.abc.MetaPathFinder):
+BLOCKED = {"ocl": ("ocl", "opencamlib"),
+           "cam": ("PathScripts.PathJob", "PathScripts.PathStock", "PathScripts.PathSetupSheet",
+                   "PathScripts.PathToolController", "PathScripts.PathToolBit",
+                   "PathScripts.PathSurface")}.get(os.environ.get("SURFCOMP_BLOCK"), ())
+
+
+class Blocker(importlib.abc.MetaPathFinder):
     def find_spec(self, fullname, path=None, target=None):
-        if fullname.split(".")[0] in ("ocl", "opencamlib"):
-            raise ImportError("no OpenCamLib here (test)")
+        if fullname in BLOCKED or fullname.split(".")[0] in BLOCKED:
+            raise ImportError("%s is not importable here (test)" % fullname)
         return None
 
 
-blocker = NoOpenCamLib() if os.environ.get("SURFCOMP_BLOCK_OCL") else None
+blocker = Blocker() if BLOCKED else None
 if blocker:
     sys.meta_path.insert(0, blocker)
 doc = FreeCAD.openDocument(os.environ["SURFCOMP_DOC"])

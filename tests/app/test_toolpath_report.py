@@ -35,7 +35,7 @@ R = 3.0                 # the shop document's ball end mill (6 mm)
 DEFLECTION = 0.01       # the Surface operation's LinearDeflection in the shop document (mm)
 
 
-def run_script(tmp, block_ocl):
+def run_script(tmp, block=""):
     home = tmp / "fchome"
     (home / "Mod").mkdir(parents=True)
     os.symlink(ROOT, home / "Mod" / "surfcomp")
@@ -43,7 +43,7 @@ def run_script(tmp, block_ocl):
     shutil.copyfile(os.path.join(DOCS, "shop-0.20.FCStd"), path)
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
     env.update(SURFCOMP_DOC=path, FREECAD_USER_HOME=str(home),
-               SURFCOMP_BLOCK_OCL="1" if block_ocl else "")
+               SURFCOMP_BLOCK=block)
     out = subprocess.run(["freecadcmd", SCRIPT], capture_output=True, text=True,
                          timeout=600, cwd=str(tmp), env=env)
     text = out.stdout.replace("\r", "\n")
@@ -54,12 +54,17 @@ def run_script(tmp, block_ocl):
 
 @pytest.fixture(scope="module")
 def opened(tmp_path_factory):
-    return run_script(tmp_path_factory.mktemp("shop_open"), block_ocl=False)
+    return run_script(tmp_path_factory.mktemp("shop_open"))
 
 
 @pytest.fixture(scope="module")
 def without_ocl(tmp_path_factory):
-    return run_script(tmp_path_factory.mktemp("shop_no_ocl"), block_ocl=True)
+    return run_script(tmp_path_factory.mktemp("shop_no_ocl"), block="ocl")
+
+
+@pytest.fixture(scope="module")
+def without_cam_modules(tmp_path_factory):
+    return run_script(tmp_path_factory.mktemp("shop_no_cam"), block="cam")
 
 
 def statuses(report):
@@ -129,11 +134,31 @@ def test_without_opencamlib_nothing_claims_a_regeneration(without_ocl):
     assert "DressupAxisErrors NOT regenerated: its base operation Surface was not" in line
     assert "regenerated (" not in line
     # Replace refuses with the reason and changes nothing
-    assert r["replace_error"].startswith("1 object(s) that use Block did not restore")
+    assert r["replace_error"].startswith("1 object(s) that use Block lost their Python "
+                                         "objects when the document was opened")
     assert "Surface (Path::FeaturePython, label 'Surface')" in r["replace_error"]
-    assert "Nothing was replaced" in r["replace_error"] and r["replace_record"] == ""
+    assert "nothing was replaced" in r["replace_error"] and r["replace_record"] == ""
     # the operation kept the tool path it was saved with through both steps
     assert r["saved"] == r["restored"] == r["replaced"]
+
+
+def test_a_job_that_lost_its_python_objects_is_reported_and_not_replaced(without_cam_modules):
+    """As 1.1 opened a 0.20 document before the names resolved: the Job, its stock, setup
+    sheet, tool controller and tool bit and the operation lose their Python objects."""
+    r = without_cam_modules
+    for name in ("Job", "Stock", "SetupSheet", "TC__Default_Tool", "BallEnd", "Surface"):
+        assert r["proxies"][name] == "NoneType", name
+    (job,) = r["restore"]
+    assert job["lost"] == ["Job", "Stock", "SetupSheet", "TC: Ball end 6 mm", "Ball end 6 mm"]
+    assert statuses(r["restore"]) == {"Surface": "lost", "DressupAxisErrors": "stale"}
+    (line,) = r["restore_lines"]
+    assert line.startswith("Path job Job: NOT regenerated: Job, Stock, SetupSheet, TC: Ball "
+                           "end 6 mm, Ball end 6 mm did not restore when the document was "
+                           "opened; ")
+    assert r["replace_error"].startswith("6 object(s) that use Block lost their Python")
+    for name in ("Job", "Stock", "SetupSheet", "TC__Default_Tool", "BallEnd", "Surface"):
+        assert "%s (" % name in r["replace_error"], name
+    assert r["replace_record"] == "" and r["saved"] == r["restored"] == r["replaced"]
 
 
 def test_replace_refuses_when_a_user_of_the_nominal_lost_its_python_object(tmp_path,
@@ -164,8 +189,9 @@ def test_replace_refuses_when_a_user_of_the_nominal_lost_its_python_object(tmp_p
         comp = features.make_compensation(doc, block, "Face2", _measurement(doc, block),
                                           output="solid")
         doc.recompute()
-        with pytest.raises(InputError, match=r"^1 object\(s\) that use Block did not restore.*"
-                                             r"Thing \(App::FeaturePython, label 'Thing'\)"):
+        with pytest.raises(InputError, match=r"^1 object\(s\) that use Block lost their "
+                                             r"Python objects.*Thing \(App::FeaturePython, "
+                                             r"label 'Thing'\)"):
             replace.replace(doc, comp)
         assert thing.Source is block and comp.ReplacedLinks == ""
     finally:
