@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-# GUI session of test_shop_document.py. Runs after the lines of OPEN (the test puts them
-# first): FreeCAD opened the 0.20 shop document before anything of surfcomp but its Init.py
-# ran. Then, as a user: select Round2, Restore nominal, select it again, Replace in document;
-# the operation's feed moves and the summaries after each step.
+# GUI session of test_shop_document.py, with and without OpenCamLib. Runs after OPEN (the
+# test puts it first): FreeCAD opened the 0.20 shop document before anything of surfcomp but
+# its Init.py ran. Then, as a user: select Round2, Restore nominal, select it again, Replace
+# in document; the operation's feed moves and the summaries after each step.
 import sys
 
 from tests.toolpath_checks import feed_moves, shop_surfaces

@@ -37,16 +37,41 @@ RESULTS["report_view_open"] = report_view_text()
 '''
 
 
-@pytest.fixture(scope="module")
-def session(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("gui_shop")
+#: a machine without OpenCamLib: it cannot be imported while the document opens
+WITHOUT_OCL = r'''
+import importlib.abc
+
+
+class NoOpenCamLib(importlib.abc.MetaPathFinder):
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname.split(".")[0] in ("ocl", "opencamlib"):
+            raise ImportError("no OpenCamLib on this machine (test)")
+        return None
+
+
+sys.meta_path.insert(0, NoOpenCamLib())
+'''
+
+
+def run_shop(tmp, session_name, first=""):
     shutil.copyfile(os.path.join(ROOT, "tests", "data", "documents", "shop-0.20.FCStd"),
                     tmp / "shop-0.20.FCStd")
-    with open(os.path.join(ROOT, "tests", "gui", "session_shop.py"), encoding="utf-8") as f:
+    with open(os.path.join(ROOT, "tests", "gui", session_name), encoding="utf-8") as f:
         body = f.read()
-    results, output = run_gui(OPEN + with_common(body), tmp, timeout=600)
+    results, output = run_gui(first + OPEN + with_common(body), tmp, timeout=600)
     results["output"] = output
     return results
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    return run_shop(tmp_path_factory.mktemp("gui_shop"), "session_shop.py")
+
+
+@pytest.fixture(scope="module")
+def without_ocl(tmp_path_factory):
+    return run_shop(tmp_path_factory.mktemp("gui_shop_no_ocl"), "session_shop.py",
+                    first=WITHOUT_OCL)
 
 
 def test_session_ran_without_exceptions(session):
@@ -99,3 +124,24 @@ def test_the_commands_move_by_what_the_correction_implies(session):
     # the replaced program is the one 0.20 computed and saved (within the deflection)
     saved = np.array(session["saved"])
     assert np.abs(saved[:, 1:] - after[:, 1:]).max() < DEFLECTION
+
+
+def test_without_opencamlib_restore_says_so_and_replace_refuses(without_ocl):
+    r = without_ocl
+    assert r["errors"] == []
+    assert r["proxies"]["Surface"] == "NoneType"
+    assert "This operation requires OpenCamLib" in r["report_view_open"]
+    infos, errors = r["restore"]
+    assert errors == []
+    (_title, text), = infos
+    assert "Surface NOT regenerated: its Python object did not restore" in text
+    assert "regenerated (" not in text
+    infos, errors = r["replace"]
+    assert infos == []
+    (title, message), = errors
+    assert title.endswith("Replace in document")
+    assert message.startswith("1 object(s) that use Block lost their Python objects")
+    assert "Surface (Path::FeaturePython, label 'Surface')" in message
+    # nothing was replaced and the operation kept its commands
+    assert r["after_replace"] == ["Block", False]
+    assert r["saved"] == r["restored"] == r["replaced"]
