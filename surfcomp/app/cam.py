@@ -16,7 +16,10 @@ version string, so a build between the releases takes the branch its modules sup
   three, but 0.20 loads them with ``PostProcessor.load`` and 1.x through a factory bound to
   a Job; :func:`load_post` loads the script itself, the same way everywhere;
 - OpenCamLib: the PyPI wheel (Debian 12) and Debian's ``python3-opencamlib`` (13 and later)
-  both ship ``opencamlib/ocl.so``; 0.20 imports ``ocl``, so it is registered under that name;
+  both ship ``opencamlib/ocl.so``; 0.20 imports ``ocl``, so that name resolves to it
+  (:func:`install_aliases`, from ``Init.py`` at start-up);
+- documents saved by 0.20 name their CAM proxies by ``PathScripts.*`` modules that 1.x does
+  not have: those names resolve to the 1.x modules (:data:`LEGACY_MODULES`, the same hook);
 - Qt: PySide2/Qt5 (0.20, 1.0) or PySide6/Qt6 (1.1); GUI code imports FreeCAD's ``PySide``
   shim only, so it needs no branch here.
 
@@ -25,6 +28,7 @@ No FreeCADGui: everything here works in ``freecadcmd`` and in a plain ``python3`
 """
 
 import importlib
+import importlib.abc
 import importlib.util
 import os
 import sys
@@ -48,23 +52,11 @@ def setup_ocl():
 
     The PyPI wheel and Debian's ``python3-opencamlib`` both ship the extension as
     ``opencamlib/ocl.so``; FreeCAD 0.20's 3D Surface operation does ``import ocl`` (1.x
-    falls back to ``import opencamlib``). The packaged module is registered under the plain
-    name. Returns True when ``ocl`` is importable afterwards.
+    falls back to ``import opencamlib``). :func:`install_aliases` resolves the plain name
+    to the packaged module. Returns True when ``ocl`` is importable afterwards.
     """
-    if "ocl" in sys.modules:
-        return True
-    try:
-        spec = importlib.util.find_spec("ocl")
-    except (ImportError, ValueError):
-        spec = None
-    if spec is not None:
-        return True
-    try:
-        mod = importlib.import_module("opencamlib.ocl")
-    except ImportError:
-        return False
-    sys.modules["ocl"] = mod
-    return True
+    install_aliases()
+    return _has_module("ocl")
 
 
 def freecad_home():
@@ -317,25 +309,74 @@ LEGACY_MODULES = {
 }
 
 
+#: every alias :func:`install_aliases` resolves: OpenCamLib's plain name and 0.20's CAM modules
+ALIASES = dict(LEGACY_MODULES, ocl="opencamlib.ocl")
+
+
+class _AliasLoader(importlib.abc.Loader):
+    """Loads an alias as the module it stands for (one module object under two names)."""
+
+    def __init__(self, target):
+        self.target = target
+        self._spec = None
+
+    def create_module(self, spec):
+        module = importlib.import_module(self.target)
+        self._spec = module.__spec__
+        return module
+
+    def exec_module(self, module):
+        # the import machinery set the alias's spec on the module: give it its own back
+        module.__spec__ = self._spec
+
+
+class _AliasFinder(importlib.abc.MetaPathFinder):
+    """Last on ``sys.meta_path``: asked only for names no other finder found.
+
+    ``ocl`` resolves to ``opencamlib.ocl``; a 0.20 CAM module name (:data:`LEGACY_MODULES`)
+    to its 1.x home. On 0.20 every legacy name exists and ``ocl`` may too, so it is never
+    asked for them; a target this FreeCAD lacks leaves the name unresolved as before.
+    """
+
+    def find_spec(self, fullname, path=None, target=None):
+        new = ALIASES.get(fullname)
+        if new is None or not _has_module(new):
+            return None
+        return importlib.util.spec_from_loader(fullname, _AliasLoader(new))
+
+
+def install_aliases():
+    """Resolve ``ocl`` and 0.20's CAM module names on demand (idempotent, imports nothing).
+
+    Called from ``Init.py`` when FreeCAD starts (GUI and ``freecadcmd``), so documents that
+    FreeCAD itself opens restore their 3D Surface operations (which import ``ocl``) and, on
+    1.x, the CAM objects a 0.20 document names by ``PathScripts.PathJob`` and so on. Nothing
+    is imported until something imports one of the names.
+    """
+    if not any(isinstance(f, _AliasFinder) for f in sys.meta_path):
+        sys.meta_path.append(_AliasFinder())
+
+
 def alias_legacy_modules(names):
     """Let a document saved by FreeCAD 0.20 restore its CAM objects on 1.x.
 
     ``names``: the proxy modules the document names (its ``Document.xml``).
 
     0.20 saved each Path object's proxy as ``PathScripts.PathJob.ObjectJob`` and so on;
-    1.x moved the classes (same names) to ``Path.*`` and cannot restore those proxies, so the
-    Job, its tools and operations come back as dead objects. Each such name that this
-    FreeCAD cannot import is registered as an alias of the module that holds the classes now;
-    the classes' own ``onDocumentRestored`` then bring the properties up to date. Does nothing
-    on 0.20. Returns ``{old: new}`` for the names aliased.
+    1.x moved the classes (same names) to ``Path.*`` and, by itself, cannot restore those
+    proxies, so the Job, its tools and operations would come back as dead objects. With
+    :func:`install_aliases` each such name resolves to the module that holds the classes
+    now; the classes' own ``onDocumentRestored`` then bring the properties up to date. Does
+    nothing on 0.20. Returns ``{old: new}`` for the names of ``names`` that resolve to
+    another module.
     """
+    install_aliases()
     done = {}
-    if api().modules != "Path":
-        return done
     for old in names:
         new = LEGACY_MODULES.get(old)
-        if new is None or old in sys.modules or _has_module(old) or not _has_module(new):
+        if new is None or not _has_module(old):
             continue
-        sys.modules[old] = importlib.import_module(new)
-        done[old] = new
+        module = importlib.import_module(old)
+        if module.__name__ != old:
+            done[old] = module.__name__
     return done

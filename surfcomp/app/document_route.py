@@ -28,7 +28,7 @@ from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.outpath import shown
-from . import cam, cam_job, features
+from . import cam, cam_job, features, toolpaths
 from .documents import open_document, restore_failures
 
 
@@ -41,7 +41,8 @@ class DocumentJobResult:
     measurement: str
     replaced: list = field(default_factory=list)       # (object, property) rebound
     jobs: list = field(default_factory=list)           # Path jobs that use the compensation
-    operations: list = field(default_factory=list)     # their operations (recomputed)
+    operations: list = field(default_factory=list)     # their operations that regenerated
+    toolpaths: list = field(default_factory=list)      # surfcomp.app.toolpaths.JobReport
     saved: str = None
     gcode: str = None
     gcode_lines: int = 0
@@ -147,6 +148,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
                              "safely (saving would lose them): %s%s"
                              % (len(problems), "; ".join(problems), why), file=document)
         nominal = _find_object(doc, object_name, document)
+        paths_before = toolpaths.snapshot(doc)
         report(progress, 0.1, "reading the measurements")
         comp, meas = _add_compensation(doc, nominal, face, measurements,
                                        (units, deviation_units), fmt, sample, options, output)
@@ -163,7 +165,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         _recompute(doc)
         jobs = _jobs_using(doc, comp)
         result.jobs = [j.Name for j in jobs]
-        result.operations = [op.Name for j in jobs for op in cam_job.operations_of(j)]
+        result.toolpaths = toolpaths.compare(doc, paths_before, result.jobs)
+        result.operations = [op.name for j in result.toolpaths for op in j.regenerated()]
         text = None
         if gcode:
             job = _one_job(jobs, job_name)
@@ -272,8 +275,8 @@ def summary_lines(result):
     if result.replaced:
         lines.append("replaced the nominal in: %s"
                      % ", ".join("%s.%s" % pair for pair in result.replaced))
-    if result.operations:
-        lines.append("regenerated: %s" % ", ".join(result.operations))
+    # per Job: which operations regenerated (commands changed), which did not and why
+    lines += toolpaths.describe(result.toolpaths)
     if result.saved:
         lines.append("wrote %s" % result.saved)
     if result.gcode:

@@ -21,7 +21,7 @@ import sys
 
 from ..errors import InputError
 from ..io.fcstd import parse_document
-from . import cam, fcenv
+from . import cam, fcenv, toolpaths
 
 
 class _Blocker(importlib.abc.MetaPathFinder):
@@ -114,11 +114,7 @@ def restore_failures(doc, path=None, info=None):
     list of str
         One description per problem (empty when everything restored).
     """
-    problems = []
-    for o in doc.Objects:
-        if "Python" in o.TypeId and "Proxy" in o.PropertiesList and o.Proxy is None:
-            problems.append("%s (%s, label %r): its Python proxy was not restored (a module it "
-                            "needs could not be imported)" % (o.Name, o.TypeId, o.Label))
+    problems = toolpaths.lost_proxies(doc.Objects)
     if info is None and path:
         info = parse_document(path)
     if info:

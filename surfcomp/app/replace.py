@@ -232,6 +232,30 @@ def _check_computed(comp):
                          "before replacing the nominal" % (comp.Label, ", ".join(comp.State)))
 
 
+def _check_restored(doc, comp):
+    """Refuse when users of the nominal, or the CAM Jobs they belong to (with their
+    operations, stock and tools), lost their Python objects at open time: their tool paths
+    could not follow the new face, and a save would make the loss permanent."""
+    from . import cam_job, toolpaths
+
+    users = {}
+    for target in _targets(comp):
+        users.update((o.Name, o) for o in target.InListRecursive)
+    for job in cam_job.jobs_of(doc):
+        if job.Name in users:
+            users.update((o.Name, o) for o in job.OutListRecursive)
+    lost = toolpaths.lost_labels(sorted(users.values(), key=lambda o: o.Name))
+    if lost:
+        raise InputError("%d object(s) that use %s lost their Python objects when the document "
+                         "was opened (a module they need could not be imported): %s. Their "
+                         "tool paths cannot follow the corrected face, and saving would lose "
+                         "them, so nothing was replaced. Close the document without saving, "
+                         "make the modules importable (OpenCamLib for the 3D Surface "
+                         "operation: tools/install.sh; FreeCAD 0.20's CAM modules resolve on "
+                         "1.x when surfcomp is installed before FreeCAD starts) and open it "
+                         "again" % (len(lost), comp.Nominal.Label, "; ".join(lost)))
+
+
 def replace(doc, comp):
     """Rebind the users of ``comp``'s nominal to ``comp``; hide the nominal.
 
@@ -249,7 +273,8 @@ def replace(doc, comp):
     Raises
     ------
     InputError
-        ``comp`` is not a computed compensation or is already replacing its nominal.
+        ``comp`` is not a computed compensation or is already replacing its nominal, or
+        users of the nominal (or their CAM Jobs) lost their Python objects at open time.
     GeometryError
         A user links a face the compensation's output does not have.
     """
@@ -258,6 +283,7 @@ def replace(doc, comp):
     if comp.ReplacedLinks:
         raise InputError("%s already replaces its nominal (restore it first)" % comp.Label)
     _check_computed(comp)
+    _check_restored(doc, comp)
     nominal = comp.Nominal
 
     def work(undo):
@@ -349,7 +375,8 @@ def _clones(changes):
 def summary(doc, comp):
     """What :func:`replace` changed, from its record on ``comp``: ``objects`` (labels of
     the objects whose links were rebound), ``links`` (number of link properties),
-    ``jobs`` (labels of the Path jobs that use a rebound object), ``renamed``
+    ``jobs`` and ``job_names`` (labels and names of the Path jobs that use a rebound
+    object: what happened to their tool paths is :mod:`surfcomp.app.toolpaths`), ``renamed``
     (``(old label, new label)``)."""
     try:
         record = json.loads(comp.ReplacedLinks or "{}")
@@ -366,11 +393,12 @@ def summary(doc, comp):
     for job in jobs_of(doc):
         used = {o.Name for o in job.OutListRecursive} | {job.Name}
         if used & set(names):
-            jobs.append(job.Label)
+            jobs.append(job)
     renamed = [(old, doc.getObject(n).Label) for n, old in record.get("labels", {}).items()
                if doc.getObject(n) is not None]
     return {"objects": [o.Label for o in objs], "links": len(record.get("links", [])),
-            "jobs": jobs, "renamed": renamed}
+            "jobs": [j.Label for j in jobs], "job_names": [j.Name for j in jobs],
+            "renamed": renamed}
 
 
 def is_replacing(comp):

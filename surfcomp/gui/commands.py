@@ -466,13 +466,14 @@ class _ReplaceCommand(Command):
         return comp is not None and replace.is_replacing(comp) == self.WHILE_REPLACING
 
     def run(self):
-        from ..app import progress, replace
+        from ..app import progress, replace, toolpaths
         from ..errors import Cancelled
 
         # surfcomp.app.replace opens and commits its own transaction
         comp = selected_compensation()
         doc = comp.Document
         before = replace.summary(doc, comp) if self.WHILE_REPLACING else None
+        paths_before = toolpaths.snapshot(doc)
         FreeCADGui.addModule("surfcomp.app.replace")
         FreeCADGui.doCommand("surfcomp.app.replace.%s(App.ActiveDocument, "
                              "App.ActiveDocument.getObject(%r))" % (self.ACTION, comp.Name))
@@ -486,15 +487,19 @@ class _ReplaceCommand(Command):
                                                                "as before."))
             return
         done = before or replace.summary(doc, comp)
+        done["toolpaths"] = toolpaths.compare(doc, paths_before, done["job_names"])
         dialogs.show_info(self.MENU, self.summary_text(done))
 
     def summary_text(self, s):
         verb = translate("SurfComp", "Restored") if self.WHILE_REPLACING \
             else translate("SurfComp", "Rebound")
         lines = [translate("SurfComp", "%s %d link(s) of %d object(s): %s")
-                 % (verb, s["links"], len(s["objects"]), ", ".join(s["objects"]) or "-"),
-                 translate("SurfComp", "Path jobs touched: %s") % (", ".join(s["jobs"]) or
-                                                                  translate("SurfComp", "none"))]
+                 % (verb, s["links"], len(s["objects"]), ", ".join(s["objects"]) or "-")]
+        # what the recompute did to each Job's operations, not just which Jobs use the face
+        from ..app import toolpaths
+
+        lines += toolpaths.describe(s["toolpaths"], lambda text: translate("SurfComp", text)) \
+            or [translate("SurfComp", "Path jobs: none")]
         for old, new in s["renamed"]:
             lines.append(translate("SurfComp", "Renamed %s -> %s") % ((new, old) if
                                                                      self.WHILE_REPLACING

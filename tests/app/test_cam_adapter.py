@@ -89,3 +89,57 @@ def test_profile_operation_and_helpers(home, doc):
         pos = cam.command_end_point(c, pos)
     box_xy = Part.Compound(edges).BoundBox
     assert 10.0 < box_xy.XLength < 20.0 and 10.0 < box_xy.YLength < 20.0
+
+
+ALIAS_SCRIPT = r"""
+import json, os, sys
+sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
+from surfcomp.app import cam, fcenv
+fcenv.import_freecad()
+cam.install_aliases()
+cam.install_aliases()                     # idempotent: one finder
+out = {"finders": sum(type(f).__name__ == "_AliasFinder" for f in sys.meta_path),
+       "loaded": sorted(m for m in sys.modules if m.split(".")[0] in ("ocl", "opencamlib",
+                                                                      "PathScripts"))}
+cam.setup_workbench(require_ocl=False)    # FreeCAD's Mod folders on the path, as freecadcmd
+import ocl
+out["ocl"] = [ocl.__name__, ocl.__spec__.name, "opencamlib.ocl" in sys.modules
+              and sys.modules["opencamlib.ocl"] is ocl]
+import PathScripts.PathJob as job
+import PathScripts.PathSurface as surface
+out["job"] = [job.__name__, job.__spec__.name, hasattr(job, "ObjectJob")]
+out["surface"] = [surface.__name__, hasattr(surface, "ObjectSurface")]
+try:
+    import PathScripts.PathNoSuchModule  # noqa: F401
+    out["unknown"] = "imported"
+except ImportError as exc:
+    out["unknown"] = type(exc).__name__
+print("RESULT " + json.dumps(out))
+"""
+
+
+def test_aliases_resolve_on_demand_to_one_module_with_its_own_spec(home):
+    """``ocl`` and 0.20's CAM names resolve when imported (nothing before), to the very module
+    they stand for, which keeps its own ``__spec__``; unknown names still fail."""
+    import json
+    import subprocess
+    import sys
+
+    from tests.conftest import ROOT
+
+    run = subprocess.run([sys.executable, "-c", ALIAS_SCRIPT], capture_output=True, text=True,
+                         timeout=300, env=dict(os.environ, SURFCOMP_ROOT=ROOT))
+    line = [s for s in run.stdout.splitlines() if s.startswith("RESULT ")]
+    assert line, run.stdout[-2000:] + run.stderr[-2000:]
+    r = json.loads(line[-1][len("RESULT "):])
+    assert r["finders"] == 1 and r["loaded"] == []
+    name, spec, same = r["ocl"]
+    # Debian 12's PyPI wheel and Debian's package ship opencamlib/ocl.so only: the alias
+    assert (name, spec, same) == ("opencamlib.ocl", "opencamlib.ocl", True)
+    if cam.api().modules == "Path":        # 1.x: 0.20's names are the 1.x modules
+        assert r["job"] == ["Path.Main.Job", "Path.Main.Job", True]
+        assert r["surface"] == ["Path.Op.Surface", True]
+    else:                                  # 0.20: its own modules, no alias
+        assert r["job"] == ["PathScripts.PathJob", "PathScripts.PathJob", True]
+        assert r["surface"] == ["PathScripts.PathSurface", True]
+    assert r["unknown"] == "ModuleNotFoundError"

@@ -3,6 +3,7 @@
 
 import hashlib
 import os
+import re
 import sys
 
 import FreeCAD
@@ -75,6 +76,13 @@ def test_update_a_shop_document(shop, tmp_path):
         assert len(clone.Shape.Faces) == 6 and clone.Shape.isValid()
         op = doc.getObject("Surface")
         assert op.Base == [(clone, ("Face2",))]
+        # the report counts the commands that changed: most moved with the correction
+        (job_rep,) = res.toolpaths
+        (op_rep,) = job_rep.operations
+        assert (job_rep.name, job_rep.lost, op_rep.name, op_rep.status) == \
+            ("Job", [], "Surface", "regenerated")
+        assert op_rep.commands == len(op.Path.Commands)
+        assert 0.5 * op_rep.commands < op_rep.changed <= op_rep.commands
         cl = cam_job.cutter_locations(op)
         # the regenerated path went down where the correction removes material (t > 0)
         assert abs(len(cl) - len(shop["cl"])) <= 0.05 * len(cl)
@@ -184,7 +192,8 @@ def test_the_batch_command_line(shop, tmp_path):
     run = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
     assert "replaced the nominal in: Clone.Objects" in run.stdout
-    assert "regenerated: Surface" in run.stdout and "wrote %s" % out in run.stdout
+    assert re.search(r"^Path job Job: Surface regenerated \((\d+) of (\d+) commands changed\)$",
+                     run.stdout, re.M) and "wrote %s" % out in run.stdout
     assert sha(shop["doc"]) == digest
     # the same program as the library route of test_update_a_shop_document
     np.testing.assert_allclose(g1_points(ngc.read_text()), g1_points(cam_gcode_of(str(out))),

@@ -23,22 +23,11 @@ import pytest
 from surfcomp.app import cam, cam_job, features, replace, reports
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.corrected import realised_correction
-from surfcomp.core.projection import project
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
+from tests.toolpath_checks import drop_cutter
 
 R = 3.0                       # ball radius (mm)
 POST_ARGS = "--no-show-editor --no-header --precision=4"
-
-
-def drop_cutter(surface, outward, xy, z_guess, r=R, iterations=8):
-    """Exact tool-tip Z of a ball end mill of radius r dropped on ``surface`` at ``xy``
-    (N, 2): the ball centre lies at distance r from the surface (Newton on the centre
-    height, d(distance)/dz = n_z at the foot point). Returns (z_tip (N,), projection)."""
-    zc = np.asarray(z_guess, dtype=float) + r
-    for _ in range(iterations):
-        pr = project(surface, np.column_stack([xy, zc]))
-        zc = zc - (pr.distance * outward - r) / (pr.normal[:, 2] * outward)
-    return zc - r, project(surface, np.column_stack([xy, zc]))
 
 
 def test_drop_cutter_reference_on_a_tilted_plane():
@@ -50,7 +39,7 @@ def test_drop_cutter_reference_on_a_tilted_plane():
     P = np.array([[[x, y, a * x + b * y + c] for y in (0.0, 40.0)] for x in (0.0, 40.0)])
     plane = Surface(P, np.array([0, 0, 1, 1.0]), np.array([0, 0, 1, 1.0]), 1, 1)
     xy = np.random.default_rng(3).uniform(8, 32, (20, 2))
-    z, _ = drop_cutter(plane, 1, xy, np.zeros(20))
+    z, _ = drop_cutter(plane, 1, xy, np.zeros(20), R)
     expected = a * xy[:, 0] + b * xy[:, 1] + c + R * (np.sqrt(1 + a * a + b * b) - 1)
     np.testing.assert_allclose(z, expected, atol=1e-10)
 
@@ -131,8 +120,8 @@ def test_cutter_locations_move_by_t_over_nz(regenerated):
     out = nominal.outward
     # both tool paths lie on their surfaces' exact drop-cutter surfaces within the mesh
     # deflection (1 um)
-    z0_exact, _ = drop_cutter(nominal.surface, out, cl0[:, :2], cl0[:, 2])
-    z1_exact, _ = drop_cutter(corrected, out, cl1[:, :2], cl1[:, 2])
+    z0_exact, _ = drop_cutter(nominal.surface, out, cl0[:, :2], cl0[:, 2], R)
+    z1_exact, _ = drop_cutter(corrected, out, cl1[:, :2], cl1[:, 2], R)
     assert np.abs(cl0[:, 2] - z0_exact).max() < 1.5e-3
     assert np.abs(cl1[:, 2] - z1_exact).max() < 1.5e-3
     # pair each new CL point with the old one of the same sample (the face's bounding box
@@ -142,8 +131,8 @@ def test_cutter_locations_move_by_t_over_nz(regenerated):
 
     dist, k = cKDTree(cl0[:, :2]).query(cl1[:, :2])
     assert dist.max() < 0.5 + 1e-6
-    z0_here, pr = drop_cutter(nominal.surface, out, cl1[:, :2], cl1[:, 2])
-    z0_there, _ = drop_cutter(nominal.surface, out, cl0[k, :2], cl0[k, 2])
+    z0_here, pr = drop_cutter(nominal.surface, out, cl1[:, :2], cl1[:, 2], R)
+    z0_there, _ = drop_cutter(nominal.surface, out, cl0[k, :2], cl0[k, 2], R)
     dz = cl1[:, 2] - (cl0[k, 2] + z0_here - z0_there)
     # expected: the correction t realised at the ball's contact point, over n_z
     t = realised_correction(nominal.surface, corrected, pr.u, pr.v, out)
