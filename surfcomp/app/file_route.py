@@ -101,6 +101,10 @@ def run_job(job, progress=None):
     from .nominal import load_nominal
 
     nominal = load_nominal(job.nominal, job.face, job.object)
+    if job.command == "compensate" and job.output:
+        from .shapes import check_rebuildable
+
+        check_rebuildable(nominal.bspline_face, job.nominal)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
@@ -225,16 +229,19 @@ def write_face(path, shape, output=None, name=None):
     (:mod:`surfcomp.io.step_face`, 5-7x faster than OpenCASCADE's writer), its product
     named ``name`` (default: the file's name).
     """
+    import Part
+
     fmt = cad_format(path)
     if fmt == "step" and output is not None and output.natural is not None:
         write_natural_face(path, output.natural, shape.Orientation == "Reversed",
                            output.edge_tolerance, name)
-    elif fmt == "step":
-        shape.exportStep(path)
-    elif fmt == "iges":
-        shape.exportIges(path)
-    else:
-        shape.exportBrep(path)
+        return
+    try:
+        {"step": shape.exportStep, "iges": shape.exportIges, "brep": shape.exportBrep}[fmt](path)
+    except (Part.OCCError, RuntimeError) as exc:
+        # OpenCASCADE's writers report a full disk or a write error only as this
+        raise InputError("OpenCASCADE could not write the %s file: %s (a full disk, or no "
+                         "permission to write there?)" % (fmt.upper(), exc), file=path) from None
     if not os.path.getsize(path):
         raise InputError("OpenCASCADE wrote an empty file", file=path)
 
