@@ -5,7 +5,6 @@ Shared by ``python3 -m surfcomp compensate|inspect`` and the ``freecadcmd`` job 
 All outputs of a job are written together or not at all.
 """
 
-import json
 import os
 from dataclasses import dataclass, field, fields
 
@@ -20,6 +19,7 @@ from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.html_report import render_html
+from ..io.jobfile import read_job_file
 from ..io.readers import read_any
 from ..io.step_face import write_natural_face
 from . import fcenv
@@ -264,15 +264,8 @@ def corrected_points_csv(comp):
 
 
 def load_job_file(path):
-    """Read a JSON job file (see README, 'freecadcmd')."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except OSError as exc:
-        raise InputError("cannot read the job file: %s" % exc, file=path) from exc
-    except json.JSONDecodeError as exc:
-        raise InputError("not valid JSON: %s (expected a JSON object)" % exc.msg,
-                         file=path, line=exc.lineno, column=exc.colno) from exc
-    if not isinstance(data, dict):
-        raise InputError("the job file must hold a JSON object", file=path)
+    """Read a JSON job file (see README, 'freecadcmd'): a regular UTF-8 file of bounded
+    size and nesting whose known keys hold values of their type
+    (:func:`surfcomp.io.jobfile.read_job_file`)."""
+    data = read_job_file(path)
     return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))
