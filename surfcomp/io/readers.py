@@ -8,6 +8,7 @@ none of the table's columns, as plain measured XYZ points.
 """
 
 from ..errors import InputError, MeasurementFileError
+from .files import read_once
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
 
@@ -34,6 +35,11 @@ def read_any(path, units="mm", fmt="auto", sample=None):
     if fmt not in FORMATS:
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)
+    with read_once(path):
+        return _read(path, units, fmt, sample)
+
+
+def _read(path, units, fmt, sample):
     if fmt != "auto" and fmt != "table":
         return read_point_file(path, fmt=fmt, units=units, sample=sample)
     detected = "table" if fmt == "table" else detect_format(path)
