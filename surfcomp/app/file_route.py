@@ -70,6 +70,9 @@ class Job:
         return cls(**kw)
 
 
+#: ignored measurement columns named in the report (the rest are counted)
+IGNORED_LISTED = 100
+
 #: the outputs of a job: (attribute of :class:`Job`, command-line option)
 OUTPUT_OPTIONS = (("output", "-o"), ("report", "--report"), ("points", "--points"),
                   ("curves", "--curves"), ("html", "--html"))
@@ -139,6 +142,8 @@ def run_job(job, progress=None):
                            write_face(tmp, shape, output if attr == "output" else None, name))
             if attr == "output":        # the report states the size of the written face
                 rep["output_shape"]["file_bytes"] = os.path.getsize(tmp)
+        if job.report:      # streamed: a million points' JSON is never one string
+            tx.write(job.report, lambda tmp: report_io.write_file(rep, tmp))
         for attr, text in _texts(job, comp, rep).items():
             tx.stage_text(getattr(job, attr), text)
         tx.commit()
@@ -146,12 +151,11 @@ def run_job(job, progress=None):
 
 
 def _texts(job, comp, rep):
-    """The text outputs of ``job`` (points CSV, JSON report, HTML report) by attribute."""
+    """The text outputs of ``job`` (points CSV, HTML report) by attribute; the JSON report
+    is written by :func:`surfcomp.io.report.write_file`."""
     texts = {}
     if job.points:
         texts["points"] = corrected_points_csv(comp)
-    if job.report:
-        texts["report"] = report_io.dumps(rep)
     if job.html:
         texts["html"] = render_html(rep)
     return texts
@@ -177,7 +181,10 @@ def _inputs_record(job, nominal, ms):
                     "u_range": list(surface.u_range), "v_range": list(surface.v_range)},
         "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
                          "units": ms.units, "kind": ms.kind(), "points": len(ms),
-                         "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
+                         "columns": dict(ms.columns),
+                         # the first names only: a table may have a million extra columns
+                         "ignored_columns": list(ms.ignored_columns[:IGNORED_LISTED]),
+                         "ignored_column_count": len(ms.ignored_columns)},
     }
 
 

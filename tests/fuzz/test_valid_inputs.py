@@ -112,3 +112,28 @@ def test_measurements_that_can_be_read_once(how, tmp_path):
     table = [t for t in out.stdout.decode().splitlines() if "Standard deviation" in t]
     assert table and table == [t for t in ref.stdout.decode().splitlines()
                                if "Standard deviation" in t]
+
+
+def test_table_with_many_extra_columns(tmp_path):
+    """30 000 unknown columns: ten named warnings and one that counts the rest; the report
+    names the first 100 and counts them all (a million columns gave a million warning lines
+    and a 100 MB report)."""
+    extra = 30_000
+    header = I.HEADER + "," + ",".join("extra%d" % k for k in range(extra))
+    body = "".join(",".join(r) + ",0" * extra + "\n" for r in I.rows(9))
+    res = run_case(Case("wide", ("inspect", "n.step", "m.csv", "--report", "r.json", "--quiet",
+                                 "--layout", "scattered"),
+                        I.setup(I.copy("n.step", EXAMPLE_STEP),
+                                I.put("m.csv", header + "\n" + body)),
+                        rc=0, writes=("r.json",)), tmp_path)
+    warnings = [t for t in res.err.splitlines() if t.startswith("warning: m.csv:1:")]
+    assert len(warnings) == 11
+    assert warnings[9].endswith("column 18 'extra9' is ignored (not a known column name)")
+    assert warnings[10].endswith("%d more columns are ignored (columns 19 to %d: not known "
+                                 "column names)" % (extra - 10, extra + 8))
+    import json
+
+    rep = json.loads((tmp_path / "r.json").read_text(encoding="utf-8"))
+    info = rep["inputs"]["measurements"]
+    assert info["ignored_column_count"] == extra and len(info["ignored_columns"]) == 100
+    assert (tmp_path / "r.json").stat().st_size < 200_000
