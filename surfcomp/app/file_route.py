@@ -10,6 +10,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..core import budget
 from ..core.memory import return_free_memory
 from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import report as report_progress
@@ -88,11 +89,14 @@ def declared_inputs(job):
     return [("NOMINAL", job.nominal), ("MEASUREMENTS", job.measurements)]
 
 
-def run_job(job, progress=None):
+def run_job(job, progress=None, max_memory=None):
     """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs.
 
     The outputs are checked against the inputs and each other before anything is read, and
-    written together at the end (:class:`surfcomp.io.atomic.Transaction`).
+    written together at the end (:class:`surfcomp.io.atomic.Transaction`). A job whose
+    estimated peak memory (from its number of points) is above ``max_memory`` (bytes;
+    None: the machine's memory) is refused once the points are read, before the work
+    (:mod:`surfcomp.core.budget`).
     """
     outputs, inputs = declared_outputs(job), declared_inputs(job)
     check_outputs(outputs, inputs)
@@ -109,6 +113,8 @@ def run_job(job, progress=None):
 
         check_rebuildable(nominal.bspline_face, job.nominal)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample)
+    budget.check(budget.job_bytes(len(ms), job.command == "compensate"), max_memory,
+                 "%s of %d points" % (job.command, len(ms)))
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
     _warn_outside_trim(nominal, prepared)

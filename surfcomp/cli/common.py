@@ -50,6 +50,26 @@ def add_input_options(p):
                         "outward normal (default 0)")
     p.add_argument("--report", metavar="OUT.json", help="write the JSON report")
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
+    add_max_memory(p)
+
+
+def add_max_memory(p):
+    """``--max-memory SIZE``: the run is refused before the work when its estimated peak
+    memory is larger (:mod:`surfcomp.core.budget`)."""
+    import argparse
+
+    from ..core.budget import parse_size
+    from ..errors import InputError
+
+    def size(text):
+        try:
+            return parse_size(text)
+        except InputError as exc:
+            raise argparse.ArgumentTypeError(exc.message.split(": ", 1)[1]) from None
+
+    p.add_argument("--max-memory", type=size, default=None, metavar="SIZE",
+                   help="refuse the run, before the work, when its estimated peak memory is "
+                        "larger than SIZE (e.g. 4G, 512M; default: the machine's memory)")
 
 
 def add_method_options(p):
@@ -95,7 +115,7 @@ def run_job_command(args, command):
     from ..app.file_route import run_job
 
     job = job_from_args(args, command)
-    comp, rep = run_job(job, progress=ProgressLine(args.quiet))
+    comp, rep = run_job(job, progress=ProgressLine(args.quiet), max_memory=args.max_memory)
     print_summary(comp, rep)
     for key in ("output", "points", "curves", "report", "html"):
         if getattr(job, key):
