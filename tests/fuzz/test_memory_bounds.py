@@ -26,6 +26,11 @@ CASES = [
          says=("gcode on 8 lines needs about 0.3 GB of memory", "split the program")),
     Case("compensate-4G", ("compensate", "n.step", "m.csv", "-o", "c.step", "--quiet",
                            "--max-memory", "4G"), JOB, rc=0, writes=("c.step",)),
+    # the document route has no estimate: the option is refused, not ignored
+    Case("document-route", ("compensate", "d.FCStd", "m.csv", "--object", "Nominal",
+                            "--replace", "--save", "out.FCStd", "--max-memory", "8G"),
+         I.setup(I.put("d.FCStd", I.document_bytes), I.put("m.csv", I.csv)),
+         says=("--max-memory cannot be combined with --replace/--save/--gcode",)),
     Case("inspect-size-garbage", ("inspect", "n.step", "m.csv", "--max-memory", "4 GB RAM"),
          JOB, usage=True, says=("argument --max-memory: expected a size",)),
 ]
