@@ -97,9 +97,9 @@ def check(needed, limit=None, what="this run", hint=""):
 #: ``simulate``: bytes per point of the evaluation grid (nodes and between) and per node
 #: of the measurement grid (its compensations), and per replica and method (statistics).
 #: Measured peaks (2026-12-02, example face, one replica, see CONTRIBUTING.md): 100x100
-#: 0.23 GB, 200x200 0.50 GB (0.32 GB with --between 1), 400x400 0.75 GB, 600x600 1.0 GB;
-#: these costs estimate 0.35, 0.50 (0.38), 1.1 and 2.1 GB
-SIM_PER_EVAL_POINT = 1000
+#: 227 MB, 200x200 486 MB (313 MB with --between 1), 400x400 728 MB, 600x600 989 MB,
+#: 800x800 1622 MB; these costs estimate 355, 520 (384), 1183, 2289 and 3836 MB
+SIM_PER_EVAL_POINT = 1200
 SIM_PER_GRID_POINT = 1000
 SIM_PER_REPLICA_METHOD = 4000
 #: ``inspect``/``compensate``: bytes per measured point (inspect measured 2026-12-01:

@@ -63,7 +63,7 @@ SIM_METHODS = ("none",) + METHODS
 #: schema name of :meth:`SimulationResult.as_dict`
 SCHEMA = "surfcomp-simulation/1"
 #: largest measurement grid per direction: 800 x 800 with the default ``between`` = 2 is
-#: estimated at 3.5 GB (:mod:`surfcomp.core.budget`; measured 1.0 GB at 600 x 600); the
+#: estimated at 3.7 GB (:mod:`surfcomp.core.budget`; measured 1.6 GB); the
 #: former 4000 x 4000 ran out of memory at 6.5 GB (it needs about 80 GB) and would have run
 #: for days
 MAX_GRID = 800

@@ -58,7 +58,7 @@ LOOP = [
     sim("max-memory-of-a-busy-machine", small=("--grid", "300x290", "--replicas", "1000",
                                                 "--max-memory=300MiB"),
         says=("simulate --grid 300x290 --between 2 --replicas 1000 (5 methods) needs about "
-              "0.7 GB of memory, more than --max-memory (0.3 GB); a coarser --grid",)),
+              "0.8 GB of memory, more than --max-memory (0.3 GB); a coarser --grid",)),
     sim("max-memory-garbage", small=SMALL + ("--max-memory", "lots"), usage=True,
         says=("argument --max-memory: expected a size such as 4G",)),
     sim("max-memory-tiny", small=SMALL + ("--max-memory", "1k"), usage=True,
