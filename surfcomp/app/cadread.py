@@ -19,10 +19,35 @@ import subprocess
 import sys
 import tempfile
 
-from ..errors import GeometryError
+from ..errors import GeometryError, InputError
 
-#: seconds the reader may take (a large assembly takes minutes; a hang must end)
-TIMEOUT = float(os.environ.get("SURFCOMP_CAD_TIMEOUT", "900"))
+#: seconds the reader may take (a large assembly takes minutes; a hang must end);
+#: ``SURFCOMP_CAD_TIMEOUT`` replaces it
+TIMEOUT = 900.0
+#: the largest ``SURFCOMP_CAD_TIMEOUT`` accepted, s (a week)
+MAX_TIMEOUT = 7 * 24 * 3600.0
+
+
+def timeout():
+    """The reader's time limit: ``SURFCOMP_CAD_TIMEOUT`` seconds when set, else
+    :data:`TIMEOUT`.
+
+    Raises
+    ------
+    InputError
+        The variable is not a number of seconds above 0 and at most :data:`MAX_TIMEOUT`.
+    """
+    text = os.environ.get("SURFCOMP_CAD_TIMEOUT")
+    if text is None:
+        return TIMEOUT
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value <= MAX_TIMEOUT:    # also NaN
+        raise InputError("SURFCOMP_CAD_TIMEOUT=%r is not a time limit (expected seconds "
+                         "above 0 and at most %d, e.g. 900)" % (text, MAX_TIMEOUT))
+    return value
 #: exit code of the child for a file OCCT refused without crashing
 _REFUSED = 3
 
@@ -46,20 +71,24 @@ def read_cad(path, label="NOMINAL"):
     """
     import Part
 
+    limit = timeout()
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     with tempfile.TemporaryDirectory(prefix="surfcomp-read-") as tmp:
         out = os.path.join(tmp, "shape.brep")
+        # the reader gets an ASCII name linked to the file: OpenCASCADE takes file names
+        # as UTF-8, and a name that is not (bytes of another encoding) cannot be passed
+        src = os.path.join(tmp, "input" + os.path.splitext(path)[1].lower())
+        os.symlink(os.path.abspath(path), src)
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
         try:
-            child = subprocess.run([_python(), "-m", "surfcomp.app.cadread",
-                                    os.path.abspath(path), out],
-                                   capture_output=True, text=True, timeout=TIMEOUT, env=env,
+            child = subprocess.run([_python(), "-m", "surfcomp.app.cadread", src, out],
+                                   capture_output=True, text=True, timeout=limit, env=env,
                                    cwd=tmp)
         except subprocess.TimeoutExpired:
             raise GeometryError("could not read %s: OpenCASCADE took more than %d s (raise "
                                 "SURFCOMP_CAD_TIMEOUT for very large files)"
-                                % (label, TIMEOUT), file=path) from None
+                                % (label, limit), file=path) from None
         if child.returncode < 0 or child.returncode > 128:
             raise GeometryError("could not read %s: the file is damaged (OpenCASCADE crashed "
                                 "while reading it)" % label, file=path)

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..core import budget
 from ..core.memory import return_free_memory
 from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import report as report_progress
@@ -20,6 +21,7 @@ from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.html_report import render_html
+from ..io.jobfile import read_job_file
 from ..io.outpath import shown
 from ..io.readers import read_any
 from ..io.step_face import write_natural_face
@@ -94,6 +96,9 @@ JOB_FILES = (("nominal", "input", "NOMINAL"), ("measurements", "input", "MEASURE
              ("output", "output", "-o"), ("report", "output", "--report"),
              ("points", "output", "--points"), ("curves", "output", "--curves"),
              ("html", "output", "--html"))
+#: ignored measurement columns named in the report (the rest are counted)
+IGNORED_LISTED = 100
+
 #: the outputs of a job: (attribute of :class:`Job`, command-line option)
 OUTPUT_OPTIONS = tuple((attr, label) for attr, role, label in JOB_FILES if role == "output")
 #: job keys that do nothing for a command (refused)
@@ -110,12 +115,14 @@ def declared_inputs(job):
     return [(label, getattr(job, attr)) for attr, role, label in JOB_FILES if role == "input"]
 
 
-def run_job(job, progress=None, inputs=()):
+def run_job(job, progress=None, inputs=(), max_memory=None):
     """Run ``job``; return ``(compensation, report_dict)``. Writes the requested outputs.
 
     The outputs are checked against the inputs (the job's and ``inputs``, e.g. the job
     file) and each other before anything is read, and written together at the end
-    (:class:`surfcomp.io.atomic.Transaction`).
+    (:class:`surfcomp.io.atomic.Transaction`). A job whose estimated peak memory (from its
+    number of points) is above ``max_memory`` (bytes; None: the machine's memory) is
+    refused once the points are read, before the work (:mod:`surfcomp.core.budget`).
     """
     outputs, inputs = declared_outputs(job), declared_inputs(job) + list(inputs)
     check_outputs(outputs, inputs)
@@ -127,8 +134,14 @@ def run_job(job, progress=None, inputs=()):
     from .nominal import load_nominal
 
     nominal = load_nominal(job.nominal, job.face, job.object)
+    if job.command == "compensate" and job.output:
+        from .shapes import check_rebuildable
+
+        check_rebuildable(nominal.bspline_face, job.nominal)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample,
                   deviation_units=job.deviation_units)
+    budget.check(budget.job_bytes(len(ms), job.command == "compensate"), max_memory,
+                 "%s of %d points" % (job.command, len(ms)))
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
     _warn_outside_trim(nominal, prepared)
@@ -162,6 +175,8 @@ def run_job(job, progress=None, inputs=()):
                            write_face(tmp, shape, output if attr == "output" else None, name))
             if attr == "output":        # the report states the size of the written face
                 rep["output_shape"]["file_bytes"] = os.path.getsize(tmp)
+        if job.report:      # streamed: a million points' JSON is never one string
+            tx.write(job.report, lambda tmp: report_io.write_file(rep, tmp))
         for attr, text in _texts(job, comp, rep).items():
             tx.stage_text(getattr(job, attr), text)
         tx.commit()
@@ -169,12 +184,11 @@ def run_job(job, progress=None, inputs=()):
 
 
 def _texts(job, comp, rep):
-    """The text outputs of ``job`` (points CSV, JSON report, HTML report) by attribute."""
+    """The text outputs of ``job`` (points CSV, HTML report) by attribute; the JSON report
+    is written by :func:`surfcomp.io.report.write_file`."""
     texts = {}
     if job.points:
         texts["points"] = corrected_points_csv(comp)
-    if job.report:
-        texts["report"] = report_io.dumps(rep)
     if job.html:
         texts["html"] = render_html(rep)
     return texts
@@ -200,7 +214,10 @@ def _inputs_record(job, nominal, ms):
                     "u_range": list(surface.u_range), "v_range": list(surface.v_range)},
         "measurements": {"path": os.path.abspath(job.measurements), "sha256": ms.sha256,
                          "units": ms.units, "kind": ms.kind(), "points": len(ms),
-                         "columns": dict(ms.columns), "ignored_columns": list(ms.ignored_columns)},
+                         "columns": dict(ms.columns),
+                         # the first names only: a table may have a million extra columns
+                         "ignored_columns": list(ms.ignored_columns[:IGNORED_LISTED]),
+                         "ignored_column_count": len(ms.ignored_columns)},
     }
 
 
@@ -252,16 +269,19 @@ def write_face(path, shape, output=None, name=None):
     (:mod:`surfcomp.io.step_face`, 5-7x faster than OpenCASCADE's writer), its product
     named ``name`` (default: the file's name).
     """
+    import Part
+
     fmt = cad_format(path)
     if fmt == "step" and output is not None and output.natural is not None:
         write_natural_face(path, output.natural, shape.Orientation == "Reversed",
                            output.edge_tolerance, name)
-    elif fmt == "step":
-        shape.exportStep(path)
-    elif fmt == "iges":
-        shape.exportIges(path)
-    else:
-        shape.exportBrep(path)
+        return
+    try:
+        {"step": shape.exportStep, "iges": shape.exportIges, "brep": shape.exportBrep}[fmt](path)
+    except (Part.OCCError, RuntimeError) as exc:
+        # OpenCASCADE's writers report a full disk or a write error only as this
+        raise InputError("OpenCASCADE could not write the %s file: %s (a full disk, or no "
+                         "permission to write there?)" % (fmt.upper(), exc), file=path) from None
     if not os.path.getsize(path):
         raise InputError("OpenCASCADE wrote an empty file", file=path)
 
@@ -284,17 +304,10 @@ def corrected_points_csv(comp):
 
 
 def load_job_file(path):
-    """Read a JSON job file (see README, 'freecadcmd')."""
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except OSError as exc:
-        raise InputError("cannot read the job file: %s" % exc, file=path) from exc
-    except json.JSONDecodeError as exc:
-        raise InputError("not valid JSON: %s (expected a JSON object)" % exc.msg,
-                         file=path, line=exc.lineno, column=exc.colno) from exc
-    if not isinstance(data, dict):
-        raise InputError("the job file must hold a JSON object", file=path)
+    """Read a JSON job file (see README, 'freecadcmd'): a regular UTF-8 file of bounded
+    size and nesting whose known keys hold values of their type
+    (:func:`surfcomp.io.jobfile.read_job_file`)."""
+    data = read_job_file(path)
     try:
         return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))
     except InputError as exc:

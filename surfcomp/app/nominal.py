@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.surface_checks import MAX_DEGREE, check_nominal
 from ..core.trimmed import inside
 from ..errors import GeometryError
 from . import fcenv
@@ -91,7 +92,7 @@ def _shape_from_document(path, object_name):
                 raise GeometryError("object %r has no shape" % object_name, file=path)
             return obj.Shape.copy(), obj.Name
         cands = [o for o in doc.Objects if hasattr(o, "Shape") and not o.Shape.isNull()
-                 and any(f.Surface.TypeId == "Part::GeomBSplineSurface" for f in o.Shape.Faces)
+                 and any(surface_type(f) == "BSplineSurface" for f in o.Shape.Faces)
                  and not o.InList]
         if len(cands) != 1:
             raise GeometryError("%s objects with B-spline faces at the top of the document (%s): "
@@ -117,20 +118,29 @@ def pick_face(shape, face_name=None, source=None):
             raise GeometryError("the shape has no %s (it has %d faces: Face1 .. Face%d)"
                                 % (name, len(faces), len(faces)), file=source)
         return faces[k - 1], name
-    bs = [(k, f) for k, f in enumerate(faces, 1) if f.Surface.TypeId == "Part::GeomBSplineSurface"]
+    bs = [(k, f) for k, f in enumerate(faces, 1) if surface_type(f) == "BSplineSurface"]
     if len(faces) == 1:
         return faces[0], "Face1"
     if len(bs) == 1:
         return bs[0][1], "Face%d" % bs[0][0]
     kinds = {}
     for f in faces:
-        kind = f.Surface.TypeId.split("::Geom")[-1]
+        kind = surface_type(f) or "unreadable"
         kinds[kind] = kinds.get(kind, 0) + 1
     raise GeometryError("%s B-spline faces among %d faces (%s): choose one with --face FaceN"
                         % ("no" if not bs else "%d" % len(bs), len(faces),
                            ", ".join("%d %s" % (c, k) for k, c in sorted(kinds.items())))
                         + ("; B-spline faces: " + ", ".join("Face%d" % k for k, _ in bs[:20])
                            if bs else ""), file=source)
+
+
+def surface_type(face):
+    """The face's surface type (``'BSplineSurface'``, ``'Plane'``, ...), or None when
+    OpenCASCADE holds no surface for it (a B-spline read with a degree above its limit)."""
+    try:
+        return face.Surface.TypeId.split("::Geom")[-1]
+    except (TypeError, RuntimeError, AttributeError):
+        return None
 
 
 def to_bspline_face(face):
@@ -143,10 +153,13 @@ def to_bspline_face(face):
     """
     import Part
 
-    surf = face.Surface
-    if surf.TypeId == "Part::GeomBSplineSurface":
+    converted = surface_type(face)
+    if converted is None:
+        raise GeometryError("the face's surface cannot be read: OpenCASCADE holds no surface "
+                            "for it (a B-spline of degree above %d, its limit, or a damaged "
+                            "file?)" % MAX_DEGREE)
+    if converted == "BSplineSurface":
         return face, None
-    converted = surf.TypeId.split("::Geom")[-1]
     try:
         return face.toNurbs().Faces[0], converted
     except (Part.OCCError, RuntimeError, IndexError) as exc:
@@ -190,10 +203,21 @@ def load_nominal(path, face_name=None, object_name=None):
 
 def nominal_from_face(face, source="<document>", face_name="Face1", object_name=None, shape=None):
     """Build a :class:`Nominal` from a ``Part.Face`` (a copy is kept)."""
+    import Part
+
     face = face.copy()
-    bface, converted = to_bspline_face(face)
+    try:
+        bface, converted = to_bspline_face(face)
+    except GeometryError as exc:
+        exc.file = exc.file or source
+        raise
     u0, u1, v0, v1 = bface.ParameterRange
-    surface = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
+    try:
+        surface = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
+    except (Part.OCCError, ValueError, OverflowError) as exc:
+        raise GeometryError("the face's B-spline surface cannot be used: %s" % exc,
+                            file=source) from None
+    check_nominal(surface, source, "the surface of %s" % face_name)
     outward = -1 if bface.Orientation == "Reversed" else 1
     return Nominal(face=face, bspline_face=bface, surface=surface, outward=outward, source=source,
                    face_name=face_name, object_name=object_name, converted=converted, shape=shape)

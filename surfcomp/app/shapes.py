@@ -87,6 +87,16 @@ def _index(items, e):
     raise GeometryError("an edge of the face's wire is not an edge of the face")
 
 
+def check_rebuildable(face, source=None):
+    """Refuse, before any work, a face whose corrected form cannot be built: one with a seam
+    (a closed surface such as a full sphere or cylinder), which a corrected surface does not
+    close again (:func:`rebuild_face` would refuse it after the computation)."""
+    if any(e.isSeam(face) for e in face.Edges):
+        raise GeometryError("the face has a seam (a closed surface such as a full sphere or "
+                            "cylinder): a corrected surface does not close it; split the face "
+                            "at the seam first (expected an open face)", file=source)
+
+
 def rebuild_face(face, bs, pcurves=None):
     """The face ``face`` with its surface replaced by ``bs`` (same parametrisation).
 

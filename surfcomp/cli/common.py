@@ -105,7 +105,7 @@ def run_job_command(args, command):
 
     job = job_from_args(args, command)
     comp, rep = run_job(job, progress=ProgressLine(args.quiet),
-                        inputs=registry.declared(args, command)[1])
+                        inputs=registry.declared(args, command)[1], max_memory=args.max_memory)
     print_summary(comp, rep)
     print_written(job)
     return 0

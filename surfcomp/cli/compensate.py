@@ -58,10 +58,12 @@ def run_document(args):
     if not args.object:
         raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
                          "holding the nominal face)", file=args.nominal)
-    other = [o for o in ("output", "report", "points", "curves", "html") if getattr(args, o)]
+    other = [o for o in ("output", "report", "points", "curves", "html", "max_memory")
+             if getattr(args, o)]
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
-                         "'compensate' without them for the files" % other[0])
+                         "'compensate' without them for the files"
+                         % other[0].replace("_", "-"))
     from ..app import fcenv
 
     fcenv.import_freecad()

@@ -13,6 +13,7 @@ import sys
 import numpy as np
 
 from .. import __version__
+from ..core import budget
 from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors, volumetric_map
 from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH, check_segments
 from ..errors import GCodeError, InputError
@@ -128,6 +129,9 @@ def run(args):
                             source=args.axis_errors)
     prog_model = model if offset is None else model.in_program_coordinates(offset)
     data = read_gcode(args.program)
+    lines = data.count(b"\n") + 1
+    budget.check(budget.gcode_bytes(lines), args.max_memory, "gcode on %d lines" % lines,
+                 "split the program into parts")
     parsed = parse_gcode(data, source=args.program, start=start)
     if parsed[0].is_empty():
         raise GCodeError("the program is empty (no G-code words, only blank lines, comments "

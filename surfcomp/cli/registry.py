@@ -41,6 +41,19 @@ class Entry:
         return name.lstrip("-").replace("-", "_")
 
 
+def _memory_size(text):
+    """argparse type of ``--max-memory``: bytes (:func:`surfcomp.core.budget.parse_size`)."""
+    import argparse
+
+    from ..core.budget import parse_size
+    from ..errors import InputError
+
+    try:
+        return parse_size(text)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(exc.message.split(": ", 1)[1]) from None
+
+
 JOB = ("compensate", "inspect")
 DOCUMENT = "shop document (NOMINAL is an .FCStd)"
 SIM_MODEL = "machining-process model (mm)"
@@ -104,6 +117,12 @@ ENTRIES = (
                help="compensated program (written atomically; - for standard output)")),
     Entry(("gcode",), ("--report",), "output", "--report",
           dict(metavar="OUT.json", help="write the JSON report")),
+    # ------------------------------------------------------------------ every command
+    Entry(("compensate", "inspect", "simulate", "gcode"), ("--max-memory",), "option",
+          "--max-memory",
+          dict(type=_memory_size, default=None, metavar="SIZE",
+               help="refuse the run, before the work, when its estimated peak memory is "
+                    "larger than SIZE (e.g. 4G, 512M; default: the machine's memory)")),
 )
 
 

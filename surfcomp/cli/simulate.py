@@ -54,6 +54,7 @@ from dataclasses import fields
 
 import numpy as np
 
+from ..core import budget
 from ..core import presets as presets_
 from ..core import simulate as sim
 from ..core.filters import EDGE_MODES
@@ -126,7 +127,8 @@ def add_parser(subparsers):
                    help="the corrected parts are measured on a grid K times denser (grid nodes "
                         "and points between them; default 2, or the preset's)")
     g.add_argument("--replicas", type=int, default=None, metavar="N",
-                   help="parts machined per method (default 4, as the mirror paper)")
+                   help="parts machined per method (default 4, as the mirror paper; at most "
+                        "%d)" % sim.MAX_REPLICAS)
     g.add_argument("--methods", default="none,offset,raw,filtered,mirror", metavar="LIST",
                    help="comma-separated methods: none, offset, raw, filtered, mirror "
                         "(default all)")
@@ -205,6 +207,9 @@ def check_loop_options(args):
         val = getattr(args, name)
         if val is not None and val < low:
             raise InputError("--%s %d: expected a whole number >= %d" % (name, val, low))
+    if args.replicas is not None and args.replicas > sim.MAX_REPLICAS:
+        raise InputError("--replicas %d: expected at most %d (the mirror paper machines 4 "
+                         "parts per method)" % (args.replicas, sim.MAX_REPLICAS))
 
 
 def model_from_args(args, preset=None):
@@ -272,6 +277,17 @@ def _nominal(args, preset):
         name, surface.shape[0], surface.shape[1], ")" if args.nominal else "")
 
 
+def check_memory(grid, between, replicas, methods, limit):
+    """Refuse a loop whose estimated peak memory is above ``limit`` (bytes; None: the
+    machine's memory), before the work (:mod:`surfcomp.core.budget`)."""
+    n, m = grid
+    evaluated = ((n - 1) * between + 1) * ((m - 1) * between + 1)
+    budget.check(budget.simulate_bytes(evaluated, n * m, replicas, methods), limit,
+                 "simulate --grid %dx%d --between %d --replicas %d (%d methods)"
+                 % (n, m, between, replicas, methods),
+                 "a coarser --grid, --between 1 or fewer --replicas need less")
+
+
 def run(args):
     preset = presets_.get_preset(args.preset) if args.preset else None
     if args.nominal is None and preset is None:
@@ -292,6 +308,7 @@ def run(args):
         raise InputError("--methods %r: expected a comma-separated list of some of %s"
                          % (args.methods, ", ".join(sim.SIM_METHODS)))
     specs = sim.method_specs(methods, masks, None, args.mask_kind, args.edge, args.refine)
+    check_memory(grid, between, replicas, len(specs), args.max_memory)
     report_label = _report_label(args, specs)
     model = model_from_args(args, preset)
     check_outputs(*_declared(args))

@@ -278,10 +278,12 @@ def normals(surf, u, v):
     u = np.asarray(u, dtype=float)
     v = np.asarray(v, dtype=float)
     _, Su, Sv = derivatives(surf, u, v, 1)
-    return _unit_normals(surf, u, v, Su, Sv)
+    return unit_normals(surf, u, v, Su, Sv)
 
 
-def _unit_normals(surf, u, v, Su, Sv):
+def unit_normals(surf, u, v, Su, Sv):
+    """The unit normals of :func:`normals` from derivatives already evaluated at
+    ``(u, v)`` (``Su``, ``Sv`` shape (..., 3))."""
     n = np.cross(Su, Sv)
     su, sv = _derivative_scales(surf)
     bad = _degenerate(n, Su, Sv, su, sv)

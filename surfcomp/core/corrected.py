@@ -129,17 +129,30 @@ def _span(width, spacing, refine, per_step=2, min_spans=MIN_SPANS):
 
 def _added_knots(nominal, spacing_u, spacing_v, refine, lines=None, per_step=2,
                  min_spans=MIN_SPANS):
-    """The knots the refined space adds to the nominal's, along u and along v."""
+    """The knots the refined space adds to the nominal's, along u and along v: only knots
+    strictly inside both the work area and the spline's domain (a surface made
+    non-periodic keeps knots beyond its domain, and a face range read from a file can end
+    a rounding error beyond it: a full sphere's 6.28318530717959 against 2 pi)."""
     (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
     if lines is not None:
-        return (node_line_knots(nominal.knots_u, u0, u1, lines[0]),
-                node_line_knots(nominal.knots_v, v0, v1, lines[1]))
-    return (refinement_knots(nominal.knots_u, nominal.degree_u, u0, u1,
-                             _span(u1 - u0, spacing_u, refine, per_step, min_spans))
-            if spacing_u else (),
-            refinement_knots(nominal.knots_v, nominal.degree_v, v0, v1,
-                             _span(v1 - v0, spacing_v, refine, per_step, min_spans))
-            if spacing_v else ())
+        added = (node_line_knots(nominal.knots_u, u0, u1, lines[0]),
+                 node_line_knots(nominal.knots_v, v0, v1, lines[1]))
+    else:
+        added = (refinement_knots(nominal.knots_u, nominal.degree_u, u0, u1,
+                                  _span(u1 - u0, spacing_u, refine, per_step, min_spans))
+                 if spacing_u else (),
+                 refinement_knots(nominal.knots_v, nominal.degree_v, v0, v1,
+                                  _span(v1 - v0, spacing_v, refine, per_step, min_spans))
+                 if spacing_v else ())
+    return tuple(_inside_domain(np.asarray(k, dtype=float), knots, p, lo, hi)
+                 for k, knots, p, (lo, hi) in zip(
+                     added, (nominal.knots_u, nominal.knots_v),
+                     (nominal.degree_u, nominal.degree_v), (nominal.u_range, nominal.v_range)))
+
+
+def _inside_domain(new, knots, degree, lo, hi):
+    lo, hi = max(lo, knots[degree]), min(hi, knots[knots.size - degree - 1])
+    return new[(new > lo) & (new < hi)]
 
 
 class _Sampling:
@@ -154,8 +167,10 @@ class _Sampling:
         self.us = bspline.greville(self.fine.knots_u, self.fine.degree_u)
         self.vs = bspline.greville(self.fine.knots_v, self.fine.degree_v)
         self.S, Su, Sv = bspline.evaluate_grid(self.fine, self.us, self.vs, order=1)
-        n = np.cross(Su, Sv)
-        self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
+        # unit normals, a collapsed edge (a cone's apex, a sphere's pole) taking the limit
+        # of its neighbours' as everywhere else (:func:`bspline.normals`)
+        uu, vv = np.meshgrid(self.us, self.vs, indexing="ij")
+        self.n = outward * bspline.unit_normals(self.fine, uu, vv, Su, Sv)
 
     def build(self, delta):
         """The surface through ``S - delta n`` at the samples; ``delta`` shape
@@ -565,8 +580,7 @@ class _NodeFrame:
         self.u = np.ravel(u).astype(float)
         self.v = np.ravel(v).astype(float)
         self.P, Su, Sv = bspline.derivatives(nominal, self.u, self.v, order=1)
-        n = np.cross(Su, Sv)
-        self.n = n * (outward / np.linalg.norm(n, axis=-1, keepdims=True))
+        self.n = outward * bspline.unit_normals(nominal, self.u, self.v, Su, Sv)
         self._last = None
 
     def realised_change(self, before, after, real):

@@ -224,49 +224,78 @@ def plan_moves(prog, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e
     lines = kind == 1
     length = np.linalg.norm(prog.end - prog.start, axis=1)
     nseg[lines] = np.maximum(1, np.ceil(length[lines] / segment_length - 1e-9)).astype(int)
-    arcs = np.flatnonzero(kind >= 2)
-    for j in arcs:
+    for j in np.flatnonzero(kind >= 2):
         nseg[j] = arc_steps(prog.start[j], prog.end[j], prog.centre[j], prog.plane[j],
                             kind[j] == 2, prog.turns[j], segment_length, arc_tolerance)
+    still = np.broadcast_to(np.asarray(still, dtype=float), (m,))
+    dev, keep, split = np.zeros(m), np.zeros(m, dtype=bool), np.zeros(m, dtype=bool)
+    nominal, comp = [], []
+    # the samples of a run of moves at a time: the points kept are those of the split
+    # moves and the ends, so the memory follows the output, not the samples
+    bounds = np.cumsum(nseg)
+    a = 0
+    while a < m:
+        b = max(a + 1, int(np.searchsorted(bounds, bounds[a] - nseg[a] + PLAN_CHUNK,
+                                           side="right")))
+        report(progress, a / max(m, 1), "compensating moves %d to %d" % (a + 1, b))
+        part = _plan_part(prog, model, nseg, a, min(b, m), tolerance, still, dev, keep, split)
+        nominal.append(part[0])
+        comp.append(part[1])
+        a = b
+    new_n = np.where(split, nseg, 1)
+    new_off = np.zeros(m + 1, dtype=int)
+    np.cumsum(new_n, out=new_off[1:])
+    report(progress, 1.0, "planned")
+    return MovePlan(new_off, np.concatenate(nominal or [np.zeros((0, 3))]),
+                    np.concatenate(comp or [np.zeros((0, 3))]), split, keep, dev)
+
+
+#: samples planned at a time by :func:`plan_moves` (a few tens of MB of temporaries)
+PLAN_CHUNK = 200_000
+
+
+def _plan_part(prog, model, nseg_all, a, b, tolerance, still, dev, keep, split):
+    """Sample, compensate and decide moves ``a`` to ``b - 1``: fills ``dev``, ``keep``,
+    ``split`` there; returns the (nominal, compensated) points kept (split moves' pieces
+    and every move's end)."""
+    kind = prog.kind[a:b]
+    start, end = prog.start[a:b], prog.end[a:b]
+    nseg = nseg_all[a:b]
+    m = b - a
+    lines = kind == 1
+    arcs = np.flatnonzero(kind >= 2)
     offsets = np.zeros(m + 1, dtype=int)
     np.cumsum(nseg, out=offsets[1:])
     total = int(offsets[-1])
     owner = np.repeat(np.arange(m), nseg)
     step = np.arange(total) - offsets[owner] + 1
     frac = step / nseg[owner]
-    nominal = prog.start[owner] + (prog.end - prog.start)[owner] * frac[:, None]
+    nominal = start[owner] + (end - start)[owner] * frac[:, None]
     for j in arcs:
+        g = a + j
         nominal[offsets[j]:offsets[j + 1]] = arc_points(
-            prog.start[j], prog.end[j], prog.centre[j], prog.plane[j], kind[j] == 2,
-            prog.turns[j], nseg[j])
+            prog.start[g], prog.end[g], prog.centre[g], prog.plane[g], prog.kind[g] == 2,
+            prog.turns[g], nseg[j])
     last = offsets[1:] - 1
-    nominal[last] = prog.end
-    report(progress, 0.3, "compensating %d points" % total)
+    nominal[last] = end
     comp = model.compensate(nominal)
-    comp_start = model.compensate(prog.start)
-    report(progress, 0.8, "splitting")
-    dev = np.zeros(m)
-    keep = np.zeros(m, dtype=bool)
+    comp_start = model.compensate(start)
+    d_part = dev[a:b]
     multi = np.flatnonzero(lines & (nseg > 1))
     if multi.size:
         sel = np.isin(owner, multi)
         own = owner[sel]
         chord = comp_start[own] + (comp[last[own]] - comp_start[own]) * frac[sel][:, None]
         d = np.linalg.norm(comp[sel] - chord, axis=1)
-        np.maximum.at(dev, own, d)
-    split_line = lines & (nseg > 1) & (dev > tolerance)
-    still = np.broadcast_to(np.asarray(still, dtype=float), (m,))
+        np.maximum.at(d_part, own, d)
+    split_line = lines & (nseg > 1) & (d_part > tolerance)
     if arcs.size:
         moved = np.abs(comp - nominal).max(axis=1)
         worst = np.zeros(m)
         np.maximum.at(worst, owner, moved)
-        worst = np.maximum(worst, np.abs(comp_start - prog.start).max(axis=1))
-        keep[arcs] = worst[arcs] <= still[arcs]
-    is_arc = kind >= 2
-    split = split_line | (is_arc & ~keep & (nseg > 1))
-    take = np.repeat(split, nseg) | np.isin(np.arange(total), last)
-    new_n = np.where(split, nseg, 1)
-    new_off = np.zeros(m + 1, dtype=int)
-    np.cumsum(new_n, out=new_off[1:])
-    report(progress, 1.0, "planned")
-    return MovePlan(new_off, nominal[take], comp[take], split, keep, dev)
+        worst = np.maximum(worst, np.abs(comp_start - start).max(axis=1))
+        keep[a + arcs] = worst[arcs] <= still[a:b][arcs]
+    split[a:b] = split_line | ((kind >= 2) & ~keep[a:b] & (nseg > 1))
+    take = np.repeat(split[a:b], nseg)
+    take[last] = True
+    return nominal[take], comp[take]

@@ -148,6 +148,11 @@ class Projector:
                       np.linalg.norm(np.diff(grid, axis=1), axis=2).ravel()]
         edges = edges[edges > 0]
         self.voxel = float(np.median(edges)) if edges.size else 1.0
+        # closed directions (a full sphere's or cylinder's seam): the first and last
+        # sample lines coincide; a foot stopped at one end is pursued from the other
+        tol = 1e-9 * max(1.0, float(np.abs(grid).max()))
+        self._closed = (bool(np.all(np.abs(grid[0] - grid[-1]) <= tol)),
+                        bool(np.all(np.abs(grid[:, 0] - grid[:, -1]) <= tol)))
         # degenerate samples (collapsed edges, poles) are no seeds: Newton cannot
         # leave them (zero gradient) and all their parameters give one point
         scale_u, scale_v = bspline._derivative_scales(surf)
@@ -295,7 +300,26 @@ class Projector:
             self._best_of(P, check[owner], seeds, u, v, D, conv)
             if sus.size:
                 self._reseed(P, check[sus], u, v, D, conv)
+        self._across_seams(P, u, v, D, conv)
         self._finish(P, idx, u, v, D, conv, res, max_distance)
+
+    def _across_seams(self, P, u, v, D, conv):
+        """Feet stopped at the end of a closed direction (the seam of a full sphere): Newton
+        again from the other end of that direction, keeping the closer foot."""
+        for axis, (lo, hi) in enumerate((self.surf.u_range, self.surf.v_range)):
+            t = (u, v)[axis]
+            k = np.flatnonzero((t <= lo) | (t >= hi)) if self._closed[axis] else ()
+            if not len(k):
+                continue
+            start = [u[k].copy(), v[k].copy()]
+            start[axis] = np.where(t[k] <= lo, hi, lo)
+            u2, v2, D2, c2 = self.newton.run(np.ascontiguousarray(P[k].T), *start)
+            ro, rn = D[0][:, k] - P[k].T, D2[0] - P[k].T
+            better = dot(rn, rn) < dot(ro, ro) * (1 - 1e-12)
+            i = k[better]
+            u[i], v[i], conv[i] = u2[better], v2[better], c2[better]
+            for a, b in zip(D, D2):
+                a[:, i] = b[:, better]
 
     def _certified(self, u, v, r, tangents, conv):
         """Interior converged feet that the region certificate proves global."""
@@ -475,7 +499,7 @@ class Projector:
         with np.errstate(divide="ignore", invalid="ignore"):
             n = n / nn
         if bad.any():
-            n[:, bad] = bspline._unit_normals(self.surf, u[bad], v[bad], Su[:, bad].T,
+            n[:, bad] = bspline.unit_normals(self.surf, u[bad], v[bad], Su[:, bad].T,
                                               Sv[:, bad].T).T
         r = P.T - S
         d = dot(r, n)

@@ -62,8 +62,14 @@ from .sim_tables import (  # noqa: F401
 SIM_METHODS = ("none",) + METHODS
 #: schema name of :meth:`SimulationResult.as_dict`
 SCHEMA = "surfcomp-simulation/1"
-#: largest measurement grid per direction
-MAX_GRID = 4000
+#: largest measurement grid per direction: 800 x 800 with the default ``between`` = 2 is
+#: estimated at 3.7 GB (:mod:`surfcomp.core.budget`; measured 1.6 GB); the
+#: former 4000 x 4000 ran out of memory at 6.5 GB (it needs about 80 GB) and would have run
+#: for days
+MAX_GRID = 800
+#: most replicas (parts machined per method; the mirror paper machines 4); each takes
+#: seconds to minutes
+MAX_REPLICAS = 1000
 #: largest evaluation grid per direction (the largest grid with the default between = 2)
 MAX_EVAL_GRID = 2 * (MAX_GRID - 1) + 1
 
@@ -326,8 +332,9 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     """
     model = model or MachiningModel()
     specs = [_with_stock(s, model.stock) for s in (method_specs() if specs is None else specs)]
-    if int(replicas) != replicas or replicas < 1:
-        raise InputError("replicas must be a whole number >= 1, got %r" % (replicas,))
+    if int(replicas) != replicas or not 1 <= replicas <= MAX_REPLICAS:
+        raise InputError("replicas must be a whole number from 1 to %d, got %r"
+                         % (MAX_REPLICAS, replicas))
     if int(seed) != seed or seed < 0:
         raise InputError("the seed must be a whole number >= 0, got %r" % (seed,))
     layout = make_layout(surface, grid, margin, between)

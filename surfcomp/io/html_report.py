@@ -63,7 +63,14 @@ figure{margin:0}figcaption{font-size:13px;text-align:center}
 
 
 def _e(x):
-    return html.escape(str(x), quote=True)
+    """``x`` as HTML text; characters that UTF-8 cannot hold (the surrogates by which Python
+    keeps the bytes of a file name that is not UTF-8) as ``\\udcff`` escapes."""
+    text = html.escape(str(x), quote=True)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        text = text.encode("utf-8", "backslashreplace").decode("utf-8")
+    return text
 
 
 def _png(fig):

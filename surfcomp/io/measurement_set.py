@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, MeasurementFileError
+from .files import clip
 
 #: largest difference (mm) between a given deviation and (measured - nominal) . normal
 DEV_CHECK_TOL = 1e-3
@@ -186,3 +187,26 @@ def decode_utf8(raw, source):
         raise MeasurementFileError("byte 0x%02x at offset %d is not UTF-8 (expected UTF-8 text: "
                                    "save the file as UTF-8)" % (raw[exc.start], exc.start),
                                    file=source, line=line) from exc
+
+
+#: ignored columns named one by one in warnings and messages; the others are counted (a
+#: table of a million extra columns gave a million warning lines)
+LISTED_COLUMNS = 10
+
+
+def listed_names(names, limit=LISTED_COLUMNS):
+    """``'a', 'b', 'c'``, or the first ``limit`` and ``and N more``."""
+    shown = ", ".join("'%s'" % clip(n) for n in names[:limit])
+    return shown + (" and %d more" % (len(names) - limit) if len(names) > limit else "")
+
+
+def ignored_column_warnings(source, line, columns):
+    """Warnings for the ignored ``columns`` ((1-based column, name, why) in order) of the
+    header on ``line``: one each up to :data:`LISTED_COLUMNS`, then one counting the rest."""
+    out = ["%s:%d: column %d '%s' is ignored (%s)" % (source, line, c, clip(name), why)
+           for c, name, why in columns[:LISTED_COLUMNS]]
+    rest = columns[LISTED_COLUMNS:]
+    if rest:
+        out.append("%s:%d: %d more columns are ignored (columns %d to %d: not known column "
+                   "names)" % (source, line, len(rest), rest[0][0], rest[-1][0]))
+    return out

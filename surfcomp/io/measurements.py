@@ -101,6 +101,8 @@ from .measurement_set import (  # noqa: F401  (MeasurementSet: the readers' resu
     MeasurementSet,
     check_coordinates,
     decode_utf8,
+    ignored_column_warnings,
+    listed_names,
 )
 from .units import SUFFIX_BRACKET, UNIT_FACTORS, split_unit_suffix, unit_factor
 
@@ -396,7 +398,7 @@ class _Parser:
         hints = sorted({_HINTS[_norm(names[c])] for c in ignored if _norm(names[c]) in _HINTS})
         hint = "".join("; " + t for t in hints)
         if not roles:
-            shown = ", ".join("'%s'" % n for n in names)
+            shown = listed_names(names)
             raise self.error("the header names no known column: %s (expected names such as "
                              "x_nom y_nom z_nom, i j k, dev, x_meas y_meas z_meas; see the alias "
                              "table)%s" % (shown, hint), h)
@@ -413,16 +415,14 @@ class _Parser:
         if need:
             got = " and ".join(" ".join(GROUPS[g]) for g in ("nominal", "measured", "normal",
                                                              "deviation") if g in have)
-            lost = ", ".join("'%s'" % names[c] for c in ignored)
+            lost = listed_names([names[c] for c in ignored])
             raise self.error("the header has %sno %s (%s)%s%s"
                              % (got + " but " if got else "",
                                 " and no ".join(_GROUP_TEXT[g] for g in need), _EXPECTED_COMBOS,
                                 "; ignored columns: " + lost if lost else "", hint), h)
-        for c in ignored:
-            name = names[c]
-            why = _HINTS.get(_norm(name), "not a known column name") if name else "it has no name"
-            self.warnings.append("%s:%d: column %d '%s' is ignored (%s)"
-                                 % (self.source, h + 1, c + 1, name, why))
+        self.warnings.extend(ignored_column_warnings(self.source, h + 1, [
+            (c + 1, names[c], _HINTS.get(_norm(names[c]), "not a known column name")
+             if names[c] else "it has no name") for c in ignored]))
         if "deviation" in have and "measured" in have and "normal" not in have:
             c = first["dev"]
             del roles[c]

@@ -10,6 +10,7 @@ none of the table's columns, as plain measured XYZ points.
 import dataclasses
 
 from ..errors import InputError, MeasurementFileError
+from .files import read_once
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
 from .units import unit_factor
@@ -52,6 +53,11 @@ def _read_any(path, units, fmt, sample):
     if fmt not in FORMATS:
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)
+    with read_once(path):
+        return _read(path, units, fmt, sample)
+
+
+def _read(path, units, fmt, sample):
     if fmt != "auto" and fmt != "table":
         return read_point_file(path, fmt=fmt, units=units, sample=sample)
     detected = "table" if fmt == "table" else detect_format(path)

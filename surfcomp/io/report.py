@@ -15,14 +15,19 @@ from ..core import plausibility
 SCHEMA = "surfcomp-report/1"
 
 
-def _list(a, digits=9):
-    """``a`` rounded to ``digits`` decimals as a list; values too large to round (the
+def _rounded(a, digits=9):
+    """``a`` rounded to ``digits`` decimals (an array); values too large to round (the
     rounding multiplies by 10**digits, which overflows from about 1e296) are kept as they
     are."""
     a = np.asarray(a, dtype=float)
     with np.errstate(over="ignore", invalid="ignore"):
         r = np.round(a, digits)
-    return np.where(np.isfinite(r) | ~np.isfinite(a), r, a).tolist()
+    return np.where(np.isfinite(r) | ~np.isfinite(a), r, a)
+
+
+def _list(a, digits=9):
+    """:func:`_rounded` as a list."""
+    return _rounded(a, digits).tolist()
 
 
 def _stock_check(deviation, options):
@@ -82,19 +87,21 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
                           "row = first grid index (along u), col = second (along v)")},
         "statistics": {k: v.as_dict() for k, v in comp.statistics.items()},
         "statistics_ddof": 1,
+        # numpy arrays, written in parts by :func:`write` (the lists of a million points
+        # would take gigabytes, their JSON text as much again)
         "points": None if not points else {
-            "line": [int(x) for x in p.lines],
-            "row": None if row is None else row.tolist(),
-            "col": None if col is None else col.tolist(),
-            "u": _list(p.u, 12),
-            "v": _list(p.v, 12),
-            "nominal": _list(p.nominal),
-            "normal": _list(p.normal, 12),
-            "deviation": _list(p.deviation),
-            "determined": _list(comp.per_point("determined")),
-            "random": _list(comp.per_point("random")),
-            "correction": _list(comp.per_point("delta")),
-            "corrected": _list(comp.corrected_points()),
+            "line": np.asarray(p.lines, dtype=np.int64),
+            "row": None if row is None else np.asarray(row, dtype=np.int64),
+            "col": None if col is None else np.asarray(col, dtype=np.int64),
+            "u": _rounded(p.u, 12),
+            "v": _rounded(p.v, 12),
+            "nominal": _rounded(p.nominal),
+            "normal": _rounded(p.normal, 12),
+            "deviation": _rounded(p.deviation),
+            "determined": _rounded(comp.per_point("determined")),
+            "random": _rounded(comp.per_point("random")),
+            "correction": _rounded(comp.per_point("delta")),
+            "corrected": _rounded(comp.corrected_points()),
         },
         "warnings": list(warnings),
     }
@@ -111,6 +118,51 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
     return out
 
 
+#: points per piece of an array written by :func:`write`
+CHUNK = 65536
+_HOLE = "\u0000surfcomp-points\u0000"
+
+
+def _array_json(a, fh):
+    """Write array ``a`` as a JSON list (of lists for 2-D), ``CHUNK`` rows a line."""
+    fh.write("[")
+    for k in range(0, a.shape[0], CHUNK):
+        text = json.dumps(a[k:k + CHUNK].tolist())
+        fh.write(("\n  " if k == 0 else ",\n  ") + text[1:-1])
+    fh.write("\n ]" if a.shape[0] else "]")
+
+
+def write(report, fh):
+    """Write ``report`` as JSON text to the text stream ``fh``: the dict indented, the
+    per-point arrays (numpy) in parts, so the memory needed stays that of one part
+    whatever the number of points."""
+    pts = report.get("points")
+    text = json.dumps(dict(report, points=_HOLE if pts is not None else None), indent=1,
+                      sort_keys=False)
+    if pts is None:
+        fh.write(text + "\n")
+        return
+    head, tail = text.split(json.dumps(_HOLE), 1)
+    fh.write(head + "{")
+    for k, (key, value) in enumerate(pts.items()):
+        fh.write(("\n  " if k == 0 else ",\n  ") + json.dumps(key) + ": ")
+        if value is None:
+            fh.write("null")
+        else:
+            _array_json(np.asarray(value), fh)
+    fh.write("\n }" + tail + "\n")
+
+
+def write_file(report, path):
+    """:func:`write` to the file ``path`` (UTF-8)."""
+    with open(path, "w", encoding="utf-8", newline="\n") as fh:
+        write(report, fh)
+
+
 def dumps(report):
-    """The report as indented JSON text."""
-    return json.dumps(report, indent=1, sort_keys=False) + "\n"
+    """The report as JSON text (:func:`write`)."""
+    import io
+
+    buf = io.StringIO()
+    write(report, buf)
+    return buf.getvalue()

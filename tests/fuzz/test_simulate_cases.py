@@ -47,8 +47,23 @@ def _loop(option, value, says=None, **kw):
 
 LOOP = [
     sim("grid-100000x100000", small=("--grid", "100000x100000"),
-        says=("--grid '100000x100000': expected at most 4000x4000",)),
+        says=("--grid '100000x100000': expected at most 800x800",)),
     sim("grid-2x2", small=("--grid", "2x2"), says=("at least 3x3",)),
+    # issue 25: the former documented maximum, replicas that never end, a small budget
+    sim("grid-4000x4000", small=("--grid", "4000x4000"),
+        says=("--grid '4000x4000': expected at most 800x800",)),
+    sim("replicas-1e9", small=("--grid", "5x5", "--replicas", "1000000000"),
+        says=("--replicas 1000000000: expected at most 1000",)),
+    sim("max-memory-below-the-estimate", small=("--grid", "800x800", "--between", "2",
+                                                 "--max-memory", "2.5G")),
+    sim("max-memory-of-a-busy-machine", small=("--grid", "300x290", "--replicas", "1000",
+                                                "--max-memory=300MiB"),
+        says=("simulate --grid 300x290 --between 2 --replicas 1000 (5 methods) needs about "
+              "0.8 GB of memory, more than --max-memory (0.3 GB); a coarser --grid",)),
+    sim("max-memory-garbage", small=SMALL + ("--max-memory", "lots"), usage=True,
+        says=("argument --max-memory: expected a size such as 4G",)),
+    sim("max-memory-tiny", small=SMALL + ("--max-memory", "1k"), usage=True,
+        says=("expected at least 64 M",)),
     sim("grid-garbage", small=("--grid", "45by45"), says=("expected NxM",)),
     sim("grid-negative", small=("--grid=-5x5",), says=("--grid",)),
     _loop("--margin", "nan"), _loop("--margin", "0.5"), _loop("--margin", "-0.1"),

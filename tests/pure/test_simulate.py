@@ -316,7 +316,7 @@ def test_bad_process_parameters_are_refused():
         sm.MachiningModel(deflection=(0.0, float("inf"), 0.0))
     with pytest.raises(InputError, match="deflection takes 3 finite values"):
         sm.MachiningModel(deflection=(0.1, 0.2))
-    with pytest.raises(InputError, match="at most 4000 x 4000"):
+    with pytest.raises(InputError, match="at most 800 x 800"):
         sm.make_layout(plane(), (4001, 9))
     with pytest.raises(InputError, match="seed must be a whole number >= 0"):
         sm.simulate(plane(), 1, grid=(3, 3), replicas=1, seed=-1)

@@ -14,7 +14,7 @@ from ...core.moves import plan_moves
 from ...core.progress import report
 from ...errors import GCodeError
 from .interpreter import parse_gcode
-from .lexer import AXIS_LETTERS, decode
+from .lexer import AXIS_LETTERS, BOM, decode
 from .result import GCodeResult, OutputState
 
 #: default output decimals per unit system
@@ -138,7 +138,9 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
     if text_out == text:
         data_out = bytes(raw) if isinstance(raw, (bytes, bytearray)) else text.encode("latin-1")
     else:
-        data_out = text_out.encode("latin-1")
+        bom = BOM if (raw.decode("latin-1") if isinstance(raw, (bytes, bytearray))
+                      else raw).startswith(BOM) else ""
+        data_out = (bom + text_out).encode("latin-1")
     res = writer.state.result(GCodeResult, data_out, len(lines),
                               len(lines) + writer.state.added, prog)
     inch = bool((prog.factor != 1.0).any())

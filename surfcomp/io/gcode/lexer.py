@@ -157,6 +157,13 @@ def split_lines(text):
     return out
 
 
+#: the UTF-8 byte-order mark as Latin-1 text (some editors start every file with it)
+BOM = "\xef\xbb\xbf"
+
+
 def decode(data):
-    """``data`` as text: bytes are decoded as Latin-1 (one character per byte)."""
-    return data.decode("latin-1") if isinstance(data, (bytes, bytearray)) else data
+    """``data`` as text: bytes are decoded as Latin-1 (one character per byte), without a
+    UTF-8 byte-order mark at the start (:func:`surfcomp.io.gcode.emitter.compensate_gcode`
+    writes it back)."""
+    text = data.decode("latin-1") if isinstance(data, (bytes, bytearray)) else data
+    return text[len(BOM):] if text.startswith(BOM) else text
