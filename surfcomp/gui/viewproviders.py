@@ -217,9 +217,10 @@ def mesh_key(obj):
             code)
 
 
-def map_data(obj, quantity, samples=None, mesh=None):
+def map_data(obj, quantity, samples=None, mesh=None, located=None):
     """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
-    :func:`map_mesh` returns it (made when not given).
+    :func:`map_mesh` returns it (made when not given); ``located`` as
+    :func:`surfcomp.app.reports.field_values` takes it.
 
     Returns
     -------
@@ -229,7 +230,7 @@ def map_data(obj, quantity, samples=None, mesh=None):
         nominal object's own coordinates.
     """
     pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
-    values = reports.deviation_field(obj, quantity)(u, v)
+    values = reports.field_values(obj, quantity, u, v, located)
     nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
     dev = np.asarray(obj.Deviation, dtype=float)
     node_values = reports.quantity_values(obj, quantity).ravel()
@@ -363,8 +364,8 @@ class ViewProviderCompensation(_MapViewProvider):
             if q not in self._data:
                 key = mesh_key(obj)     # the mesh outlives result changes (filter preview)
                 if getattr(self, "_mesh", (None,))[0] != key:
-                    self._mesh = (key, map_mesh(obj))
-                self._data[q] = map_data(obj, q, mesh=self._mesh[1])
+                    self._mesh = (key, map_mesh(obj), {})
+                self._data[q] = map_data(obj, q, mesh=self._mesh[1], located=self._mesh[2])
         except SurfcompError as exc:
             self.scene.clear()
             FreeCAD.Console.PrintWarning("%s: no map: %s\n" % (obj.Label, exc))
