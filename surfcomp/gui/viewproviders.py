@@ -398,8 +398,11 @@ class ViewProviderCompensation(_MapViewProvider):
             arrange_legends(vobj.Object.Document, changed=vobj.Object)
         self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
                                       self.shared_range()))
-        if vobj.AutoRange and self.scene.range is not None:
-            # show the automatic range in the (then unused) manual fields
+        if vobj.AutoRange and self.scene.range is not None and not np.allclose(
+                (vobj.RangeMin.Value, vobj.RangeMax.Value), self.scene.range,
+                rtol=1e-12, atol=1e-15):
+            # show the automatic range in the (then unused) manual fields; only a change
+            # is written: a write marks the document modified (one just opened included)
             self._syncing = True
             try:
                 vobj.RangeMin, vobj.RangeMax = self.scene.range
