@@ -201,3 +201,40 @@ def _result(key, probe, before, pressed, cpu0):
     seen = probe.first_render_with(final, pressed)
     return {"key": key, "seconds": None if seen is None else seen[0] - pressed,
             "cpu": None if seen is None else seen[1] - cpu0, "changed": final != before}
+
+
+class PanelKeys:
+    """Real keys for an open filter panel: the X focus on the main window, the mask's spin
+    box focused, the render probe on the map's colours and the key watch installed."""
+
+    def __init__(self, app, main_window, panel, view, scene):
+        self.app, self.panel = app, panel
+        self.keys = XKeys()
+        main_window.activateWindow()
+        self.keys.focus(main_window.winId())
+        self.focus(panel.mask)
+        self.probe = RenderProbe(view, scene.surface_colors.rgb)
+        self.watch = KeyWatch(app)
+
+    def focus(self, widget, rounds=20):
+        widget.setFocus()
+        for _ in range(rounds):
+            self.app.processEvents()
+            time.sleep(0.01)
+
+    def busy(self):
+        return self.panel.timer.isActive() or getattr(self.panel, "_busy", False)
+
+    def presses(self, keys):
+        return press_latencies(self.app, self.keys, self.probe, self.watch, self.busy, keys)
+
+    def typing(self, text, interval=0.08):
+        """Type ``text`` into the weights field (see :func:`typing_latency`)."""
+        self.focus(self.panel.weights, 10)
+        return typing_latency(self.app, self.keys, self.probe, self.watch, self.busy, text,
+                              interval)
+
+    def close(self):
+        self.probe.remove()
+        self.watch.remove()
+        self.keys.close()

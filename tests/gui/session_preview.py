@@ -55,36 +55,15 @@ RESULTS["first_click"] = [panel is not None, bool(Gui.Control.activeDialog()),
                           panel is not None and panel.form.isVisible()]
 
 # -- live preview: key press to repaint -------------------------------------------------------
-keys = latency.XKeys()
-mw.activateWindow()
-keys.focus(mw.winId())
-panel.mask.setFocus()
-for _ in range(20):
-    app.processEvents()
-    time.sleep(0.01)
+keys = latency.PanelKeys(app, mw, panel, view, comp.ViewObject.Proxy.scene)
 RESULTS["focus"] = [type(app.focusWidget()).__name__, app.activeWindow() is mw]
-probe = latency.RenderProbe(view, comp.ViewObject.Proxy.scene.surface_colors.rgb)
-watch = latency.KeyWatch(app)
-
-
-def busy():
-    return panel.timer.isActive() or getattr(panel, "_busy", False)
-
-
-RESULTS["presses"] = latency.press_latencies(app, keys, probe, watch, busy, ["Up", "Down"] * 4)
+RESULTS["presses"] = keys.presses(["Up", "Down"] * 4)
 RESULTS["mask_after_presses"] = [panel.mask.value(), comp.MaskSize]
 # typing custom weights, 80 ms a key: from the last key to the repaint
-panel.weights.setFocus()
-for _ in range(10):
-    app.processEvents()
-    time.sleep(0.01)
-RESULTS["typing"] = latency.typing_latency(app, keys, probe, watch, busy,
-                                           "1 2 1; 2 4 2; 1 2 1", 0.08)
+RESULTS["typing"] = keys.typing("1 2 1; 2 4 2; 1 2 1")
 RESULTS["typed"] = [panel.weights.text(), comp.Weights, comp.MaskSize]
 RESULTS["load"] = os.getloadavg()[0]
 RESULTS["cores"] = os.cpu_count()
-probe.remove()
-watch.remove()
 keys.close()
 panel.reject()
 Gui.updateGui()
