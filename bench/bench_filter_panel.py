@@ -76,9 +76,15 @@ def export(rev, where):
 
 
 def line(name, res):
-    secs = [r["seconds"] for r in res["presses"] if r["seconds"] is not None]
-    cpus = [r["cpu"] for r in res["presses"] if r["cpu"] is not None]
-    missed = len(res["presses"]) - len(secs)
+    changed = [r for r in res["presses"] if r["changed"]]
+    if len(changed) < len(res["presses"]) or not res["typing"]["changed"]:
+        raise SystemExit("%s: %d of %d key presses (typing: %s) changed nothing on the map: "
+                         "the keys did not reach the panel" % (
+                             name, len(res["presses"]) - len(changed), len(res["presses"]),
+                             res["typing"]["changed"]))
+    secs = [r["seconds"] for r in changed if r["seconds"] is not None]
+    cpus = [r["cpu"] for r in changed if r["cpu"] is not None]
+    missed = len(changed) - len(secs)
     t = res["typing"]
     return ("  %-22s debounce %3d ms  key press: median %.3f s, max %.3f s (CPU median %.3f s)"
             "%s; typed weights, last key: %s (CPU %s); load %.1f"

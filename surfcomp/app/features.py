@@ -71,6 +71,10 @@ class _Proxy(Proxy):
     Type = None
     VERSION = VERSION
 
+    def onDocumentRestored(self, obj):
+        super().onDocumentRestored(obj)
+        _restored(obj)
+
 
 def migrate(obj, table):
     """Bring an object restored from an older document to the current property set.
@@ -220,6 +224,18 @@ def _created(obj):
     return obj
 
 
+#: callables ``hook(obj)`` run on every surfcomp object restored from a file, while the
+#: document is still being opened: the GUI registers one that gives objects of documents
+#: made headless their view provider then, so opening such a document does not mark it
+#: modified (FreeCAD clears the flag once the restore ends; later changes would set it)
+RESTORED_HOOKS = []
+
+
+def _restored(obj):
+    for hook in RESTORED_HOOKS:
+        hook(obj)
+
+
 # -- compensation feature -----------------------------------------------------------------
 
 
@@ -247,6 +263,7 @@ class CompensationFeature(_Proxy):
         added = _migrate(obj, self.PROPERTIES, self.VERSION, self.RENAMED)
         if "Lean" in added:     # made before the lean face: recompute to the saved face
             obj.Lean = False
+        _restored(obj)
 
     def execute(self, obj):
         result = _compute(obj)

@@ -540,26 +540,29 @@ def attach_all(doc):
     """Give every surfcomp object of ``doc`` its view provider and show its map (for
     documents made headless, e.g. by ``compensate ... --save`` in ``freecadcmd``, whose
     objects have no view provider yet); returns the objects given one."""
-    done = []
-    for obj in doc.Objects:
-        if not (features.is_compensation(obj) or features.is_measurement(obj)):
-            continue
-        vobj = obj.ViewObject
-        # a view object whose proxy was never set reports 0 (FreeCAD 0.20), not None
-        if vobj is None or isinstance(vobj.Proxy, (ViewProviderCompensation,
-                                                   ViewProviderMeasurement)):
-            continue
-        attach(obj)
-        proxy = vobj.Proxy
-        if not hasattr(proxy, "scene"):  # an existing view object: FreeCAD does not attach
-            proxy.attach(vobj)
-        mode = proxy.getDisplayModes(vobj)[0]
-        modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
-        if mode not in modes:  # the enumeration was made before the proxy existed
-            vobj.DisplayMode = modes + [mode]
-        vobj.DisplayMode = mode
-        done.append(obj)
-    return done
+    return [obj for obj in doc.Objects if attach_restored(obj)]
+
+
+def attach_restored(obj):
+    """:func:`attach_all` for one object (also run while its document is being opened,
+    :data:`surfcomp.app.features.RESTORED_HOOKS`); True when it got its view provider."""
+    if not (features.is_compensation(obj) or features.is_measurement(obj)):
+        return False
+    vobj = obj.ViewObject
+    # a view object whose proxy was never set reports 0 (FreeCAD 0.20), not None
+    if vobj is None or isinstance(vobj.Proxy, (ViewProviderCompensation,
+                                               ViewProviderMeasurement)):
+        return False
+    attach(obj)
+    proxy = vobj.Proxy
+    if not hasattr(proxy, "scene"):  # an existing view object: FreeCAD does not attach
+        proxy.attach(vobj)
+    mode = proxy.getDisplayModes(vobj)[0]
+    modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
+    if mode not in modes:  # the enumeration was made before the proxy existed
+        vobj.DisplayMode = modes + [mode]
+    vobj.DisplayMode = mode
+    return True
 
 
 class _RestoreObserver:
@@ -587,3 +590,5 @@ def install_observer():
 
 if attach not in features.NEW_OBJECT_HOOKS:
     features.NEW_OBJECT_HOOKS.append(attach)
+if attach_restored not in features.RESTORED_HOOKS:
+    features.RESTORED_HOOKS.append(attach_restored)

@@ -66,14 +66,14 @@ class XKeys:
     def type_in_thread(self, keys, interval):
         """Press ``keys`` one by one, ``interval`` seconds apart, from a thread (while the
         caller keeps the event loop running); returns ``(thread, times)``, the press times
-        filled in as they happen."""
+        filled in as they happen as ``(time.perf_counter(), time.process_time())``."""
         times = []
 
         def run():
             for k, key in enumerate(keys):
                 if k:
                     time.sleep(interval)
-                times.append(self.press(key))
+                times.append((self.press(key), time.process_time()))
 
         th = threading.Thread(target=run, daemon=True)
         th.start()
@@ -191,9 +191,8 @@ def typing_latency(app, keys, probe, watch, busy, text, interval, quiet=1.0):
     while thread.is_alive():
         app.processEvents()
         time.sleep(0.001)
-    cpu0 = time.process_time()
     wait_quiet(app, busy, probe, watch, n + len(text), quiet=quiet)
-    return _result(text, probe, before, times[-1], cpu0)
+    return _result(text, probe, before, *times[-1])
 
 
 def _result(key, probe, before, pressed, cpu0):
@@ -216,11 +215,18 @@ class PanelKeys:
         self.probe = RenderProbe(view, scene.surface_colors.rgb)
         self.watch = KeyWatch(app)
 
-    def focus(self, widget, rounds=20):
-        widget.setFocus()
-        for _ in range(rounds):
-            self.app.processEvents()
-            time.sleep(0.01)
+    def focus(self, widget, limit=3.0):
+        """Focus ``widget`` and wait until Qt reports it focused (a task panel just opened
+        may still be on its way to the screen); True when it is."""
+        t0 = time.perf_counter()
+        while time.perf_counter() - t0 < limit:
+            widget.setFocus()
+            for _ in range(5):
+                self.app.processEvents()
+                time.sleep(0.01)
+            if self.app.focusWidget() is widget:
+                return True
+        return False
 
     def busy(self):
         return self.panel.timer.isActive() or getattr(self.panel, "_busy", False)
@@ -230,7 +236,7 @@ class PanelKeys:
 
     def typing(self, text, interval=0.08):
         """Type ``text`` into the weights field (see :func:`typing_latency`)."""
-        self.focus(self.panel.weights, 10)
+        self.focus(self.panel.weights)
         return typing_latency(self.app, self.keys, self.probe, self.watch, self.busy, text,
                               interval)
 

@@ -3,6 +3,8 @@
 # and the Preferences dialog shows the SurfComp page with its icon.
 import shutil  # noqa: E402
 
+from surfcomp.app import features  # noqa: E402
+
 
 def settle_open(path):
     """Open ``path`` as File > Open does and let the deferred drawing run."""
@@ -29,6 +31,22 @@ RESULTS["reopened"] = {"modified": bool(Gui.getDocument(again.Name).Modified),
 vobj.RangeMin = -0.1
 RESULTS["modified_after_change"] = bool(Gui.getDocument(again.Name).Modified)
 FreeCAD.closeDocument(again.Name)
+
+# an old document made headless (FreeCAD 0.20's freecadcmd): its surfcomp objects are
+# migrated and get their view providers and maps while it opens, and it opens unmodified
+old = os.path.join(TMP, "shop-0.20.FCStd")
+shutil.copyfile(os.path.join(ROOT, "tests", "data", "documents", "shop-0.20.FCStd"), old)
+shop = settle_open(old)
+RESULTS["old_document"] = {
+    "modified": bool(Gui.getDocument(shop.Name).Modified),
+    "views": {o.Name: [type(o.ViewObject.Proxy).__name__, o.ViewObject.DisplayMode,
+                       o.ViewObject.Proxy.scene.surface_colors.rgb.getNum()]
+              for o in shop.Objects if o.Name in ("Round1", "Round2")},
+    "versions": [shop.getObject(n).Version for n in ("Meas1", "Round1", "Round2")],
+    "version": features.VERSION,
+    "renamed": ["EdgeTol" in shop.getObject("Round2").PropertiesList,
+                "EdgeTolerance" in shop.getObject("Round2").PropertiesList]}
+FreeCAD.closeDocument(shop.Name)
 
 # -- the Preferences dialog: the SurfComp group and its icon --------------------------------
 PREFS = {}
