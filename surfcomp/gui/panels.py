@@ -248,6 +248,11 @@ class FilterPanel:
         if ok and getattr(proxy, "_dirty", False):
             proxy.redraw()      # drawn now, not after the next event loop round
         self._show_figures()
+        # ask the 3D view to paint now: left to Coin's idle sensors, a repaint after a key
+        # sometimes waited for the next input event (FreeCAD 1.1)
+        view = getattr(FreeCADGui.getDocument(self.doc.Name), "ActiveView", None)
+        if ok and hasattr(view, "redraw"):
+            view.redraw()
         return ok
 
     def _show_figures(self):
