@@ -109,7 +109,8 @@ class ReportDialog(QtGui.QDialog):
 class FilterPanel:
     """Task panel: mask size, kind, weights, edge handling, with live maps of the
     determined and random components and their RMS. Every change is checked first (no
-    failed recompute), then recomputed as a preview and redrawn after a short debounce.
+    failed recompute), then recomputed as a preview (the compensation alone, refiltering
+    the points it located before) and redrawn as soon as the queued events are handled.
     The weights, when given, set the mask size. OK keeps the change (one undo step),
     Cancel reverts it."""
 
