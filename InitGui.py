@@ -27,6 +27,9 @@ class SurfCompWorkbench(Workbench):  # noqa: F821  (Workbench is provided by Fre
         tools = [c for c in items if c is not None]
         self.appendToolbar("SurfComp", [c if c is not None else "Separator" for c in items])
         self.appendMenu("&SurfComp", [c if c is not None else "Separator" for c in items])
+        # the Preferences dialog shows group "SurfComp" with the icon named
+        # preferences-surfcomp in FreeCAD's icon paths
+        FreeCADGui.addIconPath(os.path.join(paths.RESOURCES, "icons"))
         FreeCADGui.addPreferencePage(os.path.join(paths.RESOURCES, "ui", "preferences.ui"),
                                      "SurfComp")
         FreeCADGui.addLanguagePath(os.path.join(paths.RESOURCES, "translations"))

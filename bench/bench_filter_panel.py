@@ -1,19 +1,27 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""How fast the filter task panel redraws the live map after a change, on the example's
-45 x 45 grid (issue 13: within 0.3 s).
+"""How fast the filter task panel's live map follows a key, on the example's 45 x 45 grid
+(issue 24: on screen within 0.3 s of the last key press), beside a reference version of
+surfcomp measured in the same run.
 
-    xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 bench/bench_filter_panel.py
+    xvfb-run -a -s "-screen 0 1600x1200x24" /usr/bin/python3 bench/bench_filter_panel.py \\
+        [--reference REV | --reference-tree DIR] [--presses 12]
 
-Runs inside the real FreeCAD GUI (tests/gui/harness.py). Opens the Filter panel on the
-example's deviation map and, for changes of mask size, weights, mask kind and edge handling,
-times ``FilterPanel.update`` (check, preview recompute of the compensation, map redraw, RMS
-figures) and, inside it, the recompute and the redraw alone. The panel waits its debounce
-(``FilterPanel.DEBOUNCE``) after the last key press before it starts; that is printed too.
-Prints seconds.
+Each version runs in its own fresh FreeCAD GUI (tests/gui/harness.py): the example's map,
+the Filter panel open, then real key presses at the X server (XTest, as a keyboard sends
+them; tests/gui/latency.py): Up and Down on the mask size, one at a time with the GUI quiet
+in between, and custom weights typed 80 ms a key. Each is timed from the (last) press to
+the first render of the 3D view that shows the map's new colours; FreeCAD's CPU seconds
+over that time (all its threads, the rendering's included) are printed too, as they move
+less with other jobs on the machine. ``--reference`` is a git revision of this repository
+(default: the code before the preview was made faster), exported into a temporary folder;
+``--reference-tree`` takes such a folder instead (a copy without git, e.g. in a chroot).
 """
 
+import argparse
 import os
 import pathlib
+import statistics
+import subprocess
 import sys
 import tempfile
 
@@ -22,82 +30,88 @@ sys.path.insert(0, ROOT)
 
 from tests.gui.harness import run_gui, with_common  # noqa: E402
 
+#: the code before the live preview was made faster (issue 24)
+REFERENCE = "d5598b0"
+
 BODY = r'''
+sys.path.insert(0, ROOT)
+from tests.gui import latency
+
 doc = FreeCAD.newDocument("Bench")
 comp = make_map(doc, *load_example(doc))
+view = view_top()
 Gui.Selection.addSelection(doc.Name, comp.Name)
 Gui.runCommand("SurfComp_Filter")
 panel = panels.FilterPanel.instance
-proxy = comp.ViewObject.Proxy
-parts = {"recompute": [], "redraw": []}
-real_recompute, real_redraw = doc.recompute, proxy.redraw
-
-
-def timed(name, fn):
-    def run(*a, **k):
-        t0 = time.perf_counter()
-        out = fn(*a, **k)
-        parts[name].append(time.perf_counter() - t0)
-        return out
-    return run
-
-
-proxy.redraw = timed("redraw", real_redraw)
-changes = [("mask", v) for v in (7, 9, 11, 13, 5, 3)] + \
-    [("weights", "1 2 1; 2 4 2; 1 2 1"), ("weights", "")] + \
-    [("kind", 1), ("kind", 0), ("edge", 1), ("edge", 0)]
-rows = []
-for what, value in changes:
-    if what == "mask":
-        panel.mask.setValue(value)
-    elif what == "weights":
-        panel.weights.setText(value)
-    elif what == "kind":
-        panel.kind.setCurrentIndex(value)
-    else:
-        panel.edge.setCurrentIndex(value)
-    panel.timer.stop()
-    t0, c0 = time.perf_counter(), time.process_time()
-    ok = panel.update()
-    total, cpu = time.perf_counter() - t0, time.process_time() - c0
-    Gui.updateGui()
-    rows.append([what, str(value), total, ok, cpu])
-RESULTS["rows"] = rows
-RESULTS["redraw"] = parts["redraw"]
+app = QtGui.QApplication.instance()
+keys = latency.PanelKeys(app, mw, panel, view, comp.ViewObject.Proxy.scene)
+RESULTS["presses"] = keys.presses(["Up", "Down"] * (PRESSES // 2))
+RESULTS["typing"] = keys.typing("1 2 1; 2 4 2; 1 2 1")
 RESULTS["debounce"] = panels.FilterPanel.DEBOUNCE
-# the recompute alone, for the same changes of the mask size
-rec = []
-for v in (7, 9, 11, 5):
-    comp.MaskSize = v
-    t0 = time.perf_counter()
-    doc.recompute()
-    rec.append(time.perf_counter() - t0)
-RESULTS["recompute"] = rec
+RESULTS["load"] = os.getloadavg()[0]
+RESULTS["version"] = ".".join(FreeCAD.Version()[:3])
+keys.close()
 panel.reject()
 '''
 
 
-def main():
-    with tempfile.TemporaryDirectory() as tmp:
-        res, _out = run_gui(with_common(BODY), pathlib.Path(tmp))
+def measure(tree, presses, tmp):
+    """Run the measurement with surfcomp from ``tree`` (a checkout); its results."""
+    home = tmp / "fchome"
+    (home / "Mod").mkdir(parents=True)
+    os.symlink(tree, home / "Mod" / "surfcomp")
+    body = with_common("PRESSES = %d\n" % presses + BODY)
+    res, _out = run_gui(body, tmp, home=home, timeout=600)
     if res["errors"]:
-        print("\n".join(res["errors"]))
-        raise SystemExit(1)
-    print("filter panel on the 45 x 45 example grid (seconds, after the %d ms debounce)"
-          % res["debounce"])
-    for what, value, total, ok, cpu in res["rows"]:
-        print("  %-8s %-22s update %.3f (CPU %.3f)%s" % (what, value or "(none)", total, cpu,
-                                                         "" if ok else "  (refused)"))
-    totals = sorted(r[2] for r in res["rows"])
-    cpus = sorted(r[4] for r in res["rows"])
-    print("update: median %.3f, max %.3f; CPU time median %.3f, max %.3f (the machine's load "
-          "average: %.1f)" % (totals[len(totals) // 2], totals[-1], cpus[len(cpus) // 2],
-                              cpus[-1], os.getloadavg()[0]))
-    red = sorted(res["redraw"])
-    print("of which redraw (mesh field, colours, coin): median %.3f, max %.3f"
-          % (red[len(red) // 2], red[-1]))
-    rec = sorted(res["recompute"])
-    print("of which preview recompute: median %.3f, max %.3f" % (rec[len(rec) // 2], rec[-1]))
+        raise SystemExit("\n".join(res["errors"]))
+    return res
+
+
+def export(rev, where):
+    """The files of revision ``rev`` of this repository, in ``where``."""
+    archive = subprocess.run(["git", "-C", ROOT, "archive", rev], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(where)], input=archive, check=True)
+    return str(where)
+
+
+def line(name, res):
+    changed = [r for r in res["presses"] if r["changed"]]
+    if len(changed) < len(res["presses"]) or not res["typing"]["changed"]:
+        raise SystemExit("%s: %d of %d key presses (typing: %s) changed nothing on the map: "
+                         "the keys did not reach the panel" % (
+                             name, len(res["presses"]) - len(changed), len(res["presses"]),
+                             res["typing"]["changed"]))
+    secs = [r["seconds"] for r in changed if r["seconds"] is not None]
+    cpus = [r["cpu"] for r in changed if r["cpu"] is not None]
+    missed = len(changed) - len(secs)
+    t = res["typing"]
+    return ("  %-22s debounce %3d ms  key press: median %.3f s, max %.3f s (CPU median %.3f s)"
+            "%s; typed weights, last key: %s (CPU %s); load %.1f"
+            % (name, res["debounce"], statistics.median(secs), max(secs),
+               statistics.median(cpus), "; %d not repainted" % missed if missed else "",
+               "%.3f s" % t["seconds"] if t["seconds"] is not None else "not repainted",
+               "%.3f s" % t["cpu"] if t["cpu"] is not None else "-", res["load"]))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--reference", default=REFERENCE, help="git revision to compare with")
+    ap.add_argument("--reference-tree", help="a folder holding the reference's files")
+    ap.add_argument("--presses", type=int, default=12)
+    args = ap.parse_args()
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = pathlib.Path(tmp)
+        (tmp / "ref").mkdir()
+        (tmp / "now").mkdir()
+        (tmp / "ref-run").mkdir()
+        tree = args.reference_tree or export(args.reference, tmp / "ref")
+        ref = measure(os.path.abspath(tree), args.presses, tmp / "ref-run")
+        now = measure(ROOT, args.presses, tmp / "now")
+    print("filter panel, key press to repaint of the live map (45 x 45 example grid, "
+          "FreeCAD %s, %d presses)" % (now["version"], args.presses))
+    print(line("this checkout", now))
+    print(line("reference " + (args.reference_tree or args.reference), ref))
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ Import this module where FreeCAD is importable: inside FreeCAD, or from a plain 
 after :func:`surfcomp.app.fcenv.import_freecad`.
 """
 
+import contextlib
 import json
 import os
 from dataclasses import replace as _dc_replace
@@ -41,11 +42,12 @@ import numpy as np
 from ..core.deviations import statistics
 from ..core.filters import EDGE_MODES
 from ..core.methods import METHODS
-from ..core.pipeline import Options, build_surface, compensate, prepare
+from ..core.pipeline import Options, build_surface, compensate, parameter_scale, prepare
 from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
+from . import preview as preview_cache
 from .nominal import trim_warning
 from .progress import freecad_progress
 from .properties import (
@@ -68,6 +70,10 @@ class _Proxy(Proxy):
 
     Type = None
     VERSION = VERSION
+
+    def onDocumentRestored(self, obj):
+        super().onDocumentRestored(obj)
+        _restored(obj)
 
 
 def migrate(obj, table):
@@ -222,6 +228,18 @@ def _created(obj):
     return obj
 
 
+#: callables ``hook(obj)`` run on every surfcomp object restored from a file, while the
+#: document is still being opened: the GUI registers one that gives objects of documents
+#: made headless their view provider then, so opening such a document does not mark it
+#: modified (FreeCAD clears the flag once the restore ends; later changes would set it)
+RESTORED_HOOKS = []
+
+
+def _restored(obj):
+    for hook in RESTORED_HOOKS:
+        hook(obj)
+
+
 # -- compensation feature -----------------------------------------------------------------
 
 
@@ -249,6 +267,7 @@ class CompensationFeature(_Proxy):
         added = _migrate(obj, self.PROPERTIES, self.VERSION, self.RENAMED)
         if "Lean" in added:     # made before the lean face: recompute to the saved face
             obj.Lean = False
+        _restored(obj)
 
     def execute(self, obj):
         result = _compute(obj)
@@ -395,14 +414,15 @@ def _compute(obj):
     options = options_of(obj)
     base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
-    with freecad_progress("%s: compensating" % obj.Label) as progress:
-        prepared = prepare(nominal.surface, nominal.outward, ms, options,
-                           progress=sub(progress, 0.0, 0.3))
-        warning = trim_warning(nominal, prepared)
-        if warning:
-            prepared.warnings.append(warning)
+    # a preview (the filter panel's live maps, a fraction of a second) runs without the
+    # progress indicator: it would grab the keyboard and swallow the keys typed meanwhile
+    with (contextlib.nullcontext() if preview else
+          freecad_progress("%s: compensating" % obj.Label)) as progress:
+        prepared, scale = _prepared(obj, nominal, placement, ms, options, preview,
+                                    sub(progress, 0.0, 0.3))
         comp = compensate(nominal.surface, nominal.outward, prepared, options,
-                          build=base is None and not preview, progress=sub(progress, 0.3, 1.0))
+                          build=base is None and not preview, progress=sub(progress, 0.3, 1.0),
+                          scale=scale)
         increment = comp.correction.delta
         if base is not None:
             U, V = prepared.grid.take(prepared.u), prepared.grid.take(prepared.v)
@@ -415,6 +435,24 @@ def _compute(obj):
     output.shape.Placement = placement
     comp.prepared.warnings.extend(output.warnings(obj.Label))
     return _Result(comp, nominal, increment, output, len(links))
+
+
+def _prepared(obj, nominal, placement, ms, options, preview, progress):
+    """``(prepared, parameter scale)``: the points located on the face and arranged on
+    their grid, with the trim warning. A preview reuses the ones kept from the previous
+    recompute when nothing they depend on changed (:mod:`surfcomp.app.preview`)."""
+    def make():
+        prep = prepare(nominal.surface, nominal.outward, ms, options, progress=progress)
+        return prep, trim_warning(nominal, prep), parameter_scale(nominal.surface, prep)
+
+    if preview:
+        key = preview_cache.fingerprint(nominal, placement, ms, options)
+        prep, warning, scale = preview_cache.prepared(obj, key, make)
+    else:
+        prep, warning, scale = make()
+    if warning:
+        prep.warnings.append(warning)
+    return prep, scale
 
 
 def _build(nominal, prepared, comp, total, build=True, progress=None):
@@ -434,34 +472,46 @@ def _flat(a):
     return np.asarray(a, dtype=float).ravel().tolist()
 
 
+def _put(obj, name, value):
+    """Set a property unless it already holds ``value``: every write notifies the views
+    (the property editor, the map), and a preview changes only the filtered components.
+    (NaN marks unmeasured nodes: lists equal but for their NaN count as the same.)"""
+    old = getattr(obj, name)
+    if old == value:
+        return
+    if isinstance(value, list) and value and isinstance(value[0], float) and \
+            len(old) == len(value) and any(x != x for x in value):
+        if np.array_equal(np.asarray(old, dtype=float), np.asarray(value), equal_nan=True):
+            return
+    setattr(obj, name, value)
+
+
 def _write_results(obj, r):
     comp = r.comp
     p = comp.prepared
     g = p.grid
     n, m = (g.shape[0], 1) if p.scattered else g.shape
-    obj.GridRows, obj.GridCols = n, m
-    obj.Scattered = bool(p.scattered)
-    obj.FieldScale = list(comp.scale) if p.scattered else []
-    obj.U = _flat(g.take(p.u))
-    obj.V = _flat(g.take(p.v))
-    obj.Nodes = _flat(g.take(p.nominal))
-    obj.Normals = _flat(g.take(p.normal))
     c = comp.correction
-    obj.Deviation = _flat(c.deviation)
-    obj.Determined = _flat(c.determined)
-    obj.Random = _flat(c.random)
-    obj.Increment = _flat(r.increment)
-    obj.Correction = _flat(c.delta)
-    obj.Statistics = json.dumps({k: s.as_dict() for k, s in comp.statistics.items()},
-                                sort_keys=True)
+    values = {"GridRows": n, "GridCols": m, "Scattered": bool(p.scattered),
+              "FieldScale": list(comp.scale) if p.scattered else [],
+              "U": _flat(g.take(p.u)), "V": _flat(g.take(p.v)),
+              "Nodes": _flat(g.take(p.nominal)), "Normals": _flat(g.take(p.normal)),
+              "Deviation": _flat(c.deviation), "Determined": _flat(c.determined),
+              "Random": _flat(c.random), "Increment": _flat(r.increment),
+              "Correction": _flat(c.delta),
+              "Statistics": json.dumps({k: s.as_dict() for k, s in comp.statistics.items()},
+                                       sort_keys=True)}
     if comp.checks is not None or not obj.Preview:  # a preview keeps the face's checks
-        obj.Checks = json.dumps(comp.checks.as_dict() if comp.checks else {}, sort_keys=True)
-    obj.Warnings = [str(w) for w in p.warnings]
-    obj.Round = r.round
+        values["Checks"] = json.dumps(comp.checks.as_dict() if comp.checks else {},
+                                      sort_keys=True)
+    values["Warnings"] = [str(w) for w in p.warnings]
+    values["Round"] = r.round
     if r.output is not None:                  # a preview keeps the shape's figures
-        obj.EdgeTol = float(r.output.edge_tolerance)
-        obj.VolChange = float(r.output.volume_change or 0.0)
-        obj.CorrVol = float(r.output.correction_volume)
+        values["EdgeTol"] = float(r.output.edge_tolerance)
+        values["VolChange"] = float(r.output.volume_change or 0.0)
+        values["CorrVol"] = float(r.output.correction_volume)
+    for name, value in values.items():
+        _put(obj, name, value)
 
 
 def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,

@@ -4,6 +4,8 @@
 JSON/HTML reports as the command line writes them.
 """
 
+import hashlib
+
 import numpy as np
 
 from ..core.field import GridField
@@ -87,6 +89,26 @@ def deviation_field(obj, quantity):
         return ScatteredField(_grid(obj, "U").ravel(), _grid(obj, "V").ravel(), values.ravel(),
                               scale=tuple(obj.FieldScale), box=(surf.u_range, surf.v_range))
     return GridField(_grid(obj, "U"), _grid(obj, "V"), _fill_gaps(values))
+
+
+def field_values(obj, quantity, u, v, located=None):
+    """``deviation_field(obj, quantity)(u, v)``, reusing where the points lie on the grid.
+
+    ``located`` is a dict the caller keeps with its points ``(u, v)`` (a map's mesh): the
+    points' index coordinates on the measurement grid depend only on the nodes' (u, v),
+    so they are found once per grid and a refiltered result (the filter panel's preview)
+    only evaluates the new values there. Without it this is the field's plain call.
+    """
+    if obj.Scattered or located is None:
+        return deviation_field(obj, quantity)(u, v)
+    U, V = _grid(obj, "U"), _grid(obj, "V")
+    field = GridField(U, V, _fill_gaps(quantity_values(obj, quantity)))
+    key = (np.shape(u), hashlib.sha1(U.tobytes() + V.tobytes()).hexdigest())
+    if located.get("key") != key:
+        located.clear()
+        located["st"] = field.locate(u, v)
+        located["key"] = key
+    return field.at_index(*located["st"]).reshape(np.shape(u))
 
 
 def report_of(obj):

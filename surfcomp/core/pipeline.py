@@ -394,7 +394,7 @@ def grid_spacing(prepared):
     return float(du or np.median(step_s)), float(dv or np.median(step_t))
 
 
-def compensate(surface, outward, prepared, options=None, build=True, progress=None):
+def compensate(surface, outward, prepared, options=None, build=True, progress=None, scale=None):
     """Filter, choose the correction and (optionally) build the corrected surface.
 
     Parameters
@@ -405,6 +405,9 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     options : Options
     build : bool
         False for inspection only (deviations, statistics, filtered components).
+    scale : (float, float), optional
+        :func:`parameter_scale` of ``prepared`` when the caller has it (a preview that
+        refilters the same points); computed when None.
 
     Returns
     -------
@@ -414,7 +417,7 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     check_stock(prepared.deviation, options)
     g = prepared.grid
     d = g.take(prepared.deviation)
-    scale = parameter_scale(surface, prepared)
+    scale = scale or parameter_scale(surface, prepared)
     fit = None
     if prepared.scattered:
         report(progress, 0.0, "smoothing fit of %d scattered points" % d.size)

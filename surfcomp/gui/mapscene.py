@@ -135,6 +135,7 @@ class MapScene:
         self._marker_values = None
         self._marker_points = None
         self._points = None
+        self._mesh = None           # the (points, triangles) arrays drawn
         self._title = ""
         self.range = None
 
@@ -210,6 +211,9 @@ class MapScene:
         points : ndarray, shape (N, 3)
             Mesh vertices (mm).
         triangles : ndarray of int, shape (M, 3)
+            (The very ``points`` and ``triangles`` objects of the previous call are taken
+            as the same mesh and not sent to Coin again: new values on the same mesh
+            only recolour it.)
         values : ndarray, shape (N,)
             Value at every vertex (mm).
         marker_points : ndarray, shape (K, 3), optional
@@ -219,17 +223,20 @@ class MapScene:
         restyle : bool
             Recolour with the current style now (False: the caller sets a style next).
         """
-        points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
-        tri = np.asarray(triangles, dtype=np.int32).reshape(-1, 3)
         self._values = np.asarray(values, dtype=float).ravel()
-        self._points = points.astype(float)
-        self.surface_coords.point.setNum(0)
-        self.surface_coords.point.setValues(0, len(points), points)
-        idx = np.concatenate([tri, -np.ones((len(tri), 1), dtype=np.int32)], axis=1).ravel()
-        self.faces.coordIndex.setNum(0)
-        self.faces.coordIndex.setValues(0, len(idx), idx.tolist())
-        self.faces.materialIndex.setNum(0)
-        self.faces.materialIndex.setValues(0, len(idx), idx.tolist())
+        if self._mesh is None or self._mesh[0] is not points or self._mesh[1] is not triangles:
+            # new geometry (the same mesh arrays again, a refiltered preview: only values)
+            self._mesh = (points, triangles)
+            points = np.ascontiguousarray(points, dtype=np.float32).reshape(-1, 3)
+            tri = np.asarray(triangles, dtype=np.int32).reshape(-1, 3)
+            self._points = points.astype(float)
+            self.surface_coords.point.setNum(0)
+            self.surface_coords.point.setValues(0, len(points), points)
+            idx = np.concatenate([tri, -np.ones((len(tri), 1), dtype=np.int32)], axis=1).ravel()
+            self.faces.coordIndex.setNum(0)
+            self.faces.coordIndex.setValues(0, len(idx), idx.tolist())
+            self.faces.materialIndex.setNum(0)
+            self.faces.materialIndex.setValues(0, len(idx), idx.tolist())
         if marker_points is not None and len(marker_points):
             mp = np.ascontiguousarray(marker_points, dtype=np.float32).reshape(-1, 3)
             self._marker_points = mp.astype(float)
@@ -245,7 +252,7 @@ class MapScene:
 
     def clear(self):
         """Show nothing (no data)."""
-        self._values = self._marker_values = self._marker_points = None
+        self._values = self._marker_values = self._marker_points = self._mesh = None
         for field in (self.surface_coords.point, self.faces.coordIndex,
                       self.faces.materialIndex, self.marker_coords.point):
             field.setNum(0)

@@ -217,9 +217,10 @@ def mesh_key(obj):
             code)
 
 
-def map_data(obj, quantity, samples=None, mesh=None):
+def map_data(obj, quantity, samples=None, mesh=None, located=None):
     """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
-    :func:`map_mesh` returns it (made when not given).
+    :func:`map_mesh` returns it (made when not given); ``located`` as
+    :func:`surfcomp.app.reports.field_values` takes it.
 
     Returns
     -------
@@ -229,7 +230,7 @@ def map_data(obj, quantity, samples=None, mesh=None):
         nominal object's own coordinates.
     """
     pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
-    values = reports.deviation_field(obj, quantity)(u, v)
+    values = reports.field_values(obj, quantity, u, v, located)
     nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
     dev = np.asarray(obj.Deviation, dtype=float)
     node_values = reports.quantity_values(obj, quantity).ravel()
@@ -363,8 +364,8 @@ class ViewProviderCompensation(_MapViewProvider):
             if q not in self._data:
                 key = mesh_key(obj)     # the mesh outlives result changes (filter preview)
                 if getattr(self, "_mesh", (None,))[0] != key:
-                    self._mesh = (key, map_mesh(obj))
-                self._data[q] = map_data(obj, q, mesh=self._mesh[1])
+                    self._mesh = (key, map_mesh(obj), {})
+                self._data[q] = map_data(obj, q, mesh=self._mesh[1], located=self._mesh[2])
         except SurfcompError as exc:
             self.scene.clear()
             FreeCAD.Console.PrintWarning("%s: no map: %s\n" % (obj.Label, exc))
@@ -397,8 +398,11 @@ class ViewProviderCompensation(_MapViewProvider):
             arrange_legends(vobj.Object.Document, changed=vobj.Object)
         self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
                                       self.shared_range()))
-        if vobj.AutoRange and self.scene.range is not None:
-            # show the automatic range in the (then unused) manual fields
+        if vobj.AutoRange and self.scene.range is not None and not np.allclose(
+                (vobj.RangeMin.Value, vobj.RangeMax.Value), self.scene.range,
+                rtol=1e-12, atol=1e-15):
+            # show the automatic range in the (then unused) manual fields; only a change
+            # is written: a write marks the document modified (one just opened included)
             self._syncing = True
             try:
                 vobj.RangeMin, vobj.RangeMax = self.scene.range
@@ -536,26 +540,29 @@ def attach_all(doc):
     """Give every surfcomp object of ``doc`` its view provider and show its map (for
     documents made headless, e.g. by ``compensate ... --save`` in ``freecadcmd``, whose
     objects have no view provider yet); returns the objects given one."""
-    done = []
-    for obj in doc.Objects:
-        if not (features.is_compensation(obj) or features.is_measurement(obj)):
-            continue
-        vobj = obj.ViewObject
-        # a view object whose proxy was never set reports 0 (FreeCAD 0.20), not None
-        if vobj is None or isinstance(vobj.Proxy, (ViewProviderCompensation,
-                                                   ViewProviderMeasurement)):
-            continue
-        attach(obj)
-        proxy = vobj.Proxy
-        if not hasattr(proxy, "scene"):  # an existing view object: FreeCAD does not attach
-            proxy.attach(vobj)
-        mode = proxy.getDisplayModes(vobj)[0]
-        modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
-        if mode not in modes:  # the enumeration was made before the proxy existed
-            vobj.DisplayMode = modes + [mode]
-        vobj.DisplayMode = mode
-        done.append(obj)
-    return done
+    return [obj for obj in doc.Objects if attach_restored(obj)]
+
+
+def attach_restored(obj):
+    """:func:`attach_all` for one object (also run while its document is being opened,
+    :data:`surfcomp.app.features.RESTORED_HOOKS`); True when it got its view provider."""
+    if not (features.is_compensation(obj) or features.is_measurement(obj)):
+        return False
+    vobj = obj.ViewObject
+    # a view object whose proxy was never set reports 0 (FreeCAD 0.20), not None
+    if vobj is None or isinstance(vobj.Proxy, (ViewProviderCompensation,
+                                               ViewProviderMeasurement)):
+        return False
+    attach(obj)
+    proxy = vobj.Proxy
+    if not hasattr(proxy, "scene"):  # an existing view object: FreeCAD does not attach
+        proxy.attach(vobj)
+    mode = proxy.getDisplayModes(vobj)[0]
+    modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
+    if mode not in modes:  # the enumeration was made before the proxy existed
+        vobj.DisplayMode = modes + [mode]
+    vobj.DisplayMode = mode
+    return True
 
 
 class _RestoreObserver:
@@ -583,3 +590,5 @@ def install_observer():
 
 if attach not in features.NEW_OBJECT_HOOKS:
     features.NEW_OBJECT_HOOKS.append(attach)
+if attach_restored not in features.RESTORED_HOOKS:
+    features.RESTORED_HOOKS.append(attach_restored)

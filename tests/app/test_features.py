@@ -200,6 +200,49 @@ def test_preview_updates_components_and_keeps_the_face(doc):
     assert np.abs(poles(c.Shape) - face).max() > 1e-4 and c.Checks != checks
 
 
+def test_preview_reuses_the_grid_only_while_its_inputs_stay(doc):
+    """A preview refilters the points located by the previous one (issue 24: the live map
+    within 0.3 s) and locates them again when the measurement, the nominal or an option
+    outside the filter changes; its results equal a full recompute's."""
+    from surfcomp.app import preview
+
+    nom_obj = add_part(doc, Part.read(EXAMPLE_STEP))
+    m = features.make_measurement(doc, EXAMPLE_CSV)
+    c = features.make_compensation(doc, nom_obj, "Face1", m)
+    c.Preview = True
+    made = []
+    real = features.prepare
+    features.prepare = lambda *a, **k: made.append(1) or real(*a, **k)
+    try:
+        doc.recompute()
+        for size in (3, 7, 9):
+            c.MaskSize = size
+            doc.recompute()
+        assert len(made) == 1                   # the filter alone: the kept grid
+        d = np.reshape(c.Deviation, (45, 45))
+        np.testing.assert_allclose(np.reshape(c.Determined, (45, 45)),
+                                   mask_filter(d, make_mask(9), "renormalize"), atol=1e-15)
+        on_grid = np.asarray(c.Deviation)
+        m.Deviation = (np.asarray(m.Deviation) + 0.001).tolist()    # located again
+        doc.recompute()
+        assert len(made) == 2
+        np.testing.assert_allclose(c.Deviation, on_grid + 0.001, atol=1e-15)
+        c.MaxOffset = 2.0                       # an option outside the filter
+        doc.recompute()
+        assert len(made) == 3
+        c.Edge = "reflect"
+        doc.recompute()
+        assert len(made) == 3 and "Invalid" not in c.State
+    finally:
+        features.prepare = real
+        preview.forget()
+    previewed = {k: list(getattr(c, k)) for k in ("U", "Deviation", "Determined", "Random")}
+    c.Preview = False
+    doc.recompute()
+    for k, v in previewed.items():
+        np.testing.assert_array_equal(getattr(c, k), v)
+
+
 def test_nominal_with_a_placement(doc):
     """Measurements in document coordinates of a placed nominal give the same correction."""
     shape = Part.read(EXAMPLE_STEP)
