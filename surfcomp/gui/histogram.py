@@ -25,7 +25,8 @@ class HistogramWidget(QtGui.QWidget):
         super().__init__(parent)
         self.data = None
         self.title = ""
-        self.unit = "mm"
+        self.unit = "um"
+        self.owner = None
         self.setMinimumSize(260, 200)
 
     def set_histogram(self, data, title, unit):
@@ -98,5 +99,19 @@ def show_map(vobj, scene):
     d = dock()
     title = "%s: %s [%s]" % (vobj.Object.Label, scene._title, colormap.UNIT_TEXT[style.unit])
     d.widget().set_histogram(data, title, style.unit)
+    d.widget().owner = _key(vobj)
     d.show()
     return d
+
+
+def _key(vobj):
+    obj = vobj.Object
+    return (obj.Document.Name, obj.Name)
+
+
+def close_map(vobj):
+    """Close the histogram panel when it shows the map of ``vobj`` (its Histogram was
+    switched off, or the map hidden)."""
+    d = dock(create=False)
+    if d is not None and getattr(d.widget(), "owner", None) == _key(vobj) and d.isVisible():
+        d.close()

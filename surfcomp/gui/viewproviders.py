@@ -13,15 +13,17 @@ The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
 
 import FreeCAD
 import numpy as np
+from pivy import coin
 from PySide import QtCore
 from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features, reports
+from ..app.mapmesh import map_data, map_mesh, mesh_key  # noqa: F401  (scripts, bench/)
 from ..core import colormap
 from ..errors import SurfcompError
-from . import prefs
-from .mapscene import MapScene, MapStyle, legend_layout
+from . import cover, prefs
+from .mapscene import MapScene, MapStyle
 
 #: 2: short property names that fit the property view (RENAMED)
 VERSION = 2
@@ -44,6 +46,8 @@ STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "TolBand",
                     "Labels", "Legend", "Stepped", "Shared", "WarnBand",
                     "Histogram")
 
+#: length of a flag's leader line, as a fraction of the map's size
+LEADER = 0.08
 #: compensation properties whose change invalidates the drawn map
 RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "Nodes", "Deviation",
                      "Determined", "Random", "Increment", "Correction", "Version")
@@ -105,6 +109,11 @@ MAP_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Show the histogram panel of this map, coloured like its "
                                         "legend"),
      False),
+    ("App::PropertyBool", "HideStock",
+     QT_TRANSLATE_NOOP("App::Property", "While this map is shown, a CAM Job's stock around it "
+                                        "is not drawn and takes no clicks (its Visibility is "
+                                        "kept)"),
+     True),
     ("App::PropertyIntegerList", "Flags",
      QT_TRANSLATE_NOOP("App::Property", "Measured nodes flagged on the map (click the map to add "
                                         "or remove one; empty this list to remove all)"),
@@ -119,14 +128,20 @@ def add_map_properties(vobj, from_preferences=True):
     """Add the missing colour-map properties to ``vobj`` (new objects, old documents: their
     renamed properties' values move to the new names)."""
     old_names = [o for o in RENAMED if o in vobj.PropertiesList]
+    added = []
     for typ, name, tip, default in MAP_PROPERTIES:
         if name in vobj.PropertiesList:
             continue
+        added.append(name)
         vobj.addProperty(typ, name, _G, tip)
         if default is not None:
             setattr(vobj, name, default)
         if typ == "App::PropertyEnumeration":
             setattr(vobj, name, default[0])
+    if "Unit" in added and "LegendUnit" not in old_names:
+        # no unit stored in the document (made without the GUI, or before the unit was a
+        # choice): the preference's (default um); a stored choice, mm or um, is kept
+        vobj.Unit = prefs.display_unit()
     vobj.setEditorMode("MapVersion", 2)
     for old in old_names:
         setattr(vobj, RENAMED[old], getattr(vobj, old))
@@ -147,7 +162,7 @@ def has_map_properties(vobj):
     return all(p[1] in names for p in MAP_PROPERTIES)
 
 
-def style_of(vobj, quantity=None, layout=None, shared=None):
+def style_of(vobj, quantity=None, shared=None):
     """The :class:`MapStyle` the view properties describe (``shared``: the common range
     when Shared is on)."""
     auto = vobj.AutoRange
@@ -162,80 +177,15 @@ def style_of(vobj, quantity=None, layout=None, shared=None):
                     unit=vobj.Unit, stepped=bool(vobj.Stepped),
                     out_of_range=not auto, show_points=vobj.Points,
                     show_labels=vobj.Labels, show_legend=vobj.Legend,
-                    note=NOTES.get(quantity, ""), layout=layout)
+                    note=NOTES.get(quantity, ""))
 
 
-def _shows_legend(vobj):
-    proxy = getattr(vobj, "Proxy", None)
-    if not has_map_properties(vobj) or not vobj.Legend or not vobj.Visibility:
-        return False
-    scene = getattr(proxy, "scene", None)
-    if scene is None or scene.range is None:
-        return False
-    return vobj.DisplayMode in ("Map", "Points")
+def arrange_legends(doc=None, changed=None):
+    """Bring the legend panel up to date with the shown maps (once the current event is
+    done: many maps change in one step)."""
+    from . import legend
 
-
-def arrange_legends(doc, changed=None):
-    """Give every visible map of ``doc`` its own legend slot (stacked on the right, clear of
-    the navigation cube); restyle those whose slot moved, except ``changed`` (the caller
-    restyles it). Returns ``{object name: layout}``."""
-    from . import fcgui
-
-    top, bottom, height = fcgui.legend_clearance()
-    shown = [o.ViewObject for o in doc.Objects
-             if o.ViewObject is not None and
-             isinstance(getattr(o.ViewObject, "Proxy", None),
-                        (ViewProviderCompensation, ViewProviderMeasurement)) and
-             _shows_legend(o.ViewObject)]
-    out = {}
-    for k, vobj in enumerate(shown):
-        lay = legend_layout(k, len(shown), top, bottom, height)
-        proxy = vobj.Proxy
-        moved = getattr(proxy, "_layout", None) != lay
-        proxy._layout = lay
-        out[vobj.Object.Name] = lay
-        if moved and vobj.Object is not changed:
-            proxy.restyle(arrange=False)
-    return out
-
-
-def map_mesh(obj, samples=None):
-    """``(points, triangles, u, v)``: the map's mesh of the nominal face (see
-    :func:`surfcomp.core.colormap.uv_grid_mesh`), in the nominal object's own coordinates."""
-    nominal, _placement = features.nominal_of(obj)
-    n, m = int(obj.GridRows), int(obj.GridCols)
-    samples = samples or colormap.mesh_resolution((n, m))
-    return colormap.uv_grid_mesh(nominal.surface, samples)
-
-
-def mesh_key(obj):
-    """What the mesh depends on: the nominal face's shape and the grid's shape."""
-    nom = obj.Nominal
-    shape = getattr(nom, "Shape", None)
-    code = shape.hashCode() if shape is not None and hasattr(shape, "hashCode") else id(shape)
-    return (getattr(nom, "Name", None), obj.FaceName, int(obj.GridRows), int(obj.GridCols),
-            code)
-
-
-def map_data(obj, quantity, samples=None, mesh=None):
-    """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
-    :func:`map_mesh` returns it (made when not given).
-
-    Returns
-    -------
-    dict
-        ``points`` (N, 3), ``triangles`` (M, 3), ``values`` (N,) on the mesh,
-        ``markers`` (K, 3) measured nodes and ``marker_values`` (K,), mm, in the
-        nominal object's own coordinates.
-    """
-    pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
-    values = reports.deviation_field(obj, quantity)(u, v)
-    nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
-    dev = np.asarray(obj.Deviation, dtype=float)
-    node_values = reports.quantity_values(obj, quantity).ravel()
-    keep = np.isfinite(dev) & np.isfinite(node_values)
-    return {"points": pts, "triangles": tri, "values": values, "markers": nodes[keep],
-            "marker_values": node_values[keep]}
+    legend.schedule()
 
 
 class _MapViewProvider:
@@ -251,6 +201,9 @@ class _MapViewProvider:
 
     def _reset(self):
         """Forget transient state (never saved)."""
+
+    #: set when the object is deleted (until it is drawn again: undo)
+    _deleted = False
 
     def attach(self, vobj):
         self.Object = vobj.Object
@@ -278,6 +231,25 @@ class _MapViewProvider:
 
     def redraw(self):
         raise NotImplementedError
+
+    def outside_names(self):
+        """Names of the measured points outside the trimmed face (none drawn on it)."""
+        return []
+
+    def legend_entry(self):
+        """``(key, name, legend data, outside point names)`` for the legend panel, or None
+        when this map's legend is not shown."""
+        vobj = getattr(self, "vobj", None)
+        scene = getattr(self, "scene", None)
+        if vobj is None or scene is None or getattr(self, "_deleted", False) \
+                or not has_map_properties(vobj) \
+                or not vobj.Visibility or vobj.DisplayMode != self.MODE \
+                or scene.legend_data is None or scene.range is None:
+            return None
+        obj = vobj.Object
+        return ((obj.Document.Name, obj.Name), obj.Label, scene.legend_data,
+                self.outside_names())
+
 
     def dumps(self):
         return None
@@ -343,10 +315,13 @@ class ViewProviderCompensation(_MapViewProvider):
             self.redraw()
         elif prop == "Flags":
             self.draw_flags()
-        elif prop in ("Visibility", "DisplayMode"):
-            doc = getattr(vobj.Object, "Document", None)
-            if doc is not None:
-                arrange_legends(doc)
+        elif prop in ("Visibility", "DisplayMode", "HideStock"):
+            arrange_legends()
+            cover.update(getattr(vobj.Object, "Document", None))
+            if prop == "Visibility" and not vobj.Visibility:
+                from . import histogram
+
+                histogram.close_map(vobj)
 
     def redraw(self):
         """Draw the current quantity (mesh and values are cached per Shape)."""
@@ -354,6 +329,7 @@ class ViewProviderCompensation(_MapViewProvider):
         if vobj is None or not has_map_properties(vobj):
             return
         self._dirty = False
+        self._deleted = False
         obj = vobj.Object
         q = vobj.Map
         if not obj.GridRows or not obj.GridCols or obj.Shape.isNull():
@@ -374,6 +350,7 @@ class ViewProviderCompensation(_MapViewProvider):
                             d["marker_values"], title=TITLES[q], restyle=False)
         self.restyle()
         self.draw_flags()
+        cover.update(obj.Document)
         from . import readout
 
         readout.install()
@@ -391,12 +368,8 @@ class ViewProviderCompensation(_MapViewProvider):
     def restyle(self, arrange=True):
         """Recolour from the view properties (no new geometry, no recompute)."""
         vobj = self.vobj
-        if arrange and vobj.Object.Document is not None:
-            if self.scene.range is None:    # first drawing: arrange_legends needs a range
-                self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None)))
-            arrange_legends(vobj.Object.Document, changed=vobj.Object)
-        self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
-                                      self.shared_range()))
+        self.scene.set_style(style_of(vobj, vobj.Map, self.shared_range()))
+        arrange_legends()
         if vobj.AutoRange and self.scene.range is not None:
             # show the automatic range in the (then unused) manual fields
             self._syncing = True
@@ -404,10 +377,24 @@ class ViewProviderCompensation(_MapViewProvider):
                 vobj.RangeMin, vobj.RangeMax = self.scene.range
             finally:
                 self._syncing = False
-        if vobj.Histogram and self.scene.range is not None:
-            from . import histogram
+        from . import histogram
 
+        if vobj.Histogram and self.scene.range is not None and vobj.Visibility:
             histogram.show_map(vobj, self.scene)
+        else:
+            histogram.close_map(vobj)
+
+    def outside_names(self):
+        d = self._data.get(self.vobj.Map)
+        if d is None or not len(d["outside"]):
+            return []
+        if "_outside" not in self._data:
+            try:
+                ids = self.locator().ids
+            except SurfcompError:
+                ids = None
+            self._data["_outside"] = [ids[k] if ids else "node %d" % k for k in d["outside"]]
+        return self._data["_outside"]
 
     def locator(self):
         """The :class:`~surfcomp.app.reports.PointLocator` of the drawn result (cached)."""
@@ -432,7 +419,22 @@ class ViewProviderCompensation(_MapViewProvider):
                 value = info[vobj.Map] if vobj.Map in info else info["deviation"]
                 flags.append((info["local"], "%s  %s" % (info["id"], colormap.format_value(
                     value, unit))))
-        self.scene.set_flags(flags)
+        self.scene.set_flags(flags, self._leader())
+
+    def _leader(self):
+        """The flags' leader line (mm): up and to the left on the screen of the active 3D
+        view, away from the max/min labels (which run right of their points)."""
+        from . import fcgui
+
+        view = fcgui.active_view()
+        pts = self.scene._points
+        if view is None or pts is None or not len(pts):
+            return (0.0, 0.0, 0.0)
+        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        rot = view.getCameraNode().orientation.getValue()
+        up = rot.multVec(coin.SbVec3f(0.0, 1.0, 0.0))
+        right = rot.multVec(coin.SbVec3f(1.0, 0.0, 0.0))
+        return tuple(LEADER * size * (float(up[i]) - 0.5 * float(right[i])) for i in range(3))
 
     def toggle_flag(self, node):
         """Add a flag at ``node`` or remove the one there (saved with the document)."""
@@ -490,6 +492,7 @@ class ViewProviderMeasurement(_MapViewProvider):
         vobj = getattr(self, "vobj", None)
         if vobj is None or not has_map_properties(vobj):
             return
+        self._deleted = False
         obj = vobj.Object
         ms = features.measurement_set(obj)
         pts = ms.nominal if ms.nominal is not None else ms.measured
@@ -503,14 +506,11 @@ class ViewProviderMeasurement(_MapViewProvider):
 
     def restyle(self, arrange=True):
         vobj = self.vobj
-        style = style_of(vobj, "deviation", getattr(self, "_layout", None))
+        style = style_of(vobj, "deviation")
         if not has_deviation(vobj.Object):
             style.show_legend = style.show_labels = False
         self.scene.set_style(style)
-        if arrange and vobj.Object.Document is not None:
-            arrange_legends(vobj.Object.Document, changed=vobj.Object)
-            style.layout = getattr(self, "_layout", None)
-            self.scene.set_style(style)
+        arrange_legends()
 
 
 
@@ -564,9 +564,21 @@ class _RestoreObserver:
 
     def slotActivateDocument(self, doc):
         attach_all(doc)
+        arrange_legends()       # the legend panel shows the active document's maps
 
     def slotRecomputedDocument(self, doc):
         attach_all(doc)
+
+    def slotDeletedObject(self, obj):
+        proxy = getattr(getattr(obj, "ViewObject", None), "Proxy", None)
+        if isinstance(proxy, _MapViewProvider):
+            proxy._deleted = True
+            arrange_legends()
+            cover.update(obj.Document)
+
+    def slotDeletedDocument(self, doc):
+        cover.forget(doc.Name)
+        arrange_legends()
 
 
 _OBSERVER = []
