@@ -4,7 +4,8 @@
 A CAM Job draws a stock box around its model. Around the map's face it hides the map (a
 document made by the command line leaves it opaque) or tints it (the GUI's transparent
 stock), and a click on the map selects the box in front, whose selection highlight then
-paints the face. While a map is shown with ``HideStock`` on, the stocks around it are left
+paints the face. While a map is shown with ``HideStock`` on, the stocks whose boxes meet its
+face's are left
 out of the drawing and of picking: their Coin switch is set to draw nothing. Their
 ``Visibility`` is not touched (the document is not modified, nothing enters the undo
 history); hiding or showing a stock by hand draws it again as FreeCAD's own switch is set
@@ -40,14 +41,6 @@ def _box(obj):
     return shape.BoundBox
 
 
-def _encloses(outer, inner):
-    """True when ``inner`` (a BoundBox) lies within ``outer`` (with 1 um to spare)."""
-    tol = 1e-3
-    return (outer.XMin <= inner.XMin + tol and outer.YMin <= inner.YMin + tol and
-            outer.ZMin <= inner.ZMin + tol and outer.XMax >= inner.XMax - tol and
-            outer.YMax >= inner.YMax - tol and outer.ZMax >= inner.ZMax - tol)
-
-
 def _map_box(obj):
     """The bounding box of the map's nominal face in document coordinates."""
     nominal = getattr(obj, "Nominal", None)
@@ -61,7 +54,8 @@ def _map_box(obj):
 
 
 def stocks_covering(obj):
-    """The stocks of the CAM Jobs of ``obj``'s document that enclose its map."""
+    """The stocks of the CAM Jobs of ``obj``'s document whose boxes meet its map's (a stock
+    made for an earlier model may end below the face's top: it still covers the rest)."""
     box = _map_box(obj)
     if box is None:
         return []
@@ -69,7 +63,7 @@ def stocks_covering(obj):
     for job in _jobs(obj.Document):
         stock = job.Stock
         sbox = _box(stock) if stock is not None else None
-        if sbox is not None and _encloses(sbox, box):
+        if sbox is not None and sbox.intersect(box):
             out.append(stock)
     return out
 
