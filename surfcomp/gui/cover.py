@@ -120,8 +120,9 @@ class _Hold:
         if t is None or time.monotonic() - self.since > HOLD_SECONDS:
             self.target = None
             return
-        if (doc, obj) != t or sub:
-            QtCore.QTimer.singleShot(0, self.restore)
+        # also for the map itself: FreeCAD 1.1 reports a mesh element the map's shape lacks
+        # (Vertex-3670) as the whole object here, but keeps the element in the selection
+        QtCore.QTimer.singleShot(0, self.restore)
 
     def restore(self):
         t = self.target

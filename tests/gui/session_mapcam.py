@@ -172,7 +172,10 @@ tasks = [w for w in mw.findChildren(QtGui.QWidget)
 d = legend.dock(create=False)
 RESULTS["task_and_legend"] = {
     "tasks": [global_rect(w) for w in tasks], "legend": global_rect(d.widget()),
-    "legend_shown": bool(d.isVisible() and not d.widget().visibleRegion().isEmpty()),
+    "legend_shown": [d.isVisible(), not d.isFloating(), mw.tabifiedDockWidgets(d) == [],
+                     [e.name for e in d.widget().entries if e.isVisible()]],
+    "entry": global_rect(d.widget().entries[0]) if d.widget().entries else None,
+    "window": mw.grab().save(os.path.join(TMP, "window_task.png")),
     "dialog": Gui.Control.activeDialog()}
 Gui.Control.closeDialog()
 Gui.updateGui()

@@ -116,10 +116,14 @@ def test_units_default_um_from_disk_and_stored_mm_kept(session):
 def test_filter_task_panel_does_not_cover_the_legend_panel(session):
     t = session["task_and_legend"]
     assert t["tasks"], "the Filter task panel did not open"
+    for lx, ly, lw, lh in (t["legend"], t["entry"]):
+        for tx, ty, tw, th in t["tasks"]:
+            assert lx >= tx + tw or lx + lw <= tx or ly >= ty + th or ly + lh <= ty
+    # shown, docked, not a tab behind another dock, the map's entry visible in it
+    assert t["legend_shown"] == [True, True, True, ["Compensation"]]
+    ex, ey, ew, eh = t["entry"]
     lx, ly, lw, lh = t["legend"]
-    for tx, ty, tw, th in t["tasks"]:
-        assert lx >= tx + tw or lx + lw <= tx or ly >= ty + th or ly + lh <= ty
-    assert t["legend_shown"] is True
+    assert lx <= ex and ex + ew <= lx + lw and ly <= ey < ly + lh
 
 
 def test_no_python_traceback_in_the_report_view(session):
