@@ -7,7 +7,6 @@ The counts and colours come from :func:`surfcomp.core.colormap.histogram`.
 """
 
 import FreeCAD
-import FreeCADGui
 from PySide import QtCore, QtGui
 
 from ..core import colormap
@@ -76,15 +75,10 @@ class HistogramWidget(QtGui.QWidget):
 
 def dock(create=True):
     """The histogram dock of the main window (made on first use)."""
-    mw = FreeCADGui.getMainWindow()
-    found = mw.findChild(QtGui.QDockWidget, OBJECT_NAME)
-    if found is not None or not create:
-        return found
-    d = QtGui.QDockWidget(translate("SurfComp", "SurfComp histogram"), mw)
-    d.setObjectName(OBJECT_NAME)
-    d.setWidget(HistogramWidget(d))
-    mw.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
-    return d
+    from .legend import right_dock
+
+    return right_dock(OBJECT_NAME, translate("SurfComp", "SurfComp histogram"),
+                      HistogramWidget, create)
 
 
 def show_map(vobj, scene):

@@ -178,17 +178,27 @@ class LegendPanel(QtGui.QWidget):
             w.set_legend(*item)
 
 
-def dock(create=True):
-    """The legend dock of the main window (made on first use, on the right)."""
+def right_dock(object_name, title, widget_class, create=True):
+    """The main window's dock ``object_name`` (the legend panel, the histogram), made on
+    first use on the right around a new ``widget_class`` instance; None when missing and
+    not ``create``."""
     mw = FreeCADGui.getMainWindow()
-    found = mw.findChild(QtGui.QDockWidget, OBJECT_NAME)
+    found = mw.findChild(QtGui.QDockWidget, object_name)
     if found is not None or not create:
         return found
-    d = QtGui.QDockWidget(translate("SurfComp", "SurfComp legends"), mw)
-    d.setObjectName(OBJECT_NAME)
-    d.setWidget(LegendPanel(d))
-    d.widget().setMinimumWidth(MIN_WIDTH)
+    d = QtGui.QDockWidget(title, mw)
+    d.setObjectName(object_name)
+    d.setWidget(widget_class(d))
     mw.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
+    return d
+
+
+def dock(create=True):
+    """The legend dock of the main window (made on first use, on the right)."""
+    d = right_dock(OBJECT_NAME, translate("SurfComp", "SurfComp legends"), LegendPanel,
+                   create)
+    if d is not None:
+        d.widget().setMinimumWidth(MIN_WIDTH)
     return d
 
 
