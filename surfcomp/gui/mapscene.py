@@ -102,6 +102,7 @@ class MapScene:
         self._title = ""
         self.range = None
         self.legend_data = None
+        self.label_anchors = []
 
         # the face mesh: unlit per-vertex colours, pushed back so markers stay in front
         self.surface = coin.SoSeparator()
@@ -234,20 +235,23 @@ class MapScene:
         if pts is None:
             pts = self._points
         i_max, i_min = colormap.extremes(vals)
+        self.label_anchors = []
         for idx, word in ((i_max, "max"), (i_min, "min")):
             if idx is None:
                 continue
-            self.labels.addChild(_text(pts[idx], "  %s %s" % (word, colormap.format_value(
-                vals[idx], style.unit))))
+            text = "  %s %s" % (word, colormap.format_value(vals[idx], style.unit))
+            self.labels.addChild(_text(pts[idx], text))
+            if style.show_labels:
+                self.label_anchors.append((tuple(map(float, pts[idx])), text))
         self.extreme_indices = (i_max, i_min)
 
-    def set_flags(self, flags, leader=(0.0, 0.0, 0.0)):
-        """Flag labels: ``[(point (3,), text)]`` in the map's coordinates, each text at the
-        end of a leader line from its point along ``leader`` (a vector, mm), ending there
-        (right-aligned): the max/min labels start at their points and run right."""
+    def set_flags(self, flags):
+        """Flags: ``[(point (3,), text, leader (3,), justification)]`` in the map's
+        coordinates (:func:`surfcomp.gui.flags.layout`): a dot at the point, a leader line
+        along ``leader`` and the text at its end, aligned 'right', 'left' or 'center'."""
         self.flags.removeAllChildren()
-        for point, text in flags:
-            self.flags.addChild(_flag(point, text, leader))
+        for point, text, leader, justification in flags:
+            self.flags.addChild(_flag(point, text, leader, justification))
 
     def _legend(self, style, vmin, vmax):
         """What the legend panel (:mod:`surfcomp.gui.legend`) draws for this map: the colour
@@ -278,7 +282,7 @@ class MapScene:
                 "labels": data["labels"], "side": side, "arrows": arrows,
                 "range": (vmin, vmax), "unit": style.unit}
 
-def _flag(point, text, leader):
+def _flag(point, text, leader, justification):
     """A flag at a measured point: a black dot, a leader line and its text over everything."""
     sep = coin.SoSeparator()
     col = coin.SoBaseColor()
@@ -296,5 +300,8 @@ def _flag(point, text, leader):
     line.numVertices.setValue(2)
     for node in (col, style, c3, dot, line):
         sep.addChild(node)
-    sep.addChild(_text(end, text + " ", size=14, justification=coin.SoText2.RIGHT))
+    just = {"right": coin.SoText2.RIGHT, "left": coin.SoText2.LEFT,
+            "center": coin.SoText2.CENTER}[justification]
+    pad = {"right": text + " ", "left": " " + text, "center": text}[justification]
+    sep.addChild(_text(end, pad, size=14, justification=just))
     return sep

@@ -13,7 +13,6 @@ The module path ``surfcomp.gui.viewproviders`` is stored in documents: keep it.
 
 import FreeCAD
 import numpy as np
-from pivy import coin
 from PySide import QtCore
 from PySide.QtCore import QT_TRANSLATE_NOOP
 
@@ -46,8 +45,6 @@ STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "TolBand",
                     "Labels", "Legend", "Stepped", "Shared", "WarnBand",
                     "Histogram")
 
-#: length of a flag's leader line, as a fraction of the map's size
-LEADER = 0.08
 #: compensation properties whose change invalidates the drawn map
 RESULT_PROPERTIES = ("Shape", "GridRows", "GridCols", "U", "V", "Nodes", "Deviation",
                      "Determined", "Random", "Increment", "Correction", "Version")
@@ -204,6 +201,13 @@ class _MapViewProvider:
 
     #: set when the object is deleted (until it is drawn again: undo)
     _deleted = False
+
+    def forget(self):
+        """The object or its document is deleted: no legend, no camera watch."""
+        from . import flags
+
+        self._deleted = True
+        flags.watch(self, None)
 
     def attach(self, vobj):
         self.Object = vobj.Object
@@ -405,7 +409,8 @@ class ViewProviderCompensation(_MapViewProvider):
     def draw_flags(self):
         """Flag labels at the nodes listed in the view's ``Flags``."""
         vobj = getattr(self, "vobj", None)
-        if vobj is None or not has_map_properties(vobj) or self.scene.range is None:
+        if vobj is None or self._deleted or not has_map_properties(vobj) \
+                or self.scene.range is None:
             return
         flags = []
         unit = vobj.Unit
@@ -419,22 +424,9 @@ class ViewProviderCompensation(_MapViewProvider):
                 value = info[vobj.Map] if vobj.Map in info else info["deviation"]
                 flags.append((info["local"], "%s  %s" % (info["id"], colormap.format_value(
                     value, unit))))
-        self.scene.set_flags(flags, self._leader())
+        from . import flags as flag_layout
 
-    def _leader(self):
-        """The flags' leader line (mm): up and to the left on the screen of the active 3D
-        view, away from the max/min labels (which run right of their points)."""
-        from . import fcgui
-
-        view = fcgui.active_view()
-        pts = self.scene._points
-        if view is None or pts is None or not len(pts):
-            return (0.0, 0.0, 0.0)
-        size = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
-        rot = view.getCameraNode().orientation.getValue()
-        up = rot.multVec(coin.SbVec3f(0.0, 1.0, 0.0))
-        right = rot.multVec(coin.SbVec3f(1.0, 0.0, 0.0))
-        return tuple(LEADER * size * (float(up[i]) - 0.5 * float(right[i])) for i in range(3))
+        self.scene.set_flags(flag_layout.for_map(self, flags))
 
     def toggle_flag(self, node):
         """Add a flag at ``node`` or remove the one there (saved with the document)."""
@@ -572,11 +564,14 @@ class _RestoreObserver:
     def slotDeletedObject(self, obj):
         proxy = getattr(getattr(obj, "ViewObject", None), "Proxy", None)
         if isinstance(proxy, _MapViewProvider):
-            proxy._deleted = True
+            proxy.forget()
             arrange_legends()
             cover.update(obj.Document)
 
     def slotDeletedDocument(self, doc):
+        from . import flags
+
+        flags.forget(doc.Name)      # (the view objects are gone already)
         cover.forget(doc.Name)
         arrange_legends()
 

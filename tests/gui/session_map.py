@@ -177,17 +177,26 @@ RESULTS["flag_nodes_drawn"] = scene.flags.getNumChildren()
 RESULTS["shot_flag"] = shot(view, "map_flag")
 RESULTS["flag_pixel"] = xy
 # a flag on the largest deviation, where the max label starts: its text sits at the end of a
-# leader line, up and to the left, clear of the label
+# leader line, clear of the label (a screenshot without it and one with it)
 flags_before = list(vobj.Flags)
-vobj.Flags = flags_before + [int(i_max)]
 view = view_top()
-vobj.Proxy.draw_flags()
-lead = np.array(vobj.Proxy._leader())
-p_max, p_end = project(view, [nodes[i_max], nodes[i_max] + lead])
-RESULTS["flag_on_max"] = {"point": p_max, "end": p_end, "shot": shot(view, "map_flag_max"),
-                          "texts": [scene.flags.getChild(k).getChild(5).getChild(3)
-                                    .string.getValues()[0]
-                                    for k in range(scene.flags.getNumChildren())]}
+labels_only = shot(view, "map_labels_only")
+vobj.Flags = flags_before + [int(i_max)]
+Gui.updateGui()
+flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
+end = list(flag.getChild(2).point[1])
+p_max, p_end = project(view, [nodes[i_max], end])
+RESULTS["flag_on_max"] = {"point": p_max, "end": p_end, "labels_only": labels_only,
+                          "shot": shot(view, "map_flag_max"),
+                          "text": flag.getChild(5).getChild(3).string.getValues()[0]}
+# the camera turned: the flags are laid out again for it
+before = [list(flag.getChild(2).point[1])]
+view.viewIsometric()
+settle(view)
+time.sleep(0.3)
+Gui.updateGui()
+flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
+RESULTS["flag_relaid"] = before != [list(flag.getChild(2).point[1])]
 vobj.Flags = flags_before
 
 # -- four visible maps: one legend panel, each legend named and at full size ------------------
