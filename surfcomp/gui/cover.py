@@ -5,8 +5,7 @@ A CAM Job draws a stock box around its model. Around the map's face it hides the
 document made by the command line leaves it opaque) or tints it (the GUI's transparent
 stock), and a click on the map selects the box in front, whose selection highlight then
 paints the face. While a map is shown with ``HideStock`` on, the stocks whose boxes meet its
-face's are left
-out of the drawing and of picking: their Coin switch is set to draw nothing. Their
+face's are left out of the drawing and of picking: their Coin switch draws nothing. Their
 ``Visibility`` is not touched (the document is not modified, nothing enters the undo
 history); hiding or showing a stock by hand draws it again as FreeCAD's own switch is set
 then. The Job's model copy and the corrected face need nothing here: the map is drawn in
@@ -14,18 +13,20 @@ front of them (:mod:`surfcomp.app.mapmesh`).
 
 Picking: FreeCAD's selection node handles a click before the 3D view's event callbacks
 (:mod:`surfcomp.gui.readout`), on the press and again on the release. :func:`hold_selection`
-keeps the map selected alone while the click that flagged it finishes.
+keeps the map selected alone until the click that flagged it has been released.
 """
 
 import time
 
 import FreeCADGui
-from PySide import QtCore
+from PySide import QtCore, QtGui
 
 #: stocks hidden for a map: (document name, object name) -> the switch's child before
 _HIDDEN = {}
-#: seconds after a press on a map during which another selection is put back to the map
-HOLD_SECONDS = 2.0
+#: the longest click held (seconds): a release not seen (the window lost the mouse)
+HOLD_SECONDS = 5.0
+#: milliseconds after the release that the map is still put back (the release's selection)
+RELEASE_MS = 100
 
 
 def _jobs(doc):
@@ -106,19 +107,23 @@ def hidden(doc):
     return sorted(name for d, name in _HIDDEN if d == doc.Name)
 
 
-class _Hold:
-    """Selection observer: a selection made within HOLD_SECONDS of a press on a map (the
-    selection node's, of what lay in front, or of an element of the map's mesh) is replaced
-    by the whole map alone."""
+class _Hold(QtCore.QObject):
+    """Selection observer: from a press on a map until its release has been handled, a
+    selection (the selection node's, of what lay in front, or of an element of the map's
+    mesh) is replaced by the whole map alone. The release is seen by an event filter on
+    the application, installed for the click only."""
 
     def __init__(self):
+        super().__init__()
         self.target = None
         self.since = 0.0
+        self.filtering = False
 
     def addSelection(self, doc, obj, sub, pnt):
-        t = self.target
-        if t is None or time.monotonic() - self.since > HOLD_SECONDS:
-            self.target = None
+        if self.target is None:
+            return
+        if time.monotonic() - self.since > HOLD_SECONDS:
+            self.finish()
             return
         # also for the map itself: FreeCAD 1.1 reports a mesh element the map's shape lacks
         # (Vertex-3670) as the whole object here, but keeps the element in the selection
@@ -134,6 +139,27 @@ class _Hold:
             FreeCADGui.Selection.clearSelection()
             FreeCADGui.Selection.addSelection(*t)
 
+    def start(self, target):
+        self.target = target
+        self.since = time.monotonic()
+        if not self.filtering:
+            QtGui.QApplication.instance().installEventFilter(self)
+            self.filtering = True
+        QtCore.QTimer.singleShot(0, self.restore)
+
+    def eventFilter(self, _obj, event):
+        if event.type() == QtCore.QEvent.MouseButtonRelease and self.target is not None:
+            # after the release's own selection (handled now) and its correction
+            QtCore.QTimer.singleShot(RELEASE_MS, self.finish)
+        return False
+
+    def finish(self):
+        self.restore()
+        self.target = None
+        if self.filtering:
+            QtGui.QApplication.instance().removeEventFilter(self)
+            self.filtering = False
+
 
 _OBSERVER = []
 
@@ -143,10 +169,14 @@ def hold_selection(obj):
     if not _OBSERVER:
         _OBSERVER.append(_Hold())
         FreeCADGui.Selection.addObserver(_OBSERVER[0])
-    hold = _OBSERVER[0]
-    hold.target = (obj.Document.Name, obj.Name)
-    hold.since = time.monotonic()
-    QtCore.QTimer.singleShot(0, hold.restore)
+    _OBSERVER[0].start((obj.Document.Name, obj.Name))
+
+
+def end_hold():
+    """A press elsewhere: what it selects stays selected."""
+    if _OBSERVER and _OBSERVER[0].target is not None:
+        _OBSERVER[0].target = None
+        _OBSERVER[0].finish()
 
 
 def forget(doc_name):

@@ -154,6 +154,10 @@ def _on_click(event_cb):
     if event.getState() == coin.SoButtonEvent.DOWN:
         if click(view, position):
             event_cb.setHandled()
+        else:
+            from . import cover
+
+            cover.end_hold()
     else:
         proxy = map_under(view, position)[0]
         if proxy is not None:

@@ -75,6 +75,13 @@ for _ in range(4):
     time.sleep(0.05)
 RESULTS["click_selection"] = selection()
 RESULTS["click_flags"] = list(r2.ViewObject.Flags)
+# once the click is done the map lets go: a selection right after it (in the tree) stays
+Gui.Selection.clearSelection()
+Gui.Selection.addSelection(doc.Name, "BallEnd")
+for _ in range(4):
+    Gui.updateGui()
+    time.sleep(0.05)
+RESULTS["click_elsewhere"] = [name for name, _subs in selection()]
 r2.ViewObject.Flags = []
 
 # after Replace (the model copy is the round's corrected solid) and with the nominal shown

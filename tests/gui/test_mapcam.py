@@ -43,6 +43,7 @@ def test_stock_around_the_map_is_not_drawn_but_stays_visible(session):
 def test_a_click_on_the_map_selects_the_map_alone(session):
     assert session["click_selection"] == [["Round2", []]]
     assert len(session["click_flags"]) == 1
+    assert session["click_elsewhere"] == ["BallEnd"]       # the next click is the user's
 
 
 def _matches(state, atol=0.1):
