@@ -23,8 +23,8 @@ from PySide import QtCore, QtGui
 
 #: stocks hidden for a map: (document name, object name) -> the switch's child before
 _HIDDEN = {}
-#: the longest click held (seconds): a release not seen (the window lost the mouse)
-HOLD_SECONDS = 5.0
+#: the longest hold (seconds), also where the release is not seen (FreeCAD 1.0)
+HOLD_SECONDS = 2.0
 #: milliseconds after the release that the map is still put back (the release's selection)
 RELEASE_MS = 100
 
@@ -123,7 +123,7 @@ class _Hold(QtCore.QObject):
         if self.target is None:
             return
         if time.monotonic() - self.since > HOLD_SECONDS:
-            self.finish()
+            self.finish(restore=False)
             return
         # also for the map itself: FreeCAD 1.1 reports a mesh element the map's shape lacks
         # (Vertex-3670) as the whole object here, but keeps the element in the selection
@@ -146,6 +146,11 @@ class _Hold(QtCore.QObject):
             QtGui.QApplication.instance().installEventFilter(self)
             self.filtering = True
         QtCore.QTimer.singleShot(0, self.restore)
+        QtCore.QTimer.singleShot(int(1000 * HOLD_SECONDS), self._expire)
+
+    def _expire(self):
+        if self.target is not None and time.monotonic() - self.since >= HOLD_SECONDS:
+            self.finish(restore=False)      # what was chosen since stays
 
     def eventFilter(self, _obj, event):
         if event.type() == QtCore.QEvent.MouseButtonRelease and self.target is not None:
@@ -153,8 +158,9 @@ class _Hold(QtCore.QObject):
             QtCore.QTimer.singleShot(RELEASE_MS, self.finish)
         return False
 
-    def finish(self):
-        self.restore()
+    def finish(self, restore=True):
+        if restore:
+            self.restore()
         self.target = None
         if self.filtering:
             QtGui.QApplication.instance().removeEventFilter(self)
