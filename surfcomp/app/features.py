@@ -291,7 +291,7 @@ def options_of(obj):
                    refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
                    layout=obj.Layout,
                    smoothing=(float(obj.Smoothing.Value) or None),
-                   tip_radius=float(obj.TipRadius.Value))
+                   tip_radius=float(obj.TipRadius.Value), context="document")
 
 
 #: compensation property -> core option of the filter (the task panel's fields)

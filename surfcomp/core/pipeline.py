@@ -78,6 +78,9 @@ class Options:
     smoothing: float = None
     lean: bool = True
     accept_stock: bool = False
+    #: who reads the messages: ``'cli'`` (options named as ``--max-offset``) or
+    #: ``'document'`` (as the compensation's properties, ``MaxOffset``, for the GUI)
+    context: str = "cli"
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -123,6 +126,16 @@ class Options:
                              "mm; DH = stock / 2)")
         self.mask()                                      # odd size, custom weights
         return self
+
+
+def option_name(options, name):
+    """How a message names option ``name`` (a field of :class:`Options`) for its reader:
+    the command line's ``--max-offset``, or the compensation's property ``MaxOffset``."""
+    option, prop = (_DOMAINS[name][:2] if name in _DOMAINS else
+                    {"flip_normals": ("--flip-normals", "Flip")}[name])
+    if getattr(options, "context", "cli") == "document":
+        return "the compensation's %s" % prop
+    return option
 
 
 #: option domains: field -> (option, document property, low, high, may be None, what)
@@ -248,17 +261,26 @@ def _tip_radius(ms, options, warnings):
 
 
 def _check_on_face(ms, base, proj, dist, options):
-    """Every point within ``max_offset`` of the face (NaN is not) and inside its border."""
+    """Every point within ``max_offset`` of the face (NaN is not) and inside its border.
+    A point beyond the border is far from the face because it lies beyond it (a face
+    trimmed to part of the measured area): that is what the message says then."""
     far = np.nonzero(~(np.abs(dist) <= options.max_offset))[0]
+    outside = np.nonzero(proj.outside)[0]
+    if far.size and outside.size and np.isin(far, outside).all():
+        k = outside[np.argmax(np.where(np.isfinite(dist[outside]), np.abs(dist[outside]), 0))]
+        raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face, "
+                   "%.4f mm from it (%d point(s) do; expected points on the face: is the face "
+                   "smaller than the measured area, or is it the wrong face?)"
+                   % (tuple(base[k]) + (abs(dist[k]), outside.size)))
     if far.size:
         size = np.where(np.isfinite(dist[far]), np.abs(dist[far]), np.inf)
         k = far[np.argmax(size)]
         what = "nominal point" if ms.nominal is not None else "measured point"
         raise _err(ms, k, "%s (%.4f, %.4f, %.4f) is %.4f mm from the face (expected at most "
-                   "--max-offset %g mm; %d point(s) are farther: wrong face, units or "
-                   "alignment?)" % ((what,) + tuple(base[k]) + (abs(dist[k]), options.max_offset,
-                                                                far.size)))
-    outside = np.nonzero(proj.outside)[0]
+                   "%s %g mm; %d point(s) are farther: wrong face, units or alignment?)"
+                   % ((what,) + tuple(base[k]) + (abs(dist[k]),
+                                                  option_name(options, "max_offset"),
+                                                  options.max_offset, far.size)))
     if outside.size:
         k = outside[0]
         raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
@@ -278,8 +300,9 @@ def _normals(ms, n_face, options, warnings):
     opposite = np.nonzero(cosang < 0)[0]
     if opposite.size:
         raise _err(ms, opposite[0], "the given normal points to the other side of the face "
-                   "than the face's outward normal (%d point(s)); use --flip-normals if the "
-                   "file's normals point into the material" % opposite.size)
+                   "than the face's outward normal (%d point(s)); use %s if the "
+                   "file's normals point into the material"
+                   % (opposite.size, option_name(options, "flip_normals")))
     ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
     off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
     for k in off[:10]:
@@ -306,8 +329,8 @@ def _check_deviations(ms, d, options):
             else "is this the right file?")
     # 4 decimals as the other messages, but no 300-digit number for 1e308
     shown = "%.4f" % d[k] if np.abs(d[k]) < 1e6 else "%.6g" % d[k]
-    raise _err(ms, k, "deviation %s mm (expected at most --max-offset %g mm%s; %d point(s) "
-               "exceed it): %s" % (shown, options.max_offset,
+    raise _err(ms, k, "deviation %s mm (expected at most %s %g mm%s; %d point(s) "
+               "exceed it): %s" % (shown, option_name(options, "max_offset"), options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
                                     bad.size, hint))
 

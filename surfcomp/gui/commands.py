@@ -443,13 +443,18 @@ class BuildFace(Command):
 
 
 def face_label(comp):
-    """Label of a built face: nominal, method and iteration round
-    (``nominal filtered r1``; mirror with its stock)."""
+    """Label of a built face: nominal, method (mirror with its stock), iteration round and
+    build (``Nominal filtered round 1 build 2``: the second face built from round 1). The
+    build is counted among the faces of the document with that label: FreeCAD's own suffix
+    for a repeated label (``... r002``) would read as a round."""
     nominal = comp.Nominal.Label if comp.Nominal is not None else comp.Label
     method = comp.Method
     if method == "mirror":
         method += " %gmm" % float(comp.Stock.Value)
-    return "%s %s r%d" % (nominal, method, int(comp.Round))
+    base = "%s %s round %d build " % (nominal, method, int(comp.Round))
+    builds = [o.Label[len(base):] for o in comp.Document.Objects if o.Label.startswith(base)]
+    last = max((int(b) for b in builds if b.isdigit()), default=0)
+    return base + str(last + 1)
 
 
 class _ReplaceCommand(Command):

@@ -7,7 +7,6 @@ The counts and colours come from :func:`surfcomp.core.colormap.histogram`.
 """
 
 import FreeCAD
-import FreeCADGui
 from PySide import QtCore, QtGui
 
 from ..core import colormap
@@ -25,7 +24,8 @@ class HistogramWidget(QtGui.QWidget):
         super().__init__(parent)
         self.data = None
         self.title = ""
-        self.unit = "mm"
+        self.unit = "um"
+        self.owner = None
         self.setMinimumSize(260, 200)
 
     def set_histogram(self, data, title, unit):
@@ -75,15 +75,10 @@ class HistogramWidget(QtGui.QWidget):
 
 def dock(create=True):
     """The histogram dock of the main window (made on first use)."""
-    mw = FreeCADGui.getMainWindow()
-    found = mw.findChild(QtGui.QDockWidget, OBJECT_NAME)
-    if found is not None or not create:
-        return found
-    d = QtGui.QDockWidget(translate("SurfComp", "SurfComp histogram"), mw)
-    d.setObjectName(OBJECT_NAME)
-    d.setWidget(HistogramWidget(d))
-    mw.addDockWidget(QtCore.Qt.RightDockWidgetArea, d)
-    return d
+    from .legend import right_dock
+
+    return right_dock(OBJECT_NAME, translate("SurfComp", "SurfComp histogram"),
+                      HistogramWidget, create)
 
 
 def show_map(vobj, scene):
@@ -98,5 +93,19 @@ def show_map(vobj, scene):
     d = dock()
     title = "%s: %s [%s]" % (vobj.Object.Label, scene._title, colormap.UNIT_TEXT[style.unit])
     d.widget().set_histogram(data, title, style.unit)
+    d.widget().owner = _key(vobj)
     d.show()
     return d
+
+
+def _key(vobj):
+    obj = vobj.Object
+    return (obj.Document.Name, obj.Name)
+
+
+def close_map(vobj):
+    """Close the histogram panel when it shows the map of ``vobj`` (its Histogram was
+    switched off, or the map hidden)."""
+    d = dock(create=False)
+    if d is not None and getattr(d.widget(), "owner", None) == _key(vobj) and d.isVisible():
+        d.close()

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Coin scene of a colour map: coloured face mesh, coloured point markers, labels at the
-extremes and a colour-bar legend drawn over the 3D view (FreeCAD GUI only).
+extremes and flags (FreeCAD GUI only); the colour bar legend it describes (``legend_data``)
+is drawn in the legend panel (:mod:`surfcomp.gui.legend`).
 
 No numerics here: colours, ranges and legend levels come from
 :mod:`surfcomp.core.colormap`; the mesh and the values are given by the caller.
@@ -23,31 +24,6 @@ from pivy import coin
 
 from ..core import colormap
 
-#: legend placement in normalised device coordinates (-1 .. 1 across the view): the bar's
-#: x extent, the labels' x, and the vertical region the legends share (stacked top down)
-BAR_X = (0.74, 0.79)
-LABEL_X = 0.805
-REGION_Y = (-0.92, 0.86)
-#: room above a bar for its title (NDC)
-TITLE_ROOM = 0.14
-#: pixels kept free around the navigation cube
-CUBE_MARGIN = 16
-
-
-def legend_layout(slot=0, slots=1, clear_top_px=0, clear_bottom_px=0, view_height=1000):
-    """Where legend ``slot`` of ``slots`` sits (NDC): ``bar_x``, ``bar_y``, ``label_x``,
-    ``title_y``. The legends of the visible maps share the region on the right, one
-    above the other, so they never overlap; ``clear_top_px``/``clear_bottom_px`` keep
-    the region clear of the navigation cube in a view ``view_height`` pixels high."""
-    h = max(float(view_height), 100.0)
-    y0 = max(REGION_Y[0], -1.0 + 2.0 * clear_bottom_px / h)
-    y1 = min(REGION_Y[1], 1.0 - 2.0 * clear_top_px / h)
-    step = (y1 - y0) / max(int(slots), 1)
-    top = y1 - slot * step
-    bar = (top - step + 0.05, top - TITLE_ROOM)
-    return {"bar_x": BAR_X, "bar_y": bar, "label_x": LABEL_X, "title_y": top - 0.04,
-            "slot": slot, "slots": slots}
-
 
 @dataclass
 class MapStyle:
@@ -66,7 +42,7 @@ class MapStyle:
     vmax: float = None
     tolerance: tuple = None
     warning: float = None
-    unit: str = "mm"
+    unit: str = "um"
     levels: int = 10
     stepped: bool = False
     out_of_range: bool = True
@@ -75,7 +51,6 @@ class MapStyle:
     show_legend: bool = True
     point_size: int = 7
     note: str = ""
-    layout: dict = None
 
     def manual(self):
         return self.vmin is not None and self.vmax is not None and self.vmax > self.vmin
@@ -112,17 +87,6 @@ def _text(position, text, color=(0.0, 0.0, 0.0), size=15, justification=None):
     return sep
 
 
-def _gate_for_picking(gate, action):
-    """SoCallback: close ``gate`` (an SoSwitch) to pick actions, open it to all others.
-    The field changes without notification: no redraw is scheduled by the traversal."""
-    want = coin.SO_SWITCH_NONE if action.isOfType(coin.SoPickAction.getClassTypeId()) \
-        else coin.SO_SWITCH_ALL
-    if gate.whichChild.getValue() != want:
-        gate.enableNotify(False)
-        gate.whichChild = want
-        gate.enableNotify(True)
-
-
 class MapScene:
     """The scene nodes of one colour map (see module docstring). ``root`` is the node
     to add to a view provider's display mode or to a scene graph."""
@@ -138,6 +102,8 @@ class MapScene:
         self._mesh = None           # the (points, triangles) arrays drawn
         self._title = ""
         self.range = None
+        self.legend_data = None
+        self.label_anchors = []
 
         # the face mesh: unlit per-vertex colours, pushed back so markers stay in front
         self.surface = coin.SoSeparator()
@@ -181,24 +147,7 @@ class MapScene:
         # flags: labels the user placed at measured points (value and id)
         self.flags = coin.SoAnnotation()
 
-        # legend: drawn last, over everything, in its own fixed camera, outside bounding boxes;
-        # left out of picking (the gate): a camera node sets the pick ray of the whole pick
-        # action, not only below its separator, so a pick through the legend's camera would
-        # miss every object drawn after the map (a tool path could not be selected), and a
-        # hit on the legend is no point of the map anyway
-        self.legend_switch = coin.SoSwitch()
-        self.legend = coin.SoAnnotation()
-        self.legend_switch.addChild(self.legend)
-        self._legend_gate = coin.SoSwitch()
-        self._legend_gate.whichChild = coin.SO_SWITCH_ALL
-        self._legend_gate.addChild(self.legend_switch)
-        guard = coin.SoCallback()
-        guard.setCallback(_gate_for_picking, self._legend_gate)
-        skip = coin.SoType.fromName(coin.SbName("SoSkipBoundingGroup")).createInstance()
-        skip.addChild(guard)
-        skip.addChild(self._legend_gate)
-
-        for node in (self.surface, self.markers_switch, self.labels_switch, self.flags, skip):
+        for node in (self.surface, self.markers_switch, self.labels_switch, self.flags):
             self.root.addChild(node)
 
     # -- data --------------------------------------------------------------------------
@@ -257,9 +206,9 @@ class MapScene:
                       self.faces.materialIndex, self.marker_coords.point):
             field.setNum(0)
         self.labels.removeAllChildren()
-        self.legend.removeAllChildren()
         self.flags.removeAllChildren()
         self.range = None
+        self.legend_data = None
 
     # -- style ------------------------------------------------------------------------
     def set_style(self, style):
@@ -281,7 +230,7 @@ class MapScene:
             self.marker_style.pointSize = float(style.point_size)
             self.markers_switch.whichChild = 0
         self._draw_labels(style)
-        self._draw_legend(style, vmin, vmax)
+        self.legend_data = self._legend(style, vmin, vmax) if style.show_legend else None
 
     def _draw_labels(self, style):
         self.labels.removeAllChildren()
@@ -293,138 +242,73 @@ class MapScene:
         if pts is None:
             pts = self._points
         i_max, i_min = colormap.extremes(vals)
+        self.label_anchors = []
         for idx, word in ((i_max, "max"), (i_min, "min")):
             if idx is None:
                 continue
-            self.labels.addChild(_text(pts[idx], "  %s %s" % (word, colormap.format_value(
-                vals[idx], style.unit))))
+            text = "  %s %s" % (word, colormap.format_value(vals[idx], style.unit))
+            self.labels.addChild(_text(pts[idx], text))
+            if style.show_labels:
+                self.label_anchors.append((tuple(map(float, pts[idx])), text))
         self.extreme_indices = (i_max, i_min)
 
     def set_flags(self, flags):
-        """Flag labels: ``[(point (3,), text)]`` in the map's coordinates."""
+        """Flags: ``[(point (3,), text, leader (3,), justification)]`` in the map's
+        coordinates (:func:`surfcomp.gui.flags.layout`): a dot at the point, a leader line
+        along ``leader`` and the text at its end, aligned 'right', 'left' or 'center'."""
         self.flags.removeAllChildren()
-        for point, text in flags:
-            self.flags.addChild(_flag(point, text))
+        for point, text, leader, justification in flags:
+            self.flags.addChild(_flag(point, text, leader, justification))
 
-    def _draw_legend(self, style, vmin, vmax):
-        leg = self.legend
-        leg.removeAllChildren()
-        self.legend_switch.whichChild = 0 if style.show_legend else -1
-        lay = style.layout or legend_layout()
-        self.legend_layout = lay
-        cam = coin.SoOrthographicCamera()
-        cam.viewportMapping = coin.SoCamera.LEAVE_ALONE
-        cam.position.setValue(0.0, 0.0, 1.0)
-        cam.height = 2.0
-        cam.nearDistance = 0.5
-        cam.farDistance = 1.5
-        light = coin.SoLightModel()
-        light.model = coin.SoLightModel.BASE_COLOR
-        leg.addChild(cam)
-        leg.addChild(light)
+    def _legend(self, style, vmin, vmax):
+        """What the legend panel (:mod:`surfcomp.gui.legend`) draws for this map: the colour
+        stops and labels of :func:`surfcomp.core.colormap.legend`, the title with its unit,
+        the note, the percentages beside the bar (``side``) and the out-of-range arrows."""
         data = colormap.legend(vmin, vmax, style.scheme, style.unit, style.levels,
                                style.tolerance, stepped=style.stepped, warning=style.warning)
-        y0, y1 = lay["bar_y"]
-        x0, x1 = lay["bar_x"]
-
-        def y_of(f):
-            return y0 + f * (y1 - y0)
-
-        quads = []
-        for (f0, c0), (f1, c1) in zip(data["stops"][:-1], data["stops"][1:]):
-            if f1 > f0:
-                quads.append(([(x0, y_of(f0)), (x1, y_of(f0)), (x1, y_of(f1)), (x0, y_of(f1))],
-                              [c0, c0, c1, c1]))
         values = self._marker_values if self._marker_values is not None else self._values
+        side, arrows = [], None
         if style.out_of_range and style.manual() and style.tolerance is None:
-            # arrows past the ends: the colours of values outside the manual range
-            below = colormap.OUT_OF_RANGE_COLORS["below"]
-            above = colormap.OUT_OF_RANGE_COLORS["above"]
-            xm, a = 0.5 * (x0 + x1), 0.035
-            quads.append(([(x0, y0 - 0.005), (x1, y0 - 0.005), (xm, y0 - a), (xm, y0 - a)],
-                          [below] * 4))
-            quads.append(([(x0, y1 + 0.005), (x1, y1 + 0.005), (xm, y1 + a), (xm, y1 + a)],
-                          [above] * 4))
             fr = colormap.band_fractions(values, vmin, vmax)
-            leg.addChild(_text((x0 - 0.01, y0 - a, 0.0), "< %.1f %%" % fr["below"], size=13,
-                               justification=coin.SoText2.RIGHT))
-            leg.addChild(_text((x0 - 0.01, y1 + 0.01, 0.0), "> %.1f %%" % fr["above"], size=13,
-                               justification=coin.SoText2.RIGHT))
-        leg.addChild(_quads(quads))
-        leg.addChild(_polyline([(x0, y0), (x1, y0), (x1, y1), (x0, y1), (x0, y0)]))
-        for f, text in data["labels"]:
-            leg.addChild(_text((lay["label_x"], y_of(f) - 0.01, 0.0), text))
+            arrows = {"below": tuple(colormap.OUT_OF_RANGE_COLORS["below"]),
+                      "above": tuple(colormap.OUT_OF_RANGE_COLORS["above"])}
+            side += [(0.0, "< %.1f %%" % fr["below"]), (1.0, "> %.1f %%" % fr["above"])]
         if style.tolerance is not None:
             # percent of the measured points in each block, left of the bar
             fr = colormap.band_fractions(values, *style.tolerance, warning=style.warning)
             words = {"below": "below", "inside": "in", "above": "above", "warning": "warn"}
             done = set()
             for name, f0, f1 in data["blocks"]:
-                if name in done:
-                    continue
-                done.add(name)
-                leg.addChild(_text((x0 - 0.01, y_of(0.5 * (f0 + f1)) - 0.01, 0.0),
-                                   "%s %.1f %%" % (words[name], fr[name]), size=13,
-                                   justification=coin.SoText2.RIGHT))
+                if name not in done:
+                    done.add(name)
+                    side.append((0.5 * (f0 + f1), "%s %.1f %%" % (words[name], fr[name])))
         title = self._title + (" [%s]" % colormap.UNIT_TEXT[style.unit] if self._title else "")
         if style.tolerance is not None:
             title += " - tolerance band"
-        leg.addChild(_text((x1, lay["title_y"], 0.0), title, size=17,
-                           justification=coin.SoText2.RIGHT))
-        if style.note:
-            leg.addChild(_text((x1, lay["title_y"] - 0.05, 0.0), style.note, size=14,
-                               justification=coin.SoText2.RIGHT))
+        return {"title": title, "note": style.note, "stops": data["stops"],
+                "labels": data["labels"], "side": side, "arrows": arrows,
+                "range": (vmin, vmax), "unit": style.unit}
 
-
-def _quads(quads):
-    """One face set of quadrilaterals ``[(4 xy corners, 4 rgb)]`` with per-vertex colours."""
-    coords, colors, index = [], [], []
-    for corners, cols in quads:
-        k = len(coords)
-        coords += [(x, y, 0.0) for x, y in corners]
-        colors += list(cols)
-        index += [k, k + 1, k + 2, k + 3, -1]
+def _flag(point, text, leader, justification):
+    """A flag at a measured point: a black dot, a leader line and its text over everything."""
     sep = coin.SoSeparator()
-    c3 = coin.SoCoordinate3()
-    c3.point.setValues(0, len(coords), coords)
-    bc = coin.SoBaseColor()
-    bc.rgb.setValues(0, len(colors), colors)
-    mb = coin.SoMaterialBinding()
-    mb.value = coin.SoMaterialBinding.PER_VERTEX_INDEXED
-    fs = coin.SoIndexedFaceSet()
-    fs.coordIndex.setValues(0, len(index), index)
-    fs.materialIndex.setValues(0, len(index), index)
-    for node in (c3, bc, mb, fs):
-        sep.addChild(node)
-    return sep
-
-
-def _polyline(points, color=(0.0, 0.0, 0.0)):
-    sep = coin.SoSeparator()
-    c3 = coin.SoCoordinate3()
-    c3.point.setValues(0, len(points), [(x, y, 0.01) for x, y in points])
-    col = coin.SoBaseColor()
-    col.rgb.setValue(*color)
-    line = coin.SoLineSet()
-    line.numVertices.setValue(len(points))
-    for node in (c3, col, line):
-        sep.addChild(node)
-    return sep
-
-
-def _flag(point, text):
-    """A flag at a measured point: a black dot and its text over everything."""
-    sep = coin.SoSeparator()
-    c3 = coin.SoCoordinate3()
-    c3.point.setValue(*map(float, point))
     col = coin.SoBaseColor()
     col.rgb.setValue(0.0, 0.0, 0.0)
     style = coin.SoDrawStyle()
     style.pointSize = 9
-    for node in (col, style, c3, coin.SoPointSet()):
+    style.lineWidth = 1.5
+    c3 = coin.SoCoordinate3()
+    p = [float(c) for c in point]
+    end = [a + float(b) for a, b in zip(p, leader)]
+    c3.point.setValues(0, 2, [p, end])
+    dot = coin.SoPointSet()
+    dot.numPoints = 1
+    line = coin.SoLineSet()
+    line.numVertices.setValue(2)
+    for node in (col, style, c3, dot, line):
         sep.addChild(node)
-    label = _text(point, "", size=14)
-    # on the line below the point: the min/max label may sit on the point's own line
-    label.getChild(3).string.setValues(0, 2, ["", "  " + text])
-    sep.addChild(label)
+    just = {"right": coin.SoText2.RIGHT, "left": coin.SoText2.LEFT,
+            "center": coin.SoText2.CENTER}[justification]
+    pad = {"right": text + " ", "left": " " + text, "center": text}[justification]
+    sep.addChild(_text(end, pad, size=14, justification=just))
     return sep

@@ -40,7 +40,7 @@ DEFAULTS = {
     TOLERANCE_BAND: False,
     TOLERANCE_LOWER: -0.01,
     TOLERANCE_UPPER: 0.01,
-    DISPLAY_UNIT: "mm",
+    DISPLAY_UNIT: "um",
     FILE_UNITS: "mm",
 }
 

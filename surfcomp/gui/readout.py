@@ -10,9 +10,7 @@ the hover or the click. The values come from :class:`surfcomp.app.reports.PointL
 """
 
 import FreeCAD
-import FreeCADGui
 from pivy import coin
-from PySide import QtCore
 
 from ..core import colormap
 from ..errors import SurfcompError
@@ -87,7 +85,7 @@ def map_under(view, position):
     return None, None
 
 
-def describe(info, unit="mm", label=""):
+def describe(info, unit="um", label=""):
     """The status bar text of a readout."""
     f = colormap.format_value
     x, y, z = info["xyz"]
@@ -118,17 +116,20 @@ def click(view, position):
         return False
     obj = proxy.vobj.Object
     proxy.toggle_flag(info["node"])
-    # FreeCAD's selection node may see the click after this callback (it would select a mesh
-    # element, or the tool path in front): select the whole map once the event is done
-    QtCore.QTimer.singleShot(0, lambda: _select(obj.Document.Name, obj.Name))
+    select_later(obj)
     LAST.clear()
     LAST.update(info, text=describe(info, proxy.vobj.Unit, obj.Label), clicked=True)
     return True
 
 
-def _select(doc_name, name):
-    FreeCADGui.Selection.clearSelection()
-    FreeCADGui.Selection.addSelection(doc_name, name)
+def select_later(obj):
+    """Select the whole map ``obj``, alone, once the current event is done, and keep it so
+    through the rest of the click: FreeCAD's selection node sees a click before this
+    module's callbacks and selects what it hit first (a mesh element of the map, a tool
+    path or a CAM Job's stock box in front), on the press and again on the release."""
+    from . import cover
+
+    cover.hold_selection(obj)
 
 
 def _view_of(_event_cb):
@@ -153,5 +154,12 @@ def _on_click(event_cb):
     if event.getState() == coin.SoButtonEvent.DOWN:
         if click(view, position):
             event_cb.setHandled()
-    elif map_under(view, position)[0] is not None:
-        event_cb.setHandled()       # the release too: no selection of what lies below
+        else:
+            from . import cover
+
+            cover.end_hold()
+    else:
+        proxy = map_under(view, position)[0]
+        if proxy is not None:
+            event_cb.setHandled()       # the release too: no selection of what lies below
+            select_later(proxy.vobj.Object)

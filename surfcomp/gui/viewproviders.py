@@ -18,10 +18,11 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from .. import paths
 from ..app import features, reports
+from ..app.mapmesh import map_data, map_mesh, mesh_key  # noqa: F401  (scripts, bench/)
 from ..core import colormap
 from ..errors import SurfcompError
-from . import prefs
-from .mapscene import MapScene, MapStyle, legend_layout
+from . import cover, prefs
+from .mapscene import MapScene, MapStyle
 
 #: 2: short property names that fit the property view (RENAMED)
 VERSION = 2
@@ -105,6 +106,11 @@ MAP_PROPERTIES = (
      QT_TRANSLATE_NOOP("App::Property", "Show the histogram panel of this map, coloured like its "
                                         "legend"),
      False),
+    ("App::PropertyBool", "HideStock",
+     QT_TRANSLATE_NOOP("App::Property", "While this map is shown, a CAM Job's stock around it "
+                                        "is not drawn and takes no clicks (its Visibility is "
+                                        "kept)"),
+     True),
     ("App::PropertyIntegerList", "Flags",
      QT_TRANSLATE_NOOP("App::Property", "Measured nodes flagged on the map (click the map to add "
                                         "or remove one; empty this list to remove all)"),
@@ -119,14 +125,20 @@ def add_map_properties(vobj, from_preferences=True):
     """Add the missing colour-map properties to ``vobj`` (new objects, old documents: their
     renamed properties' values move to the new names)."""
     old_names = [o for o in RENAMED if o in vobj.PropertiesList]
+    added = []
     for typ, name, tip, default in MAP_PROPERTIES:
         if name in vobj.PropertiesList:
             continue
+        added.append(name)
         vobj.addProperty(typ, name, _G, tip)
         if default is not None:
             setattr(vobj, name, default)
         if typ == "App::PropertyEnumeration":
             setattr(vobj, name, default[0])
+    if "Unit" in added and "LegendUnit" not in old_names:
+        # no unit stored in the document (made without the GUI, or before the unit was a
+        # choice): the preference's (default um); a stored choice, mm or um, is kept
+        vobj.Unit = prefs.display_unit()
     vobj.setEditorMode("MapVersion", 2)
     for old in old_names:
         setattr(vobj, RENAMED[old], getattr(vobj, old))
@@ -147,7 +159,7 @@ def has_map_properties(vobj):
     return all(p[1] in names for p in MAP_PROPERTIES)
 
 
-def style_of(vobj, quantity=None, layout=None, shared=None):
+def style_of(vobj, quantity=None, shared=None):
     """The :class:`MapStyle` the view properties describe (``shared``: the common range
     when Shared is on)."""
     auto = vobj.AutoRange
@@ -162,81 +174,15 @@ def style_of(vobj, quantity=None, layout=None, shared=None):
                     unit=vobj.Unit, stepped=bool(vobj.Stepped),
                     out_of_range=not auto, show_points=vobj.Points,
                     show_labels=vobj.Labels, show_legend=vobj.Legend,
-                    note=NOTES.get(quantity, ""), layout=layout)
+                    note=NOTES.get(quantity, ""))
 
 
-def _shows_legend(vobj):
-    proxy = getattr(vobj, "Proxy", None)
-    if not has_map_properties(vobj) or not vobj.Legend or not vobj.Visibility:
-        return False
-    scene = getattr(proxy, "scene", None)
-    if scene is None or scene.range is None:
-        return False
-    return vobj.DisplayMode in ("Map", "Points")
+def arrange_legends(doc=None, changed=None):
+    """Bring the legend panel up to date with the shown maps (once the current event is
+    done: many maps change in one step)."""
+    from . import legend
 
-
-def arrange_legends(doc, changed=None):
-    """Give every visible map of ``doc`` its own legend slot (stacked on the right, clear of
-    the navigation cube); restyle those whose slot moved, except ``changed`` (the caller
-    restyles it). Returns ``{object name: layout}``."""
-    from . import fcgui
-
-    top, bottom, height = fcgui.legend_clearance()
-    shown = [o.ViewObject for o in doc.Objects
-             if o.ViewObject is not None and
-             isinstance(getattr(o.ViewObject, "Proxy", None),
-                        (ViewProviderCompensation, ViewProviderMeasurement)) and
-             _shows_legend(o.ViewObject)]
-    out = {}
-    for k, vobj in enumerate(shown):
-        lay = legend_layout(k, len(shown), top, bottom, height)
-        proxy = vobj.Proxy
-        moved = getattr(proxy, "_layout", None) != lay
-        proxy._layout = lay
-        out[vobj.Object.Name] = lay
-        if moved and vobj.Object is not changed:
-            proxy.restyle(arrange=False)
-    return out
-
-
-def map_mesh(obj, samples=None):
-    """``(points, triangles, u, v)``: the map's mesh of the nominal face (see
-    :func:`surfcomp.core.colormap.uv_grid_mesh`), in the nominal object's own coordinates."""
-    nominal, _placement = features.nominal_of(obj)
-    n, m = int(obj.GridRows), int(obj.GridCols)
-    samples = samples or colormap.mesh_resolution((n, m))
-    return colormap.uv_grid_mesh(nominal.surface, samples)
-
-
-def mesh_key(obj):
-    """What the mesh depends on: the nominal face's shape and the grid's shape."""
-    nom = obj.Nominal
-    shape = getattr(nom, "Shape", None)
-    code = shape.hashCode() if shape is not None and hasattr(shape, "hashCode") else id(shape)
-    return (getattr(nom, "Name", None), obj.FaceName, int(obj.GridRows), int(obj.GridCols),
-            code)
-
-
-def map_data(obj, quantity, samples=None, mesh=None, located=None):
-    """Mesh and values of a computed compensation's map (no drawing); ``mesh`` as
-    :func:`map_mesh` returns it (made when not given); ``located`` as
-    :func:`surfcomp.app.reports.field_values` takes it.
-
-    Returns
-    -------
-    dict
-        ``points`` (N, 3), ``triangles`` (M, 3), ``values`` (N,) on the mesh,
-        ``markers`` (K, 3) measured nodes and ``marker_values`` (K,), mm, in the
-        nominal object's own coordinates.
-    """
-    pts, tri, u, v = mesh if mesh is not None else map_mesh(obj, samples)
-    values = reports.field_values(obj, quantity, u, v, located)
-    nodes = np.asarray(obj.Nodes, dtype=float).reshape(-1, 3)
-    dev = np.asarray(obj.Deviation, dtype=float)
-    node_values = reports.quantity_values(obj, quantity).ravel()
-    keep = np.isfinite(dev) & np.isfinite(node_values)
-    return {"points": pts, "triangles": tri, "values": values, "markers": nodes[keep],
-            "marker_values": node_values[keep]}
+    legend.schedule()
 
 
 class _MapViewProvider:
@@ -252,6 +198,16 @@ class _MapViewProvider:
 
     def _reset(self):
         """Forget transient state (never saved)."""
+
+    #: set when the object is deleted (until it is drawn again: undo)
+    _deleted = False
+
+    def forget(self):
+        """The object or its document is deleted: no legend, no camera watch."""
+        from . import flags
+
+        self._deleted = True
+        flags.watch(self, None)
 
     def attach(self, vobj):
         self.Object = vobj.Object
@@ -279,6 +235,25 @@ class _MapViewProvider:
 
     def redraw(self):
         raise NotImplementedError
+
+    def outside_names(self):
+        """Names of the measured points outside the trimmed face (none drawn on it)."""
+        return []
+
+    def legend_entry(self):
+        """``(key, name, legend data, outside point names)`` for the legend panel, or None
+        when this map's legend is not shown."""
+        vobj = getattr(self, "vobj", None)
+        scene = getattr(self, "scene", None)
+        if vobj is None or scene is None or getattr(self, "_deleted", False) \
+                or not has_map_properties(vobj) \
+                or not vobj.Visibility or vobj.DisplayMode != self.MODE \
+                or scene.legend_data is None or scene.range is None:
+            return None
+        obj = vobj.Object
+        return ((obj.Document.Name, obj.Name), obj.Label, scene.legend_data,
+                self.outside_names())
+
 
     def dumps(self):
         return None
@@ -344,10 +319,13 @@ class ViewProviderCompensation(_MapViewProvider):
             self.redraw()
         elif prop == "Flags":
             self.draw_flags()
-        elif prop in ("Visibility", "DisplayMode"):
-            doc = getattr(vobj.Object, "Document", None)
-            if doc is not None:
-                arrange_legends(doc)
+        elif prop in ("Visibility", "DisplayMode", "HideStock"):
+            arrange_legends()
+            cover.update(getattr(vobj.Object, "Document", None))
+            if prop == "Visibility" and not vobj.Visibility:
+                from . import histogram
+
+                histogram.close_map(vobj)
 
     def redraw(self):
         """Draw the current quantity (mesh and values are cached per Shape)."""
@@ -355,6 +333,7 @@ class ViewProviderCompensation(_MapViewProvider):
         if vobj is None or not has_map_properties(vobj):
             return
         self._dirty = False
+        self._deleted = False
         obj = vobj.Object
         q = vobj.Map
         if not obj.GridRows or not obj.GridCols or obj.Shape.isNull():
@@ -375,6 +354,7 @@ class ViewProviderCompensation(_MapViewProvider):
                             d["marker_values"], title=TITLES[q], restyle=False)
         self.restyle()
         self.draw_flags()
+        cover.update(obj.Document)
         from . import readout
 
         readout.install()
@@ -392,12 +372,8 @@ class ViewProviderCompensation(_MapViewProvider):
     def restyle(self, arrange=True):
         """Recolour from the view properties (no new geometry, no recompute)."""
         vobj = self.vobj
-        if arrange and vobj.Object.Document is not None:
-            if self.scene.range is None:    # first drawing: arrange_legends needs a range
-                self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None)))
-            arrange_legends(vobj.Object.Document, changed=vobj.Object)
-        self.scene.set_style(style_of(vobj, vobj.Map, getattr(self, "_layout", None),
-                                      self.shared_range()))
+        self.scene.set_style(style_of(vobj, vobj.Map, self.shared_range()))
+        arrange_legends()
         if vobj.AutoRange and self.scene.range is not None and not np.allclose(
                 (vobj.RangeMin.Value, vobj.RangeMax.Value), self.scene.range,
                 rtol=1e-12, atol=1e-15):
@@ -408,10 +384,24 @@ class ViewProviderCompensation(_MapViewProvider):
                 vobj.RangeMin, vobj.RangeMax = self.scene.range
             finally:
                 self._syncing = False
-        if vobj.Histogram and self.scene.range is not None:
-            from . import histogram
+        from . import histogram
 
+        if vobj.Histogram and self.scene.range is not None and vobj.Visibility:
             histogram.show_map(vobj, self.scene)
+        else:
+            histogram.close_map(vobj)
+
+    def outside_names(self):
+        d = self._data.get(self.vobj.Map)
+        if d is None or not len(d["outside"]):
+            return []
+        if "_outside" not in self._data:
+            try:
+                ids = self.locator().ids
+            except SurfcompError:
+                ids = None
+            self._data["_outside"] = [ids[k] if ids else "node %d" % k for k in d["outside"]]
+        return self._data["_outside"]
 
     def locator(self):
         """The :class:`~surfcomp.app.reports.PointLocator` of the drawn result (cached)."""
@@ -422,7 +412,8 @@ class ViewProviderCompensation(_MapViewProvider):
     def draw_flags(self):
         """Flag labels at the nodes listed in the view's ``Flags``."""
         vobj = getattr(self, "vobj", None)
-        if vobj is None or not has_map_properties(vobj) or self.scene.range is None:
+        if vobj is None or self._deleted or not has_map_properties(vobj) \
+                or self.scene.range is None:
             return
         flags = []
         unit = vobj.Unit
@@ -436,7 +427,9 @@ class ViewProviderCompensation(_MapViewProvider):
                 value = info[vobj.Map] if vobj.Map in info else info["deviation"]
                 flags.append((info["local"], "%s  %s" % (info["id"], colormap.format_value(
                     value, unit))))
-        self.scene.set_flags(flags)
+        from . import flags as flag_layout
+
+        self.scene.set_flags(flag_layout.for_map(self, flags))
 
     def toggle_flag(self, node):
         """Add a flag at ``node`` or remove the one there (saved with the document)."""
@@ -494,6 +487,7 @@ class ViewProviderMeasurement(_MapViewProvider):
         vobj = getattr(self, "vobj", None)
         if vobj is None or not has_map_properties(vobj):
             return
+        self._deleted = False
         obj = vobj.Object
         ms = features.measurement_set(obj)
         pts = ms.nominal if ms.nominal is not None else ms.measured
@@ -507,14 +501,11 @@ class ViewProviderMeasurement(_MapViewProvider):
 
     def restyle(self, arrange=True):
         vobj = self.vobj
-        style = style_of(vobj, "deviation", getattr(self, "_layout", None))
+        style = style_of(vobj, "deviation")
         if not has_deviation(vobj.Object):
             style.show_legend = style.show_labels = False
         self.scene.set_style(style)
-        if arrange and vobj.Object.Document is not None:
-            arrange_legends(vobj.Object.Document, changed=vobj.Object)
-            style.layout = getattr(self, "_layout", None)
-            self.scene.set_style(style)
+        arrange_legends()
 
 
 
@@ -571,9 +562,24 @@ class _RestoreObserver:
 
     def slotActivateDocument(self, doc):
         attach_all(doc)
+        arrange_legends()       # the legend panel shows the active document's maps
 
     def slotRecomputedDocument(self, doc):
         attach_all(doc)
+
+    def slotDeletedObject(self, obj):
+        proxy = getattr(getattr(obj, "ViewObject", None), "Proxy", None)
+        if isinstance(proxy, _MapViewProvider):
+            proxy.forget()
+            arrange_legends()
+            cover.update(obj.Document)
+
+    def slotDeletedDocument(self, doc):
+        from . import flags
+
+        flags.forget(doc.Name)      # (the view objects are gone already)
+        cover.forget(doc.Name)
+        arrange_legends()
 
 
 _OBSERVER = []

@@ -206,3 +206,30 @@ def read_png(path):
     data = bytes(ptr) if not hasattr(ptr, "asstring") else ptr.asstring(img.sizeInBytes())
     arr = np.frombuffer(data, dtype=np.uint8)[: h * img.bytesPerLine()]
     return arr.reshape(h, img.bytesPerLine())[:, : 3 * w].reshape(h, w, 3) / 255.0
+
+
+def legend_entries():
+    """The legend panel's entries after pending events: ``{object label: LegendEntry}``."""
+    from surfcomp.gui import legend
+
+    Gui.updateGui()
+    d = legend.dock(create=False)
+    if d is None or not d.isVisible():
+        return {}
+    return {e.name: e for e in d.widget().entries}
+
+
+def legend_shot(label, name):
+    """The legend of the map ``label`` as an image: ``{"png", "bar": [left, top, width,
+    height] in image pixels, "texts", "title"}`` (None when the panel does not show it)."""
+    e = legend_entries().get(label)
+    if e is None:
+        return None
+    pix = e.grab()
+    ratio = float(pix.width()) / max(e.width(), 1)
+    path = os.path.join(TMP, name + ".png")
+    pix.save(path)
+    r = e.bar_rect()
+    return {"png": path, "bar": [r.left() * ratio, r.top() * ratio, r.width() * ratio,
+                                 r.height() * ratio], "texts": e.texts(),
+            "size": [e.width(), e.height()], "visible": e.isVisible()}

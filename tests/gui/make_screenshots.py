@@ -5,7 +5,8 @@
 
 Not a test: it runs the bundled example through the workbench's commands and saves
 the deviation map (in µm, with a flagged point), the tolerance-band map (warning band,
-percentages) and the whole window with the filter task panel and the histogram panel open.
+percentages), each with its legend from the legend panel beside it, and the whole window
+with the filter task panel, the legend panel and the histogram panel open.
 """
 
 import os
@@ -29,17 +30,34 @@ view.viewIsometric()
 view.fitAll()
 Gui.updateGui()
 vobj = comp.ViewObject
-vobj.Unit = "um"
+
+
+def save_with_legend(name):
+    """The 3D view's image with the map's legend (the legend panel's entry) on its right."""
+    path = os.path.join(outdir, name)
+    view.saveImage(path, 1000, 650, "White")
+    entry = legend_entries()[comp.Label]
+    leg = entry.grab().toImage()
+    img = QtGui.QImage(path)
+    out = QtGui.QImage(img.width() + leg.width(), img.height(), QtGui.QImage.Format_RGB32)
+    out.fill(QtGui.QColor(255, 255, 255))
+    painter = QtGui.QPainter(out)
+    painter.drawImage(0, 0, img)
+    painter.drawImage(img.width(), 20, leg)
+    painter.end()
+    out.save(path)
+
+
 # flag a point, as a click on the map does
 dev = np.array(comp.Deviation)
 vobj.Flags = [int(np.nanargmin(np.abs(dev - 0.03)))]
-view.saveImage(os.path.join(outdir, "deviation_map.png"), 1000, 650, "White")
+save_with_legend("deviation_map.png")
 vobj.Flags = []
 vobj.TolBand = True
 vobj.TolLow = -0.01
 vobj.TolHigh = 0.01
 vobj.WarnBand = 0.8
-view.saveImage(os.path.join(outdir, "tolerance_band.png"), 1000, 650, "White")
+save_with_legend("tolerance_band.png")
 vobj.TolBand = False
 vobj.WarnBand = 0.0
 Gui.Selection.addSelection(doc.Name, comp.Name)

@@ -182,7 +182,8 @@ RESULTS["pref_choices"] = {"method": list(prefs.METHOD_CHOICES), "edge": list(pr
 RESULTS["pref_defaults"] = [prefs.mask_size(), prefs.method(), prefs.edge(), prefs.scheme(),
                             prefs.tolerance_band(), list(prefs.tolerance()), prefs.display_unit()]
 prefs.set_value(prefs.SCHEME, "blue-white-red")
-prefs.set_value(prefs.DISPLAY_UNIT, "um")
+RESULTS["pref_ui_display_unit"] = ui.findChild(QtGui.QComboBox, "displayUnit").currentText()
+prefs.set_value(prefs.DISPLAY_UNIT, "mm")
 prefs.set_value(prefs.TOLERANCE_BAND, True)
 prefs.set_value(prefs.METHOD, "raw")
 c2 = make_map(doc, nominal, meas[0])

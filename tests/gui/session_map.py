@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-# GUI session of test_map.py: the colour map, its legend (ranges, out-of-range colours,
-# tolerance and warning bands, steps, shared range, stacking, navigation cube), the
+# GUI session of test_map.py: the colour map, its legend in the legend panel (ranges,
+# out-of-range colours, tolerance and warning bands, steps, shared range, four maps), the
 # histogram panel, the point readout and flags, save and reopen.
 import Path
 import PathGui  # noqa: F401  (the view provider that draws a Path::Feature)
@@ -31,8 +31,10 @@ RESULTS["image_size"] = [W, H]
 nodes = np.array(comp.Nodes).reshape(-1, 3)
 i_max, i_min = colormap.extremes(dev)
 RESULTS["extreme_pixels"] = project(view, nodes[[i_max, i_min]])
-RESULTS["layout_one"] = dict(scene.legend_layout)
-RESULTS["navicube"] = list(fcgui.navicube(view))
+RESULTS["legend_one"] = legend_shot(comp.Label, "legend_deviation")
+RESULTS["legend_dock_beside_view"] = [list(mw.findChild(QtGui.QDockWidget, "SurfCompLegends")
+                                           .geometry().getRect()),
+                                      list(gl_widget().parentWidget().geometry().getRect())]
 RESULTS["shot_deviation"] = shot(view, "map_deviation")
 
 # a manual range narrower than the values: beyond it the out-of-range colours, with arrows
@@ -44,23 +46,14 @@ RESULTS["shot_manual"] = shot(view, "map_manual")
 
 
 def legend_texts():
-    from pivy import coin
-
-    out = []
-    sa = coin.SoSearchAction()
-    sa.setType(coin.SoText2.getClassTypeId())
-    sa.setInterest(coin.SoSearchAction.ALL)
-    sa.apply(scene.legend)
-    paths = sa.getPaths()
-    for k in range(paths.getLength()):
-        node = paths.get(k).getTail()
-        out.append(node.string.getValues()[0])
-    return out
+    return legend_entries()[comp.Label].texts()
 
 
+RESULTS["legend_manual"] = legend_shot(comp.Label, "legend_manual")
 RESULTS["legend_texts_manual"] = legend_texts()
 vobj.Stepped = True
 RESULTS["shot_stepped"] = shot(view, "map_stepped")
+RESULTS["legend_stepped"] = legend_shot(comp.Label, "legend_stepped")
 vobj.Stepped = False
 vobj.AutoRange = True
 
@@ -121,6 +114,8 @@ if hw is not None:
     hw.grab().save(os.path.join(TMP, "histogram.png"))
     RESULTS["histogram_png"] = os.path.join(TMP, "histogram.png")
 vobj.Histogram = False
+Gui.updateGui()
+RESULTS["histogram_after_off"] = d.isVisible() if d is not None else None
 
 # -- point readout: hover -> status bar, click -> flag; the map takes the click first --------
 view = view_top()
@@ -181,18 +176,49 @@ RESULTS["flags_kept"] = list(vobj.Flags)
 RESULTS["flag_nodes_drawn"] = scene.flags.getNumChildren()
 RESULTS["shot_flag"] = shot(view, "map_flag")
 RESULTS["flag_pixel"] = xy
+# a flag on the largest deviation, where the max label starts: its text sits at the end of a
+# leader line, clear of the label (a screenshot without it and one with it)
+flags_before = list(vobj.Flags)
+view = view_top()
+labels_only = shot(view, "map_labels_only")
+vobj.Flags = flags_before + [int(i_max)]
+Gui.updateGui()
+flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
+end = list(flag.getChild(2).point[1])
+p_max, p_end = project(view, [nodes[i_max], end])
+RESULTS["flag_on_max"] = {"point": p_max, "end": p_end, "labels_only": labels_only,
+                          "shot": shot(view, "map_flag_max"),
+                          "text": flag.getChild(5).getChild(3).string.getValues()[0]}
+# the camera turned: the flags are laid out again for it
+before = [list(flag.getChild(2).point[1])]
+view.viewIsometric()
+settle(view)
+time.sleep(0.3)
+Gui.updateGui()
+flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
+RESULTS["flag_relaid"] = before != [list(flag.getChild(2).point[1])]
+vobj.Flags = flags_before
 
-# -- two visible maps: their legends stack, clear of the navigation cube ---------------------
-comp2 = make_map(doc, nominal, meas)
-comp2.ViewObject.Map = "random"
+# -- four visible maps: one legend panel, each legend named and at full size ------------------
+others = []
+for q in ("random", "correction", "determined"):
+    c = make_map(doc, nominal, meas)
+    c.ViewObject.Map = q
+    others.append(c)
 Gui.updateGui()
-s2 = comp2.ViewObject.Proxy.scene
-RESULTS["layouts_two"] = [dict(scene.legend_layout), dict(s2.legend_layout)]
-RESULTS["shot_two"] = shot(view, "map_two")
-comp2.ViewObject.Visibility = False
+entries = legend_entries()
+RESULTS["legends_four"] = {name: {"title": e.texts()[1], "bar": e.bar_rect().height(),
+                                  "texts": e.texts()} for name, e in entries.items()}
+RESULTS["bar_height"] = __import__("surfcomp.gui.legend").gui.legend.BAR_HEIGHT
+RESULTS["legend_four_shots"] = {o.Label: legend_shot(o.Label, "legend_four_%s" % o.Name)
+                                for o in [comp] + others}
+others[0].ViewObject.Visibility = False
 Gui.updateGui()
-RESULTS["layout_after_hide"] = dict(scene.legend_layout)
-doc.removeObject(comp2.Name)
+RESULTS["legends_after_hide"] = sorted(legend_entries())
+for c in others:
+    doc.removeObject(c.Name)
+Gui.updateGui()
+RESULTS["legends_after_remove"] = sorted(legend_entries())
 
 # -- save and reopen: view providers and flags come back ------------------------------------------
 path = os.path.join(TMP, "session.FCStd")

@@ -74,9 +74,10 @@ def test_report_table_and_clipboard(session):
     stats = json.loads(session["statistics"])
     assert rep["rows"] == 7
     assert rep["headers"] == ["Deviation", "Determined", "Random", "Correction"]
-    assert rep["max_neg"] == "%.4f" % stats["deviation"]["max_negative"]
-    assert "Deviations (mm)" in rep["clipboard"]
-    assert ("%.4f" % stats["random"]["std"]) in rep["clipboard"]
+    # in um, the default display unit
+    assert rep["max_neg"] == "%.2f" % (1e3 * stats["deviation"]["max_negative"])
+    assert "Deviations (\u00b5m)" in rep["clipboard"]
+    assert ("%.2f" % (1e3 * stats["random"]["std"])) in rep["clipboard"]
 
 
 def test_report_html_uses_the_gui_scheme_and_range(session):

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The colour map in the real FreeCAD GUI (under Xvfb), part 2: screenshots checked pixel by
-pixel (legend, manual range with out-of-range colours, steps, tolerance and warning bands
-with percentages), the other maps, a shared range, the histogram panel, the point readout in
-the status bar and flags (also over a tool path), stacked legends clear of the navigation
-cube, save and reopen."""
+pixel (the legend panel: manual range with out-of-range colours, steps, tolerance and warning
+bands with percentages), the other maps, a shared range, the histogram panel (closed by
+Histogram = false), the point readout in the status bar and flags (also over a tool path;
+leader lines clear of the max label), four maps with one named, full-size legend each in one
+panel beside the 3D view, save and reopen."""
 
 import os
 import subprocess
@@ -53,16 +54,12 @@ def _pixel(img, xy, dx=-2, dy=2):
     return np.median(img[row - 1:row + 2, col - 1:col + 2].reshape(-1, 3), axis=0)
 
 
-def _legend_pixel(img, layout, fraction, dx=0.5):
-    h, w = img.shape[:2]
-    x = layout["bar_x"][0] + dx * (layout["bar_x"][1] - layout["bar_x"][0])
-    y0, y1 = layout["bar_y"]
-    y = y0 + fraction * (y1 - y0)
-    return img[int(round((1 - (y + 1) / 2) * h)), int(round((x + 1) / 2 * w))]
-
-
-def _row(layout, y, h):
-    return int(round((1 - (y + 1) / 2) * h))
+def _legend_pixel(shot, fraction, dx=0.5):
+    """Colour of the legend image ``shot`` (:func:`legend_shot` of the session) at
+    ``fraction`` (0 bottom .. 1 top) along its bar."""
+    img = read_image(shot["png"])
+    left, top, width, height = shot["bar"]
+    return img[int(round(top + (1.0 - fraction) * (height - 1))), int(round(left + dx * width))]
 
 
 def test_session_ran_without_exceptions(session):
@@ -81,48 +78,49 @@ def test_deviation_map_is_one_undo_step_with_symmetric_range(session):
     assert_allclose(session["view_range_props"], [-a, a], atol=1e-9)
     assert session["markers"] == 2025
     assert session["mesh_vertices"] == 90 * 90          # 2 x the 45 x 45 grid
-    assert session["labels"] == ["  max %s" % colormap.format_value(hi),
-                                 "  min %s" % colormap.format_value(lo)]
+    # um is the default display unit
+    assert session["labels"] == ["  max %s" % colormap.format_value(hi, "um"),
+                                 "  min %s" % colormap.format_value(lo, "um")]
 
 
 def test_screenshot_largest_deviation_has_the_legend_end_colour(session):
     img = read_image(session["shot_deviation"])
     assert list(img.shape[1::-1]) == session["image_size"]
-    lay = session["layout_one"]
+    leg = session["legend_one"]
     lo, hi = session["dev_minmax"]
-    assert_allclose(_legend_pixel(img, lay, 0.99), [1, 0, 0], atol=0.08)
-    assert_allclose(_legend_pixel(img, lay, 0.01), [0, 0, 1], atol=0.08)
-    assert_allclose(_legend_pixel(img, lay, 0.5), [0, 1, 0], atol=0.08)
-    assert_allclose(_pixel(img, session["extreme_pixels"][0]), _legend_pixel(img, lay, 0.99),
+    assert_allclose(_legend_pixel(leg, 0.99), [1, 0, 0], atol=0.08)
+    assert_allclose(_legend_pixel(leg, 0.01), [0, 0, 1], atol=0.08)
+    assert_allclose(_legend_pixel(leg, 0.5), [0, 1, 0], atol=0.08)
+    assert_allclose(_pixel(img, session["extreme_pixels"][0]), _legend_pixel(leg, 0.99),
                     atol=0.08)
     want = colormap.map_colors([lo], -hi, hi)[0]
     assert_allclose(_pixel(img, session["extreme_pixels"][1]), want, atol=0.08)
 
 
-def test_screenshot_legend_has_labels_title_and_sign_note(session):
-    img = read_image(session["shot_deviation"])
-    h, w = img.shape[:2]
-    lay = session["layout_one"]
+def test_legend_panel_names_the_map_with_labels_title_and_sign_note(session):
+    leg = session["legend_one"]
+    img = read_image(leg["png"])
+    left, top, width, height = leg["bar"]
     dark = img.sum(axis=2) < 0.6
-    x_text = int((lay["label_x"] + 1) / 2 * w)
-    labels = dark[:, x_text:]
-    rows_with_text = np.flatnonzero(labels.any(axis=1))
+    labels = dark[int(top) - 10:int(top + height) + 10, int(left + width) + 2:]
+    rows = np.flatnonzero(labels.any(axis=1))
     assert labels.sum() > 500
-    top_row, bottom_row = _row(lay, lay["bar_y"][1], h), _row(lay, lay["bar_y"][0], h)
-    assert rows_with_text.min() < top_row + 15 and rows_with_text.max() > bottom_row - 15
-    assert dark[:top_row - 5, int(0.5 * w):].sum() > 100      # title above the bar
-    assert "Deviation [mm]" in session["legend_texts_auto"]
-    assert "+ = material left" in session["legend_texts_auto"]
+    # labels from the top of the bar to its bottom
+    assert rows.min() < 20 and rows.max() > height - 10
+    assert dark[:int(top) - 5].sum() > 100                       # name and title above the bar
+    texts = leg["texts"]
+    assert texts[:3] == ["Compensation", "Deviation [\u00b5m]", "+ = material left"]
+    assert "+0.0 \u00b5m" in texts or "0.0 \u00b5m" in texts
+    assert "Deviation [\u00b5m]" in session["legend_texts_auto"]
 
 
-def test_legend_clear_of_the_navigation_cube(session):
-    shown, corner, size = session["navicube"]
-    w, h = session["image_size"]
-    lay = session["layout_one"]
-    title_top_px = (1 - (lay["title_y"] + 0.03 + 1) / 2) * h     # 17 px font above title_y
-    if shown and corner == 1:                                   # top right (the default)
-        assert title_top_px > size
-    assert lay["bar_y"][0] > -1.0 and lay["bar_y"][1] < lay["title_y"]
+def test_legend_panel_beside_the_3d_view(session):
+    dock, view = session["legend_dock_beside_view"]
+    dx, dy, dw, dh = dock
+    vx, vy, vw, vh = view
+    # in the main window's coordinates the dock and the 3D view do not overlap
+    assert dx >= vx + vw or dx + dw <= vx or dy >= vy + vh or dy + dh <= vy
+    assert dw >= 250
 
 
 def test_manual_range_out_of_range_colours_and_arrows(session):
@@ -135,28 +133,23 @@ def test_manual_range_out_of_range_colours_and_arrows(session):
                     colormap.OUT_OF_RANGE_COLORS["above"], atol=0.08)
     assert_allclose(_pixel(img, session["extreme_pixels"][1]),
                     colormap.OUT_OF_RANGE_COLORS["below"], atol=0.08)
-    lay = session["layout_one"]
-    h = img.shape[0]
     # the arrows past the bar's ends, in those colours
-    y_above = lay["bar_y"][1] + 0.015
-    y_below = lay["bar_y"][0] - 0.015
-    x = int(round((0.5 * sum(lay["bar_x"]) + 1) / 2 * img.shape[1]))
-    assert_allclose(img[_row(lay, y_above, h), x], colormap.OUT_OF_RANGE_COLORS["above"],
-                    atol=0.08)
-    assert_allclose(img[_row(lay, y_below, h), x], colormap.OUT_OF_RANGE_COLORS["below"],
-                    atol=0.08)
+    leg = session["legend_manual"]
+    assert_allclose(_legend_pixel(leg, 1.0 + 5.0 / leg["bar"][3]),
+                    colormap.OUT_OF_RANGE_COLORS["above"], atol=0.08)
+    assert_allclose(_legend_pixel(leg, -5.0 / leg["bar"][3]),
+                    colormap.OUT_OF_RANGE_COLORS["below"], atol=0.08)
     texts = session["legend_texts_manual"]
     assert any(t.startswith("> ") and t.endswith("%") for t in texts)
     assert any(t.startswith("< ") and t.endswith("%") for t in texts)
 
 
 def test_stepped_bar_has_flat_steps(session):
-    img = read_image(session["shot_stepped"])
-    lay = session["layout_one"]
+    leg = session["legend_stepped"]
     # inside one step (0.30 .. 0.40 of 10 steps) the colour is the step's middle colour
     want = colormap.map_colors([-0.02 + 0.35 * 0.04], -0.02, 0.02)[0]
     for f in (0.31, 0.35, 0.39):
-        assert_allclose(_legend_pixel(img, lay, f), want, atol=0.06)
+        assert_allclose(_legend_pixel(leg, f), want, atol=0.06)
 
 
 def test_tolerance_band_warning_band_and_percentages(session):
@@ -182,7 +175,7 @@ def test_other_maps_redraw_without_recompute_and_state_their_sign(session):
     assert session["maps"]["random"]["nodes_absmax"] < 0.3 * max(map(abs, session["dev_minmax"]))
     assert session["comp_touched_after_restyle"] is False
     assert "+ = material removed (the face moves in by it)" in session["correction_legend"]
-    assert "Correction [mm]" in session["correction_legend"]
+    assert "Correction [\u00b5m]" in session["correction_legend"]
 
 
 def test_shared_range_is_the_same_for_every_map_of_the_measurement(session):
@@ -203,6 +196,7 @@ def test_histogram_panel_coloured_like_the_legend(session):
                     atol=1e-12)
     img = read_image(session["histogram_png"])
     assert np.any(np.all(np.abs(img - [1, 0, 0]) < 0.1, axis=2))   # red bars at the top end
+    assert session["histogram_after_off"] is False                # Histogram = false closes it
 
 
 def test_hover_shows_the_point_in_the_status_bar(session):
@@ -210,7 +204,7 @@ def test_hover_shows_the_point_in_the_status_bar(session):
     assert hov["node"] == hov["want_node"]
     status = hov["status"]
     assert status.startswith("Compensation point P") and "deviation %s" % \
-        colormap.format_value(hov["deviation"]) in status
+        colormap.format_value(hov["deviation"], "um") in status
     for word in ("determined", "random", "correction", ") mm:"):
         assert word in status
 
@@ -232,16 +226,47 @@ def test_click_flags_the_point_and_removes_it(session):
     assert (patch.sum(axis=2) < 0.3).any()                  # the flag's black dot
 
 
-def test_two_maps_stack_their_legends(session):
-    a, b = session["layouts_two"]
-    assert a["slots"] == b["slots"] == 2
-    lo_top, hi_low = (a, b) if a["bar_y"][1] > b["bar_y"][1] else (b, a)
-    # the lower legend (bar and title) lies wholly below the upper one's bar
-    assert hi_low["title_y"] + 0.03 < lo_top["bar_y"][0]
-    img = read_image(session["shot_two"])
-    for lay in (a, b):
-        assert_allclose(_legend_pixel(img, lay, 0.99), [1, 0, 0], atol=0.08)
-    assert session["layout_after_hide"]["slots"] == 1
+def test_flag_leader_line_keeps_its_text_clear_of_the_max_label(session):
+    f = session["flag_on_max"]
+    (px, py), (ex, ey) = f["point"], f["end"]
+    assert np.hypot(ex - px, ey - py) >= 30                 # a leader line, not a label on it
+    without = read_image(f["labels_only"]).sum(axis=2) < 0.6
+    withflag = read_image(f["shot"]).sum(axis=2) < 0.6
+    h = without.shape[0]
+    row, col = h - 1 - py, px
+    # the max label: dark pixels right of the point, on its line (text grows upwards)
+    band = without[row - 16:row + 5, col + 3:col + 260]
+    rows, cols = np.nonzero(band)
+    assert cols.size > 50, "no max label found"
+    top, bottom = row - 16 + rows.min(), row - 16 + rows.max()
+    left, right = col + 3 + cols.min(), col + 3 + cols.max()
+    # what the flag added (dot, leader, text) stays out of the label's box, but for the
+    # dot and the start of the leader at the point itself
+    added = withflag & ~without
+    box = added[top - 1:bottom + 2, left - 1:right + 2].copy()
+    yy, xx = np.mgrid[top - 1:bottom + 2, left - 1:right + 2]
+    box[np.hypot(yy - row, xx - col) < 9] = False
+    assert box.sum() <= 3, box.sum()
+    mx, my = (px + ex) // 2, (py + ey) // 2
+    assert added[h - 1 - my - 2:h - my + 2, mx - 2:mx + 3].any()      # the leader line
+    assert f["text"].strip().endswith("\u00b5m")
+    assert session["flag_relaid"] is True
+
+
+def test_four_maps_one_legend_panel_named_and_full_size(session):
+    four = session["legends_four"]
+    assert len(four) == 4 and len(set(four)) == 4           # one entry per map, by its name
+    titles = sorted(v["title"] for v in four.values())
+    assert titles == ["Correction [\u00b5m]", "Determined component [\u00b5m]",
+                      "Deviation [\u00b5m]", "Random component [\u00b5m]"]
+    assert {v["bar"] for v in four.values()} == {session["bar_height"]}    # not squashed
+    for name, leg in session["legend_four_shots"].items():
+        assert leg is not None, name
+        # every bar shows its scheme's ends (the correction's range is its own)
+        assert_allclose(_legend_pixel(leg, 0.99), [1, 0, 0], atol=0.08, err_msg=name)
+        assert_allclose(_legend_pixel(leg, 0.01), [0, 0, 1], atol=0.08, err_msg=name)
+    assert len(session["legends_after_hide"]) == 3
+    assert session["legends_after_remove"] == ["Compensation"]
 
 
 def test_saved_document_reopens_with_its_map_and_flags(session):

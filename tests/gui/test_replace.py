@@ -25,7 +25,7 @@ def test_built_face_is_hidden_and_named_by_method_and_round(session):
     n, area, comp_area, label, visible, map_visible = session["corrected_face"]
     assert n == 1 and area > 2000
     assert_allclose(area, comp_area, rtol=1e-9)
-    assert label == "nominal filtered r1"
+    assert label == "nominal filtered round 1 build 1"
     assert visible is False and map_visible is True
     # no grey face over the map: the largest deviation keeps the top colour
     img = read_image(session["shot_after_build"])

@@ -121,6 +121,8 @@ def test_measurement_off_the_face_error_dialog_document_unchanged(session):
     (title, message), = session["far_errors"]
     assert "Deviation map" in title
     assert "far.csv:" in message and "mm from the face" in message
+    # the GUI names the property a GUI user can change, not the command line's option
+    assert "the compensation's MaxOffset 1 mm" in message and "--" not in message
     assert session["far_objects_unchanged"] is True
 
 
@@ -148,6 +150,7 @@ def test_preferences_page_and_defaults(session):
     for name, items in choices.items():
         assert combos[name] == items, name      # combo index <-> getter order
     assert session["pref_defaults"] == [5, "filtered", "renormalize", "rainbow", False,
-                                        [-0.01, 0.01], "mm"]
+                                        [-0.01, 0.01], "um"]
+    assert session["pref_ui_display_unit"] == "um"      # the page shows the default
     name, method, scheme, unit, band = session["pref_new_map"]
-    assert (method, scheme, unit, band) == ("raw", "blue-white-red", "um", True)
+    assert (method, scheme, unit, band) == ("raw", "blue-white-red", "mm", True)
