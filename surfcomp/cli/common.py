@@ -153,8 +153,10 @@ class ProgressLine:
         print("[%3d%%] %s" % (round(100 * fraction), message), file=self.stream, flush=True)
 
 
-def print_summary(comp, rep, out=sys.stdout):
-    """The papers' table form, the correction applied and the corrected face's checks."""
+def print_summary(comp, rep, out=None):
+    """The papers' table form, the correction applied and the corrected face's checks, on
+    ``out`` (default: ``sys.stdout`` as it is at the call, so a redirection holds)."""
+    out = sys.stdout if out is None else out
     p = comp.prepared
     st = comp.statistics
     inputs = rep["inputs"]

@@ -238,9 +238,13 @@ JOB_REFUSED = (
     + [({attr: s.format(x="nominal.step")}, s.format(x="nominal.step"),
         "cannot be written: its folder")
        for attr in JOB_OUTPUTS for s in ("nope/../{x}", "afile/../{x}")]
-    + [({attr: ""}, None, "the file name is empty") for attr in JOB_OUTPUTS]
+    # the job file's value check comes first: an empty name is not a file name
+    + [({attr: ""}, JOB_ITSELF, "job key '%s' is \"\" (expected a file name (a non-empty "
+        "string))" % attr) for attr in JOB_OUTPUTS]
     + [({"command": c}, JOB_ITSELF, '"command": %s: a job file runs' % json.dumps(c))
-       for c in ("bogus", "simulate", "gcode", "", 5)]
+       for c in ("bogus", "simulate", "gcode")]
+    + [({"command": c}, JOB_ITSELF, "job key 'command' is %s (expected a non-empty string)"
+        % json.dumps(c)) for c in ("", 5)]
     + [({"command": "inspect", k: v}, JOB_ITSELF, '"%s": does nothing for "command": '
         '"inspect"' % k) for k, v in (("output", "c.step"), ("points", "p.csv"),
                                       ("curves", "n.step"), ("face_only", True),
