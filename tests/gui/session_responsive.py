@@ -15,8 +15,14 @@ SAMPLE = float(os.environ.get("SURFCOMP_SAMPLE_INTERVAL", "1.0"))
 IN_PROCESS = os.environ.get("SURFCOMP_IN_PROCESS") == "1"
 ESC_AFTER = float(os.environ.get("SURFCOMP_ESC_AFTER", "2.0"))
 
-cam.api()      # OpenCamLib importable before the document opens
-doc = FreeCAD.openDocument(os.path.join(ROOT, "tests", "data", "documents", "shop-0.20.FCStd"))
+SHOP = os.path.join(ROOT, "tests", "data", "documents", "shop-0.20.FCStd")
+# OpenCamLib importable and, on FreeCAD 1.x, the 0.20 CAM module names aliased before the
+# document opens, as the command line does
+from surfcomp.app import documents
+
+cam.api()
+documents.prepare_modules(SHOP)
+doc = FreeCAD.openDocument(SHOP)
 Gui.updateGui()
 op = doc.getObject("Surface")
 round2 = doc.getObject("Round2")
