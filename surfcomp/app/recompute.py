@@ -3,26 +3,26 @@
 
 A 3D Surface operation spends most of its time in single long C++ calls (the tessellation,
 OpenCamLib's drop cutter), during which the GUI's event loop cannot run. So after Replace or
-Restore the operations (and their dressups) are computed by a child ``python3`` that
-imports FreeCAD as a library, on a copy of the document saved for it
-(``doc.saveCopy``); the document itself is not touched while the child runs:
+Restore the operations (and their dressups) are computed by a child process (FreeCAD's
+``freecadcmd`` next to the GUI, or this Python importing FreeCAD as a library), on a copy of
+the document saved for it (``doc.saveCopy``); the document itself is not touched while the
+child runs:
 
 - the GUI waits in its event loop (it repaints, and Esc kills the child at once: nothing in
   the document changed, so a cancel needs no recompute);
-- when the child is done, every property that an operation's recompute changed in the copy
-  (its ``Path``, ``CycleTime``, the Job's ``CycleTime``, a dressup's results) is written onto
-  the same object of the document, and the operation is marked recomputed; the cheap objects
-  around them (model clones, the Job) are recomputed in this process, in dependency order,
-  so the document ends exactly as a recompute in this process leaves it, with each operation
-  computed once.
+- the objects before the first operation (model clones) are recomputed in this process, as
+  in the child; from the first operation on, every property the child's recompute changed
+  (the operations' ``Path`` and depths, the dressups' results, the Stock's box, the Job's
+  ``CycleTime``) is written onto the same object of the document, and those objects are
+  marked recomputed. The document ends as a recompute in this process leaves it, with each
+  operation computed once (in the child).
 
 Paths go across as their commands' parameters in JSON (Python's float text is exact, where
 FreeCAD's own file keeps 6 decimals); the other properties through FreeCAD's
 ``dumpPropertyContent``/``restorePropertyContent``.
 
-The child is this module run as a script::
-
-    python3 -m surfcomp.app.recompute COPY.FCStd JOB.json OUTDIR
+The child runs :func:`_main` of this module (``python3 -m surfcomp.app.recompute COPY.FCStd
+JOB.json OUTDIR``, or a two-line script under ``freecadcmd``).
 """
 
 import base64
