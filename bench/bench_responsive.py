@@ -42,8 +42,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--step-over", type=float, default=10.0)
     ap.add_argument("--sample-interval", type=float, default=0.3)
+    ap.add_argument("--child-only", action="store_true",
+                    help="only the recompute in a child process")
+    ap.add_argument("--details", action="store_true",
+                    help="also the gaps over 0.3 s (start in the command, length) and the "
+                         "steps' times")
     args = ap.parse_args()
-    for in_process in (True, False):
+    for in_process in ((False,) if args.child_only else (True, False)):
         res = run(in_process, args)
         how = "in the GUI process" if in_process else "in a child process"
         print("FreeCAD %s, operations recomputed %s: 3D Surface with %d commands"
@@ -54,6 +59,9 @@ def main():
                   "%d x here, %s in the child" % (step, r["seconds"], r["gap"],
                                                   r["gui_executions"],
                                                   r["child_executions"] or "-"))
+            if args.details:
+                print("    gaps over 0.3 s: %s" % r["gaps"])
+                print("    steps: %s" % r["phases"])
     print("load average %.1f" % os.getloadavg()[0])
 
 

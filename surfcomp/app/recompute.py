@@ -65,6 +65,10 @@ def _snapshot(doc):
             if p not in ("Proxy", "ExpressionEngine")}
 
 
+def _is_shape(obj, prop):
+    return obj.getTypeIdOfProperty(prop) == "Part::PropertyPartShape"
+
+
 def _encode(obj, prop):
     if prop == "Path" and obj.getTypeIdOfProperty(prop) == "Path::PropertyPath":
         return ["commands", [[c.Name, dict(c.Parameters)] for c in obj.Path.Commands]]
@@ -97,12 +101,15 @@ def _count_executions(obj, counts):
 
 
 def _work(copy, job, outdir):
+    t_start = time.perf_counter()
     from . import cam, documents, fcenv
 
     fcenv.import_freecad()
     cam.setup_workbench(require_ocl=False)
     cam.setup_ocl()
+    t_open = time.perf_counter()
     doc, _refused, info = documents.open_document(copy)
+    seconds = {"(set-up)": t_open - t_start, "(open)": time.perf_counter() - t_open}
     heavy = set(job["heavy"])
     lost = [p for p in documents.restore_failures(doc, info=info)
             if p.split(" ", 1)[0] in heavy]
@@ -110,23 +117,31 @@ def _work(copy, job, outdir):
         raise ComputationError("the copy's CAM objects did not restore: %s" % "; ".join(lost))
     todo = [doc.getObject(n) for n in job["todo"]]
     first = job["first"]
-    counts, seconds, failed = {}, {}, {}
+    counts, failed = {}, {}
     for o in todo:
         o.touch()
         if o.Name in heavy:
             _count_executions(o, counts)
     for k, o in enumerate(todo):
         if k == first:
+            t0 = time.perf_counter()
             before = _snapshot(doc)
+            seconds["(snapshot)"] = time.perf_counter() - t0
         _write_json(os.path.join(outdir, STATUS), {"done": k, "total": len(todo),
                                                    "current": o.Label})
         t0 = time.perf_counter()
         if not recompute_order.recompute_one(o):
             failed[o.Name] = recompute_order.state_text(o)
         seconds[o.Name] = time.perf_counter() - t0
+    t0 = time.perf_counter()
     after = _snapshot(doc)
+    seconds["(snapshot)"] += time.perf_counter() - t0
     rank = {o.Name: k for k, o in enumerate(todo)}
-    changed = sorted((key for key, value in after.items() if before.get(key) != value),
+    # a shape of an object the child did not compute (the block, the model clone) changes
+    # only by the tessellation the operation left on it: not written back
+    ours = {o.Name for o in todo[first:]}
+    changed = sorted((key for key, value in after.items() if before.get(key) != value and
+                      (key[0] in ours or not _is_shape(doc.getObject(key[0]), key[1]))),
                      key=lambda key: rank.get(key[0], len(todo)))
     _write_json(os.path.join(outdir, RESULT), {
         "changes": [[name, prop] + _encode(doc.getObject(name), prop) for name, prop in changed],
@@ -200,6 +215,10 @@ def _child_command(root, args, tmp):
     return [cmd, script]
 
 
+def _nothing():
+    return None
+
+
 class ChildRecompute:
     """The recompute of ``doc``'s pending objects, its operations in a child process.
 
@@ -234,12 +253,16 @@ class ChildRecompute:
         """Whether anything is left for a child (False: recompute in place, it is cheap)."""
         return bool(self.heavy)
 
-    def start(self):
+    def start(self, between=None):
+        """Save the copy and start the child; ``between()`` (the GUI's event processing)
+        is called between the two."""
         import surfcomp
 
+        between = between or _nothing
         self.tmp = tempfile.mkdtemp(prefix="surfcomp-recompute-")
         copy = os.path.join(self.tmp, "copy.FCStd")
         _save_copy(self.doc, copy)
+        between()
         job = os.path.join(self.tmp, "job.json")
         _write_json(job, {"todo": [o.Name for o in self.todo], "heavy": sorted(self.heavy),
                           "first": self.first})
@@ -295,8 +318,10 @@ class ChildRecompute:
                                       tail))
         return result
 
-    def finish(self):
-        """Put the child's results onto the document and recompute the rest in place.
+    def finish(self, between=None):
+        """Put the child's results onto the document and recompute the rest in place;
+        ``between()`` (the GUI's event processing) is called after each object recomputed
+        and each property written.
 
         Returns the names of the objects recomputed (in place or by the child).
 
@@ -306,19 +331,23 @@ class ChildRecompute:
             The child failed (crashed, or the copy did not open); the document is as
             before :meth:`start`.
         """
+        between = between or _nothing
         try:
             result = self._result()
         finally:
             self._cleanup()
+        between()
         self.executions = result["executions"]
         # the cheap objects the operations use (model clones) are recomputed here, as in the
         # child; the operations and everything after them get the child's results
         for o in self.todo[:self.first]:
             recompute_order.recompute_one(o)
+            between()
         for name, prop, kind, data in result["changes"]:
             target = self.doc.getObject(name)
             if target is not None:
                 _decode(target, prop, kind, data)
+                between()
         for o in self.todo[self.first:]:
             if o.Name in result["failed"]:
                 recompute_order.recompute_one(o)    # it fails here too, with its message

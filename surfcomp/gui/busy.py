@@ -9,6 +9,8 @@ Cancel button or Esc stops the child at once (:class:`surfcomp.errors.Cancelled`
 document was not changed, so nothing is recomputed). No numerics here.
 """
 
+import time
+
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
@@ -81,9 +83,21 @@ def wait(job, dlg):
         raise Cancelled("interrupted by the user; nothing was changed")
 
 
-def _paint():
-    """Let the window paint before a step that blocks it for a moment."""
-    QtGui.QApplication.processEvents()
+#: between two steps that block the window, it paints when this long has passed (s)
+PAINT_AFTER = 0.15
+_painted = [0.0]
+
+
+def _paint(force=False):
+    """Let the window paint between two steps that block it for a moment, user input left
+    waiting (twice: the first pass runs the timers, whose repaint requests the second pass
+    paints); only when :data:`PAINT_AFTER` has passed since, as a repaint of the 3D view
+    with long tool paths costs time too."""
+    if not force and time.monotonic() - _painted[0] < PAINT_AFTER:
+        return
+    for _ in range(2):
+        QtGui.QApplication.processEvents(QtCore.QEventLoop.ExcludeUserInputEvents)
+    _painted[0] = time.monotonic()
 
 
 def recompute(doc, title):
@@ -104,13 +118,13 @@ def recompute(doc, title):
     dlg.setLabelText(translate("SurfComp", "Saving a copy of the document for the recompute"))
     dlg.show()
     try:
-        _paint()
-        job.start()
+        _paint(force=True)
+        job.start(between=_paint)
         wait(job, dlg)
         dlg.setLabelText(translate("SurfComp", "Taking over the results"))
-        _paint()
+        _paint(force=True)
         try:
-            return job.finish()
+            return job.finish(between=_paint)
         except ComputationError as exc:
             FreeCAD.Console.PrintWarning("SurfComp: %s\nRecomputing in this process instead.\n"
                                          % exc)

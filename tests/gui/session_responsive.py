@@ -60,11 +60,11 @@ def timed(name, func):
 
 
 class CountingChild(app_recompute.ChildRecompute):
-    def start(self):
-        return timed("child start", super().start)()
+    def start(self, *args, **kwargs):
+        return timed("child start", super().start)(*args, **kwargs)
 
-    def finish(self):
-        out = timed("child finish", super().finish)()
+    def finish(self, *args, **kwargs):
+        out = timed("child finish", super().finish)(*args, **kwargs)
         CHILD_EXECUTIONS.append(dict(self.executions))
         return out
 
