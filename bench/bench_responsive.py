@@ -62,6 +62,7 @@ def main():
             if args.details:
                 print("    gaps over 0.3 s: %s" % r["gaps"])
                 print("    steps: %s" % r["phases"])
+                print("    in the child: %s" % r["child_seconds"])
     print("load average %.1f" % os.getloadavg()[0])
 
 

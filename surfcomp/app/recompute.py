@@ -248,6 +248,8 @@ class ChildRecompute:
         self.tmp = None
         self.started = None
         self.executions = {}
+        #: ``{object name or '(set-up)', '(open)', '(snapshot)': seconds in the child}``
+        self.seconds = {}
 
     def needed(self):
         """Whether anything is left for a child (False: recompute in place, it is cheap)."""
@@ -338,6 +340,7 @@ class ChildRecompute:
             self._cleanup()
         between()
         self.executions = result["executions"]
+        self.seconds = result["seconds"]
         # the cheap objects the operations use (model clones) are recomputed here, as in the
         # child; the operations and everything after them get the child's results
         for o in self.todo[:self.first]:

@@ -43,7 +43,7 @@ def counted(*args, **kwargs):
 
 
 op.Proxy.opExecute = counted
-CHILD_EXECUTIONS = []
+CHILD_EXECUTIONS, CHILD_SECONDS = [], []
 
 
 PHASES = []
@@ -66,6 +66,7 @@ class CountingChild(app_recompute.ChildRecompute):
     def finish(self, *args, **kwargs):
         out = timed("child finish", super().finish)(*args, **kwargs)
         CHILD_EXECUTIONS.append(dict(self.executions))
+        CHILD_SECONDS.append({k: round(v, 3) for k, v in self.seconds.items()})
         return out
 
 
@@ -137,7 +138,7 @@ def commands(obj):
 def run(command):
     Gui.Selection.clearSelection()
     Gui.Selection.addSelection(doc.Name, round2.Name)
-    del INFOS[:], ERRORS[:], CHILD_EXECUTIONS[:], PHASES[:]
+    del INFOS[:], ERRORS[:], CHILD_EXECUTIONS[:], CHILD_SECONDS[:], PHASES[:]
     GUI_EXECUTIONS[0] = 0
     Gui.updateGui()
     t0 = time.perf_counter()
@@ -145,7 +146,7 @@ def run(command):
     t1 = time.perf_counter()
     return {"seconds": t1 - t0, "gap": longest_gap(t0, t1), "gui_executions": GUI_EXECUTIONS[0],
             "child_executions": CHILD_EXECUTIONS[:], "infos": INFOS[:], "errors": ERRORS[:],
-            "phases": PHASES[:], "gaps": gaps(t0, t1),
+            "phases": PHASES[:], "gaps": gaps(t0, t1), "child_seconds": CHILD_SECONDS[:],
             "touched": [o.Name for o in doc.Objects if "Touched" in o.State],
             "invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in
                         o.State]}
