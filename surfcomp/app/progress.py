@@ -48,26 +48,86 @@ def freecad_progress(title):
         bar.stop()
 
 
-def recompute_with_progress(doc, title):
-    """Recompute the objects of ``doc`` that need it, one by one in dependency order,
-    advancing FreeCAD's progress indicator between them (the GUI stays responsive there
-    and Esc raises :class:`surfcomp.errors.Cancelled`); then recompute the rest.
+def dependency_order(doc):
+    """The objects of ``doc``, each after everything it links (its ``OutList``).
+
+    (``doc.TopologicalSortedObjects`` lists them the other way round on FreeCAD 0.20.)
+    """
+    order, seen = [], set()
+    for root in doc.Objects:
+        stack = [(root, iter(root.OutList))]
+        if root.Name in seen:
+            continue
+        seen.add(root.Name)
+        while stack:
+            obj, deps = stack[-1]
+            dep = next((d for d in deps if d.Name not in seen), None)
+            if dep is None:
+                stack.pop()
+                order.append(obj)
+            else:
+                seen.add(dep.Name)
+                stack.append((dep, iter(dep.OutList)))
+    return order
+
+
+def pending(doc):
+    """The objects of ``doc`` that need a recompute (touched, or depending on one that is),
+    in dependency order."""
+    todo, names = [], set()
+    for o in dependency_order(doc):
+        if "Touched" in o.State or any(x.Name in names for x in o.OutList):
+            todo.append(o)
+            names.add(o.Name)
+    return todo
+
+
+def is_path_generator(obj):
+    """Whether ``obj`` computes a tool path: a CAM operation (its proxy has FreeCAD's
+    ``opExecute``) or a dressup of one (its ``Base`` is such an object)."""
+    if "Path" not in obj.PropertiesList or obj.getTypeIdOfProperty("Path") != "Path::PropertyPath":
+        return False
+    if hasattr(getattr(obj, "Proxy", None), "opExecute"):
+        return True
+    base = getattr(obj, "Base", None) if "Base" in obj.PropertiesList else None
+    return hasattr(base, "PropertiesList") and is_path_generator(base)
+
+
+def state_text(obj):
+    """Why ``obj`` failed to recompute (its status, else its state)."""
+    status = obj.getStatusString() if hasattr(obj, "getStatusString") else ""
+    return status or ", ".join(obj.State)
+
+
+def recompute_one(obj):
+    """Recompute ``obj`` alone, once, and mark it recomputed as ``doc.recompute()`` does
+    (``obj.recompute()`` leaves the object touched, so a later ``doc.recompute()`` would
+    compute it a second time). Returns False when it failed (its state says why)."""
+    obj.recompute()
+    ok = not ({"Invalid", "Error"} & set(obj.State))
+    if ok:
+        obj.purgeTouched()
+    return ok
+
+
+def recompute_with_progress(doc, title, todo=None):
+    """Recompute the objects of ``doc`` that need it (``todo``, default :func:`pending`), each
+    once, in dependency order, advancing FreeCAD's progress indicator between them (Esc
+    raises :class:`surfcomp.errors.Cancelled` there).
+
+    This runs in this process: the GUI paints only between two objects. The GUI's Replace
+    and Restore compute the CAM operations in a child process instead
+    (:mod:`surfcomp.app.recompute`).
 
     Returns the names of the objects recomputed. On Cancelled the objects already
     recomputed keep their new results: the caller undoes its change and recomputes.
     """
-    order = list(getattr(doc, "TopologicalSortedObjects", doc.Objects))
-    todo, names = [], set()
-    for o in order:
-        if "Touched" in o.State or any(x.Name in names for x in o.OutList):
-            todo.append(o)
-            names.add(o.Name)
+    todo = pending(doc) if todo is None else list(todo)
     done = []
     with freecad_progress(title) as progress:
         progress(0.0, title)
         for k, o in enumerate(todo):
-            o.recompute()
+            recompute_one(o)
             done.append(o.Name)
             progress((k + 1.0) / max(len(todo), 1), o.Label)
-    doc.recompute()
     return done

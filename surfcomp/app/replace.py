@@ -212,6 +212,14 @@ class _Undo:
         self.steps.append((o, prop, getattr(o, prop)))
         setattr(o, prop, value)
 
+    def set_record(self, o, prop, value):
+        """Set a property that records what was done (``ReplacedLinks``), not an input of
+        ``o``'s computation: ``o`` stays untouched, so it is not recomputed for it."""
+        was_touched = "Touched" in o.State
+        self.set(o, prop, value)
+        if not was_touched:
+            o.purgeTouched()
+
     def rollback(self):
         for o, prop, value in reversed(self.steps):
             setattr(o, prop, value)
@@ -312,7 +320,7 @@ def replace(doc, comp):
             if "Visibility" in earlier.PropertiesList and earlier.Visibility:
                 record["visibility"][earlier.Name] = True
                 undo.set(earlier, "Visibility", False)
-        undo.set(comp, "ReplacedLinks", json.dumps(record, sort_keys=True))
+        undo.set_record(comp, "ReplacedLinks", json.dumps(record, sort_keys=True))
         return [(o.Name, prop) for o, prop, _k, _o, _n in changes]
 
     return _run(doc, "Replace %s by %s" % (nominal.Label, comp.Label), work)
@@ -355,7 +363,7 @@ def restore(doc, comp):
             o = doc.getObject(name)
             if o is not None:
                 undo.set(o, "Label", label)
-        undo.set(comp, "ReplacedLinks", "")
+        undo.set_record(comp, "ReplacedLinks", "")
         return done
 
     return _run(doc, "Restore %s" % getattr(comp.Nominal, "Label", "nominal"), work)

@@ -471,23 +471,26 @@ class _ReplaceCommand(Command):
         return comp is not None and replace.is_replacing(comp) == self.WHILE_REPLACING
 
     def run(self):
-        from ..app import progress, replace, toolpaths
+        from ..app import recompute, replace, toolpaths
         from ..errors import Cancelled
+        from . import busy
 
         # surfcomp.app.replace opens and commits its own transaction
         comp = selected_compensation()
         doc = comp.Document
         before = replace.summary(doc, comp) if self.WHILE_REPLACING else None
         paths_before = toolpaths.snapshot(doc)
+        touched = {o.Name for o in doc.Objects if "Touched" in o.State}
         FreeCADGui.addModule("surfcomp.app.replace")
         FreeCADGui.doCommand("surfcomp.app.replace.%s(App.ActiveDocument, "
                              "App.ActiveDocument.getObject(%r))" % (self.ACTION, comp.Name))
-        # the users (Path operations) regenerate with progress; Esc undoes the step
+        # the users regenerate, each once, the Path operations in a child process under a
+        # progress dialog; Esc stops it and undoes the step (the operations keep their paths)
         try:
-            progress.recompute_with_progress(doc, "%s: %s" % (self.MENU, comp.Label))
+            busy.recompute(doc, "%s: %s" % (self.MENU, comp.Label))
         except Cancelled:
             doc.undo()
-            doc.recompute()
+            recompute.settle_after_undo(doc, touched)
             dialogs.show_info(self.MENU, translate("SurfComp", "Cancelled: the document is "
                                                                "as before."))
             return

@@ -113,12 +113,14 @@ def with_common(body):
         return f.read() + "\n" + body
 
 
-def run_session(name, tmp_path, home=None, timeout=300):
-    """Run ``tests/gui/session_<name>.py`` after the shared prologue ``gui_common.py``;
-    return the results dict with the process output under ``'output'``."""
+def run_session(name, tmp_path, home=None, timeout=300, env=None):
+    """Run ``tests/gui/session_<name>.py`` after the shared prologue ``gui_common.py``
+    (``env``: more environment variables); return the results dict with the process output
+    under ``'output'``."""
     here = os.path.dirname(os.path.abspath(__file__))
     with open(os.path.join(here, "session_%s.py" % name), encoding="utf-8") as f:
         body = f.read()
-    results, output = run_gui(with_common(body), tmp_path, home=home, timeout=timeout)
+    results, output = run_gui(with_common(body), tmp_path, home=home, timeout=timeout,
+                              env=env)
     results["output"] = output
     return results

@@ -1,0 +1,56 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Restore and Replace with a long 3D Surface recompute in the real FreeCAD GUI (under Xvfb):
+the window keeps painting (the operation computes in a child process), each operation is
+computed once (not at all in the GUI process), Esc (a key event to the focused widget) stops
+the child within a second and leaves the document as it was, without a recompute."""
+
+import pytest
+
+from tests.gui.harness import run_session
+
+#: the window must paint at least this often during Replace and Restore (s)
+MAX_GAP = 0.5
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    return run_session("responsive", tmp_path_factory.mktemp("gui_responsive"), timeout=600)
+
+
+def test_session_ran_without_exceptions(session):
+    assert session["errors"] == []
+    assert session["errors_at_end"] == []
+
+
+def _recomputed_once_in_the_child(step):
+    assert step["errors"] == [] and step["invalid"] == [] and step["touched"] == []
+    assert step["gui_executions"] == 0
+    assert step["child_executions"] == [{"Surface": 1}]
+
+
+def test_restore_keeps_painting_and_computes_the_operation_once(session):
+    step = session["restore"]
+    assert session["fine_commands"] > 500       # the committed operation has 142
+    assert step["record"] == "" and step["path_changed"] is True
+    _recomputed_once_in_the_child(step)
+    assert step["seconds"] > 2.0          # long enough to show a freeze
+    assert step["gap"] < MAX_GAP, step
+
+
+def test_replace_keeps_painting_and_computes_the_operation_once(session):
+    step = session["replace"]
+    assert step["record"] is True and step["path_changed"] is True
+    _recomputed_once_in_the_child(step)
+    assert step["gap"] < MAX_GAP, step
+
+
+def test_escape_stops_the_child_within_a_second_and_changes_nothing(session):
+    step = session["esc"]
+    assert step["modal"] == "QProgressDialog"
+    assert step["answer_seconds"] is not None and step["answer_seconds"] < 1.0
+    assert [m for _t, m in step["infos"]] == ["Cancelled: the document is as before."]
+    assert step["record"] == "" and step["source"] == "Block"
+    assert step["path_unchanged"] is True and step["clone_unchanged"] is True
+    assert step["gui_executions"] == 0 and step["child_executions"] == []
+    assert step["touched"] == [] and step["invalid"] == []
+    assert step["gap"] < MAX_GAP, step
