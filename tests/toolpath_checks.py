@@ -60,6 +60,23 @@ def shift_check(nominal, corrected, outward, before, after, r):
             "xy_moved": float(np.abs(after[:, :2] - before[:, :2]).max())}
 
 
+def assert_moved_by_the_correction(check, deflection):
+    """The checks of a regenerated tool path on :func:`shift_check`'s figures: the XY
+    samples paired (the scan lines follow the model's bounding box, which the correction
+    moves by micrometres: 2.7 um in the shop document), each path on its surface's exact
+    drop-cutter height within the operation's
+    mesh ``deflection`` (mm), the Z changes equal to ``-t / n_z`` within it (median within a
+    fifth of it) and, at the command where the correction is largest (at least 30 um), within
+    half of it."""
+    assert check["xy_moved"] < 0.5 * deflection
+    assert check["mesh_before"] < deflection and check["mesh_after"] < deflection
+    err = np.abs(check["dz"] - check["expected"])
+    assert np.median(err) < 0.2 * deflection and err.max() < deflection
+    k = int(np.argmax(np.abs(check["expected"])))
+    assert check["expected"][k] < -0.03
+    assert abs(check["dz"][k] - check["expected"][k]) < 0.5 * deflection
+
+
 def feed_moves(op):
     """``[command index, X, Y, Z]`` of each G1 of a Path operation (modal axes carried over),
     for results a FreeCAD process hands back as JSON."""
