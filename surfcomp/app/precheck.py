@@ -37,7 +37,7 @@ def check_on_face(nom_obj, face_name, ms, max_offset=1.0):
         nominal, placement = nominal_in(nom_obj, face_name)
         local = local_measurements(ms, placement)
         prepared = prepare(nominal.surface, nominal.outward, local,
-                           Options(max_offset=max_offset))
+                           Options(max_offset=max_offset, context="document"))
     except SurfcompError as exc:
         return [str(exc)], []
     return [], [w for w in prepared.warnings if w not in (ms.warnings or [])]

@@ -563,6 +563,7 @@ class _RestoreObserver:
     def slotActivateDocument(self, doc):
         attach_all(doc)
         arrange_legends()       # the legend panel shows the active document's maps
+        cover.update(doc)       # maps drawn while it opened met stocks not yet restored
 
     def slotRecomputedDocument(self, doc):
         attach_all(doc)

@@ -9,6 +9,7 @@ import shutil
 
 import Part
 
+from surfcomp.app import features
 from surfcomp.gui import cover, legend
 
 
@@ -57,6 +58,14 @@ stock, clone, block = doc.getObject("Stock"), doc.getObject("Clone"), doc.getObj
 # saved by the command line: no unit stored, so the preference's default (um)
 RESULTS["units_from_disk"] = [r1.ViewObject.Unit, r2.ViewObject.Unit]
 RESULTS["clone_base"] = [o.Name for o in getattr(clone, "Objects", [])]
+# with its CAM objects restored, the CAM GUI hides the Job's base model (Round2) as the
+# document opens: the user shows the map (Space), which hides the stock around it
+RESULTS["opened_visible"] = [r2.Visibility, r2.ViewObject.Visibility]
+Gui.Selection.clearSelection()
+Gui.Selection.addSelection(doc.Name, r2.Name)
+Gui.runCommand("Std_ToggleVisibility")
+Gui.Selection.clearSelection()
+Gui.updateGui()
 RESULTS["stock_hidden"] = [cover.hidden(doc), stock.Visibility,
                            stock.ViewObject.SwitchNode.whichChild.getValue()]
 r1.ViewObject.Visibility = False
@@ -206,9 +215,16 @@ disc = doc.addObject("Part::Feature", "Disc")
 c = Part.Geom2d.Circle2d(FreeCAD.Base.Vector2d(0.5, 0.5), 0.35)
 disc.Shape = Part.Face(bs, Part.Wire([c.toShape(bs)]))
 doc.recompute()
+# the import preview already refuses the file on the selected disc face (the points lie
+# beyond its border), so nothing is added; made by script, the map refuses it
+n_before = len(doc.Objects)
+del PREVIEWS[:]
+Gui.Selection.clearSelection()
+Gui.Selection.addSelection(doc.Name, disc.Name, "Face1")
 FILES.append(MEAS)
 Gui.runCommand("SurfComp_ImportMeasurements")
-meas = [o for o in doc.Objects if o.Name.startswith("Measurement")][-1]
+RESULTS["disc_preview"] = [PREVIEWS[-1] if PREVIEWS else "", len(doc.Objects) - n_before]
+meas = features.make_measurement(doc, MEAS)
 del ERRORS[:]
 Gui.Selection.clearSelection()
 Gui.Selection.addSelection(doc.Name, disc.Name, "Face1")

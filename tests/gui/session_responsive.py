@@ -147,6 +147,7 @@ def run(command):
     return {"seconds": t1 - t0, "gap": longest_gap(t0, t1), "gui_executions": GUI_EXECUTIONS[0],
             "child_executions": CHILD_EXECUTIONS[:], "infos": INFOS[:], "errors": ERRORS[:],
             "phases": PHASES[:], "gaps": gaps(t0, t1), "child_seconds": CHILD_SECONDS[:],
+            "load": os.getloadavg()[0], "cores": os.cpu_count() or 1,
             "touched": [o.Name for o in doc.Objects if "Touched" in o.State],
             "invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in
                         o.State]}

@@ -98,6 +98,10 @@ def test_points_in_the_hole_are_listed_in_the_legend_panel(session):
 
 
 def test_disc_face_refused_in_gui_words(session):
+    # the import preview refuses the file on the disc face: nothing added
+    text, added = session["disc_preview"]
+    assert "beyond the border of the face" in text and "--" not in text
+    assert added == 0
     (title, message), = session["disc_errors"]
     assert "beyond the border of the face" in message
     assert "--" not in message                           # no command-line option

@@ -12,6 +12,14 @@ from tests.gui.harness import run_session
 MAX_GAP = 0.5
 
 
+def _max_gap(step):
+    """:data:`MAX_GAP`, stretched only by the share of the cores that other jobs took while
+    the step ran (the load average over the cores, when above 1): a GUI process starved of
+    the CPU cannot paint on time, whatever it does (bench/bench_responsive.py reports the
+    gaps themselves)."""
+    return MAX_GAP * max(1.0, step["load"] / step["cores"])
+
+
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     return run_session("responsive", tmp_path_factory.mktemp("gui_responsive"), timeout=600)
@@ -34,14 +42,14 @@ def test_restore_keeps_painting_and_computes_the_operation_once(session):
     assert step["record"] == "" and step["path_changed"] is True
     _recomputed_once_in_the_child(step)
     assert step["seconds"] > 2.0          # long enough to show a freeze
-    assert step["gap"] < MAX_GAP, step
+    assert step["gap"] < _max_gap(step), step
 
 
 def test_replace_keeps_painting_and_computes_the_operation_once(session):
     step = session["replace"]
     assert step["record"] is True and step["path_changed"] is True
     _recomputed_once_in_the_child(step)
-    assert step["gap"] < MAX_GAP, step
+    assert step["gap"] < _max_gap(step), step
 
 
 def test_escape_stops_the_child_within_a_second_and_changes_nothing(session):
@@ -53,4 +61,4 @@ def test_escape_stops_the_child_within_a_second_and_changes_nothing(session):
     assert step["path_unchanged"] is True and step["clone_unchanged"] is True
     assert step["gui_executions"] == 0 and step["child_executions"] == []
     assert step["touched"] == [] and step["invalid"] == []
-    assert step["gap"] < MAX_GAP, step
+    assert step["gap"] < _max_gap(step), step
