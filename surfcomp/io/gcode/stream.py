@@ -209,7 +209,7 @@ class Compensator:
                            line)
 
 
-def compensate_stream(program, write, model, block_lines=BLOCK_LINES, **settings):
+def compensate_stream(program, write, model, block_lines=None, **settings):
     """Compensate the program a block at a time, writing its output as it goes.
 
     Parameters
@@ -219,8 +219,8 @@ def compensate_stream(program, write, model, block_lines=BLOCK_LINES, **settings
     write : callable
         Called with each piece of output text (Latin-1: one character per byte).
     model : surfcomp.core.axis_errors.AxisErrorModel
-    block_lines : int
-        Lines compensated at a time.
+    block_lines : int, optional
+        Lines compensated at a time (default :data:`BLOCK_LINES`).
     **settings
         Of :class:`Compensator` (``source``, ``start`` ...).
 
@@ -231,6 +231,7 @@ def compensate_stream(program, write, model, block_lines=BLOCK_LINES, **settings
         the program had any word, :meth:`Compensator.stats` and ``totals`` what was done.
     """
     source = settings.get("source")
+    block_lines = BLOCK_LINES if block_lines is None else max(1, int(block_lines))
     try:
         with program.open() as fh:
             sep = file_sep((c, tokenize(c, source, k + 1)[0])
