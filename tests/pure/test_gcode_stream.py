@@ -152,3 +152,8 @@ def test_memory_follows_the_block_not_the_program():
     assert size[0] > len(data)                            # 4 decimals, Z words added
     # measured 1.4 MB; the whole program at once takes some 3 kB a line
     assert peak < 1_000_000 + 500 * block, peak
+
+
+def test_the_memory_estimate_uses_the_block_size():
+    from surfcomp.core import budget
+    assert budget.GCODE_BLOCK_LINES == stream.BLOCK_LINES

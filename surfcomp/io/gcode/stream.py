@@ -39,7 +39,8 @@ from .lexer import BOM, decode, tokenize
 from .result import GCodeResult
 from .totals import BoundsCheck, PointTotals
 
-#: lines compensated at a time (a few tens of MB of lines, words and moves)
+#: lines compensated at a time (a few tens of MB of lines, words and moves;
+#: :data:`surfcomp.core.budget.GCODE_BLOCK_LINES` estimates with it)
 BLOCK_LINES = 10_000
 _BOM_BYTES = BOM.encode("latin-1")
 
