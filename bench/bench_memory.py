@@ -3,7 +3,7 @@
 ``--max-memory`` is checked against (``surfcomp.core.budget``), each in a fresh process::
 
     /usr/bin/python3 bench/bench_memory.py [--grids 100,200,400] [--points 250000,1000000]
-        [--lines 200000] [--whole] [--keep DIR]
+        [--lines 200000] [--segment-length MM] [--whole] [--keep DIR]
 
 - ``simulate NOMINAL --grid NxN --replicas 1`` (the example face, between 2);
 - ``inspect NOMINAL POINTS --report R.json`` on scattered ``x y z`` points (the report
@@ -64,7 +64,8 @@ from surfcomp.core.axis_errors import fit_axis_errors
 from surfcomp.io.axis_csv import read_axis_errors
 from surfcomp.io.gcode import compensate_gcode, read_gcode
 model = fit_axis_errors(read_axis_errors(sys.argv[2]).data)
-res = compensate_gcode(read_gcode(sys.argv[1]), model, max_error=1.0, source=sys.argv[1])
+res = compensate_gcode(read_gcode(sys.argv[1]), model, max_error=1.0, source=sys.argv[1],
+                       segment_length=float(sys.argv[4]))
 open(sys.argv[3], "wb").write(res.data)
 """
 
@@ -81,7 +82,7 @@ def _program(lines, folder):
     return prog
 
 
-def gcode_case(lines, folder, whole=False):
+def gcode_case(lines, folder, whole=False, segment_length=2.0):
     """``gcode`` on ``lines`` random G1 lines; the peak above the process's baseline (the
     same command on a 4-line program) per line; with ``whole``, the whole-program
     reference beside it."""
@@ -91,7 +92,8 @@ def gcode_case(lines, folder, whole=False):
 
     def cli(prog, out):
         return timed([sys.executable, "-m", "surfcomp", "gcode", prog, "--axis-errors",
-                      errors, "-o", out, "--max-memory", "1T"])
+                      errors, "-o", out, "--max-memory", "1T", "--segment-length",
+                      repr(segment_length)])
 
     base = cli(_program(1, folder), os.path.join(folder, "out_1.ngc"))["peak_mb"]
     prog = _program(lines, folder)
@@ -99,7 +101,7 @@ def gcode_case(lines, folder, whole=False):
     if whole:
         runs.append(("  whole program at once", timed(
             [sys.executable, "-c", WHOLE, prog, errors,
-             os.path.join(folder, "whole_%d.ngc" % lines)])))
+             os.path.join(folder, "whole_%d.ngc" % lines), repr(segment_length)])))
     for name, run in runs:
         _row(name, run, budget.gcode_bytes(lines + 4), lines, "line")
         print("%-34s %9.0f MB above the baseline (%.0f MB): %.0f B/line" % (
@@ -117,6 +119,9 @@ def main(argv=None):
     ap.add_argument("--grids", default="100,200,400")
     ap.add_argument("--points", default="250000,1000000")
     ap.add_argument("--lines", default="200000")
+    ap.add_argument("--segment-length", type=float, default=2.0,
+                    help="gcode's --segment-length (2 mm: 2 million lines of random moves "
+                         "up to 140 mm are more than its 10 million segments; use 20)")
     ap.add_argument("--whole", action="store_true",
                     help="also run gcode's whole-program reference (before the blocks)")
     ap.add_argument("--keep", metavar="DIR", help="keep the generated files here")
@@ -130,7 +135,7 @@ def main(argv=None):
     for n in _sizes(args.points):
         inspect_case(n, folder)
     for n in _sizes(args.lines):
-        gcode_case(n, folder, args.whole)
+        gcode_case(n, folder, args.whole, args.segment_length)
     if not args.keep:
         import shutil
 
