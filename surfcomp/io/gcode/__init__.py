@@ -2,7 +2,9 @@
 """3-axis G-code: parse, compensate machine-axis errors, rewrite (no FreeCAD).
 
 Modules: :mod:`.lexer` (lines and words), :mod:`.interpreter` (modal state, moves),
-:mod:`.emitter` (rewriting the text), :mod:`.commands` (FreeCAD Path command lists),
+:mod:`.emitter` (rewriting the text), :mod:`.stream` (a program compensated a block of
+lines at a time, or whole), :mod:`.totals` (whole-program figures added up over blocks),
+:mod:`.commands` (FreeCAD Path command lists),
 :mod:`.result` (what a compensation returns); the arc geometry and the move planning
 are compensation maths in :mod:`surfcomp.core.arcs` and :mod:`surfcomp.core.moves`.
 

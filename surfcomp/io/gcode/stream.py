@@ -94,6 +94,14 @@ class ProgramFile:
         except OSError as exc:
             raise self.error(exc) from exc
 
+    def lines(self, fh, raw=False):
+        """:func:`iter_lines` of ``fh`` (the raw byte lines with ``raw``); a read error
+        names the program (errors of whoever consumes the lines are theirs)."""
+        try:
+            yield from (fh if raw else iter_lines(fh))
+        except OSError as exc:
+            raise self.error(exc) from exc
+
     def count_lines(self):
         """Newlines plus one (without reading the lines themselves)."""
         n = 0
@@ -216,7 +224,8 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
     Parameters
     ----------
     program : ProgramFile
-        The program (read three times: the separator style, the line ending, the lines).
+        The program (read from its start for the separator style, the byte-order mark,
+        the line ending, then the lines).
     write : callable
         Called with each piece of output text (Latin-1: one character per byte).
     model : surfcomp.core.axis_errors.AxisErrorModel
@@ -233,28 +242,25 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
     """
     source = settings.get("source")
     block_lines = BLOCK_LINES if block_lines is None else max(1, int(block_lines))
-    try:
-        with program.open() as fh:
-            sep = file_sep((c, tokenize(c, source, k + 1)[0])
-                           for k, (c, _e) in enumerate(iter_lines(fh)))
-        with program.open() as fh:
-            bom = fh.read(len(_BOM_BYTES)) == _BOM_BYTES
-            fh.seek(0)
-            eol = default_eol(iter_lines(fh))
-        comp = Compensator(model, sep=sep, eol=eol, **settings)
-        if bom:
-            write(BOM)
-        with program.open() as fh:
-            block = []
-            for pair in iter_lines(fh):
-                block.append(pair)
-                if len(block) >= block_lines:
-                    write(comp.lines(block))
-                    block = []
-            if block:
+    with program.open() as fh:
+        sep = file_sep((c, tokenize(c, source, k + 1)[0])
+                       for k, (c, _e) in enumerate(program.lines(fh)))
+    with program.open() as fh:
+        bom = next(program.lines(fh, raw=True), b"").startswith(_BOM_BYTES)
+    with program.open() as fh:
+        eol = default_eol(program.lines(fh))
+    comp = Compensator(model, sep=sep, eol=eol, **settings)
+    if bom:
+        write(BOM)
+    with program.open() as fh:
+        block = []
+        for pair in program.lines(fh):
+            block.append(pair)
+            if len(block) >= block_lines:
                 write(comp.lines(block))
-    except OSError as exc:
-        raise program.error(exc) from exc
+                block = []
+        if block:
+            write(comp.lines(block))
     comp.finish()
     return comp
 
