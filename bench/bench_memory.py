@@ -3,12 +3,14 @@
 ``--max-memory`` is checked against (``surfcomp.core.budget``), each in a fresh process::
 
     /usr/bin/python3 bench/bench_memory.py [--grids 100,200,400] [--points 250000,1000000]
-        [--lines 200000] [--keep DIR]
+        [--lines 200000] [--segment-length MM] [--whole] [--keep DIR]
 
 - ``simulate NOMINAL --grid NxN --replicas 1`` (the example face, between 2);
 - ``inspect NOMINAL POINTS --report R.json`` on scattered ``x y z`` points (the report
   with every point, written in parts);
-- ``gcode PROGRAM`` on a program of random G1 moves.
+- ``gcode PROGRAM`` on a program of random G1 moves, and its peak above the baseline of
+  the same command on a 4-line program, per line (``--whole``: beside the reference of
+  the whole program compensated at once, as before the block-by-block reading).
 
 Prints one row per run: peak RSS (MB), the estimate (MB), their ratio, wall seconds, and the
 peak per grid point, point or line. An estimate below the measured peak is a defect of
@@ -54,7 +56,21 @@ def inspect_case(n, folder):
     _row("inspect %d points --report" % n, run, budget.job_bytes(n), n, "point")
 
 
-def gcode_case(lines, folder):
+#: the whole program at once, as ``gcode`` did before it read blocks (issue 25, item 7):
+#: the reference the block-by-block peak is measured beside
+WHOLE = """
+import sys
+from surfcomp.core.axis_errors import fit_axis_errors
+from surfcomp.io.axis_csv import read_axis_errors
+from surfcomp.io.gcode import compensate_gcode, read_gcode
+model = fit_axis_errors(read_axis_errors(sys.argv[2]).data)
+res = compensate_gcode(read_gcode(sys.argv[1]), model, max_error=1.0, source=sys.argv[1],
+                       segment_length=float(sys.argv[4]))
+open(sys.argv[3], "wb").write(res.data)
+"""
+
+
+def _program(lines, folder):
     rng = random.Random(lines)
     prog = os.path.join(folder, "program_%d.ngc" % lines)
     with open(prog, "w", encoding="ascii") as fh:
@@ -63,12 +79,35 @@ def gcode_case(lines, folder):
             fh.write("G1 X%.4f Y%.4f Z%.4f\n" % (rng.uniform(0, 100), rng.uniform(0, 100),
                                                  rng.uniform(-1, 0)))
         fh.write("M2\n")
+    return prog
+
+
+def gcode_case(lines, folder, whole=False, segment_length=2.0):
+    """``gcode`` on ``lines`` random G1 lines; the peak above the process's baseline (the
+    same command on a 4-line program) per line; with ``whole``, the whole-program
+    reference beside it."""
     errors = os.path.join(folder, "errors.csv")
     with open(errors, "w", encoding="ascii") as fh:
         fh.write(AXIS_CSV)
-    run = timed([sys.executable, "-m", "surfcomp", "gcode", prog, "--axis-errors", errors,
-                 "-o", os.path.join(folder, "out_%d.ngc" % lines), "--max-memory", "1T"])
-    _row("gcode %d lines" % lines, run, budget.gcode_bytes(lines + 4), lines, "line")
+
+    def cli(prog, out):
+        return timed([sys.executable, "-m", "surfcomp", "gcode", prog, "--axis-errors",
+                      errors, "-o", out, "--max-memory", "1T", "--segment-length",
+                      repr(segment_length)])
+
+    base = cli(_program(1, folder), os.path.join(folder, "out_1.ngc"))["peak_mb"]
+    prog = _program(lines, folder)
+    runs = [("gcode %d lines" % lines, cli(prog, os.path.join(folder, "out_%d.ngc" % lines)))]
+    if whole:
+        runs.append(("  whole program at once", timed(
+            [sys.executable, "-c", WHOLE, prog, errors,
+             os.path.join(folder, "whole_%d.ngc" % lines), repr(segment_length)])))
+    for name, run in runs:
+        _row(name, run, budget.gcode_bytes(lines + 4), lines, "line")
+        print("%-34s %9.0f MB above the baseline (%.0f MB): %.0f B/line" % (
+            "", run["peak_mb"] - base, base, (run["peak_mb"] - base) * 1024 ** 2 / lines),
+            flush=True)
+    os.remove(prog)
 
 
 def _sizes(text):
@@ -80,6 +119,11 @@ def main(argv=None):
     ap.add_argument("--grids", default="100,200,400")
     ap.add_argument("--points", default="250000,1000000")
     ap.add_argument("--lines", default="200000")
+    ap.add_argument("--segment-length", type=float, default=2.0,
+                    help="gcode's --segment-length (2 mm: 2 million lines of random moves "
+                         "up to 140 mm are more than its 10 million segments; use 20)")
+    ap.add_argument("--whole", action="store_true",
+                    help="also run gcode's whole-program reference (before the blocks)")
     ap.add_argument("--keep", metavar="DIR", help="keep the generated files here")
     args = ap.parse_args(argv)
     folder = args.keep or tempfile.mkdtemp(prefix="bench-memory-")
@@ -91,7 +135,7 @@ def main(argv=None):
     for n in _sizes(args.points):
         inspect_case(n, folder)
     for n in _sizes(args.lines):
-        gcode_case(n, folder)
+        gcode_case(n, folder, args.whole, args.segment_length)
     if not args.keep:
         import shutil
 

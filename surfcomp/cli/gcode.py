@@ -15,11 +15,11 @@ import numpy as np
 from .. import __version__
 from ..core import budget
 from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors, volumetric_map
-from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH, check_segments
+from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH
 from ..errors import GCodeError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
-from ..io.gcode import compensate_gcode, parse_gcode, read_gcode
+from ..io.gcode import ProgramFile, compensate_stream
 from ..io.gcode.interpreter import MAX_POSITION
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
@@ -100,16 +100,25 @@ def _um(v):
     return v * 1e3
 
 
-def _outside_travel(model, points):
-    """Program points outside the measured travel: count and largest distance (mm)."""
-    if points.size == 0:
-        return 0, 0.0
-    lo, hi = model.travel[:, 0], model.travel[:, 1]
-    ok = np.isfinite(lo) & np.isfinite(hi)
-    below = np.where(ok, lo - points, 0.0)
-    above = np.where(ok, points - hi, 0.0)
-    dist = np.maximum(np.maximum(below, above), 0.0).max(axis=1)
-    return int((dist > 1e-9).sum()), float(dist.max())
+class _Travel:
+    """Program points outside the measured travel, block by block: count and largest
+    distance (mm) of the move ends whose axes are all known."""
+
+    def __init__(self, model):
+        lo, hi = model.travel[:, 0], model.travel[:, 1]
+        self.ok = np.isfinite(lo) & np.isfinite(hi)
+        self.lo, self.hi = lo, hi
+        self.count, self.dist = 0, 0.0
+
+    def add(self, prog):
+        points = prog.end[prog.known.all(axis=1)]
+        if points.size == 0:
+            return
+        below = np.where(self.ok, self.lo - points, 0.0)
+        above = np.where(self.ok, points - self.hi, 0.0)
+        dist = np.maximum(np.maximum(below, above), 0.0).max(axis=1)
+        self.count += int((dist > 1e-9).sum())
+        self.dist = max(self.dist, float(dist.max()))
 
 
 def run(args):
@@ -128,52 +137,65 @@ def run(args):
     model = fit_axis_errors(table.data, model=args.model, reference=reference,
                             source=args.axis_errors)
     prog_model = model if offset is None else model.in_program_coordinates(offset)
-    data = read_gcode(args.program)
-    lines = data.count(b"\n") + 1
+    program = ProgramFile(args.program)
+    lines = program.count_lines()
     budget.check(budget.gcode_bytes(lines), args.max_memory, "gcode on %d lines" % lines,
                  "split the program into parts")
-    parsed = parse_gcode(data, source=args.program, start=start)
-    if parsed[0].is_empty():
-        raise GCodeError("the program is empty (no G-code words, only blank lines, comments "
-                         "or % lines; expected G0/G1/G2/G3 moves)", file=args.program)
-    check_segments(parsed[0], seg, arc_tol, names=("--segment-length", "--arc-tolerance"),
-                   source=args.program)
-    res = compensate_gcode(data, prog_model, segment_length=seg, tolerance=tol,
-                           arc_tolerance=arc_tol, decimals=args.decimals, start=start,
-                           source=args.program, parsed=parsed, max_error=max_error)
-    pred = dict(res.predicted(prog_model), max_correction_mm=res.max_correction())
-    vmap = volumetric_map(model)
-    ends = res.program.end[res.program.known.all(axis=1)]
-    n_out, d_out = _outside_travel(prog_model, ends)
-    warnings = list(res.warnings)
-    if n_out:
-        warnings.append("%d program point(s) lie outside the measured travel (up to %.3f mm): "
-                        "the error functions are extrapolated there" % (n_out, d_out))
-    spread = model.offset_spread
-    rms_fit = max([f.rms for f in model.fits] or [0.0])
-    if spread.max() > max(1e-3, 3 * rms_fit):
-        warnings.append("the axes disagree about the error at the reference point by up to "
-                        "%.3f um: are the tables measured from the same reference (--reference)?"
-                        % _um(spread.max()))
-
+    travel = _Travel(prog_model)
     outputs = {"program": shown(args.output)}
     with Transaction(*registry.declared(args, "gcode")) as tr:
-        tr.stage_bytes(args.output, res.output)
+        comp = []
+
+        def put(tmp):
+            with open(tmp, "wb") as fh:
+                comp.append(compensate_stream(
+                    program, lambda text: fh.write(text.encode("latin-1")), prog_model,
+                    segment_length=seg, tolerance=tol, arc_tolerance=arc_tol,
+                    decimals=args.decimals, start=start, source=args.program,
+                    max_error=max_error, names=("--segment-length", "--arc-tolerance"),
+                    visit=travel.add))
+
+        tr.write(args.output, put)
+        comp = comp[0]
+        if not comp.words:
+            raise GCodeError("the program is empty (no G-code words, only blank lines, "
+                             "comments or % lines; expected G0/G1/G2/G3 moves)",
+                             file=args.program)
+        stats = comp.stats()
+        pred = dict(comp.totals.predicted(), max_correction_mm=comp.totals.max_correction)
+        warnings = comp.warnings()
+        if travel.count:
+            warnings.append("%d program point(s) lie outside the measured travel (up to %.3f "
+                            "mm): the error functions are extrapolated there"
+                            % (travel.count, travel.dist))
+        warnings.extend(_model_warnings(model))
+        vmap = volumetric_map(model)
         if args.report:
             outputs["report"] = shown(args.report)
-            rep = build_report(args, table, model, prog_model, res, pred, vmap, warnings,
+            rep = build_report(args, table, model, prog_model, stats, pred, vmap, warnings,
                                outputs, seg, tol, arc_tol, reference, offset, start)
             tr.stage_text(args.report, json.dumps(rep, indent=1, allow_nan=False) + "\n")
         tr.commit()
 
-    print_summary(args, table, model, res, pred, vmap, warnings)
+    print_summary(args, table, model, stats, pred, vmap, warnings)
     for path in (args.output, args.report):
         if path is not None:
             print(wrote(path))
     return 0
 
 
-def print_summary(args, table, model, res, pred, vmap, warnings, out=None):
+def _model_warnings(model):
+    """A warning when the axes disagree about the error at the reference point."""
+    spread = model.offset_spread
+    rms_fit = max([f.rms for f in model.fits] or [0.0])
+    if spread.max() > max(1e-3, 3 * rms_fit):
+        return ["the axes disagree about the error at the reference point by up to %.3f um: "
+                "are the tables measured from the same reference (--reference)?"
+                % _um(spread.max())]
+    return []
+
+
+def print_summary(args, table, model, stats, pred, vmap, warnings, out=None):
     """The fitted model, the predicted errors and what was rewritten (stdout)."""
     out = sys.stdout if out is None else out
     rows = table.rows()
@@ -187,7 +209,7 @@ def print_summary(args, table, model, res, pred, vmap, warnings, out=None):
           "Z %.1f..%.1f mm: max %.3f um at (%.1f, %.1f, %.1f), RMS %.3f um"
           % (tuple(v for r in env for v in r) + (_um(vmap.stats["max_mm"]),)
              + tuple(vmap.stats["max_at_mm"]) + (_um(vmap.stats["rms_mm"]),)), file=out)
-    st = res.stats
+    st = stats
     print("", file=out)
     print("Program:      %s (%d lines, %d moves)" % (args.program, st["lines_in"], st["moves"]),
           file=out)
@@ -214,7 +236,7 @@ def print_summary(args, table, model, res, pred, vmap, warnings, out=None):
         print("warning: " + w, file=sys.stderr)
 
 
-def build_report(args, table, model, prog_model, res, pred, vmap, warnings, outputs, seg, tol,
+def build_report(args, table, model, prog_model, stats, pred, vmap, warnings, outputs, seg, tol,
                  arc_tol, reference, offset, start):
     """The JSON report of ``gcode`` (schema ``surfcomp-gcode-report/1``)."""
     return {
@@ -225,7 +247,7 @@ def build_report(args, table, model, prog_model, res, pred, vmap, warnings, outp
         "units": "mm",
         "inputs": {
             "program": {"path": os.path.abspath(args.program),
-                        "sha256": sha256_file(args.program), "lines": res.stats["lines_in"]},
+                        "sha256": sha256_file(args.program), "lines": stats["lines_in"]},
             "axis_errors": {"path": os.path.abspath(args.axis_errors),
                             "sha256": sha256_file(args.axis_errors), "layout": table.layout,
                             "rows": table.rows(), "units_without_suffix": args.units},
@@ -243,7 +265,7 @@ def build_report(args, table, model, prog_model, res, pred, vmap, warnings, outp
                   "sign": "error = actual - commanded; command X' solves X' + E(X') = X",
                   "program_coordinates": prog_model.to_dict()},
         "volumetric_map": vmap.as_dict(include_grid=True),
-        "program": res.stats,
+        "program": stats,
         "predicted": pred,
         "warnings": list(warnings),
         "outputs": outputs,

@@ -106,10 +106,15 @@ SIM_PER_REPLICA_METHOD = 4000
 #: 561 MB peak for a million scattered points, CONTRIBUTING.md bench_scale.py)
 JOB_PER_POINT = 1000
 JOB_PER_POINT_COMPENSATE = 6000
-#: ``gcode``: bytes per program line (parsed words, the program's arrays, the output);
-#: measured 2026-12-02: 252 MB peak for 50 000 lines of random G1 moves up to 140 mm long
-#: (split into 2 mm samples, planned 200 000 samples at a time)
-GCODE_PER_LINE = 6000
+#: ``gcode``: bytes per line of the block being compensated (parsed words, the block's
+#: arrays, its output; measured 2026-12-02 before the program was read in blocks: 252 MB
+#: peak for 50 000 lines of random G1 moves up to 140 mm long), and per program line in
+#: all (the program is compensated :data:`GCODE_BLOCK_LINES` lines at a time; issue 25
+#: asks for at most 300 bytes a line)
+GCODE_PER_BLOCK_LINE = 6000
+GCODE_PER_LINE = 300
+#: :data:`surfcomp.io.gcode.stream.BLOCK_LINES` (core does not import io)
+GCODE_BLOCK_LINES = 10_000
 
 
 def simulate_bytes(eval_points, grid_points, replicas, methods):
@@ -125,4 +130,5 @@ def job_bytes(points, build=False):
 
 def gcode_bytes(lines):
     """Estimated peak bytes of ``gcode`` on a program of ``lines`` lines."""
-    return int(BASE + GCODE_PER_LINE * lines)
+    return int(BASE + GCODE_PER_BLOCK_LINE * min(lines, GCODE_BLOCK_LINES)
+               + GCODE_PER_LINE * lines)

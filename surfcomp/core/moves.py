@@ -141,8 +141,16 @@ def check_segments(prog, segment_length, arc_tolerance, max_segments=MAX_SEGMENT
         Naming the estimate, the limit and the setting that causes it.
     """
     est = estimate_segments(prog, segment_length, arc_tolerance)
-    if est.total <= max_segments:
-        return est
+    if est.total > max_segments:
+        refuse_segments(est, prog.n_moves, segment_length, arc_tolerance, max_segments, names,
+                        source)
+    return est
+
+
+def refuse_segments(est, n_moves, segment_length, arc_tolerance, max_segments=MAX_SEGMENTS,
+                    names=("segment length", "arc tolerance"), source=None):
+    """Raise the :class:`InputError` of :func:`check_segments` for the estimate ``est`` of
+    a program of ``n_moves`` moves (a program read in blocks adds up their estimates)."""
     if est.by_angle > est.total / 2:
         raise InputError("%s %g mm: the program would be split into about %.3g segments "
                          "(%.3g of them chords of arcs, set by this tolerance), more than the "
@@ -150,7 +158,7 @@ def check_segments(prog, segment_length, arc_tolerance, max_segments=MAX_SEGMENT
                          "larger %s" % (names[1], arc_tolerance, est.total, est.by_angle,
                                         max_segments, names[1]), file=source)
     # every move adds at most one piece to length / segment_length
-    needed = est.length / max(max_segments - prog.n_moves, 1)
+    needed = est.length / max(max_segments - n_moves, 1)
     raise InputError("%s %g mm: the program's %.6g mm of G1 moves and arcs would be split "
                      "into about %.3g segments, more than the %d one compensation may write "
                      "(memory and time); expected a %s of at least %.3g mm"

@@ -65,4 +65,7 @@ def test_simulate_documented_maximum_fits_in_4_gb():
 def test_estimates_grow_with_the_input():
     assert budget.job_bytes(3_000_000) > budget.job_bytes(1_000_000) > budget.job_bytes(10)
     assert budget.job_bytes(10 ** 6, build=True) > budget.job_bytes(10 ** 6)
-    assert budget.gcode_bytes(2_000_000) > 2_000_000 * 1000
+    # G-code is compensated a block of lines at a time: at most 300 bytes a line beyond
+    # the block
+    assert budget.gcode_bytes(2_000_000) > budget.gcode_bytes(20_000) > budget.gcode_bytes(10)
+    assert budget.gcode_bytes(2_000_000) - budget.gcode_bytes(20_000) <= 300 * 1_980_000

@@ -2,7 +2,9 @@
 """3-axis G-code: parse, compensate machine-axis errors, rewrite (no FreeCAD).
 
 Modules: :mod:`.lexer` (lines and words), :mod:`.interpreter` (modal state, moves),
-:mod:`.emitter` (rewriting the text), :mod:`.commands` (FreeCAD Path command lists),
+:mod:`.emitter` (rewriting the text), :mod:`.stream` (a program compensated a block of
+lines at a time, or whole), :mod:`.totals` (whole-program figures added up over blocks),
+:mod:`.commands` (FreeCAD Path command lists),
 :mod:`.result` (what a compensation returns); the arc geometry and the move planning
 are compensation maths in :mod:`surfcomp.core.arcs` and :mod:`surfcomp.core.moves`.
 
@@ -70,16 +72,18 @@ Each programmed point ``X`` (mm) is replaced by the command ``X'`` with ``X' + E
 from ...core.arcs import ARC_RADIUS_TOL, FULL_CIRCLE_TOL, PLANES, arc_points, arc_steps
 from ...core.moves import MovePlan, plan_moves
 from .commands import command_words, compensate_commands
-from .emitter import DEFAULT_DECIMALS, _fmt, compensate_gcode
+from .emitter import DEFAULT_DECIMALS, _fmt
 from .interpreter import LineInfo, Program, interpret, parse_gcode, read_gcode
 from .lexer import AXIS_LETTERS, Word, split_lines, tokenize
 from .result import CommandsResult, CompensationResult, GCodeResult
+from .stream import BLOCK_LINES, ProgramFile, compensate_gcode, compensate_stream
 
 __all__ = [
-    "ARC_RADIUS_TOL", "AXIS_LETTERS", "DEFAULT_DECIMALS", "FULL_CIRCLE_TOL", "PLANES",
+    "ARC_RADIUS_TOL", "AXIS_LETTERS", "BLOCK_LINES", "DEFAULT_DECIMALS", "FULL_CIRCLE_TOL",
+    "PLANES",
     "CommandsResult", "CompensationResult", "GCodeResult", "LineInfo", "MovePlan", "Program",
-    "Word",
+    "ProgramFile", "Word",
     "_fmt", "arc_points", "arc_steps", "command_words", "compensate_commands",
-    "compensate_gcode", "interpret", "parse_gcode", "plan_moves", "read_gcode",
+    "compensate_gcode", "compensate_stream", "interpret", "parse_gcode", "plan_moves", "read_gcode",
     "split_lines", "tokenize",
 ]

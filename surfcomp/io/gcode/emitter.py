@@ -6,16 +6,9 @@ keep their words, spacing, case and comments, with only the axis numbers replace
 motion words where an arc became G1 pieces). See :mod:`surfcomp.io.gcode`.
 """
 
-import math
-
-import numpy as np
-
-from ...core.moves import plan_moves
-from ...core.progress import report
 from ...errors import GCodeError
-from .interpreter import parse_gcode
-from .lexer import AXIS_LETTERS, BOM, decode
-from .result import GCodeResult, OutputState
+from .lexer import AXIS_LETTERS
+from .result import OutputState
 
 #: default output decimals per unit system
 DEFAULT_DECIMALS = {"mm": 4, "in": 5}
@@ -58,13 +51,17 @@ def _word_sep(content, words, default):
     return general, general if axis is None else axis
 
 
-def _file_sep(lines, prog):
-    """The separator most multi-word lines of the file use (for one-word lines)."""
+def file_sep(pairs):
+    """The separator most multi-word lines of the file use (for one-word lines).
+
+    ``pairs`` gives ``(content, words)`` of the file's lines in order (``words`` None or
+    empty for lines without words); at most the first 200 multi-word lines are read.
+    """
     spaced = terse = 0
-    for (content, _e), info in zip(lines, prog.lines):
-        if info is None or len(info.words) < 2:
+    for content, words in pairs:
+        if not words or len(words) < 2:
             continue
-        st = _gap_style(content, info.words[0], info.words[1])
+        st = _gap_style(content, words[0], words[1])
         if st == " ":
             spaced += 1
         elif st == "":
@@ -74,80 +71,10 @@ def _file_sep(lines, prog):
     return "" if terse > spaced else " "
 
 
-def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e-3,
-                     decimals=None, start=None, source=None, progress=None, parsed=None,
-                     max_error=None):
-    """Compensate a G-code program for a machine's axis errors.
-
-    Parameters
-    ----------
-    data : bytes or str
-        The program.
-    model : surfcomp.core.axis_errors.AxisErrorModel
-        Error model in program coordinates (mm).
-    segment_length : float
-        Longest piece (mm) of a split G1 move or converted arc.
-    tolerance : float
-        Chord tolerance (mm) deciding whether a long G1 move is split.
-    arc_tolerance : float
-        Chord-to-arc deviation (mm) of converted arcs.
-    decimals : int, optional
-        Least decimals written (default 4 in mm, 5 in inch).
-    start : array_like (3,), optional
-        Known start position (mm, program coordinates).
-    source : str, optional
-        File name for messages.
-    parsed : (Program, list), optional
-        What :func:`surfcomp.io.gcode.parse_gcode` returned for the same ``data``,
-        ``source`` and ``start``, when the caller has parsed the program already.
-    max_error : float, optional
-        Largest plausible machine error (mm): a programmed point where the model predicts
-        more is refused (default no limit).
-
-    Returns
-    -------
-    GCodeResult
-        ``output`` (``data``) is the input unchanged, byte for byte, when the model is zero.
-
-    Raises
-    ------
-    GCodeError
-        For anything the compensation cannot handle correctly (see :mod:`surfcomp.io.gcode`),
-        and for an output that moves a point farther than the model explains
-        (:meth:`CompensationResult.check_bounds`): then nothing should be written.
-    InputError
-        Settings outside their domain, or more segments than
-        :data:`surfcomp.core.moves.MAX_SEGMENTS` (:func:`surfcomp.core.moves.plan_moves`).
-    """
-    raw = data
-    text = decode(data)
-    report(progress, 0.0, "parsing")
-    if parsed is None:
-        parsed = parse_gcode(text, source=source, start=start)
-    prog, lines = parsed
-    dmin_mm = DEFAULT_DECIMALS["mm"] if decimals is None else int(decimals)
-    dmin_in = DEFAULT_DECIMALS["in"] if decimals is None else int(decimals)
-    still = np.where(prog.factor == 1.0, 0.5 * 10.0 ** -dmin_mm,
-                     0.5 * 10.0 ** -dmin_in * prog.factor) * 0.999
-    plan = plan_moves(prog, model, segment_length, tolerance, arc_tolerance, still,
-                      progress=None)
-    report(progress, 0.5, "writing")
-    writer = _TextWriter(lines, prog, plan, dmin_mm, dmin_in, source)
-    text_out = "".join([writer.line(idx, content, eol)
-                        for idx, (content, eol) in enumerate(lines)])
-    if text_out == text:
-        data_out = bytes(raw) if isinstance(raw, (bytes, bytearray)) else text.encode("latin-1")
-    else:
-        bom = BOM if (raw.decode("latin-1") if isinstance(raw, (bytes, bytearray))
-                      else raw).startswith(BOM) else ""
-        data_out = (bom + text_out).encode("latin-1")
-    res = writer.state.result(GCodeResult, data_out, len(lines),
-                              len(lines) + writer.state.added, prog)
-    inch = bool((prog.factor != 1.0).any())
-    rounding = max(0.5 * 10.0 ** -dmin_mm, 25.4 * 0.5 * 10.0 ** -dmin_in if inch else 0.0)
-    res.check_bounds(model, math.sqrt(3.0) * rounding, source, max_error)
-    report(progress, 1.0, "done")
-    return res
+def default_eol(lines):
+    """The first line ending of ``(content, ending)`` pairs (for lines a move adds after
+    a last line without one), ``'\\n'`` when none has one."""
+    return next((e for _c, e in lines if e), "\n")
 
 
 class _TextWriter:
@@ -156,16 +83,23 @@ class _TextWriter:
     Numbers are held in program units (``out.held``); ``factor`` is mm per program unit.
     """
 
-    def __init__(self, lines, prog, plan, dmin_mm, dmin_in, source):
-        self.prog = prog
+    def __init__(self, file_sep, eol_default, start, dmin_mm, dmin_in, source):
         self.source = source
         self.dmin_mm, self.dmin_in = dmin_mm, dmin_in
-        self.eol_default = next((e for _c, e in lines if e), "\n")
-        self.file_sep = _file_sep(lines, prog)
-        self.state = OutputState(prog.start_pos if prog.start_known else None)
+        self.eol_default = eol_default
+        self.file_sep = file_sep
+        self.state = OutputState(start)
         self.factor_prev = 1.0
         self.last_dec = [3, 3, 3]       # decimals of the last word of each axis
         self.out_motion = None          # modal motion of the output so far
+        self.prog = None
+        self.base = 0
+
+    def block(self, prog, plan, base):
+        """The next block: its lines (from line index ``base`` on) and the plan of their
+        moves."""
+        self.prog = prog
+        self.base = base
         # plain lists: indexing them is much faster than indexing arrays
         self.known_l = prog.known.tolist()
         self.kind_l = prog.kind.tolist()
@@ -178,7 +112,7 @@ class _TextWriter:
 
     def line(self, idx, content, eol):
         """The output text of line ``idx`` (its ending included)."""
-        info = self.prog.lines[idx]
+        info = self.prog.lines[idx - self.base]
         if info is None:
             return content + eol
         f = info.factor

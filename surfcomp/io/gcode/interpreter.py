@@ -428,19 +428,35 @@ class _Interpreter:
         return centre
 
     # -------------------------------------------------------------------------- result
-    def program(self, infos):
-        """The :class:`Program` of the lines interpreted."""
-        start = self.start
-        for a, (first, count) in sorted(self.unknown_use.items()):
-            self.warnings.append(
-                "%d cutting move(s) from line %d on ran before the program gave an absolute "
+    def lines(self, line_words, base=0, line_numbers=None):
+        """Interpret the words of consecutive lines, the first being line index ``base``;
+        their :class:`LineInfo` (None for lines without words)."""
+        infos = []
+        for k, (words, block) in enumerate(line_words):
+            if not words:
+                infos.append(None)
+                continue
+            idx = base + k
+            ln = idx + 1 if line_numbers is None else line_numbers[k]
+            infos.append(self.line(idx, words, block, ln))
+        return infos
+
+    def unknown_warnings(self):
+        """Warnings about cutting moves made before an axis had a programmed position."""
+        start = np.zeros(3) if self.start is None else np.asarray(self.start)
+        return ["%d cutting move(s) from line %d on ran before the program gave an absolute "
                 "%s position: the compensation assumed %s = %g mm there and did not write %s "
                 "(give the start position if it is known)"
-                % (count, first, AXIS_LETTERS[a], AXIS_LETTERS[a],
-                   (np.zeros(3) if start is None else np.asarray(start))[a], AXIS_LETTERS[a]))
+                % (count, first, AXIS_LETTERS[a], AXIS_LETTERS[a], start[a], AXIS_LETTERS[a])
+                for a, (first, count) in sorted(self.unknown_use.items())]
+
+    def take_moves(self, infos, warnings):
+        """The :class:`Program` of the moves collected since the last call (then
+        forgotten: a program read block by block holds one block's moves at a time)."""
+        start = self.start
         mv = self.moves
         m = len(mv["kind"])
-        return Program(
+        prog = Program(
             infos,
             np.array(mv["kind"], dtype=int),
             np.array(mv["start"], dtype=float).reshape(m, 3),
@@ -451,8 +467,16 @@ class _Interpreter:
             np.array(mv["line"], dtype=int),
             np.array(mv["known"], dtype=bool).reshape(m, 3),
             np.array(mv["factor"], dtype=float),
-            self.warnings, self.source, start is not None,
+            warnings, self.source, start is not None,
             np.zeros(3) if start is None else np.array(start, dtype=float).reshape(3))
+        for v in mv.values():
+            v.clear()
+        return prog
+
+    def program(self, infos):
+        """The :class:`Program` of the lines interpreted."""
+        self.warnings.extend(self.unknown_warnings())
+        return self.take_moves(infos, self.warnings)
 
 
 def interpret(line_words, source=None, start=None, line_numbers=None, path=False):
@@ -478,14 +502,7 @@ def interpret(line_words, source=None, start=None, line_numbers=None, path=False
     Program
     """
     state = _Interpreter(source, start, path)
-    infos = []
-    for idx, (words, block) in enumerate(line_words):
-        if not words:
-            infos.append(None)
-            continue
-        ln = idx + 1 if line_numbers is None else line_numbers[idx]
-        infos.append(state.line(idx, words, block, ln))
-    return state.program(infos)
+    return state.program(state.lines(line_words, line_numbers=line_numbers))
 
 
 def parse_gcode(data, source=None, start=None):

@@ -163,7 +163,7 @@ BOM = "\xef\xbb\xbf"
 
 def decode(data):
     """``data`` as text: bytes are decoded as Latin-1 (one character per byte), without a
-    UTF-8 byte-order mark at the start (:func:`surfcomp.io.gcode.emitter.compensate_gcode`
+    UTF-8 byte-order mark at the start (:func:`surfcomp.io.gcode.stream.compensate_gcode`
     writes it back)."""
     text = data.decode("latin-1") if isinstance(data, (bytes, bytearray)) else data
     return text[len(BOM):] if text.startswith(BOM) else text

@@ -11,14 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...core.axis_errors import error_stats
-from ...errors import GCodeError
-
-#: the largest correction may exceed the largest model error at the programmed points by
-#: this fraction: ``|X' - X| = |E(X')|`` differs from ``|E(X)|`` by at most the model's
-#: slope times the correction, and no machine's errors change by 10 % of a millimetre
-#: per millimetre
-CORRECTION_SLACK = 0.1
+from .totals import BoundsCheck, PointTotals
 
 
 @dataclass
@@ -62,11 +55,9 @@ class CompensationResult:
         ``before`` = ``|E(X)|`` for the programmed points; ``after`` = ``|X' + E(X') - X|``
         for the commands written (rounding and chord effects included).
         """
-        k = self.known
-        before = model.error(self.nominal[k])
-        after = model.actual(self.emitted[k]) - self.nominal[k]
-        return {"before": error_stats(before), "after": error_stats(after),
-                "points_unknown_axes": int((~k).sum())}
+        totals = PointTotals(model)
+        totals.add(self.nominal, self.emitted, self.known)
+        return totals.predicted()
 
     def corrections(self):
         """``|emitted - nominal|`` (mm) at the points whose axes are all known, shape (n,)."""
@@ -104,41 +95,9 @@ class CompensationResult:
         GCodeError
             Naming the line of the first point out of bounds.
         """
-        if self.nominal.shape[0] == 0:
-            return
-        corr = np.linalg.norm(self.emitted - self.nominal, axis=1)
-        error = np.linalg.norm(model.error(self.nominal), axis=1)
-        if max_error is not None:
-            self._check_error(error, max_error, source)
-        largest = float(error.max())
-        limit = (1.0 + CORRECTION_SLACK) * largest + resolution + 1e-9
-        over = np.flatnonzero(~(corr <= limit))      # NaN and infinity included
-        if over.size:
-            k = over[0]
-            raise GCodeError("the compensated command (%.6g, %.6g, %.6g) mm for the "
-                             "programmed point (%.6g, %.6g, %.6g) mm moves it by %.6g mm, "
-                             "more than the error model explains (its largest error at the "
-                             "program's points is %.6g mm; %d point(s) affected): nothing "
-                             "was written"
-                             % (tuple(self.emitted[k]) + tuple(self.nominal[k])
-                                + (corr[k], largest, over.size)),
-                             file=source, line=self._line_of(k))
-
-    def _line_of(self, k):
-        return None if self.line is None else int(self.line[k])
-
-    def _check_error(self, error, max_error, source):
-        """Refuse programmed points where the model's error exceeds ``max_error`` (mm)."""
-        over = np.flatnonzero(~(error <= max_error))
-        if over.size:
-            k = over[0]
-            raise GCodeError("the error model predicts an error of %.6g mm at the programmed "
-                             "point (%.6g, %.6g, %.6g) mm, more than --max-error %g mm (%d "
-                             "point(s)): check the units of the error file, or whether the "
-                             "program leaves the measured travel (the error functions are "
-                             "extrapolated there)"
-                             % ((error[k],) + tuple(self.nominal[k]) + (max_error, over.size)),
-                             file=source, line=self._line_of(k))
+        check = BoundsCheck(model, max_error)
+        check.add(self.nominal, self.emitted, self.line, resolution)
+        check.finish(resolution, source)
 
 
 class GCodeResult(CompensationResult):
@@ -210,12 +169,22 @@ class OutputState:
         self.emitted.append(point)
         self.known.append(known[0] and known[1] and known[2])
 
+    def take_points(self):
+        """The points recorded since the last call as arrays ``(nominal, emitted, known,
+        line)``, then forgotten (a program written block by block)."""
+        pts = (np.array(self.nominal, dtype=float).reshape(-1, 3),
+               np.array(self.emitted, dtype=float).reshape(-1, 3),
+               np.array(self.known, dtype=bool), np.array(self.line, dtype=int))
+        self.nominal, self.emitted, self.known, self.line = [], [], [], []
+        return pts
+
+    def stats(self, lines_in, lines_out, moves, points):
+        return {"lines_in": lines_in, "lines_out": lines_out, "lines_changed": self.changed,
+                "lines_added": self.added, "moves": moves, "moves_split": self.split,
+                "arcs_converted": self.converted, "points": points}
+
     def result(self, cls, output, lines_in, lines_out, prog):
         """The :class:`CompensationResult` subclass ``cls`` of what was recorded."""
-        stats = {"lines_in": lines_in, "lines_out": lines_out, "lines_changed": self.changed,
-                 "lines_added": self.added, "moves": prog.n_moves, "moves_split": self.split,
-                 "arcs_converted": self.converted, "points": len(self.nominal)}
-        return cls(output, stats, np.array(self.nominal, dtype=float).reshape(-1, 3),
-                   np.array(self.emitted, dtype=float).reshape(-1, 3),
-                   np.array(self.known, dtype=bool), list(prog.warnings), prog,
-                   np.array(self.line, dtype=int))
+        stats = self.stats(lines_in, lines_out, prog.n_moves, len(self.nominal))
+        nominal, emitted, known, line = self.take_points()
+        return cls(output, stats, nominal, emitted, known, list(prog.warnings), prog, line)
