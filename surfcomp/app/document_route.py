@@ -23,11 +23,13 @@ import json
 import os
 from dataclasses import dataclass, field
 
+from ..core import budget
 from ..core.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.outpath import shown
+from ..io.readers import read_any
 from . import cam, cam_job, features, toolpaths
 from .documents import open_document, restore_failures
 
@@ -78,7 +80,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
                      gcode=None, post="linuxcnc", post_args="--no-show-editor", job_name=None,
                      units="mm", options=None, output=None, overwrite_input=False,
                      fmt="auto", sample=None,
-                     progress=None, deviation_units=None):
+                     progress=None, deviation_units=None, max_memory=None):
     """Compensate face ``face`` of ``object_name`` in the FreeCAD document ``document``.
 
     Parameters
@@ -116,6 +118,10 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Allow ``save`` to be the input document.
     fmt, sample : str, optional
         Measurement file format and QIF sample (see :func:`surfcomp.io.readers.read_any`).
+    max_memory : int, optional
+        Bytes: the compensation's estimated peak memory (from the number of points read,
+        :mod:`surfcomp.core.budget`) above it is refused before the work (None: the
+        machine's memory). FreeCAD's own recompute of the CAM Job is not estimated.
 
     Returns
     -------
@@ -151,7 +157,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         paths_before = toolpaths.snapshot(doc)
         report(progress, 0.1, "reading the measurements")
         comp, meas = _add_compensation(doc, nominal, face, measurements,
-                                       (units, deviation_units), fmt, sample, options, output)
+                                       (units, deviation_units), fmt, sample, options, output,
+                                       max_memory)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
         # computed once outside the recompute so bad input raises with file and line
         features.compensation_result(comp)
@@ -209,13 +216,18 @@ def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
     check_outputs(*_declared(document, measurements, save, gcode, overwrite_input))
 
 
-def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output):
+def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output,
+                      max_memory=None):
     """The measurement (``units``: the coordinates' and the deviation column's, or None)
-    and the compensation objects of a document job."""
+    and the compensation objects of a document job; the points are read and the estimated
+    peak memory checked before anything is added to the document."""
     if output is None:
         output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
-    meas = features.make_measurement(doc, measurements, units=units[0], fmt=fmt, sample=sample,
-                                     deviation_units=units[1])
+    ms = read_any(os.fspath(measurements), units=units[0], fmt=fmt or "auto", sample=sample,
+                  deviation_units=units[1])
+    budget.check(budget.job_bytes(len(ms), True), max_memory,
+                 "compensate of %d points" % len(ms))
+    meas = features.make_measurement_from_set(doc, ms)
     comp = features.make_compensation(
         doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
         weights=options.weights if isinstance(options.weights, str) else "",

@@ -58,7 +58,7 @@ def run_document(args):
     if not args.object:
         raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
                          "holding the nominal face)", file=args.nominal)
-    other = [o for o in ("output", "report", "points", "curves", "html", "max_memory")
+    other = [o for o in ("output", "report", "points", "curves", "html")
              if getattr(args, o)]
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
@@ -76,7 +76,7 @@ def run_document(args):
                            output="face" if args.face_only else None,
                            overwrite_input=args.overwrite_input, fmt=args.fmt,
                            sample=args.sample, progress=ProgressLine(args.quiet),
-                           deviation_units=args.deviation_units)
+                           deviation_units=args.deviation_units, max_memory=args.max_memory)
     for line in summary_lines(res):
         print(line)
     return 0

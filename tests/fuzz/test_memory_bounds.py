@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""``--max-memory`` on ``inspect``, ``compensate`` and ``gcode`` (issue 25, item 7): a run
-whose estimated peak memory is above the limit is refused before the work, naming the
-estimate and the limit, nothing written; under the limit it runs. (``simulate``'s cases are
+"""``--max-memory`` on ``inspect``, ``compensate`` (files and the shop document) and
+``gcode`` (issue 25, item 7): a run whose estimated peak memory is above the limit is
+refused before the work, naming the estimate and the limit, nothing written; under the
+limit it runs. (``simulate``'s cases are
 in test_simulate_cases.py; the estimates are checked in tests/pure/test_budget.py and
 against measured peaks by bench/bench_memory.py.)"""
 
@@ -26,11 +27,17 @@ CASES = [
          says=("gcode on 8 lines needs about 0.3 GB of memory", "split the program")),
     Case("compensate-4G", ("compensate", "n.step", "m.csv", "-o", "c.step", "--quiet",
                            "--max-memory", "4G"), JOB, rc=0, writes=("c.step",)),
-    # the document route has no estimate: the option is refused, not ignored
-    Case("document-route", ("compensate", "d.FCStd", "m.csv", "--object", "Nominal",
-                            "--replace", "--save", "out.FCStd", "--max-memory", "8G"),
+    # the document route estimates the compensation from the points read, before it adds
+    # anything to the document (FreeCAD's CAM recompute is not estimated)
+    Case("document-route-64M", ("compensate", "d.FCStd", "m.csv", "--object", "Nominal",
+                                "--replace", "--save", "out.FCStd", "--max-memory", "64M"),
          I.setup(I.put("d.FCStd", I.document_bytes), I.put("m.csv", I.csv)),
-         says=("--max-memory cannot be combined with --replace/--save/--gcode",)),
+         says=("compensate of 225 points needs about 0.3 GB of memory, more than "
+               "--max-memory (64 MB)",)),
+    Case("document-route-8G", ("compensate", "d.FCStd", "m.csv", "--object", "Nominal",
+                               "--save", "out.FCStd", "--max-memory", "8G", "--quiet"),
+         I.setup(I.put("d.FCStd", I.document_bytes), I.put("m.csv", I.csv)),
+         rc=0, writes=("out.FCStd",)),
     Case("inspect-size-garbage", ("inspect", "n.step", "m.csv", "--max-memory", "4 GB RAM"),
          JOB, usage=True, says=("argument --max-memory: expected a size",)),
 ]
