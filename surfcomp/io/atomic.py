@@ -3,9 +3,7 @@
 
 Every command declares its inputs and outputs before it does any work
 (:func:`check_outputs`). Each output is resolved once, as the kernel resolves it
-(:mod:`surfcomp.io.outpath`), its missing folders only when named plainly (``out/a``, not
-``nope/..``); they are created when it is staged and removed again unless the transaction
-commits. An output that is
+(:mod:`surfcomp.io.outpath`): its folder must exist, as for ``open()``. An output that is
 an input or another output (compared by real identity, across symbolic and hard links), a
 folder, a special file, anything in /dev, /proc or /sys, or a place that cannot be written
 is refused with the option's name and the user's path. A :class:`Transaction` then stages
@@ -184,7 +182,6 @@ class Transaction:
     def __init__(self, outputs=(), inputs=()):
         self._staged = []          # (temporary, destination)
         self._private = []         # folders holding what goes to standard output
-        self._created = []         # folders made by this transaction, outermost first
         self._dests = check_outputs(list(outputs), list(inputs))
 
     def __enter__(self):
@@ -206,10 +203,6 @@ class Transaction:
                 self._private.append(folder)
                 tmp = os.path.join(folder, "output" + suffix)
             else:
-                for folder in dest.missing:
-                    if not os.path.isdir(folder):
-                        os.mkdir(folder)
-                        self._created.append(folder)
                 tmp = _mkstemp(dest.real, suffix)
         except OSError as exc:
             raise _rename_error(dest.path, exc) from exc
@@ -268,7 +261,6 @@ class Transaction:
                     with contextlib.suppress(OSError):
                         os.unlink(backup)
             self._staged = [(tmp, d) for tmp, d in self._staged if d.stdout]
-            self._created = []
 
     def __exit__(self, *exc):
         with signals_held():
@@ -279,10 +271,6 @@ class Transaction:
             for folder in self._private:
                 shutil.rmtree(folder, ignore_errors=True)
             self._private = []
-            for folder in reversed(self._created):
-                with contextlib.suppress(OSError):
-                    os.rmdir(folder)   # only empty ones: never something a user put there
-            self._created = []
         return False
 
 

@@ -26,10 +26,8 @@ class Destination:
     ``option``/``path``: what the user typed; ``real``: the resolved path (None for
     standard output); ``key``: the identity compared with inputs and other outputs."""
 
-    def __init__(self, option, path, real, key, missing=()):
+    def __init__(self, option, path, real, key):
         self.option, self.path, self.real, self.key = option, path, real, key
-        #: folders to create (real paths, outermost first)
-        self.missing = tuple(missing)
 
     @property
     def stdout(self):
@@ -53,52 +51,30 @@ def _refuse(option, path, why):
 
 
 def _unreachable(option, path, folder, why):
-    _refuse(option, path, "cannot be written: its folder %s cannot be reached (%s; expected an "
-                          "existing folder, or new folders named plainly)" % (folder, why))
-
-
-def _split_missing(option, path, folder):
-    """(the nearest existing folder, the missing folder names below it). Missing folders
-    are created only when named plainly: a ``.`` or ``..`` after a folder that does not
-    exist is refused, as the kernel refuses it."""
-    head, missing = folder, []
-    while True:
-        try:
-            os.stat(head)
-            return head, missing[::-1]
-        except FileNotFoundError:
-            pass
-        except OSError as exc:
-            _unreachable(option, path, folder, exc.strerror)
-        parent, name = os.path.split(head)
-        if name in ("", ".", "..") or os.path.lexists(head):
-            _unreachable(option, path, folder, "No such file or directory")
-        missing.append(name)
-        if not parent:
-            return ".", missing[::-1]
-        head = parent
+    _refuse(option, path, "cannot be written: its folder %s cannot be reached (%s; expected "
+                          "an existing folder, as open() needs one: create it first)"
+                          % (folder, why))
 
 
 def _folder(option, path):
-    """The real path of ``path``'s folder, resolved by the kernel, and the real paths of
-    the folders to create (outermost first)."""
+    """The real path of ``path``'s folder, resolved by the kernel as ``open()`` resolves it:
+    a folder that does not exist (also ``nope/..``, ``file/..``) is an error."""
     folder = os.path.dirname(path) or "."
-    head, missing = _split_missing(option, path, folder)
-    st = os.stat(head)
+    try:
+        st = os.stat(folder)
+    except OSError as exc:
+        _unreachable(option, path, folder, exc.strerror)
     if not stat.S_ISDIR(st.st_mode):
-        _refuse(option, path, "cannot be written: %s is not a folder" % head)
-    real = os.path.realpath(head)
+        _refuse(option, path, "cannot be written: %s is not a folder" % folder)
+    real = os.path.realpath(folder)
     try:
         same = os.stat(real)
     except OSError:
         same = None
     if same is None or (same.st_dev, same.st_ino) != (st.st_dev, st.st_ino):
         _refuse(option, path, "cannot be written: the folder %s changed while it was resolved"
-                              % head)
-    made = []
-    for name in missing:
-        made.append(os.path.join(made[-1] if made else real, name))
-    return (made[-1] if made else real), made
+                              % folder)
+    return real
 
 
 def resolve(option, path):
@@ -117,23 +93,20 @@ def resolve(option, path):
         _refuse(option, path, "ends with '/' (expected a file name, not a folder)")
     if name in (".", "..") or os.path.isdir(path):
         _refuse(option, path, "is a folder (expected a file name)")
-    folder, missing = _folder(option, path)
+    folder = _folder(option, path)
     real = os.path.join(folder, name)
     if _special(os.path.dirname(real)):
         _refuse(option, path, "is in %s, a folder of devices and kernel state: refusing to "
                               "write there (use - for standard output)"
                               % os.path.dirname(real))
-    existing = os.path.dirname(missing[0]) if missing else folder
-    limit = name_max(existing)
+    limit = name_max(folder)
     if len(os.fsencode(name)) > limit:
         _refuse(option, path, "has a name of %d bytes; the file system takes at most %d"
                               % (len(os.fsencode(name)), limit))
     if os.path.islink(real):
         real = _through_link(option, path, real)
-    if not os.access(existing, os.W_OK | os.X_OK):
-        _refuse(option, path, "cannot be written: no permission to write in %s" % existing)
-    if missing:
-        return Destination(option, path, real, ("path", real), missing)
+    if not os.access(folder, os.W_OK | os.X_OK):
+        _refuse(option, path, "cannot be written: no permission to write in %s" % folder)
     try:
         st = os.stat(real)
     except FileNotFoundError:

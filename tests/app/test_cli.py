@@ -132,6 +132,7 @@ def test_missing_nominal(tmp_path):
 
 
 def test_freecadcmd_job_route(tmp_path):
+    (tmp_path / "out").mkdir()
     job = tmp_path / "job.json"
     job.write_text(json.dumps({"command": "compensate", "nominal": EXAMPLE_STEP,
                                "measurements": EXAMPLE_CSV, "output": "out/c.step",

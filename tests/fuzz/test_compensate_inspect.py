@@ -199,10 +199,15 @@ OPTIONS_OK = [
     comp("outputs-in-existing-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
          setup=I.setup(BASE, I.folder("out/deep")), out=("-o", "out/c.step"), rc=0,
          writes=("out/c.step", "out/r.json", "out/deep/p.csv")),
-    comp("outputs-in-new-folders", "--report", "out/r.json", "--points", "out/deep/p.csv",
-         "--html", "vlink/new/r.html", setup=I.setup(BASE, I.folder("v"), I.link("vlink", "v")),
+    comp("outputs-in-existing-and-linked-folders", "--report", "out/r.json", "--points",
+         "out/deep/p.csv", "--html", "vlink/new/r.html",
+         setup=I.setup(BASE, I.folder("out/deep"), I.folder("v/new"), I.link("vlink", "v")),
          out=("-o", "out/c.step"), rc=0,
          writes=("out/c.step", "out/r.json", "out/deep/p.csv", "v/new/r.html")),
+    # a folder that does not exist is an error, as for open(): nothing written, none made
+    comp("output-in-a-folder-that-does-not-exist", "--report", "out/r.json",
+         out=("-o", "new/c.step"), file="new/c.step",
+         says=("cannot be written: its folder new cannot be reached", "create it first")),
 ]
 
 

@@ -59,9 +59,9 @@ ALL_OR_NOTHING = [
        file="rdir", says=("--report is a folder",)),
     gc("o-in-proc", out=("-o", "/proc/out.ngc"), file="/proc/out.ngc"),
     gc("o-under-a-file", out=("-o", "e.csv/out.ngc"), file="e.csv/out.ngc"),
-    # refused after the program was read and planned: no folder may stay behind
-    gc("refused-late-in-new-folders", "--report", "new/b/r.json", "--max-error", "0.001",
-       out=("-o", "new/a/out.ngc"), file="e.csv", line=3, says=("--max-error",)),
+    # a folder that does not exist is an error before any work, as for open()
+    gc("report-in-a-folder-that-does-not-exist", "--report", "new/b/r.json",
+       out=("-o", "out.ngc"), file="new/b/r.json", says=("cannot be written: its folder",)),
 ]
 
 OPTIONS = [gc("%s=%s" % (o.lstrip("-"), v), "%s=%s" % (o, v), says=(o,)) for o, v in (

@@ -114,11 +114,11 @@ OLD_HASHES = {hashlib.sha256(b).hexdigest() for b in (b"old face", b"old report"
 CASES = [
     ("compensate-writer", COMPENSATE + ("--html", "r.html"), COMP_FILES, "write", "SIGTERM", ()),
     ("compensate-writer", COMPENSATE, COMP_FILES, "write", "SIGHUP", ()),
-    # the folders the transaction made go again
-    ("compensate-writer-in-new-folders", COMPENSATE[:4] + ("-o", "nd/a/c.step", "--report",
+    # outputs in a sub-folder: the staged files there go again, the folder stays
+    ("compensate-writer-in-sub-folders", COMPENSATE[:4] + ("-o", "nd/a/c.step", "--report",
                                                           "nd/r.json"),
-     I.setup(I.copy("nominal.step", EXAMPLE_STEP), I.put("m.csv", I.csv)), "write", "SIGTERM",
-     ()),
+     I.setup(I.copy("nominal.step", EXAMPLE_STEP), I.put("m.csv", I.csv), I.folder("nd/a")),
+     "write", "SIGTERM", ()),
     ("compensate-writer", COMPENSATE, COMP_FILES, "write", "SIGINT", ()),
     # the signal waits until the commit is complete: the outputs are there, exit 0
     ("compensate-commit-over-old-outputs", COMPENSATE[:4] + ("-o", "c.step", "--report",

@@ -54,12 +54,12 @@ ONTO = ("./{x}", ".//{x}", "v/../{x}", "v/sub/../../{x}", "vlink/../../{x}",
 #: spellings whose folder the kernel cannot reach (a missing folder, a file) before ..
 UNREACHABLE = ("nope/../{x}", "nope/./../{x}", "nope//../{x}", "afile/../{x}", "{x}/../{x}",
                "v/nope/../../{x}", "vlink/nope/../../{x}")
-#: new folders named plainly are made; the rest of the path resolved by the kernel
+#: folders that do not exist, named plainly: an error, as for open() (no folder is made)
 NEW_FOLDERS = [
-    ("compensate", "--report", "new/r.json", "new/r.json"),
-    ("compensate", "-o", "vlink/../new/a/c.step", "v/new/a/c.step"),
-    ("gcode", "--report", "v/sub/../new//r.json", "v/new/r.json"),
-    ("simulate", "--json", ".//new/s.json", "new/s.json"),
+    ("compensate", "--report", "new/r.json"),
+    ("compensate", "-o", "vlink/../new/a/c.step"),
+    ("gcode", "--report", "v/sub/../new//r.json"),
+    ("simulate", "--json", ".//new/s.json"),
 ]
 #: spellings that name a folder
 FOLDERS = ("{x}/", "{x}//", "./{x}/", "{x}/.", "v/..", "vlink/.")
@@ -134,14 +134,14 @@ def test_dotdot_after_a_link_writes_where_the_kernel_says(command, option, path,
                   writes=(written,)), tmp_path / BOX)
 
 
-@pytest.mark.parametrize("command, option, path, written", NEW_FOLDERS,
-                         ids=["-".join(c[:3]) for c in NEW_FOLDERS])
-def test_new_folders_named_plainly(command, option, path, written, tmp_path, request):
+@pytest.mark.parametrize("command, option, path", NEW_FOLDERS,
+                         ids=["-".join(c) for c in NEW_FOLDERS])
+def test_a_folder_that_does_not_exist_is_an_error(command, option, path, tmp_path, request):
     if command != "gcode":
         request.getfixturevalue("cad_cache")
-    run_case(Case(path, _argv(command, option, path), _setup(command), rc=0,
-                  writes=(written,) + (("out.ngc",) if command == "gcode" else ())),
-             tmp_path / BOX)
+    run_case(Case(path, _argv(command, option, path), _setup(command), rc=2, file=path,
+                  says=("cannot be written: its folder", "No such file or directory",
+                        "create it first")), tmp_path / BOX)
 
 
 # --------------------------------------------------------------------- every input guarded

@@ -460,6 +460,7 @@ def test_cli_compensates_bear_and_writes_a_report(tmp_path, capsys):
                                                  "y": np.linspace(0, 80, 9),
                                                  "z": np.linspace(-20, 20, 9)}), units="um")
     src = os.path.join(CAMOTICS, "bear.nc")
+    (tmp_path / "o").mkdir()
     out = tmp_path / "o" / "bear_comp.nc"
     rep = tmp_path / "o" / "bear.json"
     rc, stdout, stderr = _cli(["gcode", src, "--axis-errors", str(csv), "-o", str(out),

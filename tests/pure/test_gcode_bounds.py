@@ -60,6 +60,7 @@ def _run(tmp_path, capsys, program, *options, csv=ERR_CSV):
         src = tmp_path / "in.ngc"
         src.write_text(program)
         program = str(src)
+    (tmp_path / "out").mkdir(exist_ok=True)
     out = tmp_path / "out" / "o.ngc"
     rc, _stdout, stderr = _cli(["gcode", str(program), "--axis-errors", str(err), "-o",
                                 str(out), "--report", str(tmp_path / "out" / "r.json")]
