@@ -528,9 +528,8 @@ def attach(obj):
 
 
 def attach_all(doc):
-    """Give every surfcomp object of ``doc`` its view provider and show its map (for
-    documents made headless, e.g. by ``compensate ... --save`` in ``freecadcmd``, whose
-    objects have no view provider yet); returns the objects given one."""
+    """Give every surfcomp object of ``doc`` without one its view provider and show its map
+    (documents made headless, e.g. by ``compensate --save``); returns those objects."""
     return [obj for obj in doc.Objects if attach_restored(obj)]
 
 
