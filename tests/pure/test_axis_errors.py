@@ -379,6 +379,7 @@ def test_csv_errors_name_file_line_column(tmp_path, text, where, what):
 
 def test_csv_write_read_round_trip(tmp_path):
     data = SimulatedMachine(paper_like_model()).measure(measure_positions(), noise=1e-3)
+    (tmp_path / "sub").mkdir()
     path = tmp_path / "sub" / "m.csv"
     write_axis_errors(str(path), data, units="um")
     assert format_axis_errors(data, "um").splitlines()[0] == \
