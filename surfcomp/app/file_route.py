@@ -60,8 +60,7 @@ class Job:
 
         Unknown keys and commands, and keys that do nothing for the job's command, are
         refused."""
-        known = {f.name for f in fields(cls)} - {"options"}
-        opt_names = {f.name for f in fields(Options)}
+        known, opt_names = job_keys()
         unknown = set(data) - known - opt_names
         if unknown:
             raise InputError("unknown job file keys: %s (expected some of %s)"
@@ -86,6 +85,14 @@ class Job:
                 kw[k] = os.path.join(base_dir, kw[k])
         kw["options"] = Options(**{k: data[k] for k in opt_names if k in data})
         return cls(**kw)
+
+
+def job_keys():
+    """``(job keys, option keys)`` a job file may hold: :class:`Job`'s fields and the
+    :class:`Options` fields a user sets (not ``context``, which says who reads messages).
+    Each has a type in :data:`surfcomp.io.jobfile.KEY_TYPES` (a test checks it)."""
+    return ({f.name for f in fields(Job)} - {"options"},
+            {f.name for f in fields(Options)} - {"context"})
 
 
 #: the commands a job file runs

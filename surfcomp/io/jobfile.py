@@ -56,8 +56,9 @@ KEY_TYPES = {
     "command": _NAME,
     "nominal": _PATH, "measurements": _PATH,
     "output": _PATH, "report": _PATH, "points": _PATH, "curves": _PATH, "html": _PATH,
-    "face": _NAME, "object": _NAME, "units": _NAME, "fmt": _NAME, "sample": _NAME,
-    "face_only": _BOOL, "flip_normals": _BOOL, "lean": _BOOL,
+    "face": _NAME, "object": _NAME, "units": _NAME, "deviation_units": _NAME, "fmt": _NAME,
+    "sample": _NAME, "face_only": _BOOL, "flip_normals": _BOOL, "lean": _BOOL,
+    "accept_stock": _BOOL,
     "method": _NAME, "mask_kind": _NAME, "edge": _NAME, "layout": _NAME,
     "mask_size": _INTEGER, "refine": _INTEGER,
     "weights": ("a weights text such as \"1 2 1; 2 4 2; 1 2 1\" or a square list of lists "
@@ -67,7 +68,7 @@ KEY_TYPES = {
 }
 #: keys that may be null (meaning: not given)
 NULLABLE = {"output", "report", "points", "curves", "html", "face", "object", "units",
-            "sample", "weights", "sigma", "stock", "smoothing"}
+            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing"}
 
 
 def _describe(value):

@@ -156,3 +156,25 @@ def test_freecadcmd_refuses_with_exit_2(kind, tmp_path):
     assert "Traceback" not in out.stderr
     assert "surfcomp: error: %s: " % job in out.stderr
     assert sorted(os.listdir(tmp_path)) == before
+
+
+def test_every_key_a_job_takes_has_a_type():
+    """The job's keys (its fields and the options a user sets) and the value table agree, so
+    a key added to the job is type-checked without further code; ``context`` (who reads the
+    messages) is no job key."""
+    from surfcomp.app.file_route import job_keys
+    from surfcomp.io.jobfile import KEY_TYPES
+
+    known, options = job_keys()
+    assert known | options == set(KEY_TYPES)
+    assert "context" not in known | options
+
+
+@pytest.mark.parametrize("key, value, says", [
+    ("accept_stock", "yes", "expected true or false"),
+    ("deviation_units", 5, "expected a non-empty string")])
+def test_keys_added_later_are_checked_too(key, value, says):
+    with pytest.raises(InputError) as info:
+        check_values({"command": "compensate", "nominal": "n.step", "measurements": "m.csv",
+                      key: value}, "job.json")
+    assert "job key '%s'" % key in str(info.value) and says in str(info.value), info.value
