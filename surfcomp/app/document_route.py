@@ -225,8 +225,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
         output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
     ms = read_any(os.fspath(measurements), units=units[0], fmt=fmt or "auto", sample=sample,
                   deviation_units=units[1])
-    budget.check(budget.job_bytes(len(ms), True), max_memory,
-                 "compensate of %d points" % len(ms))
+    budget.check_job(len(ms), True, max_memory)
     meas = features.make_measurement_from_set(doc, ms)
     comp = features.make_compensation(
         doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,

@@ -147,8 +147,7 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
         check_rebuildable(nominal.bspline_face, job.nominal)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample,
                   deviation_units=job.deviation_units)
-    budget.check(budget.job_bytes(len(ms), job.command == "compensate"), max_memory,
-                 "%s of %d points" % (job.command, len(ms)))
+    budget.check_job(len(ms), job.command == "compensate", max_memory)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
     _warn_outside_trim(nominal, prepared)

@@ -128,6 +128,13 @@ def job_bytes(points, build=False):
     return int(BASE + (JOB_PER_POINT_COMPENSATE if build else JOB_PER_POINT) * points)
 
 
+def check_job(points, build, limit=None):
+    """:func:`check` of an ``inspect`` (``build`` False) or ``compensate`` run on ``points``
+    measured points, named so in the message."""
+    return check(job_bytes(points, build), limit,
+                 "%s of %d points" % ("compensate" if build else "inspect", points))
+
+
 def gcode_bytes(lines):
     """Estimated peak bytes of ``gcode`` on a program of ``lines`` lines."""
     return int(BASE + GCODE_PER_BLOCK_LINE * min(lines, GCODE_BLOCK_LINES)
