@@ -34,6 +34,9 @@ class Job:
     are optional outputs: corrected face (STEP/IGES/BREP by extension), JSON report,
     corrected points (CSV) and the papers' curve net through them (STEP).
 
+    ``plan``: the measurement plan the probe log ``measurements`` was probed from, joined
+    to it in order with ``touches`` log lines per point (:mod:`surfcomp.io.plan_join`).
+
     ``output`` holds the nominal's whole shape with the face replaced when the face sits in
     a solid or shell, the corrected face alone when it is a lone face or ``face_only``."""
 
@@ -52,6 +55,8 @@ class Job:
     fmt: str = "auto"
     sample: str = None
     face_only: bool = False
+    plan: str = None
+    touches: int = 1
     options: Options = field(default_factory=Options)
 
     @classmethod
@@ -100,6 +105,7 @@ JOB_COMMANDS = ("compensate", "inspect")
 #: the files of a job: (attribute of :class:`Job`, role, name in messages); the command
 #: line's are in :mod:`surfcomp.cli.registry`
 JOB_FILES = (("nominal", "input", "NOMINAL"), ("measurements", "input", "MEASUREMENTS"),
+             ("plan", "input", "--plan"),
              ("output", "output", "-o"), ("report", "output", "--report"),
              ("points", "output", "--points"), ("curves", "output", "--curves"),
              ("html", "output", "--html"))
@@ -145,8 +151,7 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
         from .shapes import check_rebuildable
 
         check_rebuildable(nominal.bspline_face, job.nominal)
-    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
-                  deviation_units=job.deviation_units)
+    ms = read_measured(job)
     budget.check_job(len(ms), job.command == "compensate", max_memory)
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
@@ -189,6 +194,19 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
     return comp, rep
 
 
+def read_measured(job):
+    """The job's measurement set: the file, joined to the plan when the job has one."""
+    if job.plan is None and job.touches != 1:
+        raise InputError("touches applies to a probe log read with a plan (--plan)")
+    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
+                  deviation_units=job.deviation_units)
+    if job.plan is None:
+        return ms
+    from ..io.plan_join import join_plan, read_plan
+
+    return join_plan(read_plan(job.plan, job.units), ms, job.options, job.touches)
+
+
 def _texts(job, comp, rep):
     """The text outputs of ``job`` (points CSV, HTML report) by attribute; the JSON report
     is written by :func:`surfcomp.io.report.write_file`."""
@@ -224,6 +242,8 @@ def _inputs_record(job, nominal, ms):
                          # the first names only: a table may have a million extra columns
                          "ignored_columns": list(ms.ignored_columns[:IGNORED_LISTED]),
                          "ignored_column_count": len(ms.ignored_columns)},
+        **({"plan": {"path": os.path.abspath(job.plan), "sha256": sha256_file(job.plan),
+                     "touches": job.touches}} if job.plan else {}),
     }
 
 

@@ -51,6 +51,7 @@ def add_input_options(p, command):
                    help="stylus ball radius when the measured points are tip centres (probe "
                         "logs): each contact point is the centre moved by it against the "
                         "outward normal (default 0)")
+    registry.add_options(p, command, flags=("--plan",))
     registry.add_options(p, command, flags=("--report",))
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
 
@@ -96,7 +97,8 @@ def job_from_args(args, command):
                face=args.face, object=args.object, units=args.units,
                deviation_units=args.deviation_units, fmt=args.fmt,
                sample=args.sample, face_only=bool(getattr(args, "face_only", False)),
-               options=options_from_args(args), **outputs)
+               plan=args.plan, touches=args.touches, options=options_from_args(args),
+               **outputs)
 
 
 def run_job_command(args, command):
@@ -166,6 +168,9 @@ def print_summary(comp, rep, out=None):
     print("Measurements: %s (%d points, %s, read in %s)"
           % (inputs["measurements"]["path"], inputs["measurements"]["points"],
              inputs["measurements"]["kind"], inputs["measurements"]["units"]), file=out)
+    if "plan" in inputs:
+        print("Plan:         %s (the log's lines joined to its points in order, %d per point)"
+              % (inputs["plan"]["path"], inputs["plan"]["touches"]), file=out)
     if p.scattered:
         print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
     else:

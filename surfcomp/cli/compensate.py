@@ -58,7 +58,7 @@ def run_document(args):
     if not args.object:
         raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
                          "holding the nominal face)", file=args.nominal)
-    other = [o for o in ("output", "report", "points", "curves", "html")
+    other = [o for o in ("output", "report", "points", "curves", "html", "plan")
              if getattr(args, o)]
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "

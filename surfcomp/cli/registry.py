@@ -58,6 +58,7 @@ JOB = ("compensate", "inspect")
 DOCUMENT = "shop document (NOMINAL is an .FCStd)"
 SIM_MODEL = "machining-process model (mm)"
 SIM_OUTPUT = "output"
+PROBE_PROGRAM = "probing program"
 _NOMINAL_HELP = "nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)"
 
 ENTRIES = (
@@ -68,6 +69,11 @@ ENTRIES = (
     Entry(JOB, ("measurements",), "input", "MEASUREMENTS",
           dict(metavar="MEASUREMENTS",
                help="measurement file (CSV/text; see README 'Measurement files')")),
+    Entry(JOB, ("--plan",), "input", "--plan",
+          dict(metavar="PLAN.csv",
+               help="the measurement plan MEASUREMENTS (a probe log) was probed from: the "
+                    "log's lines are its points in order, each tip centre taken back by "
+                    "--tip-radius along the plan's normal (README 'On-machine probing')")),
     Entry(("compensate",), ("-o", "--output"), "output", "-o",
           dict(metavar="OUT.step",
                help="the nominal's shape with the face replaced by the corrected face (its "
@@ -105,6 +111,11 @@ ENTRIES = (
                     "--report-method, the before/after table, the paper's table beside the "
                     "simulated one (--preset) and the simulated parts' maps"),
           group=SIM_OUTPUT),
+    # ------------------------------------------------------------------ plan
+    Entry(("plan",), ("--program",), "output", "--program",
+          dict(metavar="PROBE.ngc",
+               help="also write the probing program of the plan (tip-centre positions, in "
+                    "the plan's order; README 'On-machine probing')"), group=PROBE_PROGRAM),
     # ------------------------------------------------------------------ gcode
     Entry(("gcode",), ("program",), "input", "IN.ngc",
           dict(metavar="IN.ngc", help="G-code program (G0/G1/G2/G3, 3 axes)")),
@@ -117,6 +128,11 @@ ENTRIES = (
                help="compensated program (written atomically; - for standard output)")),
     Entry(("gcode",), ("--report",), "output", "--report",
           dict(metavar="OUT.json", help="write the JSON report")),
+    Entry(JOB, ("--touches",), "option", "--touches",
+          dict(type=int, default=1, metavar="K",
+               help="with --plan: probe moves per point in the log (2 for a LinuxCNC program "
+                    "written with --second-touch; the last one of each point is used; "
+                    "default 1)")),
     # ------------------------------------------------------------------ every command
     Entry(("compensate", "inspect", "simulate", "gcode"), ("--max-memory",), "option",
           "--max-memory",

@@ -65,10 +65,11 @@ KEY_TYPES = {
                 "of numbers, or null", lambda v: v is None or _weights(v)),
     "sigma": _OPT_NUMBER, "stock": _OPT_NUMBER, "smoothing": _OPT_NUMBER,
     "max_offset": _NUMBER, "tip_radius": _NUMBER,
+    "plan": _PATH, "touches": _INTEGER,
 }
 #: keys that may be null (meaning: not given)
 NULLABLE = {"output", "report", "points", "curves", "html", "face", "object", "units",
-            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing"}
+            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing", "plan"}
 
 
 def _describe(value):

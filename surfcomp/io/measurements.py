@@ -188,7 +188,7 @@ def read_measurements(path, units="mm"):
     return parse_measurements(read_bytes(source), source=source, units=units)
 
 
-def parse_measurements(text_or_bytes, source="<text>", units="mm"):
+def parse_measurements(text_or_bytes, source="<text>", units="mm", plan=False):
     """Parse the text of a measurement file.
 
     Parameters
@@ -200,6 +200,9 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
         Name used in messages and stored as ``MeasurementSet.source``.
     units : str or None
         As for :func:`read_measurements`.
+    plan : bool
+        Read a measurement plan: nominal points and normals are enough (no measured
+        point, no deviation); :func:`surfcomp.io.plan_join.read_plan`.
 
     Returns a :class:`MeasurementSet` (every length in mm; formats and checks: see the
     module docstring) or raises :class:`MeasurementFileError` on the first problem, with
@@ -219,7 +222,9 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
     if text.startswith("\ufeff"):
         text = text[1:]
     with np.errstate(over="ignore"):    # overflowing values are refused by the checks
-        return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
+        parser = _Parser(text, source, default_factor)
+        parser.plan = plan
+        return parser.run(hashlib.sha256(raw).hexdigest())
 
 
 def _norm(name):
@@ -278,6 +283,7 @@ class _Parser:
         self.text = text
         self.lines = text.split("\n")
         self.warnings = []
+        self.plan = False
 
     def error(self, message, index=None, column=None):
         """MeasurementFileError at the 0-based line ``index`` (1-based ``column``)."""
@@ -411,7 +417,8 @@ class _Parser:
         have = {g for g, rs in GROUPS.items() if rs[0] in first}
         need = [g for g in ("nominal", "normal", "deviation", "measured")
                 if g not in have and not (g == "measured" and have >= {"normal", "deviation"})
-                and not (g in ("normal", "deviation") and "measured" in have)]
+                and not (g in ("normal", "deviation") and "measured" in have)
+                and not (self.plan and g in ("deviation", "measured"))]
         if need:
             got = " and ".join(" ".join(GROUPS[g]) for g in ("nominal", "measured", "normal",
                                                              "deviation") if g in have)

@@ -1,0 +1,100 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The probing program options of ``python3 -m surfcomp plan`` and the program they write.
+
+:func:`add_program_options` adds the ``probing program`` option group to the ``plan``
+parser (``--program`` comes from :mod:`surfcomp.cli.registry`, so it is checked against
+the command's inputs and outputs); :func:`write_from_args` writes the program of a plan
+(:mod:`surfcomp.io.probe_program`) and returns the summary lines. The tip radius is the
+plan command's own ``--tip-radius``.
+"""
+
+from ..io.probe_path import DIALECTS, WORK_OFFSETS
+from ..io.probe_program import ProbeSettings, write_probe_program
+from . import registry
+from .common import wrote
+
+
+def add_program_options(parser):
+    """Add ``--program`` and the options of the probing program to ``parser``."""
+    d = ProbeSettings()
+    g = parser.add_argument_group(
+        registry.PROBE_PROGRAM,
+        "Positions are stylus tip centres (set the probe's tool length to the ball's centre); "
+        "the points are probed in the plan's order along their normals.")
+    registry.add_options(parser, "plan", {registry.PROBE_PROGRAM: g}, flags=("--program",))
+    g.add_argument("--dialect", choices=DIALECTS, default=d.dialect,
+                   help="linuxcnc: G38.2 and a PROBEOPEN log; fanuc: G31 and macro B, "
+                        "#5061-#5063 written by DPRNT (default linuxcnc)")
+    g.add_argument("--tool", type=int, default=d.tool, metavar="N",
+                   help="the probe's tool number (default %d)" % d.tool)
+    g.add_argument("--work-offset", choices=WORK_OFFSETS, default=d.work_offset,
+                   help="the work offset the part was machined in (default G54)")
+    g.add_argument("--clearance", type=float, default=d.clearance, metavar="MM",
+                   help="the ball's distance from the part during rapid moves; the safe "
+                        "height is the part's top plus it (default %g)" % d.clearance)
+    g.add_argument("--standoff", type=float, default=d.standoff, metavar="MM",
+                   help="where the probe move starts, along the normal from the nominal "
+                        "contact (default %g)" % d.standoff)
+    g.add_argument("--overtravel", type=float, default=d.overtravel, metavar="MM",
+                   help="how far past the nominal contact the probe move may go (default %g)"
+                        % d.overtravel)
+    g.add_argument("--feed", type=float, default=d.feed, metavar="MM/MIN",
+                   help="fast approach and retract feed (default %g)" % d.feed)
+    g.add_argument("--touch-feed", type=float, default=d.touch_feed, metavar="MM/MIN",
+                   help="probing feed (default %g)" % d.touch_feed)
+    g.add_argument("--second-touch", action="store_true",
+                   help="back off and touch again slower (a LinuxCNC log then holds two lines "
+                        "per point: read it back with --touches 2)")
+    g.add_argument("--second-feed", type=float, default=None, metavar="MM/MIN",
+                   help="feed of the second touch (default a fifth of --touch-feed)")
+    g.add_argument("--backoff", type=float, default=d.backoff, metavar="MM",
+                   help="back-off before the second touch (default %g)" % d.backoff)
+    g.add_argument("--probe-log", default=d.log_file, metavar="NAME",
+                   help="file LinuxCNC writes the probe log to (PROBEOPEN; default %s)"
+                        % d.log_file)
+
+
+def settings_from_args(args, safe_z, plan_hash):
+    """The :class:`ProbeSettings` of a command line (``args.tip_radius`` is the plan's)."""
+    return ProbeSettings(
+        dialect=args.dialect, tip_radius=args.tip_radius, tool=args.tool,
+        work_offset=args.work_offset, safe_z=safe_z, clearance=args.clearance,
+        standoff=args.standoff, overtravel=args.overtravel, feed=args.feed,
+        touch_feed=args.touch_feed, second_touch=args.second_touch,
+        second_feed=args.second_feed, backoff=args.backoff, plan_hash=plan_hash,
+        log_file=args.probe_log)
+
+
+def write_from_args(args, ids, points, normals, safe_z, plan_hash):
+    """Write ``args.program`` for the plan (nothing without ``--program``).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        With the options of :func:`add_program_options` and ``tip_radius``.
+    ids, points, normals
+        The plan in visiting order (points and unit outward normals (N, 3), mm).
+    safe_z : float
+        The part's top (mm).
+    plan_hash : str
+        Hex SHA-256 of the written plan file.
+
+    Returns
+    -------
+    list of str
+        Summary lines (the program, the travel, ``wrote ...``).
+    """
+    if not getattr(args, "program", None):
+        return []
+    s = settings_from_args(args, safe_z, plan_hash)
+    inputs = registry.declared(args, "plan")[1]
+    res = write_probe_program(args.program, ids, points, normals, s, inputs=inputs)
+    t = res["travel"]
+    log = ("probe log %s, %d lines" % (s.log_file, res["log_lines"])
+           if s.dialect == "linuxcnc" else "DPRNT log, %d lines" % res["log_lines"])
+    return ["Program:      %s (%s, %d points, tip radius %g mm, %s, %s, safe height Z%.3f)"
+            % (args.program, s.dialect, res["points"], s.tip_radius, s.work_offset, log,
+               res["safe_height"]),
+            "Travel:       %.1f mm (traverse %.1f mm, feed %.1f mm, probing %.1f mm)"
+            % (t["total"], t["traverse"], t["feed"], t["probe"]),
+            wrote(args.program)]
