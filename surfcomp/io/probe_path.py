@@ -91,7 +91,7 @@ class ProbeSettings:
     touch_feed: float = 100.0
     second_touch: bool = False
     second_feed: float = None
-    backoff: float = 0.5
+    backoff: float = 1.0
     plan_hash: str = ""
     log_file: str = "probe.log"
     program_number: int = 1000

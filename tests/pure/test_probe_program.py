@@ -52,11 +52,11 @@ def test_linuxcnc_program_read_by_rs274(tmp_path, second):
     probes, worst = check_probe_moves(moves, P, N, R, 1.0)
     assert len(probes) == (2 if second else 1) * len(ids) == summary["log_lines"]
     # every probe starts on the line through its point: the stand-off (2 mm) or, for the
-    # second touch, the back-off (0.5 mm) from rs274's trip point (the end point)
+    # second touch, 1 mm back off from rs274's trip point (the end point, 1 mm past)
     starts = np.array([a for a, _b in probes])
     per = 2 if second else 1
     want = np.repeat(P + R * N, per, axis=0) + np.repeat(N, per, axis=0) * (
-        np.tile([2.0, -0.5] if second else [2.0], len(ids))[:, None])
+        np.tile([2.0, 0.0] if second else [2.0], len(ids))[:, None])
     assert_allclose(starts, want, atol=2 * PRINTED, rtol=0)
     # traverses: horizontal ones at the safe height 10 + R + 4, vertical ones down to the
     # retract point 4 mm out along the normal and back up
