@@ -158,6 +158,7 @@ _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _NONFINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
 #: white space other than blanks, tabs and newlines (ASCII; str.isspace's others)
 _OTHER_SPACE = "\r\x0b\x0c\x1c\x1d\x1e\x1f"
+_EXPECTED_PLAN = "expected a plan: id, nominal x_nom y_nom z_nom and normal i j k"
 _SEP_NAMES = {",": "','", ";": "';'", "\t": "tabs", None: "blanks"}
 _UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
@@ -425,7 +426,8 @@ class _Parser:
             lost = listed_names([names[c] for c in ignored])
             raise self.error("the header has %sno %s (%s)%s%s"
                              % (got + " but " if got else "",
-                                " and no ".join(_GROUP_TEXT[g] for g in need), _EXPECTED_COMBOS,
+                                " and no ".join(_GROUP_TEXT[g] for g in need),
+                                _EXPECTED_PLAN if self.plan else _EXPECTED_COMBOS,
                                 "; ignored columns: " + lost if lost else "", hint), h)
         self.warnings.extend(ignored_column_warnings(self.source, h + 1, [
             (c + 1, names[c], _HINTS.get(_norm(names[c]), "not a known column name")
