@@ -1,0 +1,167 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The on-machine probing loop on the example face: plan -> program -> LinuxCNC's rs274 ->
+probe log of a known deformed face -> ``compensate --plan --tip-radius``.
+
+The plan is built here (a UV grid with the core's normals, in serpentine order); the
+program is read by rs274; the traverses are checked against the part's solid (the face
+extruded 20 mm down) with OpenCASCADE; the log is computed by moving the tip sphere along
+every STRAIGHT_PROBE segment rs274 printed until it first touches the deformed face.
+"""
+
+import hashlib
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+from scipy.optimize import brentq
+
+from surfcomp.app.nominal import load_nominal
+from surfcomp.io.probe_program import ProbeSettings, write_probe_program
+from tests.app.helpers import EXAMPLE_STEP, ROOT, grid_on_face, realised_by_occt
+from tests.probe_checks import check_probe_moves, rs274_moves
+
+R = 1.0
+CLEARANCE = 3.0
+OVERTRAVEL = 1.0
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "surfcomp", *map(str, args)], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def loop(tmp_path_factory):
+    """Plan, program and rs274's moves on the example face."""
+    tmp = tmp_path_factory.mktemp("probe_loop")
+    nom = load_nominal(EXAMPLE_STEP)
+    P, N, _U, _V = grid_on_face(nom, 8, 9, margin=0.1)
+    order = [(i, j) for j in range(9) for i in (range(8) if j % 2 == 0 else range(7, -1, -1))]
+    P = np.array([P[i, j] for i, j in order])
+    N = np.array([N[i, j] for i, j in order])
+    ids = ["U%dV%d" % ij for ij in order]
+    plan = tmp / "plan.csv"
+    plan.write_text("id,x_nom,y_nom,z_nom,i,j,k\n" + "".join(
+        "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f\n" % ((i,) + tuple(p) + tuple(n))
+        for i, p, n in zip(ids, P, N)))
+    import FreeCAD
+    import Part
+
+    solid = Part.read(EXAMPLE_STEP).Faces[0].extrude(FreeCAD.Vector(0, 0, -20))
+    assert solid.isValid() and solid.ShapeType == "Solid"
+    s = ProbeSettings(tip_radius=R, safe_z=solid.BoundBox.ZMax, clearance=CLEARANCE,
+                      standoff=2.0, overtravel=OVERTRAVEL,
+                      plan_hash=hashlib.sha256(plan.read_bytes()).hexdigest())
+    prog = tmp / "probe.ngc"
+    summary = write_probe_program(str(prog), ids, P, N, s)
+    moves = rs274_moves(prog, tmp, diameter=2 * R)
+    return dict(tmp=tmp, P=P, N=N, ids=ids, plan=plan, solid=solid, moves=moves,
+                summary=summary, prog=prog)
+
+
+def test_program_probes_the_plan_and_keeps_clear_of_the_solid(loop):
+    probes, worst = check_probe_moves(loop["moves"], loop["P"], loop["N"], R, OVERTRAVEL)
+    assert len(probes) == 72
+    import FreeCAD
+    import Part
+
+    # the first traverse starts at rs274's origin, not at a position of the program
+    trav = [(a, b) for kind, a, b in loop["moves"] if kind == "STRAIGHT_TRAVERSE"][1:]
+    dist = np.array([loop["solid"].distToShape(Part.LineSegment(
+        FreeCAD.Vector(*a), FreeCAD.Vector(*b)).toShape())[0] for a, b in trav])
+    # tip centres: the ball's surface stays CLEARANCE from the part (rs274's 4 decimals)
+    assert dist.min() >= R + CLEARANCE - 1e-4, dist.min()
+    print("72 probe moves, largest angle to -normal %.5f deg; %d traverses, nearest %.4f mm "
+          "from the solid (ball surface %.4f mm); travel %.1f mm"
+          % (worst, len(trav), dist.min(), dist.min() - R, loop["summary"]["travel"]["total"]))
+
+
+def deformed_face(amplitude=0.02):
+    """The example face with its poles moved up by a smooth field (about +-20 um)."""
+    import FreeCAD
+    import Part
+
+    surf = Part.read(EXAMPLE_STEP).Faces[0].Surface.copy()
+    for i in range(1, surf.NbUPoles + 1):
+        for j in range(1, surf.NbVPoles + 1):
+            p = surf.getPole(i, j)
+            dz = amplitude * np.sin(p.x / 45 * np.pi) * np.cos(p.y / 45 * 1.5 * np.pi) + 0.005
+            surf.setPole(i, j, FreeCAD.Vector(p.x, p.y, p.z + dz))
+    return surf
+
+
+def sphere_touch(surf, a, b):
+    """The centre where a ball of radius R moving from a to b first touches ``surf``."""
+    import FreeCAD
+
+    u = (b - a) / np.linalg.norm(b - a)
+
+    def gap(s):
+        c = FreeCAD.Vector(*(a + s * u))
+        return (c - surf.value(*surf.parameter(c))).Length - R
+
+    steps = np.arange(0.0, np.linalg.norm(b - a) + 1e-9, 0.05)
+    values = [gap(s) for s in steps]
+    k = next(k for k in range(1, len(steps)) if values[k] <= 0.0)
+    return a + brentq(gap, steps[k - 1], steps[k], xtol=1e-12) * u
+
+
+def test_round_trip_recovers_the_correction(loop):
+    import Part
+
+    surf = deformed_face()
+    probes = [(a, b) for kind, a, b in loop["moves"] if kind == "STRAIGHT_PROBE"]
+    centres = np.array([sphere_touch(surf, a, b) for a, b in probes])
+    tmp = loop["tmp"]
+    log = tmp / "probe.log"
+    log.write_text("".join("%.6f %.6f %.6f 0.000000 0.000000 0.000000 0.000000 0.000000 "
+                           "0.000000\n" % tuple(c) for c in centres))
+    # the deformation along the planned normals, found independently (ray and face)
+    truth = -realised_by_occt(Part.Face(surf), loop["P"], loop["N"], reach=0.5)
+    cmm = tmp / "truth.csv"
+    cmm.write_text("id,x_nom,y_nom,z_nom,i,j,k,dev\n" + "".join(
+        "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % ((i,) + tuple(p) + tuple(n) + (d,))
+        for i, p, n, d in zip(loop["ids"], loop["P"], loop["N"], truth)))
+    out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
+                  "--report", tmp / "probe.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "Plan:         %s" % loop["plan"] in out.stdout and "8 x 9" in out.stdout.replace(
+        "9 x 8", "8 x 9")
+    ref = run_cli("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json", "--quiet")
+    assert ref.returncode == 0, ref.stderr
+    got, want = (json.loads((tmp / n).read_text()) for n in ("probe.json", "truth.json"))
+    assert got["inputs"]["plan"]["sha256"] == hashlib.sha256(
+        loop["plan"].read_bytes()).hexdigest()
+    dev = np.array(got["points"]["deviation"])
+    assert_allclose(dev, truth, atol=1e-4, rtol=0)
+    assert np.abs(truth).max() > 0.015          # a real deformation, not a zero
+    corr, corr_ref = (np.array(r["points"]["correction"]) for r in (got, want))
+    assert_allclose(corr, corr_ref, atol=1e-4, rtol=0)
+    print("round trip: deviation recovered within %.4f um, correction within %.4f um "
+          "(largest deviation %.1f um)" % (np.abs(dev - truth).max() * 1e3,
+                                           np.abs(corr - corr_ref).max() * 1e3,
+                                           np.abs(truth).max() * 1e3))
+
+
+def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
+    tmp = loop["tmp"]
+    centres = loop["P"] + (R + 0.01) * loop["N"]
+    log = tmp / "short.log"
+    log.write_text("".join("%.6f %.6f %.6f 0 0 0 0 0 0\n" % tuple(c) for c in centres[:-1]))
+    report = tmp / "never.json"
+    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
+                  "--report", report, "--quiet")
+    assert out.returncode == 2 and not report.exists()
+    assert "%s:73: planned point %s has no probe line" % (loop["plan"], loop["ids"][-1]) \
+        in out.stderr
+    swapped = centres[[1, 0] + list(range(2, 72))]
+    log.write_text("".join("%.6f %.6f %.6f 0 0 0 0 0 0\n" % tuple(c) for c in swapped))
+    out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
+                  "--report", report, "--quiet")
+    assert out.returncode == 2 and not report.exists()
+    assert "%s:1: probe line 1 (" % log in out.stderr and "--max-offset 1 mm" in out.stderr
+    out = run_cli("inspect", EXAMPLE_STEP, log, "--touches", "2", "--quiet")
+    assert out.returncode == 2 and "touches applies to a probe log read with a plan" in out.stderr
