@@ -22,6 +22,7 @@ from .harness import EXAMPLE_STEP, Case, check_message, check_tree, run_case, sn
 BOX = "box"
 INPUTS = I.setup(I.copy("nominal.step", EXAMPLE_STEP), I.put("m.csv", I.csv),
                  I.put("in.ngc", I.SMALL_PROGRAM), I.put("e.csv", I.AXIS_CSV),
+                 I.put("plan.csv", I.csv),
                  I.folder("v/sub"), I.link("vlink", "v/sub"), I.put("afile", "a file"))
 DOC_INPUTS = I.setup(INPUTS, I.put("d.FCStd", I.document_bytes))
 
@@ -153,7 +154,7 @@ def _registry_pairs():
 
 #: a file for each input of the registry (by label)
 FILE_OF = {"NOMINAL": "nominal.step", "MEASUREMENTS": "m.csv", "--axis-errors": "e.csv",
-           "IN.ngc": "in.ngc"}
+           "IN.ngc": "in.ngc", "--plan": "plan.csv"}
 
 
 @pytest.mark.parametrize("command, inp, out", _registry_pairs(),
