@@ -109,18 +109,28 @@ def sphere_touch(surf, a, b):
     return a + brentq(gap, steps[k - 1], steps[k], xtol=1e-12) * u
 
 
-def test_round_trip_recovers_the_correction(loop):
+def write_log(path, centres):
+    """A LinuxCNC probe log of tip centres (its layout: 9 axes, 6 decimals)."""
+    path.write_text("".join("%.6f %.6f %.6f 0.000000 0.000000 0.000000 0.000000 0.000000 "
+                            "0.000000\n" % tuple(c) for c in centres))
+
+
+@pytest.fixture(scope="module")
+def probed(loop):
+    """The deformed face, the probe log of the program on it and the deformation along
+    the planned normals, found independently (ray and face)."""
     import Part
 
     surf = deformed_face()
     probes = [(a, b) for kind, a, b in loop["moves"] if kind == "STRAIGHT_PROBE"]
-    centres = np.array([sphere_touch(surf, a, b) for a, b in probes])
-    tmp = loop["tmp"]
-    log = tmp / "probe.log"
-    log.write_text("".join("%.6f %.6f %.6f 0.000000 0.000000 0.000000 0.000000 0.000000 "
-                           "0.000000\n" % tuple(c) for c in centres))
-    # the deformation along the planned normals, found independently (ray and face)
+    log = loop["tmp"] / "probe.log"
+    write_log(log, [sphere_touch(surf, a, b) for a, b in probes])
     truth = -realised_by_occt(Part.Face(surf), loop["P"], loop["N"], reach=0.5)
+    return dict(surf=surf, log=log, truth=truth)
+
+
+def test_round_trip_recovers_the_correction(loop, probed):
+    tmp, log, truth = loop["tmp"], probed["log"], probed["truth"]
     cmm = tmp / "truth.csv"
     cmm.write_text("id,x_nom,y_nom,z_nom,i,j,k,dev\n" + "".join(
         "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % ((i,) + tuple(p) + tuple(n) + (d,))
@@ -165,3 +175,51 @@ def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
     assert "%s:1: probe line 1 (" % log in out.stderr and "--max-offset 1 mm" in out.stderr
     out = run_cli("inspect", EXAMPLE_STEP, log, "--touches", "2", "--quiet")
     assert out.returncode == 2 and "touches applies to a probe log read with a plan" in out.stderr
+
+
+def test_job_file_with_a_plan(loop, probed):
+    """The freecadcmd job route takes the plan as the key ``plan`` (relative to the job
+    file) and gives the command line's deviations."""
+    from surfcomp.cli.jobfile import run_job_file
+
+    tmp = loop["tmp"]
+    job = tmp / "job.json"
+    job.write_text(json.dumps({"command": "inspect", "nominal": EXAMPLE_STEP,
+                               "measurements": probed["log"].name, "plan": "plan.csv",
+                               "tip_radius": R, "report": "job_report.json"}))
+    assert run_job_file(str(job)) == 0
+    rep = json.loads((tmp / "job_report.json").read_text())
+    assert rep["inputs"]["plan"]["path"] == str(loop["plan"])
+    assert_allclose(rep["points"]["deviation"], probed["truth"], atol=1e-4, rtol=0)
+
+
+def test_second_touch_round_trip(loop, probed):
+    """A second-touch program: rs274 reads it, and the log of two lines per point (the
+    first touch, then the touch from 1 mm back off the first trip point) is read back with
+    --touches 2."""
+    tmp = loop["tmp"]
+    s = ProbeSettings(tip_radius=R, safe_z=loop["solid"].BoundBox.ZMax, clearance=CLEARANCE,
+                      standoff=2.0, overtravel=OVERTRAVEL, second_touch=True, backoff=1.0)
+    prog = tmp / "probe2.ngc"
+    summary = write_probe_program(str(prog), loop["ids"], loop["P"], loop["N"], s)
+    probes, worst = check_probe_moves(rs274_moves(prog, tmp, diameter=2 * R), loop["P"],
+                                      loop["N"], R, OVERTRAVEL)
+    assert len(probes) == summary["log_lines"] == 144
+    centres = []
+    for k in range(72):
+        a, b = probes[2 * k]
+        first = sphere_touch(probed["surf"], a, b)
+        # on the machine the second touch starts 1 mm back from the first trip point
+        # (rs274 has no probe: it backs off from the end point instead)
+        centres += [first, sphere_touch(probed["surf"], first + 1.0 * loop["N"][k], b)]
+    log = tmp / "probe2.log"
+    write_log(log, centres)
+    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
+                  "--touches", 2, "--report", tmp / "probe2.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    dev = np.array(json.loads((tmp / "probe2.json").read_text())["points"]["deviation"])
+    assert_allclose(dev, probed["truth"], atol=1e-4, rtol=0)
+    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
+                  "--quiet")
+    assert out.returncode == 2 and "%s:73: probe line 73 has no planned point" % log \
+        in out.stderr
