@@ -17,7 +17,10 @@ point by default); this module writes them in a dialect.
     ``POPEN`` and ``PCLOS``, as ``X Y Z 0 0 0 0 0 0`` with 4 decimals (format ``[44]``), the
     LinuxCNC log's layout, so the same reader reads it (one line per point). No other
     variable is read or written. The output goes to the control's external output device
-    (I/O channel setting), not to a named file.
+    (I/O channel setting), not to a named file. How DPRNT prints leading zeros and signs
+    depends on the control's parameters (No. 6001, PRT); the reader needs nine blank-
+    separated numbers per line, so compare a real output's first lines with it before
+    relying on it (no Fanuc control or interpreter was available to check this).
 
 Both record the plan's SHA-256, the tip radius and the dialect in their header.
 """

@@ -98,3 +98,19 @@ def test_plan_without_normals_is_refused(tmp_path):
     with pytest.raises(MeasurementFileError,
                        match=r"plan.csv:1: .*no normal \(i j k\) \(expected a plan: id, nominal"):
         read_plan(str(path))
+
+
+def test_fanuc_dprnt_output_reads_as_a_probe_log(tmp_path):
+    """The Fanuc dialect's DPRNT[#5061[44]*#5062[44]*#5063[44]*0*0*0*0*0*0] lines (leading
+    zeros printed as blanks, 4 decimals) are read as the LinuxCNC log's layout."""
+    P, N = write_plan(tmp_path / "plan.csv")
+    plan = read_plan(str(tmp_path / "plan.csv"))
+    d = np.array([0.004, -0.002, 0.0, 0.001, 0.003, -0.001])
+    centres = P + (R + d)[:, None] * N
+    log = tmp_path / "dprnt.txt"
+    log.write_text("".join("%9.4f%10.4f%10.4f 0 0 0 0 0 0\n" % tuple(c) for c in centres))
+    ms = read_any(str(log))
+    assert ms.tip_centres and ms.measured.shape == (6, 3)
+    joined = join_plan(plan, ms, Options(tip_radius=R))
+    dev = np.einsum("ij,ij->i", joined.measured - joined.nominal, joined.normal) - R
+    assert_allclose(dev, d, atol=1e-4)       # 4 decimals
