@@ -175,23 +175,20 @@ class ProbePath:
     def polyline(self):
         """The tip centre's planned path: ``(positions (M, 3), kinds (M,))`` with kinds
         ``traverse``, ``feed`` and ``probe`` (a probe ends at the nominal contact, where
-        it stops on a part of nominal shape). Starts above the first point."""
-        pos, kind = [], []
-        for k in range(len(self.ids)):
-            above = np.array([self.retract[k, 0], self.retract[k, 1], self.safe])
-            pos += [above, self.retract[k]]
-            kind += ["traverse", "traverse"]
-            if self.approach:
-                pos.append(self.standoff[k])
-                kind.append("feed")
-            pos.append(self.contact[k])
-            kind.append("probe")
-            if self.backoff:
-                pos += [self.contact[k] + self.backoff * self.normals[k], self.contact[k]]
-                kind += ["feed", "probe"]
-            pos += [self.retract[k], above]
-            kind += ["feed", "traverse"]
-        return np.array(pos), kind
+        it stops on a part of nominal shape); each kind is that of the move ending at the
+        position. Starts above the first point."""
+        above = self.retract.copy()
+        above[:, 2] = self.safe
+        seq = [(above, "traverse"), (self.retract, "traverse")]
+        if self.approach:
+            seq.append((self.standoff, "feed"))
+        seq.append((self.contact, "probe"))
+        if self.backoff:
+            seq += [(self.contact + self.backoff * self.normals, "feed"),
+                    (self.contact, "probe")]
+        seq += [(self.retract, "feed"), (above, "traverse")]
+        pos = np.stack([p for p, _k in seq], axis=1).reshape(-1, 3)
+        return pos, [k for _p, k in seq] * len(self.ids)
 
 
 def probe_path(ids, points, normals, settings):
