@@ -136,8 +136,9 @@ def test_round_trip_recovers_the_correction(loop, probed):
         "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % ((i,) + tuple(p) + tuple(n) + (d,))
         for i, p, n, d in zip(loop["ids"], loop["P"], loop["N"], truth)))
     out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
-                  "--report", tmp / "probe.json", "--quiet")
+                  "--report", tmp / "probe.json", "--html", tmp / "probe.html", "--quiet")
     assert out.returncode == 0, out.stderr
+    assert "<b>%s</b>" % loop["plan"] in (tmp / "probe.html").read_text()
     assert "Plan:         %s" % loop["plan"] in out.stdout and "8 x 9" in out.stdout.replace(
         "9 x 8", "8 x 9")
     ref = run_cli("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json", "--quiet")
