@@ -8,9 +8,9 @@ contact is ``c = p + R n``. Per point, in the plan's order:
 
 1. traverse at the safe height ``Zs = safe_z + R + clearance`` (the ball's lowest point
    ``clearance`` above the part's top ``safe_z``) to above the retract point
-   ``r = c + clearance n``, then traverse down to ``r``;
+   ``r = c + max(clearance, standoff) n``, then traverse down to ``r``;
 2. feed at the fast feed to the stand-off point ``s = c + standoff n`` (the fast
-   approach; left out when ``standoff >= clearance``, then the probe starts at ``r``);
+   approach; left out when ``standoff >= clearance``: then ``r`` is ``s``);
 3. probe at the touch feed from there along ``-n`` to ``e = c - overtravel n``, the
    overtravel past the nominal contact (the probe stops at the contact);
 4. with ``second_touch``: back off ``backoff`` along ``n`` from where the probe stopped
@@ -231,7 +231,8 @@ def probe_path(ids, points, normals, settings):
     R = s.tip_radius
     contact = P + R * N
     return ProbePath(ids=ids, points=P, normals=N, contact=contact,
-                     retract=contact + s.clearance * N, standoff=contact + s.standoff * N,
+                     retract=contact + max(s.clearance, s.standoff) * N,
+                     standoff=contact + s.standoff * N,
                      end=contact - s.overtravel * N, approach=s.standoff < s.clearance,
                      safe=s.safe_height(), backoff=s.backoff if s.second_touch else 0.0)
 

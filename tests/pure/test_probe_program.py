@@ -38,11 +38,14 @@ def settings(**kw):
     return ProbeSettings(**base)
 
 
-@pytest.mark.parametrize("second", [False, True])
-def test_linuxcnc_program_read_by_rs274(tmp_path, second):
+@pytest.mark.parametrize("second, clearance", [(False, 4.0), (True, 4.0), (False, 1.5)])
+def test_linuxcnc_program_read_by_rs274(tmp_path, second, clearance):
+    """Clearance 1.5 mm below the 2 mm stand-off: no fast approach, the rapid move goes to
+    the stand-off point."""
     ids, P, N = dome_plan()
     prog = tmp_path / "probe.ngc"
-    summary = write_probe_program(str(prog), ids, P, N, settings(second_touch=second))
+    summary = write_probe_program(str(prog), ids, P, N,
+                                  settings(second_touch=second, clearance=clearance))
     text = prog.read_text()
     assert "(plan sha256 0123456789abcdef0123456789abcdef)" in text
     assert "(tip radius 1.5000 mm, 37 points" in text and "dialect linuxcnc" in text
@@ -58,10 +61,14 @@ def test_linuxcnc_program_read_by_rs274(tmp_path, second):
     want = np.repeat(P + R * N, per, axis=0) + np.repeat(N, per, axis=0) * (
         np.tile([2.0, 0.0] if second else [2.0], len(ids))[:, None])
     assert_allclose(starts, want, atol=2 * PRINTED, rtol=0)
-    # traverses: horizontal ones at the safe height 10 + R + 4, vertical ones down to the
-    # retract point 4 mm out along the normal and back up
+    # traverses: horizontal ones at the safe height 10 + R + clearance, vertical ones down
+    # to the retract point (clearance or stand-off out along the normal) and back up
     trav = [(a, b) for kind, a, b in moves if kind == "STRAIGHT_TRAVERSE"][1:]
-    safe = 10 + R + 4
+    safe = 10 + R + clearance
+    assert len(trav) == 3 * len(ids)        # per point: across, down, up
+    ends = np.array([b for a, b in trav[1::3]])
+    assert_allclose(ends, P + (R + max(clearance, 2.0)) * N, atol=PRINTED, rtol=0)
+    assert ("G1 " in text.split("(point 1 ")[1].split("G38.2")[0]) == (clearance > 2.0)
     for a, b in trav:
         assert (abs(a[2] - safe) < 1e-9 and abs(b[2] - safe) < 1e-9) or \
             np.allclose(a[:2], b[:2], atol=1e-9)
