@@ -174,6 +174,14 @@ def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
                   "--report", report, "--quiet")
     assert out.returncode == 2 and not report.exists()
     assert "%s:1: probe line 1 (" % log in out.stderr and "--max-offset 1 mm" in out.stderr
+    bad_plan = tmp / "bad_plan.csv"
+    lines = loop["plan"].read_text().splitlines()
+    lines[5] = lines[5].replace(",", ",x", 1)
+    bad_plan.write_text("\n".join(lines) + "\n")
+    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", bad_plan, "--report", report,
+                  "--quiet")
+    assert out.returncode == 2 and not report.exists()
+    assert "%s:6:2: column 'x_nom' holds 'x" % bad_plan in out.stderr, out.stderr
     out = run_cli("inspect", EXAMPLE_STEP, log, "--touches", "2", "--quiet")
     assert out.returncode == 2 and "touches applies to a probe log read with a plan" in out.stderr
 
