@@ -120,8 +120,8 @@ def _fanuc(path, s):
         raise InputError("plan point %s: a tip-centre coordinate beyond %g mm does not fit "
                          "DPRNT's [44] format of the fanuc dialect" % (path.ids[big[0]],
                                                                        FANUC_LIMIT))
-    out = ["%", "O%04d %s" % (s.program_number, comment("surfcomp probing program"))]
-    out += _header(path, s, comment)[1:]
+    header = _header(path, s, comment)
+    out = ["%", "O%04d %s" % (s.program_number, header[0])] + header[1:]
     out += [comment("G31 skip, #5061 #5062 #5063 skip position X Y Z, DPRNT X Y Z 0 0 0 0 0 0"),
             "G21 G17 G40 G49 G80 G90 G94", "T%d M06" % s.tool, s.work_offset,
             "G43 H%d G00 Z%s" % (s.tool, _num(path.safe)), "POPEN"]

@@ -90,7 +90,8 @@ def test_fanuc_program_by_parsing(tmp_path):
     prog = tmp_path / "probe.nc"
     summary = write_probe_program(str(prog), ids, P, N, s)
     lines = prog.read_text().splitlines()
-    assert lines[0] == "%" and lines[-1] == "%" and lines[1].startswith("O1000 (")
+    assert lines[0] == "%" and lines[-1] == "%"
+    assert lines[1] == "O1000 (SURFCOMP PROBING PROGRAM, DIALECT FANUC)"
     assert all(ln == ln.upper() for ln in lines)
     assert "(PLAN SHA256 0123456789ABCDEF0123456789ABCDEF)" in lines
     assert any(ln.startswith("(TIP RADIUS 1.5000 MM, 12 POINTS") for ln in lines)
