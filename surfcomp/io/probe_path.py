@@ -17,8 +17,10 @@ contact is ``c = p + R n``. Per point, in the plan's order:
    and probe again to ``e`` at the slower ``second_feed``;
 5. feed back along ``n`` to ``r`` and traverse up to ``Zs``.
 
-The traverses thus keep the ball ``clearance`` away from the nominal points (and from the
-part, where the approach from above is free: the plan checks that against the solid).
+The traverses thus keep the ball ``clearance`` away from the nominal points, and from the
+part wherever the way down from the safe height to ``r`` is free: this module has no solid
+to check that against (``tests/app/test_probe_loop.py`` checks it on the example's solid
+with OpenCASCADE).
 """
 
 import math
