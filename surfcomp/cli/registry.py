@@ -105,6 +105,14 @@ ENTRIES = (
                     "--report-method, the before/after table, the paper's table beside the "
                     "simulated one (--preset) and the simulated parts' maps"),
           group=SIM_OUTPUT),
+    # ------------------------------------------------------------------ plan
+    Entry(("plan",), ("nominal",), "input", "NOMINAL",
+          dict(metavar="NOMINAL", help=_NOMINAL_HELP)),
+    Entry(("plan",), ("-o", "--output"), "output", "-o",
+          dict(required=True, metavar="PLAN.csv",
+               help="the plan: id, nominal XYZ, outward normal IJK (mm), in visiting order")),
+    Entry(("plan",), ("--dropped",), "output", "--dropped",
+          dict(metavar="OUT.csv", help="also write every dropped point with its reason")),
     # ------------------------------------------------------------------ gcode
     Entry(("gcode",), ("program",), "input", "IN.ngc",
           dict(metavar="IN.ngc", help="G-code program (G0/G1/G2/G3, 3 axes)")),

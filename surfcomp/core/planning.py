@@ -215,28 +215,52 @@ def min_concave_radius(domain, flat, ins):
 
 # ---------------------------------------------------------------------- layouts
 def _grid_layout(domain, count, margin):
-    """U x V nodes along the parameter lines over the box drawn in by ``margin``."""
+    """U x V nodes along the parameter lines over the box drawn in by ``margin``: each side
+    drawn in by the margin over the rate at which distance grows across it, then further
+    while a node of its outer row is nearer than the margin to the box's border curves."""
+    from .planning_face import FaceDomain
+
     (u0, u1), (v0, v1) = domain.surface.u_range, domain.surface.v_range
     t = np.linspace(0.0, 1.0, 65)
 
-    def inset(along_u, at):
+    def rate(along_u, at):
         uu = np.full(t.shape, at) if along_u else u0 + (u1 - u0) * t
         vv = v0 + (v1 - v0) * t if along_u else np.full(t.shape, at)
         _, Su, Sv = bspline.derivatives(domain.surface, uu, vv, 1)
         d, o = (Su, Sv) if along_u else (Sv, Su)
         # distance across the side per unit parameter: |d| sin(angle between d and o)
-        rate = np.linalg.norm(np.cross(d, o), axis=1) / np.maximum(
-            np.linalg.norm(o, axis=1), 1e-300)
-        return 1.05 * margin / max(float(rate.min()), 1e-300)
+        return max(float((np.linalg.norm(np.cross(d, o), axis=1) / np.maximum(
+            np.linalg.norm(o, axis=1), 1e-300)).min()), 1e-300)
 
-    a0, a1 = u0 + inset(True, u0), u1 - inset(True, u1)
-    b0, b1 = v0 + inset(False, v0), v1 - inset(False, v1)
+    rates = [rate(True, u0), rate(True, u1), rate(False, v0), rate(False, v1)]
+    inset = [1.02 * margin / r for r in rates]
+    border = FaceDomain(domain.surface, domain.outward)
     nu, nv = count
-    us = np.linspace(a0, a1, nu) if nu > 1 else np.array([0.5 * (u0 + u1)])
-    vs = np.linspace(b0, b1, nv) if nv > 1 else np.array([0.5 * (v0 + v1)])
+    for _ in range(8):
+        us = _spread(u0 + inset[0], u1 - inset[1], nu)
+        vs = _spread(v0 + inset[2], v1 - inset[3], nv)
+        sides = [(us[:1], vs), (us[-1:], vs), (us, vs[:1]), (us, vs[-1:])]
+        short = []
+        for a, b in sides:
+            A, B = np.meshgrid(a, b, indexing="ij")
+            S = bspline.evaluate(domain.surface, A.ravel(), B.ravel())
+            # a hair beyond the margin, so the checks' rounding keeps the nodes
+            want = margin * (1 + 1e-6) + 1e-9
+            short.append(want - float(border.boundary_distance(S, want).min()))
+        if max(short) <= 0:
+            break
+        inset = [i + 1.05 * s / r if s > 0 else i for i, s, r in zip(inset, short, rates)]
     U, V = np.meshgrid(us, vs, indexing="ij")
     rows = np.broadcast_to(np.arange(nv), U.shape)
     return dict(u=U.ravel(), v=V.ravel(), row=rows.ravel(), along=U.ravel())
+
+
+def _spread(lo, hi, n):
+    """``n`` values from ``lo`` to ``hi`` (one: the middle; an empty range: all in its
+    middle, so the margin check drops them)."""
+    if n == 1 or lo >= hi:
+        return np.full(n, 0.5 * (lo + hi))
+    return np.linspace(lo, hi, n)
 
 
 def _xy_layout(domain, count, cloud, allowed_cloud):
@@ -249,8 +273,8 @@ def _xy_layout(domain, count, cloud, allowed_cloud):
                     clipped=np.zeros(0, int), nodes=0)
     lo, hi = xy_ok.min(axis=0), xy_ok.max(axis=0)
     nx, ny = count
-    xs = np.linspace(lo[0], hi[0], nx) if nx > 1 else np.array([0.5 * (lo[0] + hi[0])])
-    ys = np.linspace(lo[1], hi[1], ny) if ny > 1 else np.array([0.5 * (lo[1] + hi[1])])
+    xs = _spread(lo[0], hi[0], nx)
+    ys = _spread(lo[1], hi[1], ny)
     X, Y = np.meshgrid(xs, ys, indexing="ij")
     target = np.stack([X.ravel(), Y.ravel()], axis=1)
     on = np.flatnonzero(ins)

@@ -162,8 +162,9 @@ _SEP_NAMES = {",": "','", ";": "';'", "\t": "tabs", None: "blanks"}
 _UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
 
-def read_measurements(path, units="mm"):
-    """Read a measurement file.
+def read_measurements(path, units="mm", plan=False):
+    """Read a measurement file (``plan``: a measurement plan, nominal points and normals
+    without deviations or measured points, as ``python3 -m surfcomp plan`` writes it).
 
     Parameters
     ----------
@@ -185,10 +186,10 @@ def read_measurements(path, units="mm"):
         and what was expected in the message).
     """
     source = os.fspath(path)
-    return parse_measurements(read_bytes(source), source=source, units=units)
+    return parse_measurements(read_bytes(source), source=source, units=units, plan=plan)
 
 
-def parse_measurements(text_or_bytes, source="<text>", units="mm"):
+def parse_measurements(text_or_bytes, source="<text>", units="mm", plan=False):
     """Parse the text of a measurement file.
 
     Parameters
@@ -200,6 +201,9 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
         Name used in messages and stored as ``MeasurementSet.source``.
     units : str or None
         As for :func:`read_measurements`.
+    plan : bool
+        Accept nominal points and normals without deviations or measured points (a
+        measurement plan; ``deviation`` and ``measured`` are None then).
 
     Returns a :class:`MeasurementSet` (every length in mm; formats and checks: see the
     module docstring) or raises :class:`MeasurementFileError` on the first problem, with
@@ -219,7 +223,9 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm"):
     if text.startswith("\ufeff"):
         text = text[1:]
     with np.errstate(over="ignore"):    # overflowing values are refused by the checks
-        return _Parser(text, source, default_factor).run(hashlib.sha256(raw).hexdigest())
+        parser = _Parser(text, source, default_factor)
+        parser.plan = bool(plan)
+        return parser.run(hashlib.sha256(raw).hexdigest())
 
 
 def _norm(name):
@@ -267,6 +273,9 @@ def _is_number(text):
 
 class _Parser:
     """One parse of one file: keeps the source lines for messages."""
+
+    #: a measurement plan: nominal points and normals suffice
+    plan = False
 
     def __init__(self, text, source, default_factor):
         self.source = source
@@ -411,6 +420,7 @@ class _Parser:
         have = {g for g, rs in GROUPS.items() if rs[0] in first}
         need = [g for g in ("nominal", "normal", "deviation", "measured")
                 if g not in have and not (g == "measured" and have >= {"normal", "deviation"})
+                and not (self.plan and g in ("measured", "deviation"))
                 and not (g in ("normal", "deviation") and "measured" in have)]
         if need:
             got = " and ".join(" ".join(GROUPS[g]) for g in ("nominal", "measured", "normal",
