@@ -29,6 +29,7 @@ from ..core.planning import (
     LAYOUTS,
     MAX_POINTS,
     ORDERS,
+    POINT_LAYOUTS,
     REASONS,
     PlanSettings,
     check_points,
@@ -68,12 +69,13 @@ def add_parser(subparsers):
     p.add_argument("--layout", choices=LAYOUTS, default="grid",
                    help="grid: U x V along the parameter lines (default); xy: U x V in the "
                         "machine's XY plane clipped to the face; adaptive: --points N, denser "
-                        "where the slope changes fast")
+                        "where the slope changes fast; uniform: --points N spread evenly")
     p.add_argument("--count", metavar="UxV", default=None,
                    help="grid and xy: points along u (x) and v (y) (default 10x10; at most "
                         "%d in all)" % MAX_POINTS)
     p.add_argument("--points", type=int, default=None, metavar="N",
-                   help="adaptive: number of points (default 100; at most %d)" % MAX_POINTS)
+                   help="adaptive and uniform: number of points (default 100; at most %d)"
+                        % MAX_POINTS)
     g = p.add_argument_group("probe")
     g.add_argument("--tip-radius", type=float, default=_DEFAULTS.tip_radius, metavar="MM",
                    help="stylus ball radius (default %g mm)" % _DEFAULTS.tip_radius)
@@ -106,11 +108,11 @@ def settings_from_args(args):
 
 def layout_count(args):
     """``(layout, count)`` from ``--layout``, ``--count`` and ``--points`` (checked)."""
-    if args.layout == "adaptive":
+    if args.layout in POINT_LAYOUTS:
         if args.count is not None:
-            raise InputError("--count applies to the grid and xy layouts; the adaptive layout "
-                             "takes --points N")
-        return "adaptive", check_points(100 if args.points is None else args.points)
+            raise InputError("--count applies to the grid and xy layouts; the %s layout "
+                             "takes --points N" % args.layout)
+        return args.layout, check_points(100 if args.points is None else args.points)
     if args.points is not None:
         raise InputError("--points applies to the adaptive layout; the %s layout takes --count "
                          "UxV" % args.layout)
@@ -147,7 +149,7 @@ def program_settings(args, plan, sha256):
 
 def _comments(args, plan, nominal):
     s = plan.settings
-    count = ("%d points" % plan.requested if plan.layout == "adaptive"
+    count = ("%d points" % plan.requested if plan.layout in POINT_LAYOUTS
              else "%s" % (args.count or "10x10"))
     return ["surfcomp measurement plan of %s (%s)" % (os.path.basename(args.nominal),
                                                     nominal.face_name),

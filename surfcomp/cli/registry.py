@@ -96,6 +96,10 @@ ENTRIES = (
           dict(metavar="ERR.csv",
                help="per-axis error measurements (as for the gcode command); the fitted "
                     "Dobariya 2015 model adds its error along the normal"), group=SIM_MODEL),
+    Entry(("simulate",), ("--plan",), "input", "--plan",
+          dict(metavar="PLAN.csv",
+               help="measure the simulated parts at this plan's points (python3 -m surfcomp "
+                    "plan)"), group="measurement plan (instead of the --grid nodes)"),
     Entry(("simulate",), ("--json",), "output", "--json",
           dict(metavar="OUT.json", help="write every replica's statistics (JSON)"),
           group=SIM_OUTPUT),

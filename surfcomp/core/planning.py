@@ -14,6 +14,9 @@ Layouts (``layout``):
 ``adaptive`` (``points`` = N)
     N points, denser where the slope changes fast (mirror paper 2019, section 2.3):
     :mod:`surfcomp.core.planning_adaptive`.
+``uniform`` (``points`` = N)
+    N points spread evenly: the adaptive layout's rows with a constant density (its twin
+    for comparisons at equal point counts).
 
 Every point then passes the same checks, and a point that fails one is dropped with its
 reason (:class:`Drop`):
@@ -50,7 +53,9 @@ from .planning_reach import (
 )
 from .progress import report
 
-LAYOUTS = ("grid", "xy", "adaptive")
+LAYOUTS = ("grid", "xy", "adaptive", "uniform")
+#: layouts whose count is a number of points (the others take U x V)
+POINT_LAYOUTS = ("adaptive", "uniform")
 ORDERS = ("auto", "serpentine", "nearest")
 #: most points a plan may have
 MAX_POINTS = 1_000_000
@@ -372,9 +377,10 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
     Parameters
     ----------
     domain : FaceDomain
-    layout : {'grid', 'xy', 'adaptive'}
+    layout : {'grid', 'xy', 'adaptive', 'uniform'}
     count : (int, int) or int
-        ``(U, V)`` for ``grid`` and ``xy``; the number of points for ``adaptive``.
+        ``(U, V)`` for ``grid`` and ``xy``; the number of points for ``adaptive`` and
+        ``uniform``.
     settings : PlanSettings
     top_z : float, optional
         The part's top (mm); default the face's highest sample.
@@ -421,7 +427,8 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
         lay = _xy_layout(domain, parse_count("%sx%s" % tuple(count)), cloud, ok)
         info["clipped"] = int(len(lay["clipped"]))
     else:
-        lay = adaptive_layout(domain, check_points(count), allowed)
+        lay = adaptive_layout(domain, check_points(count), allowed,
+                              uniform=layout == "uniform")
         info.update(kappa_mean=lay["kappa_mean"], rows=lay["rows"])
     requested = lay.get("nodes", len(lay["u"]))
     report(progress, 0.5, "checking %d points" % len(lay["u"]))

@@ -69,19 +69,19 @@ def _allocate(shares, total):
     return out
 
 
-def _row_profile(domain, us, v, allowed, kappa_mean):
+def _row_profile(domain, us, v, allowed, kappa_mean, uniform=False):
     """Density, allowed mask and arc length along the u-curve at ``v`` (samples ``us``):
     ``(rho (Gu,), ok (Gu,), seg_len (Gu - 1,))``."""
     vv = np.full(us.shape, float(v))
     D = bspline.derivatives(domain.surface, us, vv, 2)
     k1, k2 = curvatures_from(D, domain.outward)
-    rho = kappa_mean + np.hypot(k1, k2)
+    rho = kappa_mean + np.hypot(k1, k2) * (0.0 if uniform else 1.0)
     ok = allowed(us, vv, D[0], D[1], D[2])
     seg = np.linalg.norm(np.diff(D[0], axis=0), axis=1)
     return rho, ok, seg
 
 
-def adaptive_layout(domain, count, allowed, samples=None):
+def adaptive_layout(domain, count, allowed, samples=None, uniform=False):
     """``count`` adaptive points on the face (module docstring).
 
     Parameters
@@ -94,6 +94,9 @@ def adaptive_layout(domain, count, allowed, samples=None):
         margin, tilt).
     samples : int, optional
         Density samples over the face (default ``max(MIN_SAMPLES, 8 * count)``).
+    uniform : bool
+        A constant density instead (the same rows and equidistribution: the adaptive
+        layout's uniform twin, for comparisons at equal point counts).
 
     Returns
     -------
@@ -107,7 +110,7 @@ def adaptive_layout(domain, count, allowed, samples=None):
     U, V = np.meshgrid(us, vs, indexing="ij")
     ok = allowed(U.ravel(), V.ravel(), flat[0], flat[1], flat[2]).reshape(U.shape)
     k1, k2 = curvatures_from(flat, domain.outward)
-    kappa = np.hypot(k1, k2).reshape(U.shape)
+    kappa = np.hypot(k1, k2).reshape(U.shape) * (0.0 if uniform else 1.0)
     area = np.linalg.norm(np.cross(D[1], D[2]), axis=-1) * ok
     empty = dict(u=np.zeros(0), v=np.zeros(0), row=np.zeros(0, int), along=np.zeros(0),
                  kappa_mean=0.0, rows=0)
@@ -133,7 +136,7 @@ def adaptive_layout(domain, count, allowed, samples=None):
     v_rows = _cdf_quantiles(vs, w, n_rows)
     gu = int(np.clip(len(us), *ROW_SAMPLES))
     ur = np.linspace(us[0], us[-1], gu)
-    profiles = [_row_profile(domain, ur, v, allowed, kappa_mean) for v in v_rows]
+    profiles = [_row_profile(domain, ur, v, allowed, kappa_mean, uniform) for v in v_rows]
     shares = []
     for rho_r, ok_r, seg in profiles:
         both_r = ok_r[:-1] & ok_r[1:]

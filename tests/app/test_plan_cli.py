@@ -150,3 +150,60 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     # the kept floor points up to x = 19 are all there: 41 columns 1 mm apart from 1.5 mm
     xs = np.unique(np.round(ms.nominal[:, 0], 6))
     assert len(ms.nominal) == 9 * len(xs) and xs.size >= 17
+
+
+# ------------------------------------------------------------------ simulate with a plan
+def run_simulate(*args):
+    return subprocess.run([sys.executable, "-m", "surfcomp", "simulate", *map(str, args),
+                           "--quiet"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+
+
+def test_simulate_at_a_written_plan(tmp_path):
+    import json
+
+    plan = tmp_path / "plan.csv"
+    assert run_plan(EXAMPLE_STEP, "-o", plan, "--layout", "adaptive",
+                    "--points", "120").returncode == 0
+    out = run_simulate(EXAMPLE_STEP, "--plan", plan, "--grid", "15x15", "--replicas", "1",
+                       "--methods", "none,filtered", "--json", tmp_path / "s.json")
+    assert out.returncode == 0, out.stderr
+    assert "Measured:  120 points of %s" % plan in out.stdout
+    d = json.loads((tmp_path / "s.json").read_text())
+    assert d["inputs"]["plan"]["points"] == 120
+    assert (d["inputs"]["plan"]["sha256"]
+            == hashlib.sha256(plan.read_bytes()).hexdigest())
+    methods = {m["label"]: m for m in d["methods"]}
+    assert methods["filtered"]["replicas"][0]["grid"]["count"] == 120
+    assert methods["filtered"]["replicas"][0]["all"]["count"] == 29 * 29
+    # the example's default model: about 16.5 um before, well under a quarter after
+    before = methods["none"]["replicas"][0]["all"]["std"]
+    assert 0.014 < before < 0.019
+    assert methods["filtered"]["replicas"][0]["all"]["std"] < 0.25 * before
+
+
+def test_simulate_refuses_a_plan_of_another_face(tmp_path):
+    plan = tmp_path / "plan.csv"
+    assert run_plan(EXAMPLE_STEP, "-o", plan, "--count", "4x4").returncode == 0
+    lines = plan.read_text().splitlines()
+    k = next(i for i, t in enumerate(lines) if t.startswith("P3,"))
+    f = lines[k].split(",")
+    f[3] = "%.6f" % (float(f[3]) + 0.5)
+    lines[k] = ",".join(f)
+    plan.write_text("\n".join(lines) + "\n")
+    out = run_simulate(EXAMPLE_STEP, "--plan", plan, "--grid", "9x9", "--replicas", "1",
+                       "--json", tmp_path / "s.json")
+    assert out.returncode == 2
+    assert "%s:%d: point P3 lies 0.4" % (plan, k + 1) in out.stderr
+    assert not (tmp_path / "s.json").exists()
+
+
+@pytest.mark.parametrize("args,message", [
+    (("--compare-layouts", "20", "--html", "x.html"), "--html shows the maps of grid"),
+    (("--compare-layouts", "0"), "--compare-layouts 0: expected a whole number"),
+    (("--layout", "adaptive", "--count", "3x3"), "--layout adaptive takes --points N"),
+    (("--layout", "grid", "--points", "9"), "--layout grid takes --count UxV"),
+    (("--points", "9"), "--count and --points go with --layout"),
+])
+def test_simulate_plan_options_refused(tmp_path, args, message):
+    out = run_simulate("--preset", "mirror2019-s1", *args)
+    assert out.returncode == 2 and message in out.stderr, out.stderr

@@ -287,3 +287,39 @@ def test_adaptive_on_a_plane_is_uniform():
     y = np.sort(np.unique(np.round(plan.points[:, 1], 9)))
     assert len(x) == 20 and len(y) == 20
     assert np.ptp(np.diff(x)) < 1e-6 and np.ptp(np.diff(y)) < 1e-6
+
+
+# ------------------------------------------------------------------ the virtual loop
+def test_simulate_at_plan_points_and_the_layout_comparison():
+    """The loop measured at a plan's points: the 'grid' statistics are those at the points,
+    'all' the evaluation grid's; the uniform and adaptive runs share the evaluation grid's
+    random draws, so the parts machined from the nominal are the same to the last bit, and
+    the comparison's figures are the runs' own."""
+    from surfcomp.core import presets
+    from surfcomp.core import simulate as sim
+    from surfcomp.core.sim_layouts import compare_layouts
+
+    pr = presets.get_preset("mirror2019-s2")
+    surf, outward = pr.surface()
+    model = sim.MachiningModel(**pr.model)
+    specs = sim.method_specs(["none", "filtered", "mirror"])
+    cmp = compare_layouts(FaceDomain(surf, outward), model, 49, grid=(10, 8), specs=specs,
+                          replicas=2, seed=3, between=2)
+    uni, ada = cmp.results["uniform"], cmp.results["adaptive"]
+    assert len(cmp.plans["uniform"]) == len(cmp.plans["adaptive"]) == 49
+    for res in (uni, ada):
+        assert res.before[0]["grid"].count == 49 and res.before[0]["all"].count == 19 * 15
+    assert_allclose(uni.values("before", "std"), ada.values("before", "std"), rtol=0, atol=0)
+    rows = {r[0]: r for r in cmp.rows()}
+    assert set(rows) == {"filtered", "mirror"}
+    assert rows["mirror"][1] == pytest.approx(uni.values("mirror", "std").mean(), abs=1e-15)
+    assert rows["mirror"][3] == pytest.approx(ada.values("mirror", "std").mean(), abs=1e-15)
+    # both compensate: the residual is well below the uncompensated part's
+    for label in ("filtered", "mirror"):
+        assert rows[label][1] < 0.7 * uni.values("none", "std").mean()
+        assert rows[label][3] < 0.7 * ada.values("none", "std").mean()
+    assert cmp.verdict() in ("reproduced", "not supported")
+    assert "The mirror paper's claim" in cmp.table()
+    with pytest.raises(InputError, match="maps of a simulation need the grid"):
+        sim.simulate(surf, outward, model, grid=(10, 8), specs=specs, replicas=1,
+                     points=cmp.plans["uniform"].points, keep=True)
