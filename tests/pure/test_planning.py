@@ -23,6 +23,7 @@ from surfcomp.core.planning_reach import (
 )
 from surfcomp.core.presets import mirror_surface, werner_surface
 from surfcomp.errors import InputError
+from tests.pure.test_trimmed import _circle, _square_pieces
 
 
 def _plane(size=40.0):
@@ -31,19 +32,6 @@ def _plane(size=40.0):
     P = np.stack([*np.meshgrid(x, x, indexing="ij"), np.zeros((2, 2))], axis=-1)
     k = np.array([0.0, 0.0, 1.0, 1.0])
     return Surface(P, k, k, 1, 1)
-
-
-def _circle(c, r, n=400, reverse=False):
-    t = np.linspace(0.0, 2 * np.pi, n)
-    if reverse:
-        t = t[::-1]
-    return np.stack([c[0] + r * np.cos(t), c[1] + r * np.sin(t)], axis=1)
-
-
-def _box(u0, u1, v0, v1, n=100):
-    s = np.linspace(0.0, 1.0, n)[:, None]
-    c = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1], [u0, v0]])
-    return [a + s * (b - a) for a, b in zip(c[:-1], c[1:])]
 
 
 def _edge_distance(surface, points, n=4000):
@@ -100,7 +88,7 @@ def test_hole_and_trim_margin_measured():
     the nodes in the hole are 'outside', those near it 'margin'."""
     s = _plane()
     c, r = (0.5, 0.5), 5.0 / 40.0
-    polys = _box(0.125, 0.875, 0.125, 0.875) + [_circle(c, r, reverse=True)]
+    polys = _square_pieces(0.125, 0.875, 0.125, 0.875) + [_circle(c, r, 400, reverse=True)]
     dom = FaceDomain(s, 1, polys)
     plan = plan_points(dom, "grid", (40, 40), PlanSettings(tip_radius=1.0, edge_margin=0.5))
     xy = plan.points[:, :2]
@@ -124,7 +112,8 @@ def test_hole_and_trim_margin_measured():
 
 def test_adaptive_points_avoid_hole():
     s = _plane()
-    dom = FaceDomain(s, 1, _box(0, 1, 0, 1) + [_circle((0.5, 0.5), 0.2, reverse=True)])
+    dom = FaceDomain(s, 1, _square_pieces(0, 1, 0, 1)
+                     + [_circle((0.5, 0.5), 0.2, 400, reverse=True)])
     plan = plan_points(dom, "adaptive", 400, PlanSettings(tip_radius=1.0, edge_margin=1.0))
     assert len(plan) == 400 and not plan.dropped
     assert (np.linalg.norm(plan.points[:, :2] - 20, axis=1) - 8.0).min() >= 2.0 - 2e-3
