@@ -94,3 +94,20 @@ def part_check(shape, face_name, tip_radius):
         return [("part-approach", approach), ("part-descent", descent)]
 
     return check
+
+
+def plan_face(nominal, layout, count, settings, order="auto", progress=None):
+    """``(plan, checked_part)``: plan on a :class:`surfcomp.app.nominal.Nominal` face with
+    its trim boundary, the part's top and, when the shape has other faces, the paths checked
+    against them (``checked_part`` True then)."""
+    from ..core.planning import plan_points
+    from ..core.planning_face import FaceDomain
+    from .nominal import boundary_polylines
+
+    domain = FaceDomain(nominal.surface, nominal.outward,
+                        boundary_polylines(nominal.bspline_face))
+    check = part_check(nominal.shape, nominal.face_name, settings.tip_radius)
+    plan = plan_points(domain, layout, count, settings,
+                       top_z=part_top(nominal.shape, nominal.face), order=order,
+                       extra_check=check, progress=progress)
+    return plan, check is not None

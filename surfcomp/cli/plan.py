@@ -123,19 +123,12 @@ def make_plan(path, face_name, object_name, layout, count, settings, order="auto
               progress=None):
     """``(plan, nominal, checked_part)``: load the nominal face and plan on it; the part's
     other faces (a solid's) are checked too (``checked_part`` True then)."""
-    from ..app.nominal import boundary_polylines, load_nominal
-    from ..app.plan_reach import part_check, part_top
-    from ..core.planning import plan_points
-    from ..core.planning_face import FaceDomain
+    from ..app.nominal import load_nominal
+    from ..app.plan_reach import plan_face
 
     nominal = load_nominal(path, face_name, object_name)
-    domain = FaceDomain(nominal.surface, nominal.outward,
-                        boundary_polylines(nominal.bspline_face))
-    check = part_check(nominal.shape, nominal.face_name, settings.tip_radius)
-    plan = plan_points(domain, layout, count, settings,
-                       top_z=part_top(nominal.shape, nominal.face), order=order,
-                       extra_check=check, progress=progress)
-    return plan, nominal, check is not None
+    plan, part = plan_face(nominal, layout, count, settings, order, progress)
+    return plan, nominal, part
 
 
 def program_settings(args, plan, sha256):
