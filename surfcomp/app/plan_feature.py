@@ -80,29 +80,37 @@ class MeasurementPlanFeature(Proxy):
         compute_plan(obj)
 
 
-def settings_of(obj):
-    """The :class:`PlanSettings` of the object's properties (checked)."""
-    return PlanSettings(tip_radius=obj.TipRadius, edge_margin=obj.EdgeMargin,
-                        max_tilt=obj.MaxTilt, stand_off=obj.StandOff,
-                        clearance=obj.Clearance).check()
+def trial_plan(obj, **values):
+    """The plan of ``obj`` with some properties replaced by ``values`` (``Layout``,
+    ``Count``, ``Points``, ``TipRadius``, ...), nothing written: a task panel checks its
+    fields with it before they reach the object, so no recompute fails. Raises the
+    planner's :class:`~surfcomp.errors.SurfcompError`."""
+    from .nominal import nominal_from_face, pick_face
+    from .plan_reach import plan_face
+
+    def val(name):
+        return values.get(name, getattr(obj, name))
+
+    if obj.Nominal is None or not hasattr(obj.Nominal, "Shape") or obj.Nominal.Shape.isNull():
+        raise GeometryError("the measurement plan needs a nominal object with a shape")
+    shape = obj.Nominal.Shape
+    face, name = pick_face(shape, val("Face") or None, source=obj.Nominal.Label)
+    nominal = nominal_from_face(face, source=obj.Nominal.Label, face_name=name, shape=shape)
+    layout = val("Layout")
+    count = check_points(val("Points")) if layout in POINT_LAYOUTS else parse_count(val("Count"))
+    settings = PlanSettings(tip_radius=val("TipRadius"), edge_margin=val("EdgeMargin"),
+                            max_tilt=val("MaxTilt"), stand_off=val("StandOff"),
+                            clearance=val("Clearance")).check()
+    return plan_face(nominal, layout, count, settings)[0]
 
 
 def compute_plan(obj):
     """Plan on the linked face and write the results (and the points' Shape) to ``obj``."""
     import Part
 
-    from .nominal import nominal_from_face, pick_face
     from .plan_reach import REASONS as PART_REASONS
-    from .plan_reach import plan_face
 
-    if obj.Nominal is None or not hasattr(obj.Nominal, "Shape") or obj.Nominal.Shape.isNull():
-        raise GeometryError("the measurement plan needs a nominal object with a shape")
-    shape = obj.Nominal.Shape
-    face, name = pick_face(shape, obj.Face or None, source=obj.Nominal.Label)
-    nominal = nominal_from_face(face, source=obj.Nominal.Label, face_name=name, shape=shape)
-    count = (check_points(obj.Points) if obj.Layout in POINT_LAYOUTS
-             else parse_count(obj.Count))
-    plan, _part = plan_face(nominal, obj.Layout, count, settings_of(obj))
+    plan = trial_plan(obj)
     V = FreeCAD.Vector
     obj.PlanPoints = [V(*p) for p in plan.points]
     obj.PlanNormals = [V(*n) for n in plan.normals]
