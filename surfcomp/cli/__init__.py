@@ -22,7 +22,7 @@ from . import registry, runner
 from .runner import Terminated  # noqa: F401  (the signal exception, for callers)
 
 #: subcommand modules, in the order ``--help`` lists them
-COMMANDS = ("compensate", "inspect", "simulate", "gcode")
+COMMANDS = ("compensate", "inspect", "simulate", "gcode", "plan")
 
 
 def build_parser(only=None):

@@ -4,12 +4,16 @@
 :func:`add_program_options` adds the ``probing program`` option group to the ``plan``
 parser (``--program`` comes from :mod:`surfcomp.cli.registry`, so it is checked against
 the command's inputs and outputs); :func:`write_from_args` writes the program of a plan
-(:mod:`surfcomp.io.probe_program`) and returns the summary lines. The tip radius is the
-plan command's own ``--tip-radius``.
+(:mod:`surfcomp.io.probe_program`) and returns the summary lines;
+:func:`program_from_args` gives the text for the plan command to stage beside the plan in
+one transaction. The tip radius, the stand-off and the clearance are the plan command's own
+``--tip-radius``, ``--stand-off`` and ``--clearance`` (its reach checks test the moves the
+program makes with them).
 """
 
+from ..io.atomic import write_text
 from ..io.probe_path import DIALECTS, WORK_OFFSETS
-from ..io.probe_program import ProbeSettings, write_probe_program
+from ..io.probe_program import ProbeSettings, program_summary, program_text
 from . import registry
 from .common import wrote
 
@@ -29,12 +33,6 @@ def add_program_options(parser):
                    help="the probe's tool number (default %d)" % d.tool)
     g.add_argument("--work-offset", choices=WORK_OFFSETS, default=d.work_offset,
                    help="the work offset the part was machined in (default G54)")
-    g.add_argument("--clearance", type=float, default=d.clearance, metavar="MM",
-                   help="the ball's distance from the part during rapid moves; the safe "
-                        "height is the part's top plus it (default %g)" % d.clearance)
-    g.add_argument("--standoff", type=float, default=d.standoff, metavar="MM",
-                   help="where the probe move starts, along the normal from the nominal "
-                        "contact (default %g)" % d.standoff)
     g.add_argument("--overtravel", type=float, default=d.overtravel, metavar="MM",
                    help="how far past the nominal contact the probe move may go (default %g)"
                         % d.overtravel)
@@ -55,46 +53,58 @@ def add_program_options(parser):
 
 
 def settings_from_args(args, safe_z, plan_hash):
-    """The :class:`ProbeSettings` of a command line (``args.tip_radius`` is the plan's)."""
+    """The :class:`ProbeSettings` of a command line (``args.tip_radius``, ``args.clearance``
+    and ``args.stand_off`` are the plan's)."""
     return ProbeSettings(
         dialect=args.dialect, tip_radius=args.tip_radius, tool=args.tool,
         work_offset=args.work_offset, safe_z=safe_z, clearance=args.clearance,
-        standoff=args.standoff, overtravel=args.overtravel, feed=args.feed,
+        standoff=args.stand_off, overtravel=args.overtravel, feed=args.feed,
         touch_feed=args.touch_feed, second_touch=args.second_touch,
         second_feed=args.second_feed, backoff=args.backoff, plan_hash=plan_hash,
         log_file=args.probe_log)
 
 
-def write_from_args(args, ids, points, normals, safe_z, plan_hash):
-    """Write ``args.program`` for the plan (nothing without ``--program``).
+def program_from_args(args, ids, points, normals, safe_z, plan_hash):
+    """The program text of ``args.program`` for the plan and its summary lines.
 
     Parameters
     ----------
     args : argparse.Namespace
-        With the options of :func:`add_program_options` and ``tip_radius``.
+        With the options of :func:`add_program_options` and the plan's ``tip_radius``,
+        ``clearance`` and ``stand_off``.
     ids, points, normals
         The plan in visiting order (points and unit outward normals (N, 3), mm).
     safe_z : float
         The part's top (mm).
     plan_hash : str
-        Hex SHA-256 of the written plan file.
+        Hex SHA-256 of the plan file's text.
 
     Returns
     -------
-    list of str
-        Summary lines (the program, the travel, ``wrote ...``).
+    (str, list of str)
+        The program and the summary lines (the program, the travel, ``wrote ...``).
     """
-    if not getattr(args, "program", None):
-        return []
     s = settings_from_args(args, safe_z, plan_hash)
-    inputs = registry.declared(args, "plan")[1]
-    res = write_probe_program(args.program, ids, points, normals, s, inputs=inputs)
+    text, moves = program_text(ids, points, normals, s)
+    res = program_summary(args.program, moves, s)
     t = res["travel"]
     log = ("probe log %s, %d lines" % (s.log_file, res["log_lines"])
            if s.dialect == "linuxcnc" else "DPRNT log, %d lines" % res["log_lines"])
-    return ["Program:      %s (%s, %d points, tip radius %g mm, %s, %s, safe height Z%.3f)"
-            % (args.program, s.dialect, res["points"], s.tip_radius, s.work_offset, log,
-               res["safe_height"]),
-            "Travel:       %.1f mm (traverse %.1f mm, feed %.1f mm, probing %.1f mm)"
-            % (t["total"], t["traverse"], t["feed"], t["probe"]),
-            wrote(args.program)]
+    return text, [
+        "Program:      %s (%s, %d points, tip radius %g mm, %s, %s, safe height Z%.3f)"
+        % (args.program, s.dialect, res["points"], s.tip_radius, s.work_offset, log,
+           res["safe_height"]),
+        "Travel:       %.1f mm (traverse %.1f mm, feed %.1f mm, probing %.1f mm)"
+        % (t["total"], t["traverse"], t["feed"], t["probe"]),
+        wrote(args.program)]
+
+
+def write_from_args(args, ids, points, normals, safe_z, plan_hash):
+    """Write ``args.program`` for the plan (nothing without ``--program``); arguments as
+    for :func:`program_from_args`; returns the summary lines."""
+    if not getattr(args, "program", None):
+        return []
+    text, lines = program_from_args(args, ids, points, normals, safe_z, plan_hash)
+    write_text(args.program, text, inputs=registry.declared(args, "plan")[1],
+               option="--program")
+    return lines

@@ -102,6 +102,10 @@ ENTRIES = (
           dict(metavar="ERR.csv",
                help="per-axis error measurements (as for the gcode command); the fitted "
                     "Dobariya 2015 model adds its error along the normal"), group=SIM_MODEL),
+    Entry(("simulate",), ("--plan",), "input", "--plan",
+          dict(metavar="PLAN.csv",
+               help="measure the simulated parts at this plan's points (python3 -m surfcomp "
+                    "plan)"), group="measurement plan (instead of the --grid nodes)"),
     Entry(("simulate",), ("--json",), "output", "--json",
           dict(metavar="OUT.json", help="write every replica's statistics (JSON)"),
           group=SIM_OUTPUT),
@@ -112,6 +116,13 @@ ENTRIES = (
                     "simulated one (--preset) and the simulated parts' maps"),
           group=SIM_OUTPUT),
     # ------------------------------------------------------------------ plan
+    Entry(("plan",), ("nominal",), "input", "NOMINAL",
+          dict(metavar="NOMINAL", help=_NOMINAL_HELP)),
+    Entry(("plan",), ("-o", "--output"), "output", "-o",
+          dict(required=True, metavar="PLAN.csv",
+               help="the plan: id, nominal XYZ, outward normal IJK (mm), in visiting order")),
+    Entry(("plan",), ("--dropped",), "output", "--dropped",
+          dict(metavar="OUT.csv", help="also write every dropped point with its reason")),
     Entry(("plan",), ("--program",), "output", "--program",
           dict(metavar="PROBE.ngc",
                help="also write the probing program of the plan (tip-centre positions, in "

@@ -63,7 +63,7 @@ from ..errors import InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
-from . import registry
+from . import registry, simulate_plan
 from .common import ProgressLine, wrote
 
 _DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
@@ -157,6 +157,7 @@ def add_parser(subparsers):
                         "refused as a likely unit mistake (default 1 mm, as for gcode)")
     m.add_argument("--reference", default="0,0,0", metavar="X,Y,Z",
                    help="reference point of the axis error measurements (default 0,0,0)")
+    simulate_plan.add_options(p)
     o = p.add_argument_group(registry.SIM_OUTPUT)
     registry.add_options(p, "simulate", {registry.SIM_OUTPUT: o}, flags=("--json", "--html"))
     o.add_argument("--report-method", metavar="LABEL",
@@ -310,21 +311,31 @@ def run(args):
     specs = sim.method_specs(methods, masks, None, args.mask_kind, args.edge, args.refine)
     check_memory(grid, between, replicas, len(specs), args.max_memory)
     report_label = _report_label(args, specs)
+    simulate_plan.check(args)
     model = model_from_args(args, preset)
     check_outputs(*_declared(args))
     progress = ProgressLine(args.quiet)
     surface, outward, info, name = _nominal(args, preset)
-    res = sim.simulate(surface, outward, model, grid=grid, specs=specs, replicas=replicas,
-                       seed=args.seed, margin=args.margin, between=between,
-                       keep=bool(args.html), progress=sub(progress, 0, 0.95))
+    loop = dict(grid=grid, specs=specs, replicas=replicas, seed=args.seed, margin=args.margin,
+                between=between)
+    if args.compare_layouts is not None:
+        print("Nominal:   %s" % name)
+        return simulate_plan.run_compare(args, surface, outward, model, loop,
+                                         {"nominal": info}, sub(progress, 0, 0.95))
+    plan = simulate_plan.resolve(args, surface, outward)
+    res = sim.simulate(surface, outward, model, keep=bool(args.html),
+                       progress=sub(progress, 0, 0.95),
+                       points=None if plan is None else plan.points, **loop)
     res.preset = preset
     inputs = {"nominal": info}
+    if plan is not None:
+        inputs["plan"] = plan.info
     data = res.as_dict()
     if preset is not None and args.nominal is not None:
         data["preset"]["surface_replaced_by"] = info["path"]
     data = dict({"command": "simulate", "inputs": inputs}, **data)
     _write(args, res, data, inputs, report_label)
-    _print(args, res, grid, name, preset)
+    _print(args, res, grid, name, preset, plan)
     return 0
 
 
@@ -354,14 +365,19 @@ def _write(args, res, data, inputs, report_label):
         tx.commit()
 
 
-def _print(args, res, grid, name, preset):
+def _print(args, res, grid, name, preset, plan=None):
     print("Nominal:   %s" % name)
     if preset is not None:
         print("Preset:    %s (%s)%s" % (preset.name, preset.imitates,
                                         "; surface replaced by NOMINAL" if args.nominal else ""))
-    print("Grid:      %d x %d measured, %d x %d evaluated (nodes and between); "
-          "%d replica(s), seed %d"
-          % (grid + res.eval_shape + (res.replicas, res.seed)))
+    if plan is not None:
+        print("Measured:  %s ('grid' statistics: at these points); %d x %d evaluated; "
+              "%d replica(s), seed %d" % ((plan.text,) + res.eval_shape
+                                          + (res.replicas, res.seed)))
+    else:
+        print("Grid:      %d x %d measured, %d x %d evaluated (nodes and between); "
+              "%d replica(s), seed %d"
+              % (grid + res.eval_shape + (res.replicas, res.seed)))
     print("Methods:   %s" % ", ".join(res.labels))
     print("")
     print(res.table())

@@ -255,14 +255,38 @@ class _Shop:
     layout: Layout
     projector: Projector
     _nominal: tuple = None
+    #: (u, v) (P,) of measured points off the grid (a plan), machined with the grid
+    probe_uv: tuple = None
 
     def cam(self, given):
-        """CAM points and normals of ``given`` on the evaluation grid (the nominal's kept)."""
-        if given is self.surface:
-            if self._nominal is None:
-                self._nominal = cam_grid(given, self.outward, self.layout.us, self.layout.vs)
+        """CAM points and normals of ``given`` on the evaluation grid (the nominal's kept);
+        with ``probe_uv``, flat (Ne * Me + P, 3): the grid's, then the probed points'."""
+        if given is self.surface and self._nominal is not None:
             return self._nominal
-        return cam_grid(given, self.outward, self.layout.us, self.layout.vs)
+        S, n = cam_grid(given, self.outward, self.layout.us, self.layout.vs)
+        if self.probe_uv is not None:
+            Sp, Su, Sv = bspline.derivatives(given, *self.probe_uv, 1)
+            npr = np.cross(Su, Sv)
+            npr *= self.outward / np.linalg.norm(npr, axis=-1, keepdims=True)
+            S, n = np.concatenate([S.reshape(-1, 3), Sp]), np.concatenate([n.reshape(-1, 3), npr])
+        if given is self.surface:
+            self._nominal = (S, n)
+        return S, n
+
+    def split(self, d):
+        """Values of a machined part ``(on the evaluation grid (Ne, Me), at the measured
+        points)``: the grid nodes (n, m), or the probed points (P,)."""
+        if self.probe_uv is None:
+            return d, d[::self.layout.between, ::self.layout.between]
+        k = self.layout.us.size * self.layout.vs.size
+        return d[:k].reshape(self.layout.eval_shape), d[k:]
+
+    def stats(self, d, at, nodes):
+        """``{'all', 'grid', 'between'}`` statistics; with probed points 'grid' is theirs."""
+        out = _stats3(d, nodes)
+        if self.probe_uv is not None:
+            out["grid"] = statistics(at)
+        return out
 
     def semi_finish(self, given, rng, cam=None):
         """The semi-finishing pass from ``given``: its points and error ``e_1`` (Ne, Me)."""
@@ -285,9 +309,12 @@ class _Shop:
         return measure(self.projector, self.outward, M, rng, self.model.probe_sigma)
 
     def measure_nodes(self, points, rng):
-        b = self.layout.between
-        return measure(self.projector, self.outward, points[::b, ::b], rng,
-                       self.model.probe_sigma)
+        """Measure machined ``points`` at the grid nodes, or at the probed points."""
+        if self.probe_uv is None:
+            at = points[::self.layout.between, ::self.layout.between]
+        else:
+            at = points[self.layout.us.size * self.layout.vs.size:]
+        return measure(self.projector, self.outward, at, rng, self.model.probe_sigma)
 
 
 def _with_stock(spec, stock):
@@ -298,7 +325,7 @@ def _with_stock(spec, stock):
 
 
 def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4, seed=0,
-             margin=0.02, between=2, keep=False, progress=None):
+             margin=0.02, between=2, keep=False, progress=None, points=None):
     """Run the virtual machining loop (module docstring) for every method and replica.
 
     Parameters
@@ -325,6 +352,11 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
         machining), the evaluation grid's nominal points (``SimulationResult.points``,
         (Ne, Me, 3)) and :class:`~surfcomp.core.pipeline.Compensation` objects
         (``SimulationResult.compensations[label]``) for reports.
+    points : ndarray (P, 3), optional
+        Measure at these nominal points (a measurement plan, in its order) instead of the
+        grid nodes, compensated as a scattered layout; ``grid`` then sets the evaluation
+        grid only, and the statistics' ``'grid'`` are those at the points. (Not with
+        ``keep``.)
 
     Returns
     -------
@@ -337,19 +369,21 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
                          % (MAX_REPLICAS, replicas))
     if int(seed) != seed or seed < 0:
         raise InputError("the seed must be a whole number >= 0, got %r" % (seed,))
+    if points is not None and keep:
+        raise InputError("the maps of a simulation need the grid: measure on the grid, or "
+                         "give no report")
     layout = make_layout(surface, grid, margin, between)
     shop = _Shop(model, model.frame(surface), surface, outward, layout, Projector(surface))
     nodes = layout.node_mask()
     b = layout.between
+    ms = _measurement_set(surface, outward, layout, points)
+    # a plan's points are a scattered layout (the smoothing fit), even when nearly in rows
+    prepared = prepare(surface, outward, ms, Options(
+        max_offset=100.0, layout="auto" if points is None else "scattered"))
+    nrm = ms.normal
+    if points is not None:
+        shop.probe_uv = (prepared.u, prepared.v)
     n, m = layout.grid
-    # the measurement set's nominal points and normals on the grid (fixed for all parts)
-    S, Su, Sv = bspline.evaluate_grid(surface, layout.us[::b], layout.vs[::b], order=1)
-    nrm = np.cross(Su, Sv)
-    nrm *= outward / np.linalg.norm(nrm, axis=-1, keepdims=True)
-    rows, cols = np.indices((n, m))
-    ms = GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                          deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
-    prepared = prepare(surface, outward, ms, Options(max_offset=100.0))
     result = SimulationResult(model=model, specs=specs, grid=(n, m), eval_shape=layout.eval_shape,
                               between=b, margin=margin, replicas=int(replicas), seed=int(seed),
                               noise_floor=model.noise_floor(nrm.reshape(-1, 3)))
@@ -357,15 +391,16 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     k = 0
     for r in range(replicas):
         report(progress, k / steps, "replica %d: machining the nominal" % (r + 1))
-        first = shop.finish(surface, _rng(seed, r, 0), semi_rng=_rng(seed, r, "semi"))
-        result.before.append(_stats3(first, nodes))
+        first, first_at = shop.split(shop.finish(surface, _rng(seed, r, 0),
+                                                 semi_rng=_rng(seed, r, "semi")))
+        result.before.append(shop.stats(first, first_at, nodes))
         k += 1
         for spec in specs:
             report(progress, k / steps, "replica %d: %s" % (r + 1, spec.label))
             rng = _rng(seed, r, spec.label)
             e_semi, comp = None, None
             if spec.method == "none":
-                given, d_grid, delta = surface, first[::b, ::b], np.zeros((n, m))
+                given, d_grid, delta = surface, first_at, np.zeros(first_at.shape)
             else:
                 if spec.method == "mirror":
                     # on the machine: the part's own semi-finished surface, stock included
@@ -373,14 +408,16 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
                     d_grid = shop.measure_nodes(M, rng)
                     result.add_semi(spec.label, d_grid, model.stock)
                 else:
-                    d_grid = first[::b, ::b]
-                prep = replace(prepared, deviation=_file_order(prepared, d_grid))
+                    d_grid = first_at
+                prep = replace(prepared, deviation=d_grid if points is not None
+                               else _file_order(prepared, d_grid))
                 comp = compensate(surface, outward, prep, spec.options,
                                   progress=sub(progress, k / steps, (k + 0.9) / steps))
                 given, delta = comp.corrected, comp.correction.delta
                 result.checks.setdefault(spec.label, []).append(comp.checks.max_error_at_points)
-            after = shop.finish(given, rng, e_semi, semi_rng=_rng(seed, r, "semi " + spec.label))
-            result.after.setdefault(spec.label, []).append(_stats3(after, nodes))
+            after, after_at = shop.split(shop.finish(given, rng, e_semi,
+                                                     semi_rng=_rng(seed, r, "semi " + spec.label)))
+            result.after.setdefault(spec.label, []).append(shop.stats(after, after_at, nodes))
             if keep and r == 0:
                 result.maps[spec.label] = {"measured": d_grid, "correction": delta, "after": after}
                 if comp is not None:
@@ -391,6 +428,23 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
             result.points = bspline.evaluate_grid(surface, layout.us, layout.vs)
     report(progress, 1.0, "done")
     return result
+
+
+def _measurement_set(surface, outward, layout, points=None):
+    """The measurement set (deviations zero) of the grid nodes, or of ``points`` (P, 3)."""
+    b = layout.between
+    if points is not None:
+        P = np.asarray(points, dtype=float).reshape(-1, 3)
+        proj = Projector(surface).project(P)
+        return GridMeasurements(nominal=P, normal=proj.normal * outward,
+                                deviation=np.zeros(len(P)), row=None, col=None)
+    n, m = layout.grid
+    S, Su, Sv = bspline.evaluate_grid(surface, layout.us[::b], layout.vs[::b], order=1)
+    nrm = np.cross(Su, Sv)
+    nrm *= outward / np.linalg.norm(nrm, axis=-1, keepdims=True)
+    rows, cols = np.indices((n, m))
+    return GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                            deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
 
 
 def _file_order(prepared, grid_values):

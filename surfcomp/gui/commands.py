@@ -126,6 +126,11 @@ TEXTS = {
         QT_TRANSLATE_NOOP("SurfComp_Report", "Statistics of deviations, determined and random "
                                              "components and correction (like the papers' "
                                              "tables), copyable")),
+    "SurfComp_PlanMeasurement": (
+        QT_TRANSLATE_NOOP("SurfComp_PlanMeasurement", "Plan measurement"),
+        QT_TRANSLATE_NOOP("SurfComp_PlanMeasurement", "Place the probing points on the "
+                                                      "selected face (grid, XY grid or "
+                                                      "adaptive) for on-machine measurement")),
 }
 
 # -- the base command -----------------------------------------------------------------------
@@ -538,15 +543,29 @@ class Report(_CompensationCommand):
         dialogs.run_dialog(ReportDialog(comp))
 
 
+class PlanMeasurement(Command):
+    ID = "SurfComp_PlanMeasurement"
+
+    def active(self):
+        return selected_face() is not None
+
+    def run(self):
+        from .plan_panel import PlanPanel
+
+        nom, face = selected_face()
+        FreeCADGui.Control.showDialog(PlanPanel(nom, face))
+
+
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
             ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
-            RestoreNominal, Report)
+            RestoreNominal, Report, PlanMeasurement)
 #: command groups (toolbar drop-downs)
 GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
            "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
-           "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report")
+           "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report",
+           None, "SurfComp_PlanMeasurement")
 
 
 def register():

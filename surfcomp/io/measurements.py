@@ -163,8 +163,9 @@ _SEP_NAMES = {",": "','", ";": "';'", "\t": "tabs", None: "blanks"}
 _UNIT_NAMES = {1.0: "mm", 1e-3: "um", 25.4: "in", 10.0: "cm", 1000.0: "m"}
 
 
-def read_measurements(path, units="mm"):
-    """Read a measurement file.
+def read_measurements(path, units="mm", plan=False):
+    """Read a measurement file (``plan``: a measurement plan, nominal points and normals
+    without deviations or measured points, as ``python3 -m surfcomp plan`` writes it).
 
     Parameters
     ----------
@@ -186,7 +187,7 @@ def read_measurements(path, units="mm"):
         and what was expected in the message).
     """
     source = os.fspath(path)
-    return parse_measurements(read_bytes(source), source=source, units=units)
+    return parse_measurements(read_bytes(source), source=source, units=units, plan=plan)
 
 
 def parse_measurements(text_or_bytes, source="<text>", units="mm", plan=False):
@@ -273,6 +274,9 @@ def _is_number(text):
 
 class _Parser:
     """One parse of one file: keeps the source lines for messages."""
+
+    #: a measurement plan: nominal points and normals suffice
+    plan = False
 
     def __init__(self, text, source, default_factor):
         self.source = source

@@ -182,6 +182,12 @@ def write_probe_program(path, ids, points, normals, settings, inputs=(), option=
     """
     text, moves = program_text(ids, points, normals, settings)
     write_text(path, text, inputs=inputs, option=option)
+    return program_summary(path, moves, settings)
+
+
+def program_summary(path, moves, settings):
+    """The summary :func:`write_probe_program` returns, for the moves of
+    :func:`program_text`."""
     per_point = 2 if settings.second_touch and settings.dialect == "linuxcnc" else 1
     return {"path": path, "dialect": settings.dialect, "points": len(moves.ids),
             "log_lines": per_point * len(moves.ids), "tip_radius": settings.tip_radius,

@@ -43,6 +43,8 @@ COMMANDS = {
     "gcode": (("gcode", "in.ngc", "--axis-errors", "e.csv"),
               {"in.ngc": "IN.ngc", "e.csv": "--axis-errors"},
               {"-o": "out.ngc", "--report": "r.json"}, ("-o",)),
+    "plan": (("plan", "nominal.step", "--quiet"), {"nominal.step": "NOMINAL"},
+             {"-o": "p.csv", "--dropped": "d.csv"}, ("-o",)),
     "document": (("compensate", "d.FCStd", "m.csv", "--object", "Nominal", "--replace",
                   "--quiet"),
                  {"d.FCStd": "document", "m.csv": "MEASUREMENTS"},
@@ -148,7 +150,7 @@ def test_a_folder_that_does_not_exist_is_an_error(command, option, path, tmp_pat
 # --------------------------------------------------------------------- every input guarded
 def _registry_pairs():
     """(command, input entry, output entry) of every command line the registry allows."""
-    return [(cmd, i, o) for cmd in ("compensate", "inspect", "simulate", "gcode")
+    return [(cmd, i, o) for cmd in ("compensate", "inspect", "simulate", "gcode", "plan")
             for i in registry.entries(cmd, "input") for o in registry.entries(cmd, "output")]
 
 

@@ -5,40 +5,6 @@
 from surfcomp.app import features
 
 
-def click(widget):
-    """A real left click in the middle of ``widget``."""
-    Gui.updateGui()
-    pos = QtCore.QPointF(widget.width() / 2.0, widget.height() / 2.0)
-    glob = QtCore.QPointF(widget.mapToGlobal(pos.toPoint()))
-    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
-                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        ev = QtGui.QMouseEvent(kind, pos, glob, QtCore.Qt.LeftButton, buttons,
-                               QtCore.Qt.NoModifier)
-        QtGui.QApplication.sendEvent(widget, ev)
-    Gui.updateGui()
-
-
-def key(widget, code, text="", modifiers=None):
-    """A real key press and release on ``widget``."""
-    mods = QtCore.Qt.NoModifier if modifiers is None else modifiers
-    for kind in (QtCore.QEvent.KeyPress, QtCore.QEvent.KeyRelease):
-        QtGui.QApplication.sendEvent(widget, QtGui.QKeyEvent(kind, code, mods, text))
-    Gui.updateGui()
-
-
-def type_value(spin, text):
-    """Select the spin box's text (Ctrl+A) and type ``text`` key by key."""
-    spin.setFocus()
-    key(spin, QtCore.Qt.Key_A, "a", QtCore.Qt.ControlModifier)
-    point = spin.locale().decimalPoint()
-    point = point if isinstance(point, str) else chr(point)
-    for ch in text:
-        if ch == ".":
-            key(spin, QtCore.Qt.Key_Period if point == "." else QtCore.Qt.Key_Comma, point)
-        else:
-            key(spin, getattr(QtCore.Qt, "Key_" + ch), ch)
-
-
 def shown(dlg):
     dlg.show()
     for _ in range(5):

@@ -16,7 +16,8 @@ from tests.gui.harness import run_session
 
 COMMAND_IDS = ["SurfComp_BuildFace", "SurfComp_DeviationMap", "SurfComp_Filter",
                "SurfComp_ImportMeasurements", "SurfComp_LoadNominal", "SurfComp_Mirror",
-               "SurfComp_ReplaceInDocument", "SurfComp_Report", "SurfComp_RestoreNominal",
+               "SurfComp_PlanMeasurement", "SurfComp_ReplaceInDocument", "SurfComp_Report",
+               "SurfComp_RestoreNominal",
                "SurfComp_ShowCorrection", "SurfComp_ShowDetermined", "SurfComp_ShowDeviation",
                "SurfComp_ShowMaps", "SurfComp_ShowRandom"]
 

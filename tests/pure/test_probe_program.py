@@ -12,7 +12,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.cli.plan_program import add_program_options, write_from_args
+from surfcomp.cli import plan as plan_cli
+from surfcomp.cli.plan_program import write_from_args
 from surfcomp.errors import InputError
 from surfcomp.io.probe_program import ProbeSettings, program_text, write_probe_program
 from tests.probe_checks import PRINTED, check_probe_moves, rs274_moves
@@ -157,14 +158,15 @@ def test_bad_plans_and_settings_write_nothing(tmp_path, change, words):
 
 
 def test_program_options_from_the_command_line(tmp_path):
-    """The options as the plan command adds them, through argparse."""
+    """The options as the plan command adds them, through its own parser (the tip radius,
+    stand-off and clearance are the plan's)."""
     parser = argparse.ArgumentParser()
-    parser.add_argument("--tip-radius", type=float, default=1.0)
-    add_program_options(parser)
+    plan_cli.add_parser(parser.add_subparsers())
     ids, P, N = dome_plan(8)
     prog = tmp_path / "p.ngc"
-    args = parser.parse_args(["--program", str(prog), "--tip-radius", "1.5", "--tool", "7",
-                              "--work-offset", "G55", "--clearance", "4", "--standoff", "2",
+    base = ["plan", str(tmp_path / "n.step"), "-o", str(tmp_path / "plan.csv")]
+    args = parser.parse_args(base + ["--program", str(prog), "--tip-radius", "1.5", "--tool", "7",
+                              "--work-offset", "G55", "--clearance", "4", "--stand-off", "2",
                               "--overtravel", "1", "--feed", "800", "--touch-feed", "40",
                               "--probe-log", "run1.txt"])
     lines = write_from_args(args, ids, P, N, 10.0, HASH)
@@ -181,6 +183,6 @@ def test_program_options_from_the_command_line(tmp_path):
     total = float(re.search(r"Travel: +([0-9.]+) mm", lines[1]).group(1))
     pos, _kinds = path.polyline()
     assert abs(total - np.linalg.norm(np.diff(pos, axis=0), axis=1).sum()) < 0.05
-    assert write_from_args(parser.parse_args([]), ids, P, N, 10.0, HASH) == []
+    assert write_from_args(parser.parse_args(base), ids, P, N, 10.0, HASH) == []
     with pytest.raises(SystemExit):
-        parser.parse_args(["--dialect", "siemens"])
+        parser.parse_args(base + ["--dialect", "siemens"])

@@ -1,0 +1,113 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Reach of planned points against the whole part, with OpenCASCADE (app layer, headless).
+
+The core (:mod:`surfcomp.core.planning_reach`) checks the probe's paths against the planned
+face itself; when the nominal face is a face of a solid (or of a shell with other faces),
+the stylus ball must also stay clear of every other face: on the approach along the normal
+(stand-off to touch) and on the descent from the safe height to the stand-off. Each path is
+a segment; a face whose bounding box, widened by the ball radius, misses the segment's is
+skipped, the others are measured with ``distToShape`` (exact, OCCT's BRepExtrema).
+"""
+
+import numpy as np
+
+from ..core.planning_reach import CLEAR_TOL
+
+#: the reasons added to :data:`surfcomp.core.planning.REASONS`
+REASONS = {
+    "part-approach": "the stylus meets another face of the part on the approach along the "
+                     "normal",
+    "part-descent": "the stylus meets another face of the part on the descent from the safe "
+                    "height",
+}
+
+
+def other_faces(shape, face_name):
+    """The faces of ``shape`` other than its ``face_name`` (``FaceN``)."""
+    if shape is None:
+        return []
+    k = int(face_name[4:]) - 1
+    return [f for i, f in enumerate(shape.Faces) if i != k]
+
+
+def part_top(shape, face):
+    """The part's top (mm): the highest Z of the shape (or the face when there is none), from
+    OCCT's optimal bounding box where this FreeCAD has it."""
+    target = shape if shape is not None else face
+    box = target.optimalBoundingBox() if hasattr(target, "optimalBoundingBox") else \
+        target.BoundBox
+    return float(box.ZMax)
+
+
+def _boxes(faces):
+    out = np.empty((len(faces), 6))
+    for k, f in enumerate(faces):
+        b = f.optimalBoundingBox() if hasattr(f, "optimalBoundingBox") else f.BoundBox
+        out[k] = (b.XMin, b.YMin, b.ZMin, b.XMax, b.YMax, b.ZMax)
+    return out
+
+
+def _path_shape(a, b):
+    import FreeCAD
+    import Part
+
+    va, vb = FreeCAD.Vector(*a), FreeCAD.Vector(*b)
+    if (vb - va).Length <= 1e-9:
+        return Part.Vertex(va)
+    return Part.LineSegment(va, vb).toShape()
+
+
+def blocked_by_faces(a, b, faces, boxes, radius, tol=CLEAR_TOL):
+    """Which segments ``a``-``b`` (N, 3) pass closer than ``radius - tol`` to one of
+    ``faces``: bool (N,)."""
+    out = np.zeros(len(a), dtype=bool)
+    if not faces:
+        return out
+    lo = np.minimum(a, b) - radius
+    hi = np.maximum(a, b) + radius
+    for i in range(len(a)):
+        hit = np.flatnonzero(np.all(boxes[:, :3] <= hi[i], axis=1)
+                             & np.all(boxes[:, 3:] >= lo[i], axis=1))
+        if not hit.size:
+            continue
+        path = _path_shape(a[i], b[i])
+        for k in hit:
+            if path.distToShape(faces[k])[0] < radius - tol:
+                out[i] = True
+                break
+    return out
+
+
+def part_check(shape, face_name, tip_radius):
+    """The ``extra_check`` of :func:`surfcomp.core.planning.plan_points` for the face
+    ``face_name`` (``FaceN``) of ``shape`` (None when the shape has no other face: a lone
+    face)."""
+    faces = other_faces(shape, face_name)
+    if not faces:
+        return None
+    boxes = _boxes(faces)
+
+    def check(points, normals, touch, standoff, top):
+        approach = blocked_by_faces(standoff, touch, faces, boxes, tip_radius)
+        descent = blocked_by_faces(top, standoff, faces, boxes, tip_radius)
+        descent &= ~approach
+        return [("part-approach", approach), ("part-descent", descent)]
+
+    return check
+
+
+def plan_face(nominal, layout, count, settings, order="auto", progress=None):
+    """``(plan, checked_part)``: plan on a :class:`surfcomp.app.nominal.Nominal` face with
+    its trim boundary, the part's top and, when the shape has other faces, the paths checked
+    against them (``checked_part`` True then)."""
+    from ..core.planning import plan_points
+    from ..core.planning_face import FaceDomain
+    from .nominal import boundary_polylines
+
+    domain = FaceDomain(nominal.surface, nominal.outward,
+                        boundary_polylines(nominal.bspline_face))
+    check = part_check(nominal.shape, nominal.face_name, settings.tip_radius)
+    plan = plan_points(domain, layout, count, settings,
+                       top_z=part_top(nominal.shape, nominal.face), order=order,
+                       extra_check=check, progress=progress)
+    return plan, check is not None

@@ -1,0 +1,151 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Task panel of the Plan measurement command: the layout, its count and the probe.
+
+The panel makes a ``SurfComp_MeasurementPlan`` object on the selected face (one undo step
+with everything the panel does): **Plan** applies the fields and recomputes (the points show
+in the 3D view, the counts and the drops in the panel), OK applies them and keeps the
+object, Cancel removes it. An error (a tip larger than the face's concave radius, no
+reachable point) stays in the panel; OK then keeps the panel open. No numerics here: the
+object's proxy (:mod:`surfcomp.app.plan_feature`) plans.
+"""
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtGui
+
+from ..app.undo import UndoStep
+from ..core.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
+
+translate = FreeCAD.Qt.translate
+
+
+def _spin(value, low, high, step=1.0, decimals=None):
+    box = QtGui.QDoubleSpinBox() if decimals is not None else QtGui.QSpinBox()
+    if decimals is not None:
+        box.setDecimals(decimals)
+    box.setRange(low, high)
+    box.setSingleStep(step)
+    box.setValue(value)
+    return box
+
+
+class PlanPanel:
+    """Task panel (module docstring)."""
+
+    #: the open panel (None when closed), for scripts and tests
+    instance = None
+
+    def __init__(self, nominal, face):
+        PlanPanel.instance = self
+        self.doc = nominal.Document
+        self.step = UndoStep(self.doc, translate("SurfComp", "Plan measurement")).open()
+        FreeCADGui.addModule("surfcomp.app.plan_feature")
+        FreeCADGui.doCommand("_plan = surfcomp.app.plan_feature.make_measurement_plan("
+                             "App.getDocument(%r), App.getDocument(%r).getObject(%r), %r)"
+                             % (self.doc.Name, self.doc.Name, nominal.Name, face))
+        self.obj = self.doc.Objects[-1]
+        # no view provider of its own: the Part view provider's (FreeCAD's idiom: a proxy
+        # of 0), whose Points mode draws the plan's vertices
+        FreeCADGui.doCommand("_plan.ViewObject.Proxy = 0")
+        FreeCADGui.doCommand("_plan.ViewObject.PointSize = 6")
+        FreeCADGui.doCommand("_plan.ViewObject.PointColor = (0.85, 0.1, 0.1)")
+        obj = self.obj
+        self.form = QtGui.QWidget()
+        self.form.setWindowTitle(translate("SurfComp", "Plan measurement"))
+        lay = QtGui.QFormLayout(self.form)
+        self.layout = QtGui.QComboBox()
+        self.layout.addItems(list(LAYOUTS))
+        self.layout.setToolTip(translate(
+            "SurfComp", "grid: U x V along the parameter lines; xy: U x V in the machine's XY "
+                        "plane; adaptive: denser where the slope changes fast; uniform: evenly "
+                        "spread"))
+        u, v = (int(x) for x in obj.Count.lower().split("x"))
+        self.count_u, self.count_v = _spin(u, 1, 1000), _spin(v, 1, 1000)
+        self.points = _spin(int(obj.Points), 1, MAX_POINTS)
+        self.tip = _spin(obj.TipRadius, 0.001, 100.0, 0.1, 3)
+        self.margin = _spin(obj.EdgeMargin, 0.0, 100.0, 0.1, 3)
+        self.tilt = _spin(obj.MaxTilt, 0.0, 90.0, 5.0, 1)
+        self.result = QtGui.QLabel("")
+        self.result.setWordWrap(True)
+        self.plan_button = QtGui.QPushButton(translate("SurfComp", "Plan"))
+        lay.addRow(translate("SurfComp", "Layout"), self.layout)
+        lay.addRow(translate("SurfComp", "Points along u (x)"), self.count_u)
+        lay.addRow(translate("SurfComp", "Points along v (y)"), self.count_v)
+        lay.addRow(translate("SurfComp", "Points"), self.points)
+        lay.addRow(translate("SurfComp", "Tip radius (mm)"), self.tip)
+        lay.addRow(translate("SurfComp", "Edge margin (mm)"), self.margin)
+        lay.addRow(translate("SurfComp", "Max tilt (deg)"), self.tilt)
+        lay.addRow(self.plan_button)
+        lay.addRow(self.result)
+        self.layout.currentIndexChanged.connect(self._enable)
+        self.plan_button.clicked.connect(self.apply)
+        self._enable()
+        self.apply()
+
+    def _enable(self, *_args):
+        points = self.layout.currentText() in POINT_LAYOUTS
+        self.points.setEnabled(points)
+        self.count_u.setEnabled(not points)
+        self.count_v.setEnabled(not points)
+
+    def values(self):
+        return {"Layout": self.layout.currentText(),
+                "Count": "%dx%d" % (self.count_u.value(), self.count_v.value()),
+                "Points": int(self.points.value()), "TipRadius": float(self.tip.value()),
+                "EdgeMargin": float(self.margin.value()), "MaxTilt": float(self.tilt.value())}
+
+    def apply(self):
+        """Check the fields (a trial plan, nothing written), then write them to the object
+        (macro lines) and recompute; show the outcome. Returns True when the plan has
+        points."""
+        from ..app.plan_feature import trial_plan
+        from ..errors import SurfcompError
+
+        try:
+            trial_plan(self.obj, **self.values())
+        except SurfcompError as exc:
+            self.result.setText(str(exc))
+            self.result.setStyleSheet("color: #c53030;")
+            return False
+        lines = ["_plan = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]
+        lines += ["_plan.%s = %r" % (k, v) for k, v in self.values().items()]
+        lines.append("App.getDocument(%r).recompute()" % self.doc.Name)
+        vobj = self.obj.ViewObject
+        if vobj is not None and vobj.DisplayMode != "Points" \
+                and "Points" in vobj.listDisplayModes():
+            lines.append("_plan.ViewObject.DisplayMode = 'Points'")
+        for line in lines:
+            FreeCADGui.doCommand(line)
+        obj = self.obj
+        if "Invalid" in obj.State or "Error" in obj.State:
+            self.result.setText(obj.getStatusString())
+            self.result.setStyleSheet("color: #c53030;")
+            return False
+        text = translate("SurfComp", "%d of %d points kept; travel %.1f mm (%s order); "
+                                     "safe Z %.3f mm") % (obj.Kept, obj.Placed, obj.Travel,
+                                                          obj.Order, obj.SafeZ)
+        if obj.Dropped:
+            text += "\n" + translate("SurfComp", "Dropped: %s") % "; ".join(obj.Dropped)
+        self.result.setText(text)
+        self.result.setStyleSheet("")
+        return True
+
+    def accept(self):
+        if not self.apply():
+            return False        # keep the panel open with the message
+        self.step.commit()
+        self._close()
+        return True
+
+    def reject(self):
+        self.step.abort()
+        self._close()
+        return True
+
+    def _close(self):
+        PlanPanel.instance = None
+        FreeCADGui.Control.closeDialog()
+
+    def getStandardButtons(self):
+        buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
+        return buttons.value if hasattr(buttons, "value") else int(buttons)

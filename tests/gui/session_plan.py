@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+# GUI session of test_plan_gui.py: the Plan measurement command on the example face, its
+# task panel driven by real key and mouse events, OK, undo and Cancel.
+from surfcomp.gui import plan_panel
+
+doc = FreeCAD.newDocument("Plan")
+FILES.append(NOMINAL)
+Gui.runCommand("SurfComp_LoadNominal")
+Gui.updateGui()
+nominal = doc.getObject("Nominal")
+RESULTS["active_no_face"] = active(commands.PlanMeasurement)
+Gui.Selection.addSelection(doc.Name, nominal.Name, "Face1")
+RESULTS["active_face"] = active(commands.PlanMeasurement)
+n0 = len(doc.Objects)
+Gui.runCommand("SurfComp_PlanMeasurement")
+Gui.updateGui()
+panel = plan_panel.PlanPanel.instance
+obj = panel.obj
+RESULTS["default"] = [panel.result.text(), obj.Layout, obj.Kept, obj.Placed,
+                      len(obj.Shape.Vertexes), panel.points.isEnabled()]
+# the adaptive layout with 60 points, chosen with the keyboard, planned with the button
+panel.layout.setFocus()
+key(panel.layout, QtCore.Qt.Key_Down)
+key(panel.layout, QtCore.Qt.Key_Down)
+type_value(panel.points, "60")
+click(panel.plan_button)
+RESULTS["adaptive"] = [panel.layout.currentText(), panel.result.text(), obj.Layout, obj.Kept,
+                       obj.Placed, panel.points.isEnabled(), panel.count_u.isEnabled(),
+                       [tuple(p) for p in obj.PlanPoints[:3]]]
+vo = obj.ViewObject
+RESULTS["view_object"] = [vo.TypeId, bool(vo.Visibility), vo.DisplayMode, vo.PointSize,
+                          len(obj.Shape.Vertexes)]
+view = Gui.ActiveDocument.ActiveView
+view.viewIsometric()
+Gui.SendMsgToActiveView("ViewFit")
+Gui.updateGui()
+view.saveImage(os.path.join(TMP, "plan.png"), 800, 600, "White")
+# a tip larger than the face's smallest concave radius: the message stays in the panel and
+# OK keeps the panel open
+type_value(panel.tip, "60")
+click(panel.plan_button)
+RESULTS["bad"] = [panel.result.text(), panel.accept(), plan_panel.PlanPanel.instance is panel]
+type_value(panel.tip, "1.5")
+RESULTS["ok"] = [panel.accept(), plan_panel.PlanPanel.instance is None, obj.Kept,
+                 obj.TipRadius, len(doc.Objects) - n0, list(obj.State)]
+doc.undo()
+Gui.updateGui()
+RESULTS["after_undo"] = len(doc.Objects) - n0
+# Cancel removes the object it made
+Gui.Selection.clearSelection()
+Gui.Selection.addSelection(doc.Name, nominal.Name, "Face1")
+Gui.runCommand("SurfComp_PlanMeasurement")
+Gui.updateGui()
+second = plan_panel.PlanPanel.instance
+name2 = second.obj.Name
+RESULTS["cancel"] = [second.reject(), doc.getObject(name2) is None, len(doc.Objects) - n0]
+RESULTS["report_view_end"] = report_view_text()
+RESULTS["errors_at_end"] = ERRORS[:]

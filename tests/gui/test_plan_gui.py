@@ -1,0 +1,63 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The Plan measurement command in the real FreeCAD GUI (under Xvfb): active on a selected
+face, its task panel planning the example face (grid, then adaptive chosen with the keys),
+the points drawn in the 3D view, a tip too large for the face refused in the panel, OK as one
+undo step, Cancel leaving nothing."""
+
+import pytest
+
+from tests.gui.harness import read_image, run_session
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("gui_plan")
+    res = run_session("plan", tmp)
+    res["tmp"] = tmp
+    return res
+
+
+def test_session_ran_without_exceptions(session):
+    assert session["errors"] == [], session["errors"]
+    assert session["errors_at_end"] == []
+    assert "Traceback" not in session["report_view_end"]
+
+
+def test_command_needs_a_face(session):
+    assert session["active_no_face"] is False and session["active_face"] is True
+
+
+def test_panel_plans_the_default_grid(session):
+    text, layout, kept, placed, vertices, points_enabled = session["default"]
+    assert (layout, kept, placed, vertices) == ("grid", 100, 100, 100)
+    assert text.startswith("100 of 100 points kept; travel ") and points_enabled is False
+
+
+def test_adaptive_chosen_with_the_keys(session):
+    combo, text, layout, kept, placed, points_on, count_on, first = session["adaptive"]
+    assert (combo, layout, kept, placed) == ("adaptive", "adaptive", 60, 60)
+    assert points_on is True and count_on is False
+    assert text.startswith("60 of 60 points kept")
+    # the points lie on the example face (45 x 45 mm, z from 0 to 10 mm)
+    assert all(0 < p[0] < 45 and 0 < p[1] < 45 and 0 <= p[2] <= 10 for p in first)
+
+
+def test_points_drawn_in_the_view(session):
+    img = read_image(session["tmp"] / "plan.png")
+    red = (img[..., 0] > 0.6) & (img[..., 1] < 0.3) & (img[..., 2] < 0.3)
+    # 60 red points of 6 pixels: at least a few hundred red pixels
+    assert red.sum() > 200
+
+
+def test_tip_too_large_stays_in_the_panel(session):
+    text, accepted, still_open = session["bad"]
+    assert "--tip-radius 60 mm is larger than the face's smallest concave radius" in text
+    assert accepted is False and still_open is True
+
+
+def test_ok_is_one_undo_step_and_cancel_leaves_nothing(session):
+    accepted, closed, kept, tip, added, state = session["ok"]
+    assert accepted is True and closed is True and kept == 60 and tip == 1.5
+    assert added == 1 and "Invalid" not in state and "Error" not in state
+    assert session["after_undo"] == 0
+    assert session["cancel"] == [True, True, 0]
