@@ -2,14 +2,16 @@
 """The on-machine probing loop on the example face: plan -> program -> LinuxCNC's rs274 ->
 probe log of a known deformed face -> ``compensate --plan --tip-radius``.
 
-The plan is built here (a UV grid with the core's normals, in serpentine order); the
-program is read by rs274; the traverses are checked against the part's solid (the face
-extruded 20 mm down) with OpenCASCADE; the log is computed by moving the tip sphere along
+The part is the example face extruded 20 mm down, written as STEP; ``plan --program``
+places an 8 x 9 grid on its B-spline face and writes the plan and the probing program in
+one run; the program is read by rs274; the traverses are checked against the solid with
+OpenCASCADE; the log is computed by moving the tip sphere along
 every STRAIGHT_PROBE segment rs274 printed until it first touches the deformed face.
 """
 
 import hashlib
 import json
+import re
 import subprocess
 import sys
 
@@ -18,9 +20,9 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.optimize import brentq
 
-from surfcomp.app.nominal import load_nominal
+from surfcomp.io.plan_join import read_plan
 from surfcomp.io.probe_program import ProbeSettings, write_probe_program
-from tests.app.helpers import EXAMPLE_STEP, ROOT, grid_on_face, realised_by_occt
+from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt
 from tests.probe_checks import check_probe_moves, rs274_moves
 
 R = 1.0
@@ -37,29 +39,32 @@ def run_cli(*args):
 def loop(tmp_path_factory):
     """Plan, program and rs274's moves on the example face."""
     tmp = tmp_path_factory.mktemp("probe_loop")
-    nom = load_nominal(EXAMPLE_STEP)
-    P, N, _U, _V = grid_on_face(nom, 8, 9, margin=0.1)
-    order = [(i, j) for j in range(9) for i in (range(8) if j % 2 == 0 else range(7, -1, -1))]
-    P = np.array([P[i, j] for i, j in order])
-    N = np.array([N[i, j] for i, j in order])
-    ids = ["U%dV%d" % ij for ij in order]
-    plan = tmp / "plan.csv"
-    plan.write_text("id,x_nom,y_nom,z_nom,i,j,k\n" + "".join(
-        "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f\n" % ((i,) + tuple(p) + tuple(n))
-        for i, p, n in zip(ids, P, N)))
     import FreeCAD
     import Part
 
     solid = Part.read(EXAMPLE_STEP).Faces[0].extrude(FreeCAD.Vector(0, 0, -20))
     assert solid.isValid() and solid.ShapeType == "Solid"
-    s = ProbeSettings(tip_radius=R, safe_z=solid.BoundBox.ZMax, clearance=CLEARANCE,
-                      standoff=2.0, overtravel=OVERTRAVEL,
-                      plan_hash=hashlib.sha256(plan.read_bytes()).hexdigest())
-    prog = tmp / "probe.ngc"
-    summary = write_probe_program(str(prog), ids, P, N, s)
+    part = tmp / "part.step"
+    solid.exportStep(str(part))
+    faces = Part.read(str(part)).Faces
+    face = next("Face%d" % (k + 1) for k, f in enumerate(faces)
+                if f.Surface.TypeId == "Part::GeomBSplineSurface")
+    plan, prog = tmp / "plan.csv", tmp / "probe.ngc"
+    out = run_cli("plan", part, "--face", face, "-o", plan, "--count", "8x9", "--tip-radius",
+                  R, "--clearance", CLEARANCE, "--stand-off", 2, "--program", prog, "--quiet")
+    assert out.returncode == 0, out.stderr
+    assert "paths checked against the part's other faces" in out.stdout
+    p = read_plan(str(plan))
+    assert len(p) == 72
+    sha = hashlib.sha256(plan.read_bytes()).hexdigest()
+    head = prog.read_text().split("G38.2")[0]
+    # the hash in two comments (a LinuxCNC comment holds at most 32 characters of it)
+    halves = re.findall(r"\(plan sha256(?: cont)? ([0-9a-f]+)\)", head)
+    assert "".join(halves) == sha and "linuxcnc" in head and "tip radius 1" in head, head
+    travel = float(re.search(r"Travel: +([0-9.]+) mm", out.stdout).group(1))
     moves = rs274_moves(prog, tmp, diameter=2 * R)
-    return dict(tmp=tmp, P=P, N=N, ids=ids, plan=plan, solid=solid, moves=moves,
-                summary=summary, prog=prog)
+    return dict(tmp=tmp, P=p.points, N=p.normals, ids=p.ids, plan=plan, solid=solid,
+                moves=moves, travel=travel, prog=prog)
 
 
 def test_program_probes_the_plan_and_keeps_clear_of_the_solid(loop):
@@ -76,7 +81,7 @@ def test_program_probes_the_plan_and_keeps_clear_of_the_solid(loop):
     assert dist.min() >= R + CLEARANCE - 1e-4, dist.min()
     print("72 probe moves, largest angle to -normal %.5f deg; %d traverses, nearest %.4f mm "
           "from the solid (ball surface %.4f mm); travel %.1f mm"
-          % (worst, len(trav), dist.min(), dist.min() - R, loop["summary"]["travel"]["total"]))
+          % (worst, len(trav), dist.min(), dist.min() - R, loop["travel"]))
 
 
 def deformed_face(amplitude=0.02):
@@ -166,8 +171,9 @@ def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
     out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
                   "--report", report, "--quiet")
     assert out.returncode == 2 and not report.exists()
-    assert "%s:73: planned point %s has no probe line" % (loop["plan"], loop["ids"][-1]) \
-        in out.stderr
+    rows = read_plan(str(loop["plan"])).lines     # the plan's own line of each point
+    assert "%s:%d: planned point %s has no probe line" % (loop["plan"], rows[-1],
+                                                           loop["ids"][-1]) in out.stderr
     swapped = centres[[1, 0] + list(range(2, 72))]
     log.write_text("".join("%.6f %.6f %.6f 0 0 0 0 0 0\n" % tuple(c) for c in swapped))
     out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
@@ -176,12 +182,12 @@ def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
     assert "%s:1: probe line 1 (" % log in out.stderr and "--max-offset 1 mm" in out.stderr
     bad_plan = tmp / "bad_plan.csv"
     lines = loop["plan"].read_text().splitlines()
-    lines[5] = lines[5].replace(",", ",x", 1)
+    lines[rows[4] - 1] = lines[rows[4] - 1].replace(",", ",x", 1)
     bad_plan.write_text("\n".join(lines) + "\n")
     out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", bad_plan, "--report", report,
                   "--quiet")
     assert out.returncode == 2 and not report.exists()
-    assert "%s:6:2: column 'x_nom' holds 'x" % bad_plan in out.stderr, out.stderr
+    assert "%s:%d:2: column 'x_nom' holds 'x" % (bad_plan, rows[4]) in out.stderr, out.stderr
     out = run_cli("inspect", EXAMPLE_STEP, log, "--touches", "2", "--quiet")
     assert out.returncode == 2 and "touches applies to a probe log read with a plan" in out.stderr
 
@@ -232,3 +238,17 @@ def test_second_touch_round_trip(loop, probed):
                   "--quiet")
     assert out.returncode == 2 and "%s:73: probe line 73 has no planned point" % log \
         in out.stderr
+
+
+def test_plan_and_program_are_written_together_or_not_at_all(tmp_path):
+    """A program setting no program can be made with (a second-touch back-off beyond the
+    stand-off) fails the whole plan run: exit 2, neither the plan nor the program."""
+    plan, prog = tmp_path / "plan.csv", tmp_path / "probe.ngc"
+    out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", prog,
+                  "--second-touch", "--backoff", 3, "--stand-off", 2, "--quiet")
+    assert out.returncode == 2, out.stderr
+    assert "backoff 3 mm is larger than standoff 2 mm" in out.stderr, out.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", plan,
+                  "--quiet")
+    assert out.returncode == 2 and not plan.exists(), out.stderr
