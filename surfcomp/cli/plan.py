@@ -13,13 +13,15 @@ and writes nothing.
 
 Where the probing program plugs in (``--program PROBE.ngc --dialect linuxcnc|fanuc``):
 :func:`_write` stages every output in one :class:`~surfcomp.io.atomic.Transaction`; the
-program is one more staged output there, written by
+program is one more staged output there (the marked line), written by
 ``surfcomp.io.probe_program.write_probe_program(path, plan.ids, plan.points, plan.normals,
-settings)`` with ``settings = program_settings(args, plan, sha256)``: the plan's points in
-visiting order (nominal surface points, unit outward normals), and in ``settings`` the tip
-radius, stand-off, clearance, the part's top Z and the safe height, and the SHA-256 of the
-plan file's text (the bytes that are written). The program is an output option in
-:mod:`surfcomp.cli.registry` (``("plan",)``), so it is checked against the inputs like ``-o``.
+settings)`` with ``settings`` the ``program`` dict :func:`program_settings` made there: the
+plan's points in visiting order (nominal surface points, unit outward normals), and in
+``settings`` the tip radius, stand-off, clearance, the part's top Z (the highest Z of the
+solid's, else the face's, optimal bounding box: :func:`surfcomp.app.plan_reach.part_top`)
+and the safe height, and the SHA-256 of the plan file's text (the bytes that are written).
+The program is an output option in :mod:`surfcomp.cli.registry` (``("plan",)``), so it is
+checked against the inputs like ``-o``.
 """
 
 import hashlib
@@ -164,17 +166,19 @@ def _reason_text(key):
 
 
 def _write(args, plan, nominal):
-    """Stage and commit the outputs; return the plan file's SHA-256."""
+    """Stage and commit the outputs together; return :func:`program_settings` (what the
+    probing program needs: the plan file's SHA-256 among them)."""
     text = plan_text(args.plan_format, plan.ids, plan.points, plan.normals,
                      _comments(args, plan, nominal))
-    sha256 = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    program = program_settings(args, plan, hashlib.sha256(text.encode("utf-8")).hexdigest())
     with Transaction(*registry.declared(args, "plan")) as tx:
         tx.stage_text(args.output, text)
+        # --program PROBE.ngc is staged here (module docstring) with ``program``
         if args.dropped:
             tx.stage_text(args.dropped, dropped_text(
                 [(d.index, _reason_text(d.reason), d.u, d.v, d.point) for d in plan.dropped]))
         tx.commit()
-    return sha256
+    return program
 
 
 def run(args):
@@ -183,12 +187,12 @@ def run(args):
     progress = ProgressLine(args.quiet)
     plan, nominal, part = make_plan(args.nominal, args.face, args.object, layout, count,
                                     settings, args.order, progress)
-    sha256 = _write(args, plan, nominal)
-    _print(args, plan, nominal, part, sha256)
+    program = _write(args, plan, nominal)
+    _print(args, plan, nominal, part, program)
     return 0
 
 
-def _print(args, plan, nominal, part, sha256):
+def _print(args, plan, nominal, part, program):
     s = plan.settings
     surf = nominal.surface
     print("Nominal:   %s (%s), %d x %d poles; %s" % (
@@ -211,11 +215,11 @@ def _print(args, plan, nominal, part, sha256):
     print("Probe:     tip radius %g mm, margin %g mm, max tilt %g deg, stand-off %g mm; "
           "smallest concave radius of the face %s"
           % (s.tip_radius, s.margin, s.max_tilt, s.stand_off, radius))
-    print("Safe Z:    %.4f mm (part top %.4f + clearance %g)" % (plan.safe_z, plan.top_z,
-                                                                  s.clearance))
+    print("Safe Z:    %.4f mm (part top %.4f + clearance %g)"
+          % (program["safe_z"], program["top_z"], program["clearance"]))
     print("Order:     %s; travel %.1f mm between stand-off positions" % (plan.order,
                                                                           plan.travel))
-    print("Plan:      %d points, SHA-256 %s" % (len(plan), sha256))
+    print("Plan:      %d points, SHA-256 %s" % (len(plan), program["plan_sha256"]))
     for out in (args.output, args.dropped):
         if out is not None:
             print(wrote(out))
