@@ -34,7 +34,7 @@ view = Gui.ActiveDocument.ActiveView
 view.viewIsometric()
 Gui.SendMsgToActiveView("ViewFit")
 Gui.updateGui()
-view.saveImage(os.path.join(TMP, "plan.png"), 800, 600, "White")
+RESULTS["shot"] = shot(view, "plan")
 # a tip larger than the face's smallest concave radius: the message stays in the panel and
 # OK keeps the panel open
 type_value(panel.tip, "60")

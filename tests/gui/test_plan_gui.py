@@ -43,7 +43,7 @@ def test_adaptive_chosen_with_the_keys(session):
 
 
 def test_points_drawn_in_the_view(session):
-    img = read_image(session["tmp"] / "plan.png")
+    img = read_image(session["shot"])
     red = (img[..., 0] > 0.6) & (img[..., 1] < 0.3) & (img[..., 2] < 0.3)
     # 60 red points of 6 pixels: at least a few hundred red pixels
     assert red.sum() > 200
