@@ -54,5 +54,13 @@ Gui.updateGui()
 second = plan_panel.PlanPanel.instance
 name2 = second.obj.Name
 RESULTS["cancel"] = [second.reject(), doc.getObject(name2) is None, len(doc.Objects) - n0]
+# a plan made by a script (the macro's factory) draws its points too
+from surfcomp.app.plan_feature import make_measurement_plan
+
+scripted = make_measurement_plan(doc, nominal, "Face1", Layout="uniform", Points=25)
+doc.recompute()
+Gui.updateGui()
+RESULTS["scripted"] = [scripted.Kept, scripted.ViewObject.DisplayMode,
+                       scripted.ViewObject.PointSize]
 RESULTS["report_view_end"] = report_view_text()
 RESULTS["errors_at_end"] = ERRORS[:]

@@ -61,3 +61,7 @@ def test_ok_is_one_undo_step_and_cancel_leaves_nothing(session):
     assert added == 1 and "Invalid" not in state and "Error" not in state
     assert session["after_undo"] == 0
     assert session["cancel"] == [True, True, 0]
+
+
+def test_a_scripted_plan_shows_its_points(session):
+    assert session["scripted"] == [25, "Points", 6.0]
