@@ -31,9 +31,10 @@ vo = obj.ViewObject
 RESULTS["view_object"] = [vo.TypeId, bool(vo.Visibility), vo.DisplayMode, vo.PointSize,
                           len(obj.Shape.Vertexes)]
 view = Gui.ActiveDocument.ActiveView
+settle(view)
 view.viewIsometric()
-Gui.SendMsgToActiveView("ViewFit")
-Gui.updateGui()
+view.fitAll()
+settle(view)       # FreeCAD 1.x animates the camera: a picture taken before it ends is blank
 RESULTS["shot"] = shot(view, "plan")
 # a tip larger than the face's smallest concave radius: the message stays in the panel and
 # OK keeps the panel open
