@@ -21,8 +21,7 @@ from ..core.planning import (
     parse_count,
 )
 from ..errors import GeometryError
-from .features import _created, _restored
-from .proxies import Proxy
+from .features import _created, _Proxy
 
 PLAN_TYPE = "SurfComp_MeasurementPlan"
 PLAN_VERSION = 1
@@ -66,16 +65,12 @@ PLAN_PROPERTIES = (
 )
 
 
-class MeasurementPlanFeature(Proxy):
+class MeasurementPlanFeature(_Proxy):
     """Proxy of ``SurfComp_MeasurementPlan`` (module docstring)."""
 
     Type = PLAN_TYPE
     PROPERTIES = PLAN_PROPERTIES
     VERSION = PLAN_VERSION
-
-    def onDocumentRestored(self, obj):
-        super().onDocumentRestored(obj)
-        _restored(obj)
 
     def execute(self, obj):
         compute_plan(obj)

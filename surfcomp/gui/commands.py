@@ -19,7 +19,7 @@ from .. import paths
 from ..app import features
 from ..app.undo import UndoStep
 from ..errors import ComputationError, InputError, SurfcompError
-from . import dialogs, fcgui, prefs
+from . import dialogs, fcgui, plan_panel, prefs
 
 translate = FreeCAD.Qt.translate
 
@@ -550,10 +550,8 @@ class PlanMeasurement(Command):
         return selected_face() is not None
 
     def run(self):
-        from .plan_panel import PlanPanel
-
         nom, face = selected_face()
-        FreeCADGui.Control.showDialog(PlanPanel(nom, face))
+        FreeCADGui.Control.showDialog(plan_panel.PlanPanel(nom, face))
 
 
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,

@@ -13,10 +13,28 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
+from ..app import features
 from ..app.undo import UndoStep
 from ..core.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
 
 translate = FreeCAD.Qt.translate
+
+
+def show_points(obj):
+    """Draw a plan object's points: the Part view provider's own (FreeCAD's idiom: a view
+    proxy of 0, no view provider class of ours) in its Points mode, 6 px, red. A creation
+    hook of :mod:`surfcomp.app.features` (so plans made by scripts show too); idempotent."""
+    from ..app.plan_feature import PLAN_TYPE
+
+    vobj = getattr(obj, "ViewObject", None)
+    if vobj is None or getattr(getattr(obj, "Proxy", None), "Type", None) != PLAN_TYPE:
+        return
+    if vobj.Proxy is None:
+        vobj.Proxy = 0
+        vobj.PointSize = 6
+        vobj.PointColor = (0.85, 0.1, 0.1)
+    if vobj.DisplayMode != "Points" and "Points" in vobj.listDisplayModes():
+        vobj.DisplayMode = "Points"
 
 
 def _spin(value, low, high, step=1.0, decimals=None):
@@ -44,11 +62,6 @@ class PlanPanel:
                              "App.getDocument(%r), App.getDocument(%r).getObject(%r), %r)"
                              % (self.doc.Name, self.doc.Name, nominal.Name, face))
         self.obj = self.doc.Objects[-1]
-        # no view provider of its own: the Part view provider's (FreeCAD's idiom: a proxy
-        # of 0), whose Points mode draws the plan's vertices
-        FreeCADGui.doCommand("_plan.ViewObject.Proxy = 0")
-        FreeCADGui.doCommand("_plan.ViewObject.PointSize = 6")
-        FreeCADGui.doCommand("_plan.ViewObject.PointColor = (0.85, 0.1, 0.1)")
         obj = self.obj
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("SurfComp", "Plan measurement"))
@@ -110,12 +123,9 @@ class PlanPanel:
         lines = ["_plan = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]
         lines += ["_plan.%s = %r" % (k, v) for k, v in self.values().items()]
         lines.append("App.getDocument(%r).recompute()" % self.doc.Name)
-        vobj = self.obj.ViewObject
-        if vobj is not None and vobj.DisplayMode != "Points" \
-                and "Points" in vobj.listDisplayModes():
-            lines.append("_plan.ViewObject.DisplayMode = 'Points'")
         for line in lines:
             FreeCADGui.doCommand(line)
+        show_points(self.obj)
         obj = self.obj
         if "Invalid" in obj.State or "Error" in obj.State:
             self.result.setText(obj.getStatusString())
@@ -149,3 +159,7 @@ class PlanPanel:
     def getStandardButtons(self):
         buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
         return buttons.value if hasattr(buttons, "value") else int(buttons)
+
+
+if show_points not in features.NEW_OBJECT_HOOKS:
+    features.NEW_OBJECT_HOOKS.append(show_points)

@@ -208,3 +208,33 @@ def test_simulate_refuses_a_plan_of_another_face(tmp_path):
 def test_simulate_plan_options_refused(tmp_path, args, message):
     out = run_simulate("--preset", "mirror2019-s1", *args)
     assert out.returncode == 2 and message in out.stderr, out.stderr
+
+
+def test_plate_with_a_hole_keeps_the_margin(tmp_path):
+    """A 40 x 30 x 5 mm plate with a 10 mm hole through it: the top face is trimmed by the
+    hole; every kept point lies at least tip radius + edge margin (1.5 mm) from the hole's
+    edge and the plate's border, measured with OpenCASCADE against the face's edges, and
+    none lies in the hole."""
+    import FreeCAD
+    import Part
+
+    V = FreeCAD.Vector
+    plate = Part.makeBox(40, 30, 5).cut(Part.makeCylinder(5, 5, V(20, 15, 0)))
+    step = tmp_path / "plate.step"
+    plate.exportStep(str(step))
+    back = Part.read(str(step))
+    k = next(i for i, f in enumerate(back.Faces)
+             if abs(f.BoundBox.ZMin - 5) < 1e-9 and abs(f.BoundBox.ZMax - 5) < 1e-9)
+    out = run_plan(step, "--face", "Face%d" % (k + 1), "-o", tmp_path / "plan.csv",
+                   "--count", "30x22", "--tip-radius", "1", "--edge-margin", "0.5")
+    assert out.returncode == 0, out.stderr
+    ms = read_measurements(tmp_path / "plan.csv", plan=True)
+    top = back.Faces[k]
+    edges = Part.Compound(top.Edges)
+    dist = np.array([edges.distToShape(Part.Vertex(V(*p)))[0] for p in ms.nominal])
+    assert dist.min() >= 1.5 - 1e-3
+    assert np.all(np.hypot(ms.nominal[:, 0] - 20, ms.nominal[:, 1] - 15) >= 6.5 - 1e-3)
+    # the nodes in and around the hole were dropped, and said so
+    assert "not on the trimmed face" in out.stdout
+    assert "closer than the margin to the boundary or a hole" in out.stdout
+    assert 500 < len(ms.nominal) < 660

@@ -31,10 +31,11 @@ vo = obj.ViewObject
 RESULTS["view_object"] = [vo.TypeId, bool(vo.Visibility), vo.DisplayMode, vo.PointSize,
                           len(obj.Shape.Vertexes)]
 view = Gui.ActiveDocument.ActiveView
+settle(view)
 view.viewIsometric()
-Gui.SendMsgToActiveView("ViewFit")
-Gui.updateGui()
-view.saveImage(os.path.join(TMP, "plan.png"), 800, 600, "White")
+view.fitAll()
+settle(view)       # FreeCAD 1.x animates the camera: a picture taken before it ends is blank
+RESULTS["shot"] = shot(view, "plan")
 # a tip larger than the face's smallest concave radius: the message stays in the panel and
 # OK keeps the panel open
 type_value(panel.tip, "60")
@@ -54,5 +55,13 @@ Gui.updateGui()
 second = plan_panel.PlanPanel.instance
 name2 = second.obj.Name
 RESULTS["cancel"] = [second.reject(), doc.getObject(name2) is None, len(doc.Objects) - n0]
+# a plan made by a script (the macro's factory) draws its points too
+from surfcomp.app.plan_feature import make_measurement_plan
+
+scripted = make_measurement_plan(doc, nominal, "Face1", Layout="uniform", Points=25)
+doc.recompute()
+Gui.updateGui()
+RESULTS["scripted"] = [scripted.Kept, scripted.ViewObject.DisplayMode,
+                       scripted.ViewObject.PointSize]
 RESULTS["report_view_end"] = report_view_text()
 RESULTS["errors_at_end"] = ERRORS[:]

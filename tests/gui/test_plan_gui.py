@@ -43,7 +43,7 @@ def test_adaptive_chosen_with_the_keys(session):
 
 
 def test_points_drawn_in_the_view(session):
-    img = read_image(session["tmp"] / "plan.png")
+    img = read_image(session["shot"])
     red = (img[..., 0] > 0.6) & (img[..., 1] < 0.3) & (img[..., 2] < 0.3)
     # 60 red points of 6 pixels: at least a few hundred red pixels
     assert red.sum() > 200
@@ -61,3 +61,7 @@ def test_ok_is_one_undo_step_and_cancel_leaves_nothing(session):
     assert added == 1 and "Invalid" not in state and "Error" not in state
     assert session["after_undo"] == 0
     assert session["cancel"] == [True, True, 0]
+
+
+def test_a_scripted_plan_shows_its_points(session):
+    assert session["scripted"] == [25, "Points", 6.0]
