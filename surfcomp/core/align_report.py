@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""An alignment as a job runs it: the known transform, the fit, and what it moved (no FreeCAD).
+
+:func:`align` applies a known rigid transform, then the best fit
+(:func:`surfcomp.core.align.best_fit`) or the 3-2-1 alignment
+(:func:`surfcomp.core.align_rps.rps_fit`), and returns the moved points with an
+:class:`Alignment` record: the matrix (measured -> nominal), the RMS distance of the points
+to each reference face before and after, the iterations, and, when the compensated face
+took part in the fit, what the fit absorbed there: the mean normal shift it gave the face's
+points and the tilt of that shift across the face (the range of its linear part). A best
+fit on the compensated face removes exactly that much of the machining error's mean and
+tilt from the deviations, and the corrected face would then leave it in the part.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import InputError
+from .align import DOF_NAMES, Distances, Reference, apply, best_fit, check_rigid, describe
+from .align import parse_dof as _parse_dof
+from .align_rps import rps_fit
+
+#: alignment methods
+METHODS = ("none", "bestfit", "rps")
+
+
+@dataclass
+class AlignOptions:
+    """What a job aligns: ``method`` one of :data:`METHODS`; ``faces`` the reference face
+    names (empty: the compensated face); ``dof`` the degrees of freedom (text for
+    :func:`surfcomp.core.align.parse_dof`); ``rps`` the 3-2-1 groups (dict); ``transform``
+    a known 4 x 4 matrix applied first (list of rows) with ``transform_source`` its file."""
+
+    method: str = "none"
+    faces: tuple = ()
+    dof: str = "all"
+    rps: dict = None
+    transform: object = None
+    transform_source: str = None
+
+    def active(self):
+        return self.method != "none" or self.transform is not None
+
+    def validate(self):
+        if self.method not in METHODS:
+            raise InputError("--align %r: expected one of %s" % (self.method, ", ".join(METHODS)))
+        if self.method == "rps" and self.rps is None:
+            raise InputError("--align rps needs --rps (the 3-2-1 point ids)")
+        if self.rps is not None and self.method != "rps":
+            raise InputError("--rps is used by --align rps only (got --align %s)" % self.method)
+        dof = _parse_dof(self.dof)
+        if self.method == "rps" and dof != DOF_NAMES:
+            raise InputError("--align-dof applies to --align bestfit (3-2-1 fixes all six)")
+        if self.transform is not None:
+            check_rigid(self.transform, self.transform_source)
+        return self
+
+
+@dataclass
+class Alignment:
+    """What an alignment did (see the module docstring); lengths in mm."""
+
+    method: str
+    matrix: np.ndarray
+    known: np.ndarray = None
+    dof: tuple = DOF_NAMES
+    faces: list = field(default_factory=list)
+    iterations: int = 0
+    converged: bool = True
+    start: str = "as given"
+    rms_before: dict = None
+    rms_after: dict = None
+    points: dict = None
+    outliers: int = 0
+    absorbed: dict = None
+    warnings: list = field(default_factory=list)
+
+    def as_dict(self):
+        """The report's ``"alignment"`` object."""
+        return {"method": self.method,
+                "matrix": [[float(x) for x in row] for row in self.matrix],
+                "known_transform": None if self.known is None else
+                [[float(x) for x in row] for row in self.known],
+                **describe(self.matrix), "dof": list(self.dof), "faces": list(self.faces),
+                "start": self.start, "iterations": self.iterations,
+                "converged": self.converged, "points": self.points,
+                "outliers": self.outliers,
+                "rms_before_um": _um(self.rms_before), "rms_after_um": _um(self.rms_after),
+                "absorbed": self.absorbed}
+
+    def lines(self):
+        """Summary lines for the command line."""
+        d = describe(self.matrix)
+        out = ["Alignment:    %s%s: translation %s mm, rotation %s deg about X, Y, Z (%.6f deg)"
+               % (self.method, "" if self.known is None or self.method == "none"
+                  else " after the known transform",
+                  " ".join("%+.6f" % x for x in d["translation_mm"]),
+                  " ".join("%+.6f" % x for x in d["rotation_deg"]), d["angle_deg"])]
+        if self.method != "none":
+            out.append("  %s on %s, degrees of freedom %s, start %s; %d iterations, %s"
+                       % ("fitted" if self.method == "bestfit" else "3-2-1",
+                          ", ".join(self.faces), " ".join(self.dof), self.start,
+                          self.iterations, "converged" if self.converged else "NOT converged"))
+            for name in self.faces:
+                if name in (self.rms_after or {}):
+                    out.append("  %s: %d points, RMS distance %.3f um before, %.3f um after"
+                               % (name, self.points[name], self.rms_before[name] * 1e3,
+                                  self.rms_after[name] * 1e3))
+            if self.outliers:
+                out.append("  %d point(s) weighted out as outliers" % self.outliers)
+        if self.absorbed:
+            out.append("  absorbed on the compensated face: mean offset %.3f um, tilt %.3f um "
+                       "across the face" % (self.absorbed["mean_offset_um"],
+                                            self.absorbed["tilt_um"]))
+        return out
+
+
+def _um(d):
+    return None if d is None else {k: v * 1e3 for k, v in d.items()}
+
+
+def per_face_rms(r, face, names):
+    """RMS of the finite residuals of each face's points, and their counts."""
+    rms, count = {}, {}
+    for k, name in enumerate(names):
+        sel = (face == k) & np.isfinite(r)
+        count[name] = int(sel.sum())
+        if sel.any():
+            rms[name] = float(np.sqrt(np.mean(r[sel] ** 2)))
+    return rms, count
+
+
+def absorbed(before, after, normal):
+    """What a fit moved on the compensated face: the shift of its points along the outward
+    normal, ``s = n . (after - before)``; its mean and the range of its least-squares
+    linear part ``a + g . x`` over the points (the tilt across the face), in um."""
+    s = np.einsum("ij,ij->i", normal, after - before)
+    X = after - after.mean(axis=0)
+    A = np.hstack([np.ones((X.shape[0], 1)), X])
+    coef = np.linalg.lstsq(A, s, rcond=None)[0]
+    lin = X @ coef[1:]
+    return {"mean_offset_um": float(s.mean() * 1e3),
+            "tilt_um": float((lin.max() - lin.min()) * 1e3) if lin.size else 0.0}
+
+
+def align(points, options, references, compensated=None, ids=None, assign=None, offset=0.0,
+          progress=None, source=None):
+    """Align measured points (see the module docstring).
+
+    Parameters
+    ----------
+    points : ndarray (N, 3)
+        Measured points (mm), in the measuring frame.
+    options : AlignOptions
+    references : list of Reference
+        The reference faces (the compensated face alone when the user named none).
+    compensated : int, optional
+        Index of the compensated face in ``references`` (None: it takes no part).
+
+    Returns
+    -------
+    (ndarray (N, 3), Alignment)
+        The points in the nominal's frame and the record.
+    """
+    options.validate()
+    P = np.asarray(points, dtype=float)
+    known = None if options.transform is None else check_rigid(options.transform,
+                                                               options.transform_source)
+    start = np.eye(4) if known is None else known
+    if options.method == "none":
+        return apply(start, P), Alignment("none", start, known=known)
+    names = [r.name for r in references]
+    dof = _parse_dof(options.dof)
+    if options.method == "rps":
+        fit, idx = rps_fit(P, options.rps, references, ids, start, offset, source=source)
+        dist, sel = Distances(references, 6), idx
+        label, dof = "as given", DOF_NAMES
+    else:
+        fit, label = best_fit(P, references, assign, dof, start, offset=offset, progress=progress)
+        dist, sel = None, slice(None)
+    before_pts = apply(start, P)
+    if dist is None:
+        dist = Distances(references, P.shape[0])
+    r0, g0, f0 = dist(before_pts[sel], None if assign is None else np.asarray(assign)[sel])
+    rms_before, _ = per_face_rms(r0 - offset, f0, names)
+    rms_after, count = per_face_rms(fit.residual, fit.face, names)
+    rec = Alignment(options.method, fit.matrix, known, dof, names, fit.iterations, fit.converged,
+                    label, rms_before, rms_after, count, int((fit.weight == 0).sum()))
+    after = apply(fit.matrix, P)
+    if compensated is not None and options.method == "bestfit":
+        on = fit.face == compensated
+        _r, g, _f = dist(after[on], np.zeros(int(on.sum()), dtype=int) + compensated
+                         if len(references) > 1 else None)
+        rec.absorbed = absorbed(before_pts[on], after[on], g)
+        if not options.faces:
+            rec.warnings.append("the best fit used the compensated face itself: it absorbed a "
+                                "mean offset of %.3f um and a tilt of %.3f um of the machining "
+                                "error, which the corrected face will leave in the part "
+                                "(name datum faces with --align-faces to keep them)"
+                                % (rec.absorbed["mean_offset_um"], rec.absorbed["tilt_um"]))
+    return after, rec
+
+
+__all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms"]
