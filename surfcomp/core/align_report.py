@@ -23,6 +23,9 @@ from .align_rps import rps_fit
 
 #: alignment methods
 METHODS = ("none", "bestfit", "rps")
+#: a fit that moves the compensated face's points farther (mm, along the normal) started
+#: in another frame: its absorbed mean and tilt are mostly that frame's offset
+FAR_START = 1.0
 
 
 @dataclass
@@ -89,31 +92,32 @@ class Alignment:
                 "rms_before_um": _um(self.rms_before), "rms_after_um": _um(self.rms_after),
                 "absorbed": self.absorbed}
 
-    def lines(self):
-        """Summary lines for the command line."""
-        d = describe(self.matrix)
-        out = ["Alignment:    %s%s: translation %s mm, rotation %s deg about X, Y, Z (%.6f deg)"
-               % (self.method, "" if self.known is None or self.method == "none"
-                  else " after the known transform",
-                  " ".join("%+.6f" % x for x in d["translation_mm"]),
-                  " ".join("%+.6f" % x for x in d["rotation_deg"]), d["angle_deg"])]
-        if self.method != "none":
-            out.append("  %s on %s, degrees of freedom %s, start %s; %d iterations, %s"
-                       % ("fitted" if self.method == "bestfit" else "3-2-1",
-                          ", ".join(self.faces), " ".join(self.dof), self.start,
-                          self.iterations, "converged" if self.converged else "NOT converged"))
-            for name in self.faces:
-                if name in (self.rms_after or {}):
-                    out.append("  %s: %d points, RMS distance %.3f um before, %.3f um after"
-                               % (name, self.points[name], self.rms_before[name] * 1e3,
-                                  self.rms_after[name] * 1e3))
-            if self.outliers:
-                out.append("  %d point(s) weighted out as outliers" % self.outliers)
-        if self.absorbed:
-            out.append("  absorbed on the compensated face: mean offset %.3f um, tilt %.3f um "
-                       "across the face" % (self.absorbed["mean_offset_um"],
-                                            self.absorbed["tilt_um"]))
-        return out
+
+def summary_lines(d):
+    """Summary lines of a report's ``"alignment"`` object (:meth:`Alignment.as_dict`)."""
+    if not d:
+        return []
+    out = ["Alignment:    %s%s: translation %s mm, rotation %s deg about X, Y, Z (%.6f deg)"
+           % (d["method"], "" if d["known_transform"] is None else " (with the known transform)",
+              " ".join("%+.6f" % x for x in d["translation_mm"]),
+              " ".join("%+.6f" % x for x in d["rotation_deg"]), d["angle_deg"])]
+    if d["method"] != "none":
+        out.append("  %s on %s, degrees of freedom %s, start %s; %d iterations, %s"
+                   % ("best fit" if d["method"] == "bestfit" else "3-2-1",
+                      ", ".join(d["faces"]), " ".join(d["dof"]), d["start"], d["iterations"],
+                      "converged" if d["converged"] else "NOT converged"))
+        for name in d["faces"]:
+            if name in (d["rms_after_um"] or {}):
+                out.append("  %s: %d points, RMS distance %.3f um before, %.3f um after"
+                           % (name, d["points"][name], d["rms_before_um"][name],
+                              d["rms_after_um"][name]))
+        if d["outliers"]:
+            out.append("  %d point(s) weighted out as outliers" % d["outliers"])
+    if d["absorbed"]:
+        out.append("  absorbed on the compensated face: mean offset %.3f um, tilt %.3f um "
+                   "across the face" % (d["absorbed"]["mean_offset_um"],
+                                        d["absorbed"]["tilt_um"]))
+    return out
 
 
 def _um(d):
@@ -134,7 +138,9 @@ def per_face_rms(r, face, names):
 def absorbed(before, after, normal):
     """What a fit moved on the compensated face: the shift of its points along the outward
     normal, ``s = n . (after - before)``; its mean and the range of its least-squares
-    linear part ``a + g . x`` over the points (the tilt across the face), in um."""
+    linear part ``a + g . x`` over the points (the tilt across the face), in um. ``before``
+    is where the points came in (after a known transform): the deviations change by ``s``
+    (``d_after - d_before``)."""
     s = np.einsum("ij,ij->i", normal, after - before)
     X = after - after.mean(axis=0)
     A = np.hstack([np.ones((X.shape[0], 1)), X])
@@ -193,7 +199,14 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
         _r, g, _f = dist(after[on], np.zeros(int(on.sum()), dtype=int) + compensated
                          if len(references) > 1 else None)
         rec.absorbed = absorbed(before_pts[on], after[on], g)
-        if not options.faces:
+        moved = np.abs(np.einsum("ij,ij->i", g, after[on] - before_pts[on])).max()
+        if not options.faces and moved > FAR_START:
+            rec.warnings.append("the best fit used the compensated face itself and moved its "
+                                "points up to %.3f mm from where they came in: what it absorbed "
+                                "of the machining error's mean and tilt cannot be told apart "
+                                "from that move (bring them near with --transform, or name "
+                                "datum faces with --align-faces)" % moved)
+        elif not options.faces:
             rec.warnings.append("the best fit used the compensated face itself: it absorbed a "
                                 "mean offset of %.3f um and a tilt of %.3f um of the machining "
                                 "error, which the corrected face will leave in the part "
@@ -202,4 +215,5 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
     return after, rec
 
 
-__all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms"]
+__all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms",
+           "summary_lines"]

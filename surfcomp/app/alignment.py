@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""A job's measured points aligned to the nominal before the deviations (FreeCAD, no GUI).
+
+Builds the reference faces from the nominal's shape (``--align-faces``; default the
+compensated face itself), reads the transform and 3-2-1 files, and calls
+:func:`surfcomp.core.align_report.align` on the measurement set's points.
+"""
+
+import dataclasses
+
+from ..core.align import Reference
+from ..core.align_report import AlignOptions, align
+from ..errors import InputError
+from ..io.align_files import read_rps, read_transform
+
+
+def align_options(job):
+    """The :class:`AlignOptions` of a job (files read, values checked)."""
+    faces = tuple(f.strip() for f in (job.align_faces or "").split(",") if f.strip())
+    transform = read_transform(job.transform) if job.transform else None
+    rps, _source = read_rps(job.rps) if job.rps else (None, None)
+    return AlignOptions(job.align or "none", faces, job.align_dof or "all", rps, transform,
+                        job.transform).validate()
+
+
+def references(nominal, names):
+    """``(references, index of the compensated face or None)``: the named faces of the
+    nominal's shape, or the compensated face alone."""
+    from .nominal import nominal_from_face, pick_face
+
+    if not names:
+        return [Reference(nominal.face_name, nominal.surface, nominal.outward)], 0
+    shape = nominal.shape if nominal.shape is not None else nominal.face
+    refs = []
+    for name in names:
+        if name == nominal.face_name:
+            refs.append(Reference(name, nominal.surface, nominal.outward))
+            continue
+        face, _ = pick_face(shape, name, nominal.source)
+        other = nominal_from_face(face, nominal.source, name)
+        refs.append(Reference(name, other.surface, other.outward))
+    comp = names.index(nominal.face_name) if nominal.face_name in names else None
+    return refs, comp
+
+
+def align_measurements(job, nominal, ms, progress=None):
+    """``(measurement set with the aligned points, Alignment)`` of a job whose alignment
+    is active; refuses sets that carry nominal points or deviations (already in the
+    nominal's frame)."""
+    opts = align_options(job)
+    if ms.nominal is not None or ms.measured is None:
+        raise InputError("--align/--transform move measured points: this file gives %s, "
+                         "which are already in the nominal's frame (expected a point file "
+                         "of measured points only)" % ms.kind(), file=ms.source)
+    refs, comp = references(nominal, opts.faces)
+    tip = float(job.options.tip_radius or 0.0) if ms.tip_centres else 0.0
+    points, record = align(ms.measured, opts, refs, comp, ids=ms.ids, offset=tip,
+                           progress=progress, source=job.rps)
+    return dataclasses.replace(ms, measured=points), record
