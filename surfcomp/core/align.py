@@ -37,6 +37,8 @@ DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
 MAX_ITER = 100
 #: a fit has converged when its last step moved no point more than this (mm)
 STEP_TOL = 1e-9
+#: a robust fit keeps its scale once a step moved no point farther than this (mm)
+FREEZE_STEP = 1e-3
 #: Tukey biweight constant (95 % efficiency at the normal distribution)
 TUKEY_C = 4.685
 #: smallest robust scale of the residuals (mm): exact data keeps its weights at 1
@@ -46,6 +48,9 @@ SCALE_FLOOR = 1e-4
 RANK_TOL = 1e-5
 #: largest rotation of one Gauss-Newton step (rad); longer steps are shortened
 MAX_STEP_ROT = 0.3
+#: after a step that moved no point farther (mm), the feet are found by Newton from the
+#: last ones (:meth:`surfcomp.core.projection.Projector.project_near`)
+WARM_STEP = 0.01
 #: points a fit iterates on before it takes all points (a subsample spread over the file)
 FIT_SAMPLE = 50000
 #: points of the coarse starts' short fits, and their iterations
@@ -166,19 +171,34 @@ class Distances:
         self.refs = list(references)
         self.proj = [Projector(r.surface, workers=workers, min_samples=min(points, 10 ** 6) // 16)
                      for r in self.refs]
+        self._feet = {}
 
-    def __call__(self, Q, assign=None):
+    def _project(self, k, Q, idx, key, near):
+        """Projection of ``Q`` on reference ``k``. ``key``: under it the feet are kept for
+        the next call; ``near``: the points moved little since the last call with ``key``
+        (Newton from the kept feet)."""
+        last = self._feet.get((key, k)) if near else None
+        if last is not None and last[0].shape == idx.shape and (last[0] == idx).all():
+            p = self.proj[k].project_near(Q, last[1], last[2])
+        else:
+            p = self.proj[k].project(Q)
+        if key is not None:
+            self._feet[(key, k)] = (idx, p.u, p.v)
+        return p
+
+    def __call__(self, Q, assign=None, key=None, near=False):
         """``(r, g, face)``: outward distances (N,), their gradients (N, 3) (unit vectors;
         the face normal inside the face, towards the boundary foot beyond it) and the
-        reference of every point (N,); NaN where a point could not be projected."""
+        reference of every point (N,); NaN where a point could not be projected.
+        ``key``, ``near``: see :meth:`_project`."""
         N = Q.shape[0]
         r, g = np.full(N, np.nan), np.full((N, 3), np.nan)
         face = np.zeros(N, dtype=int) if assign is None else np.asarray(assign)
-        for k, (ref, pr) in enumerate(zip(self.refs, self.proj)):
+        for k, ref in enumerate(self.refs):
             idx = np.arange(N) if assign is None else np.flatnonzero(face == k)
             if not idx.size:
                 continue
-            p = pr.project(Q[idx])
+            p = self._project(k, Q[idx], idx, key, near)
             d = p.distance * ref.outward
             diff = Q[idx] - p.foot
             ln = np.linalg.norm(diff, axis=1)
@@ -193,15 +213,24 @@ class Distances:
         return r, g, face
 
 
-def tukey_weights(r, robust=True):
-    """Tukey biweight of residuals ``r`` over the scale ``1.4826 median |r|`` (at least
-    :data:`SCALE_FLOOR`); all ones when not ``robust``; zero for NaN."""
+def robust_scale(r):
+    """``1.4826 median |r|`` of the finite residuals, at least :data:`SCALE_FLOOR`."""
+    ok = np.isfinite(r)
+    return max(1.4826 * float(np.median(np.abs(r[ok]))) if ok.any() else 0.0, SCALE_FLOOR)
+
+
+def tukey_weights(r, robust=True, scale=None):
+    """``(w, h)``: Tukey's biweight ``w = psi(r) / r`` of residuals ``r`` and the second
+    derivative ``h = rho''(r)`` of its loss, over ``scale`` (default :func:`robust_scale`);
+    all ones when not ``robust``; zero for NaN."""
     ok = np.isfinite(r)
     if not robust:
-        return ok.astype(float)
-    scale = max(1.4826 * float(np.median(np.abs(r[ok]))) if ok.any() else 0.0, SCALE_FLOOR)
-    x = np.where(ok, r, np.inf) / (TUKEY_C * scale)
-    return np.where(np.abs(x) < 1.0, (1.0 - x * x) ** 2, 0.0)
+        return ok.astype(float), ok.astype(float)
+    scale = robust_scale(r) if scale is None else scale
+    x2 = (np.where(ok, r, np.inf) / (TUKEY_C * scale)) ** 2
+    inside = x2 < 1.0
+    return (np.where(inside, (1.0 - x2) ** 2, 0.0),
+            np.where(inside, (1.0 - x2) * (1.0 - 5.0 * x2), 0.0))
 
 
 def free_directions(J, w, cols, lever):
@@ -254,45 +283,68 @@ class Solver:
         self.tol = tol
         self.names = names
 
-    def residuals(self, P, M, assign=None):
+    def residuals(self, P, M, assign=None, key=None, near=False):
         Q = apply(M, P)
-        r, g, face = self.dist(Q, assign)
+        r, g, face = self.dist(Q, assign, key, near)
         return Q, r - self.offset, g, face
 
     def run(self, P, M, max_iter, assign=None, weights=None, check=True):
-        """Iterate from ``M``; ``weights`` fixed (else robust weights each iteration)."""
+        """Iterate from ``M``; ``weights`` fixed, else Tukey's loss over the robust scale
+        of each iteration's residuals until a step moves no point more than
+        :data:`FREEZE_STEP`, then over that scale (Newton steps on the loss converge
+        quadratically, reweighting alone only linearly). ``check``: refuse directions the
+        data cannot fix (at the first iteration and at the end)."""
         if len(self.cols) > P.shape[0]:
             raise InputError("%d point(s) cannot fix %d degrees of freedom (%s): expected at "
                              "least as many points as degrees of freedom"
                              % (P.shape[0], len(self.cols), " ".join(DOF_NAMES[c]
                                                                       for c in self.cols)))
-        M = M.copy()
+        M, moved, key, scale = M.copy(), np.inf, ("run", P.shape[0]), None
         for it in range(1, max_iter + 1):
-            Q, r, g, face = self.residuals(P, M, assign)
-            w = tukey_weights(r, self.robust) if weights is None else weights
+            Q, r, g, face = self.residuals(P, M, assign, key, moved <= WARM_STEP)
+            if weights is None:
+                if moved > FREEZE_STEP:
+                    scale = robust_scale(r)
+                w, h = tukey_weights(r, self.robust, scale)
+            else:
+                w = h = weights
             c = Q.mean(axis=0) if self.pivot is None else self.pivot
             J = np.hstack([g, np.cross(Q - c, g)])
             ok = w > 0
-            lever = max(float(np.sqrt(((Q[ok] - c) ** 2).sum(axis=1).mean())) if ok.any()
-                        else 1.0, 1.0)
-            if check:
-                free = free_directions(J[ok], w[ok], self.cols, lever)
-                if free:
-                    refuse_free(free, self.cols, self.names)
-            step, moved = self._step(J[ok], r[ok], w[ok], Q[ok] - c)
+            if check and (it == 1 or moved <= 10 * self.tol):
+                self._check(J[ok], w[ok], Q[ok] - c)
+            step, moved = self._step(J[ok], r[ok], w[ok], h[ok], Q[ok] - c)
             M = step_matrix(step, c) @ M
             if moved <= self.tol:
-                Q, r, g, face = self.residuals(P, M, assign)
-                w = tukey_weights(r, self.robust) if weights is None else weights
+                Q, r, g, face = self.residuals(P, M, assign, key, True)
                 return Fit(M, it, True, r, w, face)
         Q, r, g, face = self.residuals(P, M, assign)
-        return Fit(M, max_iter, False, r, tukey_weights(r, self.robust) if weights is None
-                   else weights, face)
+        return Fit(M, max_iter, False, r, w, face)
 
-    def _step(self, J, r, w, arm):
+    def _check(self, J, w, arm):
+        lever = max(float(np.sqrt((arm ** 2).sum(axis=1).mean())) if arm.size else 1.0, 1.0)
+        free = free_directions(J, w, self.cols, lever)
+        if free:
+            refuse_free(free, self.cols, self.names)
+
+    def _step(self, J, r, w, h, arm):
+        """Newton step of the robust loss (Hessian ``J^T diag(h) J``, gradient
+        ``J^T diag(w) r``), the reweighted least-squares step where that Hessian is not
+        positive definite."""
         A = J[:, self.cols]
-        sw = np.sqrt(w)
-        x = np.linalg.lstsq(A * sw[:, None], -r * sw, rcond=None)[0]
+        grad = A.T @ (w * r)
+        x = None
+        for hw in (h, w):
+            H = A.T @ (A * hw[:, None])
+            try:
+                L = np.linalg.cholesky(H)
+            except np.linalg.LinAlgError:
+                continue
+            x = -np.linalg.solve(L.T, np.linalg.solve(L, grad))
+            break
+        if x is None:
+            sw = np.sqrt(w)
+            x = np.linalg.lstsq(A * sw[:, None], -r * sw, rcond=None)[0]
         step = np.zeros(6)
         step[self.cols] = x
         rot = np.linalg.norm(step[3:])
@@ -447,7 +499,8 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     if P.shape[0] > FIT_SAMPLE:
         s = spread(P.shape[0], FIT_SAMPLE)
         report(progress, 0.2, "fitting on %d of %d points" % (s.size, P.shape[0]))
-        fit = solver.run(P[s], M0, max_iter, None if assign is None else np.asarray(assign)[s])
+        sub = Solver(dist, dof, robust, offset, pivot, 1e-6, solver.names)
+        fit = sub.run(P[s], M0, max_iter, None if assign is None else np.asarray(assign)[s])
         if not fit.converged:
             _not_converged(max_iter)
         M0, iterations = fit.matrix, fit.iterations
