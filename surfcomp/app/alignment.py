@@ -24,12 +24,14 @@ def align_options(job):
 
 
 def references(nominal, names):
-    """``(references, index of the compensated face or None)``: the named faces of the
-    nominal's shape, or the compensated face alone."""
+    """``(references, index of the compensated face, passive indices)``: the named faces of
+    the nominal's shape and the compensated face (passive when not named: it only claims
+    its points), or the compensated face alone."""
     from .nominal import nominal_from_face, pick_face
 
+    own = Reference(nominal.face_name, nominal.surface, nominal.outward)
     if not names:
-        return [Reference(nominal.face_name, nominal.surface, nominal.outward)], 0
+        return [own], 0, ()
     shape = nominal.shape if nominal.shape is not None else nominal.face
     refs = []
     for name in names:
@@ -39,8 +41,9 @@ def references(nominal, names):
         face, _ = pick_face(shape, name, nominal.source)
         other = nominal_from_face(face, nominal.source, name)
         refs.append(Reference(name, other.surface, other.outward))
-    comp = names.index(nominal.face_name) if nominal.face_name in names else None
-    return refs, comp
+    if nominal.face_name in names:
+        return refs, names.index(nominal.face_name), ()
+    return refs + [own], len(refs), (len(refs),)
 
 
 def align_measurements(job, nominal, ms, progress=None):
@@ -52,8 +55,30 @@ def align_measurements(job, nominal, ms, progress=None):
         raise InputError("--align/--transform move measured points: this file gives %s, "
                          "which are already in the nominal's frame (expected a point file "
                          "of measured points only)" % ms.kind(), file=ms.source)
-    refs, comp = references(nominal, opts.faces)
+    refs, comp, passive = references(nominal, opts.faces)
     tip = float(job.options.tip_radius or 0.0) if ms.tip_centres else 0.0
     points, record = align(ms.measured, opts, refs, comp, ids=ms.ids, offset=tip,
-                           progress=progress, source=job.rps)
-    return dataclasses.replace(ms, measured=points), record
+                           progress=progress, source=job.rps, passive=passive)
+    ms = dataclasses.replace(ms, measured=points)
+    if len(refs) > 1 and record.point_face is not None:
+        keep = record.point_face == comp
+        if not keep.any():
+            raise InputError("no measured point lies nearer to the compensated face %s than "
+                             "to the reference faces %s after the alignment"
+                             % (nominal.face_name, ", ".join(opts.faces)), file=ms.source)
+        ms = subset(ms, keep)
+        record.warnings.append("%s: %d point(s) on the reference faces served the alignment "
+                               "only; the deviations are those of the %d point(s) on %s"
+                               % (ms.source, int((~keep).sum()), int(keep.sum()),
+                                  nominal.face_name))
+    return ms, record
+
+
+def subset(ms, keep):
+    """The measurement set of the points ``keep`` (bool, N) only."""
+    arrays = {f: getattr(ms, f)[keep] for f in ("nominal", "measured", "normal", "deviation",
+                                                "row", "col", "lines")
+              if getattr(ms, f) is not None}
+    if ms.ids is not None:
+        arrays["ids"] = [i for i, k in zip(ms.ids, keep) if k]
+    return dataclasses.replace(ms, **arrays)

@@ -155,7 +155,7 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
     ms = read_any(job.measurements, job.units, job.fmt, job.sample,
                   deviation_units=job.deviation_units)
     budget.check_job(len(ms), job.command == "compensate", max_memory)
-    alignment = None
+    alignment, read = None, ms          # the report counts the file's points
     if job.align not in (None, "none") or job.transform or job.rps or job.align_faces \
             or job.align_dof:
         from .alignment import align_measurements
@@ -179,7 +179,7 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
                                  nominal.face_name)
         prepared.warnings.extend(output.warnings(nominal.face_name))
         shapes["output"] = output.shape
-    rep = report_io.build_report(job.command, _inputs_record(job, nominal, ms), comp,
+    rep = report_io.build_report(job.command, _inputs_record(job, nominal, read), comp,
                                  prepared.warnings,
                                  {attr: shown(getattr(job, attr))
                                   for attr, _opt in OUTPUT_OPTIONS if getattr(job, attr)},

@@ -274,8 +274,9 @@ class Solver:
     """Gauss-Newton iterations of the robust rigid fit (see the module docstring)."""
 
     def __init__(self, distances, dof=DOF_NAMES, robust=True, offset=0.0, pivot=None,
-                 tol=STEP_TOL, names=()):
+                 tol=STEP_TOL, names=(), passive=()):
         self.dist = distances
+        self.passive = tuple(passive)
         self.cols = [DOF_NAMES.index(n) for n in dof]
         self.robust = robust
         self.offset = float(offset)
@@ -286,6 +287,8 @@ class Solver:
     def residuals(self, P, M, assign=None, key=None, near=False):
         Q = apply(M, P)
         r, g, face = self.dist(Q, assign, key, near)
+        if self.passive:        # points nearest to a passive face take no part (NaN)
+            r = np.where(np.isin(face, self.passive), np.nan, r)
         return Q, r - self.offset, g, face
 
     def run(self, P, M, max_iter, assign=None, weights=None, check=True):
@@ -293,7 +296,7 @@ class Solver:
         of each iteration's residuals until a step moves no point more than
         :data:`FREEZE_STEP`, then over that scale (Newton steps on the loss converge
         quadratically, reweighting alone only linearly). ``check``: refuse directions the
-        data cannot fix (at the first iteration and at the end)."""
+        data cannot fix (at the solution: a far start may see fewer faces)."""
         if len(self.cols) > P.shape[0]:
             raise InputError("%d point(s) cannot fix %d degrees of freedom (%s): expected at "
                              "least as many points as degrees of freedom"
@@ -303,19 +306,21 @@ class Solver:
         for it in range(1, max_iter + 1):
             Q, r, g, face = self.residuals(P, M, assign, key, moved <= WARM_STEP)
             if weights is None:
-                if moved > FREEZE_STEP:
+                settled = moved <= FREEZE_STEP
+                if not settled:
                     scale = robust_scale(r)
                 w, h = tukey_weights(r, self.robust, scale)
+                h = h if settled else w         # Newton only near the solution
             else:
                 w = h = weights
             c = Q.mean(axis=0) if self.pivot is None else self.pivot
             J = np.hstack([g, np.cross(Q - c, g)])
             ok = w > 0
-            if check and (it == 1 or moved <= 10 * self.tol):
-                self._check(J[ok], w[ok], Q[ok] - c)
             step, moved = self._step(J[ok], r[ok], w[ok], h[ok], Q[ok] - c)
             M = step_matrix(step, c) @ M
             if moved <= self.tol:
+                if check:
+                    self._check(J[ok], w[ok], Q[ok] - c)
                 Q, r, g, face = self.residuals(P, M, assign, key, True)
                 return Fit(M, it, True, r, w, face)
         Q, r, g, face = self.residuals(P, M, assign)
@@ -424,15 +429,22 @@ def trimmed_rms(r, keep=0.8):
     return float(np.sqrt(np.mean(a * a)))
 
 
+def _cost(solver, P, M):
+    """Trimmed RMS distance of the points moved by ``M`` to their nearest faces, passive
+    ones included (a start must not win by handing points to them)."""
+    return trimmed_rms(solver.dist(apply(M, P))[0] - solver.offset)
+
+
 def pre_align(P, solver, M0, progress=None):
     """The best start among ``M0`` and the principal-axes starts (:func:`coarse_starts`):
     each fitted briefly on a subsample (all for 3 iterations, the best three on), another
     start wins only when its trimmed RMS is below half of ``M0``'s.
     Returns ``(matrix, label)``."""
     sub = P[spread(P.shape[0], COARSE_SAMPLE)]
-    quick = Solver(solver.dist, robust=solver.robust, offset=solver.offset, tol=1e-6)
+    quick = Solver(solver.dist, robust=solver.robust, offset=solver.offset, tol=1e-6,
+                   passive=solver.passive)
     first = quick.run(sub, M0, COARSE_ITER, check=False)
-    best, best_cost, label = first.matrix, trimmed_rms(first.residual), "as given"
+    best, best_cost, label = first.matrix, _cost(solver, sub, first.matrix), "as given"
     if first.converged and best_cost < GOOD_RMS:
         return best, label
     starts = coarse_starts(apply(M0, P), solver.dist.refs)
@@ -440,10 +452,10 @@ def pre_align(P, solver, M0, progress=None):
     for k, S in enumerate(starts):
         report(progress, 0.1 * (k + 1) / len(starts), "pre-aligning (principal axes)")
         fit = quick.run(sub[::3], S @ M0, 3, check=False)
-        tries.append((trimmed_rms(fit.residual), k, fit.matrix))
-    for _cost, _k, M in sorted(tries, key=lambda x: x[:2])[:3]:
+        tries.append((_cost(solver, sub[::3], fit.matrix), k, fit.matrix))
+    for _c, _k, M in sorted(tries, key=lambda x: x[:2])[:3]:
         fit = quick.run(sub, M, COARSE_ITER, check=False)
-        cost = trimmed_rms(fit.residual)
+        cost = _cost(solver, sub, fit.matrix)
         if cost < (0.5 if label == "as given" else 1.0) * best_cost:
             best, best_cost, label = fit.matrix, cost, "principal axes"
     return best, label
@@ -451,7 +463,7 @@ def pre_align(P, solver, M0, progress=None):
 
 def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=True,
              robust=True, offset=0.0, max_iter=MAX_ITER, tol=STEP_TOL, workers=None,
-             progress=None):
+             progress=None, passive=()):
     """Robust rigid least-squares fit of measured points to reference faces.
 
     Parameters
@@ -474,6 +486,9 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     max_iter, tol
         Iteration limit of each stage (subsample, all points) and the convergence step
         (mm, largest motion of a point).
+    passive : tuple of int
+        References that only claim their nearest points, which then take no part in the
+        fit (the compensated face beside datum faces); their residuals are NaN.
 
     Returns
     -------
@@ -491,7 +506,8 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     M0 = np.eye(4) if start is None else np.asarray(start, dtype=float)
     dist = Distances(references, P.shape[0], workers)
     pivot = None if {"x", "y", "z"} <= set(dof) else np.zeros(3)
-    solver = Solver(dist, dof, robust, offset, pivot, tol, [r.name for r in references])
+    names = [r.name for r in references if references.index(r) not in passive]
+    solver = Solver(dist, dof, robust, offset, pivot, tol, names, passive)
     label = "as given"
     if coarse and len(dof) == 6 and P.shape[0] >= 6:
         M0, label = pre_align(P, solver, M0, progress)
@@ -499,7 +515,7 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     if P.shape[0] > FIT_SAMPLE:
         s = spread(P.shape[0], FIT_SAMPLE)
         report(progress, 0.2, "fitting on %d of %d points" % (s.size, P.shape[0]))
-        sub = Solver(dist, dof, robust, offset, pivot, 1e-6, solver.names)
+        sub = Solver(dist, dof, robust, offset, pivot, 1e-6, names, passive)
         fit = sub.run(P[s], M0, max_iter, None if assign is None else np.asarray(assign)[s])
         if not fit.converged:
             _not_converged(max_iter)

@@ -78,6 +78,7 @@ class Alignment:
     outliers: int = 0
     absorbed: dict = None
     warnings: list = field(default_factory=list)
+    point_face: np.ndarray = None
 
     def as_dict(self):
         """The report's ``"alignment"`` object."""
@@ -106,11 +107,10 @@ def summary_lines(d):
                    % ("best fit" if d["method"] == "bestfit" else "3-2-1",
                       ", ".join(d["faces"]), " ".join(d["dof"]), d["start"], d["iterations"],
                       "converged" if d["converged"] else "NOT converged"))
-        for name in d["faces"]:
-            if name in (d["rms_after_um"] or {}):
-                out.append("  %s: %d points, RMS distance %.3f um before, %.3f um after"
-                           % (name, d["points"][name], d["rms_before_um"][name],
-                              d["rms_after_um"][name]))
+        for name, after in (d["rms_after_um"] or {}).items():
+            out.append("  %s: %d points, RMS distance %.3f um before, %.3f um after"
+                       % (name, d["points"][name],
+                          d["rms_before_um"].get(name, float("nan")), after))
         if d["outliers"]:
             out.append("  %d point(s) weighted out as outliers" % d["outliers"])
     if d["absorbed"]:
@@ -151,7 +151,7 @@ def absorbed(before, after, normal):
 
 
 def align(points, options, references, compensated=None, ids=None, assign=None, offset=0.0,
-          progress=None, source=None):
+          progress=None, source=None, passive=()):
     """Align measured points (see the module docstring).
 
     Parameters
@@ -162,12 +162,16 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
     references : list of Reference
         The reference faces (the compensated face alone when the user named none).
     compensated : int, optional
-        Index of the compensated face in ``references`` (None: it takes no part).
+        Index of the compensated face in ``references`` (None: it is not among them).
+    passive : tuple of int
+        References that only claim their nearest points (the compensated face beside datum
+        faces): those points take no part in the fit.
 
     Returns
     -------
     (ndarray (N, 3), Alignment)
-        The points in the nominal's frame and the record.
+        The points in the nominal's frame and the record (``point_face``: the nearest
+        reference of every aligned point).
     """
     options.validate()
     P = np.asarray(points, dtype=float)
@@ -176,43 +180,43 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
     start = np.eye(4) if known is None else known
     if options.method == "none":
         return apply(start, P), Alignment("none", start, known=known)
-    names = [r.name for r in references]
-    dof = _parse_dof(options.dof)
+    every = [r.name for r in references]
+    active = [n for k, n in enumerate(every) if k not in passive]
     if options.method == "rps":
-        fit, idx = rps_fit(P, options.rps, references, ids, start, offset, source=source)
-        dist, sel = Distances(references, 6), idx
-        label, dof = "as given", DOF_NAMES
+        fit, _idx = rps_fit(P, options.rps, references, ids, start, offset, source=source)
+        label, dof, outliers = "as given", DOF_NAMES, 0
     else:
-        fit, label = best_fit(P, references, assign, dof, start, offset=offset, progress=progress)
-        dist, sel = None, slice(None)
-    before_pts = apply(start, P)
-    if dist is None:
-        dist = Distances(references, P.shape[0])
-    r0, g0, f0 = dist(before_pts[sel], None if assign is None else np.asarray(assign)[sel])
-    rms_before, _ = per_face_rms(r0 - offset, f0, names)
-    rms_after, count = per_face_rms(fit.residual, fit.face, names)
-    rec = Alignment(options.method, fit.matrix, known, dof, names, fit.iterations, fit.converged,
-                    label, rms_before, rms_after, count, int((fit.weight == 0).sum()))
-    after = apply(fit.matrix, P)
-    if compensated is not None and options.method == "bestfit":
-        on = fit.face == compensated
-        _r, g, _f = dist(after[on], np.zeros(int(on.sum()), dtype=int) + compensated
-                         if len(references) > 1 else None)
-        rec.absorbed = absorbed(before_pts[on], after[on], g)
-        moved = np.abs(np.einsum("ij,ij->i", g, after[on] - before_pts[on])).max()
-        if not options.faces and moved > FAR_START:
-            rec.warnings.append("the best fit used the compensated face itself and moved its "
-                                "points up to %.3f mm from where they came in: what it absorbed "
-                                "of the machining error's mean and tilt cannot be told apart "
-                                "from that move (bring them near with --transform, or name "
-                                "datum faces with --align-faces)" % moved)
-        elif not options.faces:
-            rec.warnings.append("the best fit used the compensated face itself: it absorbed a "
-                                "mean offset of %.3f um and a tilt of %.3f um of the machining "
-                                "error, which the corrected face will leave in the part "
-                                "(name datum faces with --align-faces to keep them)"
-                                % (rec.absorbed["mean_offset_um"], rec.absorbed["tilt_um"]))
+        dof = _parse_dof(options.dof)
+        fit, label = best_fit(P, references, assign, dof, start, offset=offset,
+                              progress=progress, passive=passive)
+        outliers = int(((fit.weight == 0) & np.isfinite(fit.residual)).sum())
+    before, after = apply(start, P), apply(fit.matrix, P)
+    dist = Distances(references, P.shape[0])
+    r0, _g, f0 = dist(before, assign)
+    r1, g1, f1 = dist(after, assign)
+    rms_before, _ = per_face_rms(r0 - offset, f0, every)
+    rms_after, count = per_face_rms(r1 - offset, f1, every)
+    rec = Alignment(options.method, fit.matrix, known, dof, active, fit.iterations,
+                    fit.converged, label, rms_before, rms_after, count, outliers)
+    rec.point_face = f1
+    if compensated is not None and compensated not in passive and options.method == "bestfit":
+        on = f1 == compensated
+        rec.absorbed = absorbed(before[on], after[on], g1[on])
+        rec.warnings.append(_absorbed_warning(rec.absorbed, g1[on], after[on] - before[on]))
     return after, rec
+
+
+def _absorbed_warning(absorbed_, normal, shift):
+    moved = float(np.abs(np.einsum("ij,ij->i", normal, shift)).max()) if shift.size else 0.0
+    if moved > FAR_START:
+        return ("the best fit used the compensated face itself and moved its points up to "
+                "%.3f mm from where they came in: what it absorbed of the machining error's "
+                "mean and tilt cannot be told apart from that move (bring them near with "
+                "--transform, or name datum faces with --align-faces)" % moved)
+    return ("the best fit used the compensated face itself: it absorbed a mean offset of %.3f "
+            "um and a tilt of %.3f um of the machining error, which the corrected face will "
+            "leave in the part (name datum faces with --align-faces to keep them)"
+            % (absorbed_["mean_offset_um"], absorbed_["tilt_um"]))
 
 
 __all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms",

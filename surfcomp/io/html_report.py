@@ -283,12 +283,10 @@ def _section_alignment(report):
                  ("Degrees of freedom", _e(" ".join(a["dof"]))),
                  ("Iterations", _e("%d, %s" % (a["iterations"], "converged" if a["converged"]
                                                else "NOT converged")))]
-        for name in a["faces"]:
-            if name in (a["rms_after_um"] or {}):
-                rows.append(("RMS distance %s (um)" % name, _e(
-                    "%.3f before, %.3f after (%d points)" % (a["rms_before_um"][name],
-                                                              a["rms_after_um"][name],
-                                                              a["points"][name]))))
+        for name, after in (a["rms_after_um"] or {}).items():
+            rows.append(("RMS distance %s (um)" % name, _e(
+                "%.3f before, %.3f after (%d points)"
+                % (a["rms_before_um"].get(name, float("nan")), after, a["points"][name]))))
     if a.get("absorbed"):
         rows.append(("Absorbed on the compensated face", _e(
             "mean offset %.3f um, tilt %.3f um across the face"

@@ -89,3 +89,45 @@ def test_bad_alignment_input_exits_2_and_writes_nothing(tmp_path):
                   "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 2 and "already in the nominal's frame" in out.stderr
     assert not (tmp_path / "r.json").exists()
+
+
+def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
+    """Points on three datum faces of a block and on its top face, all moved: the fit on the
+    datums puts the top's points back; their deviations are those never moved (0.1 um) and
+    nothing is absorbed; the datum points serve the alignment only."""
+    import Part
+
+    box = Part.makeBox(40.0, 30.0, 20.0)
+    box.exportStep(str(tmp_path / "box.step"))
+    rng = np.random.default_rng(28)
+
+    def on(origin, eu, ev, n, a=(2.0, 38.0), b=(2.0, 18.0)):
+        s, t = rng.uniform(*a, n), rng.uniform(*b, n)
+        return np.asarray(origin) + s[:, None] * eu + t[:, None] * ev
+
+    ex, ey, ez = np.eye(3)
+    datums = np.vstack([on((0, 0, 0), ey, ez, 150, (2, 28)), on((0, 0, 0), ex, ez, 150),
+                        on((0, 0, 0), ex, ey, 150, b=(2, 28))])
+    top = on((0, 0, 20.0), ex, ey, 300, b=(2, 28))
+    dev = 0.02 + 0.01 * np.sin(top[:, 0] / 7.0) + 0.0005 * top[:, 1]
+    pts = align.apply(MOVE, np.vstack([datums, top + dev[:, None] * ez]))
+    np.savetxt(tmp_path / "p.xyz", pts, fmt="%.10f", header="x y z", comments="")
+    faces = [f for f in box.Faces]
+    names = ["Face%d" % (k + 1) for k, f in enumerate(faces)
+             if abs(f.CenterOfMass.x) < 1e-9 or abs(f.CenterOfMass.y) < 1e-9
+             or abs(f.CenterOfMass.z) < 1e-9]
+    top_name = next("Face%d" % (k + 1) for k, f in enumerate(faces)
+                    if abs(f.CenterOfMass.z - 20.0) < 1e-9)
+    out = run_cli("inspect", tmp_path / "box.step", tmp_path / "p.xyz", "--face", top_name,
+                  "--align", "bestfit", "--align-faces", ",".join(names),
+                  "--report", tmp_path / "r.json", "--quiet")
+    assert out.returncode == 0, out.stderr
+    rep = json.loads((tmp_path / "r.json").read_text())
+    a = rep["alignment"]
+    assert a["faces"] == names and a["absorbed"] is None and a["converged"]
+    assert rep["inputs"]["measurements"]["points"] == 750
+    assert len(rep["points"]["deviation"]) == 300
+    assert_allclose(rep["points"]["deviation"], dev, atol=1e-4)
+    assert_allclose(a["matrix"], np.linalg.inv(MOVE), atol=1e-9)
+    assert all(a["rms_after_um"][n] < 1e-3 for n in names)
+    assert "served the alignment only" in out.stderr
