@@ -463,7 +463,7 @@ def pre_align(P, solver, M0, progress=None):
 
 def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=True,
              robust=True, offset=0.0, max_iter=MAX_ITER, tol=STEP_TOL, workers=None,
-             progress=None, passive=()):
+             progress=None, passive=(), distances=None):
     """Robust rigid least-squares fit of measured points to reference faces.
 
     Parameters
@@ -489,6 +489,9 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     passive : tuple of int
         References that only claim their nearest points, which then take no part in the
         fit (the compensated face beside datum faces); their residuals are NaN.
+    distances : Distances, optional
+        The references' projection engines when the caller has them; the feet of the last
+        iteration stay in it under the key ``("run", N)``.
 
     Returns
     -------
@@ -504,7 +507,7 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     """
     P = np.asarray(points, dtype=float)
     M0 = np.eye(4) if start is None else np.asarray(start, dtype=float)
-    dist = Distances(references, P.shape[0], workers)
+    dist = distances or Distances(references, P.shape[0], workers)
     pivot = None if {"x", "y", "z"} <= set(dof) else np.zeros(3)
     names = [r.name for r in references if references.index(r) not in passive]
     solver = Solver(dist, dof, robust, offset, pivot, tol, names, passive)

@@ -17,7 +17,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .align import DOF_NAMES, Distances, Reference, apply, best_fit, check_rigid, describe
+from .align import (
+    DOF_NAMES,
+    Distances,
+    Reference,
+    apply,
+    best_fit,
+    check_rigid,
+    describe,
+    spread,
+)
 from .align import parse_dof as _parse_dof
 from .align_rps import rps_fit
 
@@ -26,6 +35,9 @@ METHODS = ("none", "bestfit", "rps")
 #: a fit that moves the compensated face's points farther (mm, along the normal) started
 #: in another frame: its absorbed mean and tilt are mostly that frame's offset
 FAR_START = 1.0
+#: the RMS before the alignment is taken over this many points at most (spread over the
+#: file): points far from the faces take a projection each
+BEFORE_SAMPLE = 20000
 
 
 @dataclass
@@ -182,18 +194,20 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
         return apply(start, P), Alignment("none", start, known=known)
     every = [r.name for r in references]
     active = [n for k, n in enumerate(every) if k not in passive]
+    dist = Distances(references, P.shape[0])
     if options.method == "rps":
         fit, _idx = rps_fit(P, options.rps, references, ids, start, offset, source=source)
         label, dof, outliers = "as given", DOF_NAMES, 0
     else:
         dof = _parse_dof(options.dof)
         fit, label = best_fit(P, references, assign, dof, start, offset=offset,
-                              progress=progress, passive=passive)
+                              progress=progress, passive=passive, distances=dist)
         outliers = int(((fit.weight == 0) & np.isfinite(fit.residual)).sum())
     before, after = apply(start, P), apply(fit.matrix, P)
-    dist = Distances(references, P.shape[0])
-    r0, _g, f0 = dist(before, assign)
-    r1, g1, f1 = dist(after, assign)
+    # before: on a sample (far points cost a projection each); after: from the fit's feet
+    s = spread(P.shape[0], BEFORE_SAMPLE)
+    r0, _g, f0 = dist(before[s], None if assign is None else np.asarray(assign)[s])
+    r1, g1, f1 = dist(after, assign, ("run", P.shape[0]), options.method == "bestfit")
     rms_before, _ = per_face_rms(r0 - offset, f0, every)
     rms_after, count = per_face_rms(r1 - offset, f1, every)
     rec = Alignment(options.method, fit.matrix, known, dof, active, fit.iterations,
