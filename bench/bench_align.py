@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Best fit of measured points to the example face, beside a point-to-plane ICP baseline.
 
-Run: /usr/bin/python3 bench/bench_align.py [--points N] [--grid G] [--workers W]
+Run: /usr/bin/python3 bench/bench_align.py [--points N] [--grid G] [--workers W] [--sigma MM]
 
 Data: N points (default 1,000,000) spread over the bundled example face
-(:func:`surfcomp.core.presets.werner_surface`, 45 x 45 mm), 2 um normal noise, moved by a
-known rigid transform (3 degrees about a skew axis, 5 mm). Ours: the whole
-:func:`surfcomp.core.align.best_fit` call (projection engines built, pre-alignment, the fit
+(:func:`surfcomp.core.presets.werner_surface`, 45 x 45 mm), 2 um normal noise (``--sigma 0``:
+exact points), moved by a known rigid transform (3 degrees about a skew axis, 5 mm). Ours: the
+whole :func:`surfcomp.core.align.best_fit` call (projection engines built, pre-alignment, the fit
 on a subsample, then on all points, exact point-to-surface distance, Tukey weights).
 Baseline in the same run on the same points: point-to-plane ICP (Chen & Medioni 1992)
 against a G x G tessellation of the face (vertex normals), nearest vertex by scipy's
@@ -78,18 +78,19 @@ def main():
     ap.add_argument("--points", type=int, default=1_000_000)
     ap.add_argument("--grid", type=int, default=400)
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument("--sigma", type=float, default=2e-3, help="normal noise (mm)")
     a = ap.parse_args()
     surf = werner_surface()
-    P, T, S = data(surf, a.points)
+    P, T, S = data(surf, a.points, a.sigma)
     t0, c0 = time.perf_counter(), time.process_time()
     fit, label = align.best_fit(P, [align.Reference("Face1", surf)], workers=a.workers)
     t_ours, c_ours = time.perf_counter() - t0, time.process_time() - c0
     t0, c0 = time.perf_counter(), time.process_time()
     M_icp, it_icp = icp(P, surf, a.grid)
     t_icp, c_icp = time.perf_counter() - t0, time.process_time() - c0
-    sigma_n = 2e-3 / np.sqrt(a.points)
-    print("best fit of %d points to the example face (2 um noise, moved 3 deg / 5 mm), "
-          "%d cores" % (a.points, os.cpu_count()))
+    sigma_n = a.sigma / np.sqrt(a.points)
+    print("best fit of %d points to the example face (%g um noise, moved 3 deg / 5 mm), "
+          "%d cores" % (a.points, a.sigma * 1e3, os.cpu_count()))
     print("%-44s %8s %8s %6s %12s %12s" % ("", "wall s", "CPU s", "iter", "rot err rad",
                                             "max err um"))
     for name, M, t, cpu, it in (("ours: exact distance, robust (%s start)" % label,

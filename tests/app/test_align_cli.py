@@ -131,3 +131,17 @@ def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
     assert_allclose(a["matrix"], np.linalg.inv(MOVE), atol=1e-9)
     assert all(a["rms_after_um"][n] < 1e-3 for n in names)
     assert "served the alignment only" in out.stderr
+
+
+def test_shop_document_route_refuses_alignment(tmp_path, fresh_doc):
+    import Part
+
+    nom = fresh_doc.addObject("Part::Feature", "Nominal")
+    nom.Shape = Part.read(EXAMPLE_STEP)
+    fresh_doc.recompute()
+    fresh_doc.saveAs(str(tmp_path / "d.FCStd"))
+    out = run_cli("compensate", tmp_path / "d.FCStd", _points(tmp_path, np.eye(4)), "--object",
+                  "Nominal", "--save", tmp_path / "out.FCStd", "--align", "bestfit", "--quiet")
+    assert out.returncode == 2
+    assert "--align cannot be combined with --replace/--save/--gcode" in out.stderr
+    assert not (tmp_path / "out.FCStd").exists()
