@@ -48,17 +48,24 @@ def references(nominal, names):
 
 def align_measurements(job, nominal, ms, progress=None):
     """``(measurement set with the aligned points, Alignment)`` of a job whose alignment
-    is active; refuses sets that carry nominal points or deviations (already in the
-    nominal's frame)."""
-    opts = align_options(job)
+    is active."""
+    tip = float(job.options.tip_radius or 0.0)
+    return align_set(align_options(job), nominal, ms, tip, job.rps, progress)
+
+
+def align_set(opts, nominal, ms, tip_radius=0.0, source=None, progress=None):
+    """``(measurement set with the aligned points, Alignment)``: ``ms`` aligned to
+    ``nominal`` as ``opts`` say; with datum faces, only the points on the compensated face
+    stay. Refuses sets that carry nominal points or deviations (already in the nominal's
+    frame)."""
     if ms.nominal is not None or ms.measured is None:
         raise InputError("--align/--transform move measured points: this file gives %s, "
                          "which are already in the nominal's frame (expected a point file "
                          "of measured points only)" % ms.kind(), file=ms.source)
     refs, comp, passive = references(nominal, opts.faces)
-    tip = float(job.options.tip_radius or 0.0) if ms.tip_centres else 0.0
+    tip = float(tip_radius or 0.0) if ms.tip_centres else 0.0
     points, record = align(ms.measured, opts, refs, comp, ids=ms.ids, offset=tip,
-                           progress=progress, source=job.rps, passive=passive)
+                           progress=progress, source=source, passive=passive)
     ms = dataclasses.replace(ms, measured=points)
     if len(refs) > 1 and record.point_face is not None:
         keep = record.point_face == comp
