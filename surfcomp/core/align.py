@@ -48,9 +48,6 @@ SCALE_FLOOR = 1e-4
 RANK_TOL = 1e-5
 #: largest rotation of one Gauss-Newton step (rad); longer steps are shortened
 MAX_STEP_ROT = 0.3
-#: after a step that moved no point farther (mm), the feet are found by Newton from the
-#: last ones (:meth:`surfcomp.core.projection.Projector.project_near`)
-WARM_STEP = 0.01
 #: points a fit iterates on before it takes all points (a subsample spread over the file)
 FIT_SAMPLE = 50000
 #: points of the coarse starts' short fits, and their iterations
@@ -171,26 +168,11 @@ class Distances:
         self.refs = list(references)
         self.proj = [Projector(r.surface, workers=workers, min_samples=min(points, 10 ** 6) // 16)
                      for r in self.refs]
-        self._feet = {}
 
-    def _project(self, k, Q, idx, key, near):
-        """Projection of ``Q`` on reference ``k``. ``key``: under it the feet are kept for
-        the next call; ``near``: the points moved little since the last call with ``key``
-        (Newton from the kept feet)."""
-        last = self._feet.get((key, k)) if near else None
-        if last is not None and last[0].shape == idx.shape and (last[0] == idx).all():
-            p = self.proj[k].project_near(Q, last[1], last[2])
-        else:
-            p = self.proj[k].project(Q)
-        if key is not None:
-            self._feet[(key, k)] = (idx, p.u, p.v)
-        return p
-
-    def __call__(self, Q, assign=None, key=None, near=False):
+    def __call__(self, Q, assign=None):
         """``(r, g, face)``: outward distances (N,), their gradients (N, 3) (unit vectors;
         the face normal inside the face, towards the boundary foot beyond it) and the
-        reference of every point (N,); NaN where a point could not be projected.
-        ``key``, ``near``: see :meth:`_project`."""
+        reference of every point (N,); NaN where a point could not be projected."""
         N = Q.shape[0]
         r, g = np.full(N, np.nan), np.full((N, 3), np.nan)
         face = np.zeros(N, dtype=int) if assign is None else np.asarray(assign)
@@ -198,7 +180,7 @@ class Distances:
             idx = np.arange(N) if assign is None else np.flatnonzero(face == k)
             if not idx.size:
                 continue
-            p = self._project(k, Q[idx], idx, key, near)
+            p = self.proj[k].project(Q[idx])
             d = p.distance * ref.outward
             diff = Q[idx] - p.foot
             ln = np.linalg.norm(diff, axis=1)
@@ -260,7 +242,8 @@ def refuse_free(free, cols, faces):
 @dataclass
 class Fit:
     """One fit's result: ``matrix`` (4 x 4, points -> nominal), ``iterations``,
-    ``converged``, and per point the final residual (mm), weight and reference."""
+    ``converged``, and per point the final residual (mm; NaN on passive faces), weight,
+    reference and the distance's gradient (N, 3)."""
 
     matrix: np.ndarray
     iterations: int
@@ -268,6 +251,7 @@ class Fit:
     residual: np.ndarray
     weight: np.ndarray
     face: np.ndarray
+    gradient: np.ndarray = None
 
 
 class Solver:
@@ -284,9 +268,9 @@ class Solver:
         self.tol = tol
         self.names = names
 
-    def residuals(self, P, M, assign=None, key=None, near=False):
+    def residuals(self, P, M, assign=None):
         Q = apply(M, P)
-        r, g, face = self.dist(Q, assign, key, near)
+        r, g, face = self.dist(Q, assign)
         if self.passive:        # points nearest to a passive face take no part (NaN)
             r = np.where(np.isin(face, self.passive), np.nan, r)
         return Q, r - self.offset, g, face
@@ -302,9 +286,9 @@ class Solver:
                              "least as many points as degrees of freedom"
                              % (P.shape[0], len(self.cols), " ".join(DOF_NAMES[c]
                                                                       for c in self.cols)))
-        M, moved, key, scale = M.copy(), np.inf, ("run", P.shape[0]), None
+        M, moved, scale = M.copy(), np.inf, None
         for it in range(1, max_iter + 1):
-            Q, r, g, face = self.residuals(P, M, assign, key, moved <= WARM_STEP)
+            Q, r, g, face = self.residuals(P, M, assign)
             if weights is None:
                 settled = moved <= FREEZE_STEP
                 if not settled:
@@ -321,10 +305,10 @@ class Solver:
             if moved <= self.tol:
                 if check:
                     self._check(J[ok], w[ok], Q[ok] - c)
-                Q, r, g, face = self.residuals(P, M, assign, key, True)
-                return Fit(M, it, True, r, w, face)
+                Q, r, g, face = self.residuals(P, M, assign)
+                return Fit(M, it, True, r, w, face, g)
         Q, r, g, face = self.residuals(P, M, assign)
-        return Fit(M, max_iter, False, r, w, face)
+        return Fit(M, max_iter, False, r, w, face, g)
 
     def _check(self, J, w, arm):
         lever = max(float(np.sqrt((arm ** 2).sum(axis=1).mean())) if arm.size else 1.0, 1.0)
@@ -490,8 +474,7 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
         References that only claim their nearest points, which then take no part in the
         fit (the compensated face beside datum faces); their residuals are NaN.
     distances : Distances, optional
-        The references' projection engines when the caller has them; the feet of the last
-        iteration stay in it under the key ``("run", N)``.
+        The references' projection engines when the caller has them.
 
     Returns
     -------

@@ -204,12 +204,16 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
                               progress=progress, passive=passive, distances=dist)
         outliers = int(((fit.weight == 0) & np.isfinite(fit.residual)).sum())
     before, after = apply(start, P), apply(fit.matrix, P)
-    # before: on a sample (far points cost a projection each); after: from the fit's feet
+    # before: on a sample (far points cost a projection each); after: the fit's last state
     s = spread(P.shape[0], BEFORE_SAMPLE)
     r0, _g, f0 = dist(before[s], None if assign is None else np.asarray(assign)[s])
-    r1, g1, f1 = dist(after, assign, ("run", P.shape[0]), options.method == "bestfit")
+    if options.method == "bestfit" and not passive:
+        r1, g1, f1 = fit.residual, fit.gradient, fit.face
+    else:
+        r1, g1, f1 = dist(after, assign)
+        r1 = r1 - offset
     rms_before, _ = per_face_rms(r0 - offset, f0, every)
-    rms_after, count = per_face_rms(r1 - offset, f1, every)
+    rms_after, count = per_face_rms(r1, f1, every)
     rec = Alignment(options.method, fit.matrix, known, dof, active, fit.iterations,
                     fit.converged, label, rms_before, rms_after, count, outliers)
     rec.point_face = f1

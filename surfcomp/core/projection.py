@@ -223,7 +223,9 @@ class Projector:
         if P.ndim != 2 or P.shape[1] != 3:
             raise InputError("points must have shape (N, 3), got %r" % (P.shape,))
         N = P.shape[0]
-        res = _empty(N)
+        res = dict(u=np.full(N, np.nan), v=np.full(N, np.nan), foot=np.full((N, 3), np.nan),
+                   normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
+                   outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
         good = np.flatnonzero(np.all(np.isfinite(P), axis=1))
         # blocks are independent (disjoint result rows): one thread each; two per thread
         # at most (each ends with a tail of iterations on its few slow points)
@@ -234,25 +236,6 @@ class Projector:
                                                 "projecting points"))
         if not good.size:
             report(progress, 1.0, "projecting points")
-        return Projection(**res)
-
-    def project_near(self, points, u, v):
-        """Points whose feet lie near ``(u, v)`` (N,), feet :meth:`project` found before a
-        move far below the face's radii (an alignment's last steps): Newton from there, no
-        seeds or global checks; the points it leaves unconverged go through :meth:`project`."""
-        P = np.asarray(points, dtype=float)
-        res, idx = _empty(P.shape[0]), np.arange(P.shape[0])
-
-        def block(sl):
-            uu, vv, D, conv = self.newton.run(np.ascontiguousarray(P[sl].T), u[sl], v[sl])
-            self._finish(P[sl], idx[sl], uu, vv, D, conv, res, None)
-
-        for_chunks(block, idx.size, CHUNK, workers=self.workers)
-        redo = np.flatnonzero(~res["converged"] & np.all(np.isfinite(P), axis=1))
-        if redo.size:
-            again = self.project(P[redo])
-            for key in res:
-                res[key][redo] = getattr(again, key)
         return Projection(**res)
 
     # ------------------------------------------------------------------ internals
@@ -538,13 +521,6 @@ class Projector:
         res["distance"][idx] = d[keep]
         res["outside"][idx] = out[keep]
         res["converged"][idx] = conv[keep]
-
-
-def _empty(N):
-    """The result arrays of N points before projection (NaN, not converged)."""
-    return dict(u=np.full(N, np.nan), v=np.full(N, np.nan), foot=np.full((N, 3), np.nan),
-                normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
-                outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
 
 
 def tangent_lengths(surf, u, v, chunk=CHUNK):

@@ -257,19 +257,3 @@ def test_bad_input_fewer_points_and_no_convergence():
     with pytest.raises(InputError, match="did not converge in 1 iterations"):
         align.best_fit(align.apply(transform(93), pts), REF, coarse=False, max_iter=1)
 
-
-def test_project_near_matches_project():
-    """The fit's last iterations find the feet by Newton from the previous ones."""
-    from surfcomp.core.projection import Projector
-
-    surf = wavy_patch()
-    pts, n = on_surface(surf, 2000, 101)
-    pts = pts + n * np.random.default_rng(102).uniform(-0.5, 0.5, 2000)[:, None]
-    pr = Projector(surf)
-    first = pr.project(pts)
-    moved = pts + [1e-3, -2e-3, 1e-3]
-    near, full = pr.project_near(moved, first.u, first.v), pr.project(moved)
-    assert near.converged.all()
-    np.testing.assert_allclose(near.distance, full.distance, atol=1e-12)
-    np.testing.assert_allclose(near.foot, full.foot, atol=1e-9)
-    np.testing.assert_array_equal(near.outside, full.outside)
