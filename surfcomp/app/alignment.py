@@ -7,11 +7,14 @@ compensated face itself), reads the transform and 3-2-1 files, and calls
 """
 
 import dataclasses
+import os
+
+import numpy as np
 
 from ..core.align import Reference
 from ..core.align_report import AlignOptions, align
 from ..errors import InputError
-from ..io.align_files import read_rps, read_transform
+from ..io.align_files import face_column, read_rps, read_transform
 
 
 def align_options(job):
@@ -64,8 +67,9 @@ def align_set(opts, nominal, ms, tip_radius=0.0, source=None, progress=None):
                          "of measured points only)" % ms.kind(), file=ms.source)
     refs, comp, passive = references(nominal, opts.faces)
     tip = float(tip_radius or 0.0) if ms.tip_centres else 0.0
+    assign = assigned_faces(ms, refs) if opts.method != "none" else None
     points, record = align(ms.measured, opts, refs, comp, ids=ms.ids, offset=tip,
-                           progress=progress, source=source, passive=passive)
+                           progress=progress, source=source, passive=passive, assign=assign)
     ms = dataclasses.replace(ms, measured=points)
     if len(refs) > 1 and record.point_face is not None:
         keep = record.point_face == comp
@@ -79,6 +83,22 @@ def align_set(opts, nominal, ms, tip_radius=0.0, source=None, progress=None):
                                % (ms.source, int((~keep).sum()), int(keep.sum()),
                                   nominal.face_name))
     return ms, record
+
+
+def assigned_faces(ms, refs):
+    """The reference index of every point from the file's face column, or None."""
+    named = face_column(ms) if os.path.isfile(str(ms.source)) else None
+    if named is None:
+        return None
+    index = {r.name: k for k, r in enumerate(refs)}
+    out = np.empty(len(named), dtype=int)
+    for k, name in enumerate(named):
+        if name not in index:
+            raise InputError("face %r is not a reference face (expected one of %s: the "
+                             "faces of --align-faces and the compensated face)"
+                             % (name, ", ".join(index)), file=ms.source, line=int(ms.lines[k]))
+        out[k] = index[name]
+    return out
 
 
 def subset(ms, keep):

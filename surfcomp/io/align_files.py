@@ -14,6 +14,9 @@ Transform file (``--transform``), one of:
 "tertiary": [1 id]}`` (a group may be ``{"points": [...], "face": "Face2"}``), or the ids
 inline, groups separated by ``;``: ``"P1,P2,P3;P4,P5;P6"``. Ids are the measurement
 file's point ids, or 1-based point numbers when it has none.
+
+Face column: a plain point file (``x y z face``) may name the reference face of every
+point (:func:`face_column`).
 """
 
 import json
@@ -115,3 +118,42 @@ def read_rps(value):
                          "separated by ';' (3, 2 and 1 ids, e.g. P1,P2,P3;P4,P5;P6)" % value)
     names = ("primary", "secondary", "tertiary")
     return {n: [x.strip() for x in p.split(",")] for n, p in zip(names, parts)}, "--rps"
+
+
+def face_column(ms):
+    """The face each point names in a ``face`` column of a plain point file (the readers
+    leave that column aside as not numeric), or None when the file has none.
+
+    Returns
+    -------
+    list of str (one per point, in file order) or None
+    """
+    names = [c.strip().lower() for c in ms.ignored_columns]
+    if "face" not in names or ms.nominal is not None:
+        return None
+    data = read_bytes(ms.source, "the measurement file", InputError)
+    lines = data.decode("utf-8-sig", errors="replace").splitlines()
+    split = _splitter(ms.separator)
+    first = int(ms.lines[0]) - 1
+    header = next(k for k in range(first - 1, -1, -1)
+                  if lines[k].split("#", 1)[0].split("//", 1)[0].strip())
+    head = [f.strip().strip('"').lower() for f in split(_bare(lines[header]))]
+    col = head.index("face")
+    out = []
+    for line in ms.lines:
+        fields = split(_bare(lines[int(line) - 1]))
+        if col >= len(fields) or not fields[col].strip().strip('"'):
+            raise InputError("no face named in the face column", file=ms.source,
+                             line=int(line), column=col + 1)
+        out.append(fields[col].strip().strip('"'))
+    return out
+
+
+def _bare(line):
+    return line.split("#", 1)[0].split("//", 1)[0].strip()
+
+
+def _splitter(sep):
+    if sep in (" ", "\t", None):
+        return lambda s: s.split()
+    return lambda s: s.split(sep)

@@ -91,10 +91,10 @@ def test_bad_alignment_input_exits_2_and_writes_nothing(tmp_path):
     assert not (tmp_path / "r.json").exists()
 
 
-def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
-    """Points on three datum faces of a block and on its top face, all moved: the fit on the
-    datums puts the top's points back; their deviations are those never moved (0.1 um) and
-    nothing is absorbed; the datum points serve the alignment only."""
+def block_points(tmp_path):
+    """A block's STEP file and points on three of its datum faces (x = 0, y = 0, z = 0) and
+    on its top face (with a machining error), moved by MOVE: ``(top face, datum faces,
+    deviations, face of every point)``; writes ``box.step`` and ``p.xyz``."""
     import Part
 
     box = Part.makeBox(40.0, 30.0, 20.0)
@@ -112,25 +112,56 @@ def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
     dev = 0.02 + 0.01 * np.sin(top[:, 0] / 7.0) + 0.0005 * top[:, 1]
     pts = align.apply(MOVE, np.vstack([datums, top + dev[:, None] * ez]))
     np.savetxt(tmp_path / "p.xyz", pts, fmt="%.10f", header="x y z", comments="")
-    faces = [f for f in box.Faces]
-    names = ["Face%d" % (k + 1) for k, f in enumerate(faces)
-             if abs(f.CenterOfMass.x) < 1e-9 or abs(f.CenterOfMass.y) < 1e-9
-             or abs(f.CenterOfMass.z) < 1e-9]
-    top_name = next("Face%d" % (k + 1) for k, f in enumerate(faces)
-                    if abs(f.CenterOfMass.z - 20.0) < 1e-9)
+
+    def face_at(axis, value):
+        return next("Face%d" % (k + 1) for k, f in enumerate(box.Faces)
+                    if abs(f.CenterOfMass[axis] - value) < 1e-9)
+
+    names = [face_at(0, 0.0), face_at(1, 0.0), face_at(2, 0.0)]
+    top_name = face_at(2, 20.0)
+    per_point = [n for n in names for _ in range(150)] + [top_name] * 300
+    return top_name, names, dev, per_point, pts
+
+
+def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
+    """Points on three datum faces of a block and on its top face, all moved: the fit on the
+    datums puts the top's points back; their deviations are those never moved (0.1 um) and
+    nothing is absorbed; the datum points serve the alignment only."""
+    top_name, names, dev, _faces, _pts = block_points(tmp_path)
     out = run_cli("inspect", tmp_path / "box.step", tmp_path / "p.xyz", "--face", top_name,
                   "--align", "bestfit", "--align-faces", ",".join(names),
                   "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     a = rep["alignment"]
-    assert a["faces"] == names and a["absorbed"] is None and a["converged"]
-    assert rep["inputs"]["measurements"]["points"] == 750
+    assert a["faces"] == names and a["absorbed"] is None
+    assert a["converged"] and rep["inputs"]["measurements"]["points"] == 750
     assert len(rep["points"]["deviation"]) == 300
     assert_allclose(rep["points"]["deviation"], dev, atol=1e-4)
     assert_allclose(a["matrix"], np.linalg.inv(MOVE), atol=1e-9)
     assert all(a["rms_after_um"][n] < 1e-3 for n in names)
     assert "served the alignment only" in out.stderr
+
+
+def test_face_column_assigns_the_points(tmp_path):
+    """A face column names every point's face; a name that is no reference is refused
+    with its line."""
+    top_name, names, dev, faces, pts = block_points(tmp_path)
+    rows = ["x,y,z,face"] + ["%.10f,%.10f,%.10f,%s" % (tuple(p) + (f,))
+                             for p, f in zip(pts, faces)]
+    (tmp_path / "f.csv").write_text("\n".join(rows) + "\n")
+    args = ("inspect", tmp_path / "box.step", tmp_path / "f.csv", "--face", top_name,
+            "--align", "bestfit", "--align-faces", ",".join(names), "--quiet")
+    out = run_cli(*args, "--report", tmp_path / "r.json")
+    assert out.returncode == 0, out.stderr
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert_allclose(rep["points"]["deviation"], dev, atol=1e-4)
+    assert rep["alignment"]["points"] == {**{n: 150 for n in names}, top_name: 300}
+    rows[5] = rows[5].rsplit(",", 1)[0] + ",Face9"
+    (tmp_path / "f.csv").write_text("\n".join(rows) + "\n")
+    out = run_cli(*args, "--report", tmp_path / "r2.json")
+    assert out.returncode == 2 and "f.csv:6: face 'Face9' is not a reference face" in out.stderr
+    assert not (tmp_path / "r2.json").exists()
 
 
 def test_shop_document_route_refuses_alignment(tmp_path, fresh_doc):
