@@ -492,7 +492,7 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     M0 = np.eye(4) if start is None else np.asarray(start, dtype=float)
     dist = distances or Distances(references, P.shape[0], workers)
     pivot = None if {"x", "y", "z"} <= set(dof) else np.zeros(3)
-    names = [r.name for r in references if references.index(r) not in passive]
+    names = [r.name for k, r in enumerate(references) if k not in passive]
     solver = Solver(dist, dof, robust, offset, pivot, tol, names, passive)
     label = "as given"
     if coarse and len(dof) == 6 and P.shape[0] >= 6:
