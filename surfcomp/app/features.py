@@ -47,6 +47,7 @@ from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
+from . import align_doc
 from . import preview as preview_cache
 from .nominal import trim_warning
 from .progress import freecad_progress
@@ -272,6 +273,7 @@ class CompensationFeature(_Proxy):
     def execute(self, obj):
         result = _compute(obj)
         _write_results(obj, result)
+        align_doc.store(obj, result.alignment)
         if result.shape is None:  # preview: the components changed, the face did not
             return
         # during a recompute Part::Feature gives the Shape the Placement property's value:
@@ -351,7 +353,8 @@ class _Result:
     """What ``_compute`` returns: the core compensation plus the app-side products
     (``output``: a :class:`surfcomp.app.shapes.Output`, None for a preview)."""
 
-    def __init__(self, comp, nominal, increment, output, round_):
+    def __init__(self, comp, nominal, increment, output, round_, alignment=None):
+        self.alignment = alignment
         self.comp = comp
         self.nominal = nominal
         self.increment = increment
@@ -412,6 +415,7 @@ def _compute(obj):
     nominal, placement = nominal_of(obj)
     ms = local_measurements(measurement_set(obj.Measurement), placement)
     options = options_of(obj)
+    ms, alignment = align_doc.aligned(obj.Measurement, nominal, ms, options.tip_radius)
     base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
     # a preview (the filter panel's live maps, a fraction of a second) runs without the
@@ -429,12 +433,14 @@ def _compute(obj):
             total = increment + deviation_field(base, "correction")(U, V)
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
+    if alignment is not None:
+        comp.prepared.warnings.extend(alignment.warnings)
     if preview:
-        return _Result(comp, nominal, increment, None, len(links))
+        return _Result(comp, nominal, increment, None, len(links), alignment)
     output = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     output.shape.Placement = placement
     comp.prepared.warnings.extend(output.warnings(obj.Label))
-    return _Result(comp, nominal, increment, output, len(links))
+    return _Result(comp, nominal, increment, output, len(links), alignment)
 
 
 def _prepared(obj, nominal, placement, ms, options, preview, progress):

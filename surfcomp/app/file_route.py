@@ -57,6 +57,11 @@ class Job:
     face_only: bool = False
     plan: str = None
     touches: int = 1
+    align: str = "none"
+    align_faces: str = None
+    align_dof: str = None
+    rps: str = None
+    transform: str = None
     options: Options = field(default_factory=Options)
 
     @classmethod
@@ -88,6 +93,8 @@ class Job:
         for k, _role, _label in JOB_FILES:
             if kw.get(k) and kw[k] != "-":
                 kw[k] = os.path.join(base_dir, kw[k])
+        if kw.get("rps") and os.path.isfile(os.path.join(base_dir, kw["rps"])):
+            kw["rps"] = os.path.join(base_dir, kw["rps"])     # a file, not inline ids
         kw["options"] = Options(**{k: data[k] for k in opt_names if k in data})
         return cls(**kw)
 
@@ -108,7 +115,7 @@ JOB_FILES = (("nominal", "input", "NOMINAL"), ("measurements", "input", "MEASURE
              ("plan", "input", "--plan"),
              ("output", "output", "-o"), ("report", "output", "--report"),
              ("points", "output", "--points"), ("curves", "output", "--curves"),
-             ("html", "output", "--html"))
+             ("html", "output", "--html"), ("transform", "input", "--transform"))
 #: ignored measurement columns named in the report (the rest are counted)
 IGNORED_LISTED = 100
 
@@ -153,9 +160,17 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
         check_rebuildable(nominal.bspline_face, job.nominal)
     ms = read_measured(job)
     budget.check_job(len(ms), job.command == "compensate", max_memory)
+    alignment, read = None, ms          # the report counts the file's points
+    if job.align not in (None, "none") or job.transform or job.rps or job.align_faces \
+            or job.align_dof:
+        from .alignment import align_measurements
+
+        ms, alignment = align_measurements(job, nominal, ms, progress=sub(progress, 0, 0.1))
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
     _warn_outside_trim(nominal, prepared)
+    if alignment is not None:
+        prepared.warnings.extend(alignment.warnings)
     build = job.command == "compensate"
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options, build=build,
                       progress=sub(progress, 0.3, 0.9))
@@ -169,12 +184,13 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
                                  nominal.face_name)
         prepared.warnings.extend(output.warnings(nominal.face_name))
         shapes["output"] = output.shape
-    rep = report_io.build_report(job.command, _inputs_record(job, nominal, ms), comp,
+    rep = report_io.build_report(job.command, _inputs_record(job, nominal, read), comp,
                                  prepared.warnings,
                                  {attr: shown(getattr(job, attr))
                                   for attr, _opt in OUTPUT_OPTIONS if getattr(job, attr)},
                                  points=bool(job.report or job.html),
                                  output_shape=output.as_dict() if output else None)
+    rep["alignment"] = alignment.as_dict() if alignment is not None else None
     if build and job.curves:
         shapes["curves"] = curve_net(comp)
     return_free_memory()    # the shape's conversions, before the CAD writer's gigabyte

@@ -109,12 +109,46 @@ MEASUREMENT_PROPERTIES = (
     ("App::PropertyStringList", "ReadWarnings", _MEAS,
      QT_TRANSLATE_NOOP("App::Property", "Warnings of the file reader"),
      None, _RO),
+    ("App::PropertyEnumeration", "AlignMethod", "Alignment",
+     QT_TRANSLATE_NOOP("App::Property", "Align the measured points to the nominal before the "
+                                        "deviations: none (they are in its frame), bestfit, "
+                                        "rps (3-2-1 on AlignRps); README 'Alignment'"),
+     ["none", "bestfit", "rps"], 0),
+    ("App::PropertyString", "AlignFaces", "Alignment",
+     QT_TRANSLATE_NOOP("App::Property", "Reference faces of the nominal, e.g. Face1,Face3 "
+                                        "(empty: the compensated face, which absorbs the "
+                                        "error's mean and tilt)"),
+     "", 0),
+    ("App::PropertyString", "AlignDof", "Alignment",
+     QT_TRANSLATE_NOOP("App::Property", "Degrees of freedom of the best fit: all, or some of "
+                                        "x y z rx ry rz (xyz, z, rz, ...)"),
+     "all", 0),
+    ("App::PropertyString", "AlignRps", "Alignment",
+     QT_TRANSLATE_NOOP("App::Property", "3-2-1 point ids: P1,P2,P3;P4,P5;P6 (the file's ids, "
+                                        "or 1-based point numbers)"),
+     "", 0),
+    ("App::PropertyFloatList", "AlignTransform", "Alignment",
+     QT_TRANSLATE_NOOP("App::Property", "Known rigid transform applied first: 16 numbers, the "
+                                        "4x4 matrix row-major, measured -> nominal (empty: "
+                                        "none)"),
+     None, 0),
     ("App::PropertyInteger", "Version", "Base",
      QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
 _IN, _RES = "Compensation", "Result"
+#: the results of an alignment on the compensation (its settings are the measurement's)
+ALIGNMENT_RESULTS = (
+    ("App::PropertyFloatList", "AlignMatrix", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "The measured points' alignment: 4x4 matrix row-major, "
+                                        "measured -> nominal (empty: none)"),
+     None, _RO),
+    ("App::PropertyStringList", "AlignSummary", _RES,
+     QT_TRANSLATE_NOOP("App::Property", "The alignment: transform, RMS before and after per "
+                                        "face, iterations, what it absorbed"),
+     None, _RO),
+)
 COMPENSATION_PROPERTIES = (
     ("App::PropertyLink", "Nominal", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Object holding the nominal face"),
@@ -276,4 +310,4 @@ COMPENSATION_PROPERTIES = (
     ("App::PropertyInteger", "Version", "Base",
      QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
-)
+) + ALIGNMENT_RESULTS

@@ -52,7 +52,7 @@ def add_input_options(p, command):
                         "logs): each contact point is the centre moved by it against the "
                         "outward normal (default 0)")
     registry.add_options(p, command, flags=("--plan",))
-    registry.add_options(p, command, flags=("--report",))
+    registry.add_options(p, command, flags=("--report", "--transform"))
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
 
 
@@ -97,8 +97,10 @@ def job_from_args(args, command):
                face=args.face, object=args.object, units=args.units,
                deviation_units=args.deviation_units, fmt=args.fmt,
                sample=args.sample, face_only=bool(getattr(args, "face_only", False)),
-               plan=args.plan, touches=args.touches, options=options_from_args(args),
-               **outputs)
+               plan=args.plan, touches=args.touches,
+               align=args.align, align_faces=args.align_faces, align_dof=args.align_dof,
+               rps=args.rps, transform=args.transform,
+               options=options_from_args(args), **outputs)
 
 
 def run_job_command(args, command):
@@ -175,6 +177,10 @@ def print_summary(comp, rep, out=None):
         print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
     else:
         print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
+    from ..core.align_report import summary_lines
+
+    for line in summary_lines(rep.get("alignment")):
+        print(line, file=out)
     for w in p.warnings:
         print("warning: " + w, file=sys.stderr)
     o = comp.options

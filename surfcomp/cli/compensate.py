@@ -58,8 +58,9 @@ def run_document(args):
     if not args.object:
         raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
                          "holding the nominal face)", file=args.nominal)
-    other = [o for o in ("output", "report", "points", "curves", "html", "plan")
-             if getattr(args, o)]
+    other = [o for o in ("output", "report", "points", "curves", "html", "plan", "transform",
+                         "align_faces", "align_dof", "rps") if getattr(args, o)]
+    other += ["align"] if args.align != "none" else []
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
                          "'compensate' without them for the files"

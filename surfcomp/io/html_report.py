@@ -10,6 +10,8 @@ no external resources. Sections carry stable ids for tools and tests:
 
 ``inputs``      input files with SHA-256, the nominal face
 ``method``      method, mask, edge handling, stock, grid
+``alignment``   the transform applied to the measured points, RMS before/after per face,
+                what a fit on the compensated face absorbed (or that none was applied)
 ``maps``        raw deviation, determined, random, correction, predicted residual (um)
 ``histograms``  distributions of raw deviation, random component, predicted residual
 ``statistics``  the papers' table (Werner 2022 Tab. 1 and 3) for every quantity
@@ -44,8 +46,8 @@ from .atomic import write_text
 DEFAULT_STYLE = {"scheme": colormap.DEFAULT_SCHEME, "range": None}
 
 #: section ids in document order
-SECTIONS = ("inputs", "method", "maps", "histograms", "statistics", "checks", "simulation",
-            "warnings")
+SECTIONS = ("inputs", "method", "alignment", "maps", "histograms", "statistics", "checks",
+            "simulation", "warnings")
 
 _STAT_ROWS = (("count", "Points", None), ("max_negative", "Max. negative", 1e3),
               ("max_positive", "Max. positive", 1e3), ("mean", "Average value", 1e3),
@@ -259,6 +261,37 @@ def _section_method(report):
             ("Refinement", _e("at most %s knot spans per grid step" % m.get("refine"))),
             ("Layout", _e(layout))]
     return '<section id="method"><h2>Method and parameters</h2>%s</section>' % _kv_table(rows)
+
+
+def _signed(xs):
+    return " ".join("%+.6f" % x for x in xs)
+
+
+def _section_alignment(report):
+    a = report.get("alignment")
+    if not a:
+        body = "<p>None: the measured points were taken in the nominal's frame.</p>"
+        return '<section id="alignment"><h2>Alignment</h2>%s</section>' % body
+    rows = [("Method", _e(a["method"])),
+            ("Matrix (measured to nominal)", "<br>".join(
+                "<code>%s</code>" % _e(" ".join("%.9f" % x for x in r)) for r in a["matrix"])),
+            ("Translation (mm)", _e(_signed(a["translation_mm"]))),
+            ("Rotation about X, Y, Z (deg)", _e("%s (%.6f in all)" % (_signed(a["rotation_deg"]),
+                                                                      a["angle_deg"])))]
+    if a["method"] != "none":
+        rows += [("Reference faces", _e(", ".join(a["faces"]))),
+                 ("Degrees of freedom", _e(" ".join(a["dof"]))),
+                 ("Iterations", _e("%d, %s" % (a["iterations"], "converged" if a["converged"]
+                                               else "NOT converged")))]
+        for name, after in (a["rms_after_um"] or {}).items():
+            rows.append(("RMS distance %s (um)" % name, _e(
+                "%.3f before, %.3f after (%d points)"
+                % (a["rms_before_um"].get(name, float("nan")), after, a["points"][name]))))
+    if a.get("absorbed"):
+        rows.append(("Absorbed on the compensated face", _e(
+            "mean offset %.3f um, tilt %.3f um across the face"
+            % (a["absorbed"]["mean_offset_um"], a["absorbed"]["tilt_um"]))))
+    return '<section id="alignment"><h2>Alignment</h2>%s</section>' % _kv_table(rows)
 
 
 def _section_maps(arrays, style=None):
@@ -542,7 +575,8 @@ def render_html(report, simulation=None, style=None):
     parts = ['<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">',
              "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
              "<h1>%s</h1>" % _e(title),
-             _section_inputs(report), _section_method(report), _section_maps(arrays, style),
+             _section_inputs(report), _section_method(report), _section_alignment(report),
+             _section_maps(arrays, style),
              _section_histograms(arrays), _section_statistics(report, arrays),
              _section_checks(report), _section_simulation(simulation),
              '<section id="warnings"><h2>Warnings</h2>%s</section>' % warn_html,

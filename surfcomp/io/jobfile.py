@@ -66,10 +66,14 @@ KEY_TYPES = {
     "sigma": _OPT_NUMBER, "stock": _OPT_NUMBER, "smoothing": _OPT_NUMBER,
     "max_offset": _NUMBER, "tip_radius": _NUMBER,
     "plan": _PATH, "touches": _INTEGER,
+    "align": ("one of \"none\", \"bestfit\", \"rps\"",
+              lambda v: v in ("none", "bestfit", "rps")),
+    "align_faces": _NAME, "align_dof": _NAME, "rps": _NAME, "transform": _PATH,
 }
 #: keys that may be null (meaning: not given)
 NULLABLE = {"output", "report", "points", "curves", "html", "face", "object", "units",
-            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing", "plan"}
+            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing", "plan",
+            "align_faces", "align_dof", "rps", "transform"}
 
 
 def _describe(value):

@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""A compensation object's measured points aligned to its nominal (FreeCAD, no GUI).
+
+The settings are properties of the measurement object (``AlignMethod``, ``AlignFaces``,
+``AlignDof``, ``AlignRps``, ``AlignTransform``: the measurement knows its frame); the
+result goes to the compensation (``AlignMatrix``, ``AlignSummary``). Messages name those
+properties.
+"""
+
+import numpy as np
+
+from ..core.align import check_rigid, parse_dof
+from ..core.align_report import AlignOptions, summary_lines
+from ..errors import InputError
+from ..io.align_files import read_rps
+
+
+def options_of(meas):
+    """The :class:`AlignOptions` of a measurement object, checked (None: no alignment)."""
+    method = getattr(meas, "AlignMethod", "none")
+    matrix = list(getattr(meas, "AlignTransform", []) or [])
+    if method == "none" and not matrix:
+        return None
+    label = meas.Label
+    if matrix and len(matrix) != 16:
+        raise InputError("%s: AlignTransform holds %d numbers (expected 16: the 4x4 matrix "
+                         "row-major, or none)" % (label, len(matrix)))
+    transform = check_rigid(np.reshape(matrix, (4, 4)), label) if matrix else None
+    dof = meas.AlignDof or "all"
+    parse_dof(dof, "%s: AlignDof" % label)
+    rps = None
+    if method == "rps":
+        if not meas.AlignRps.strip():
+            raise InputError("%s: AlignMethod rps needs AlignRps (the 3-2-1 point ids, "
+                             "P1,P2,P3;P4,P5;P6)" % label)
+        rps = read_rps(meas.AlignRps)[0]
+    faces = tuple(f.strip() for f in meas.AlignFaces.split(",") if f.strip())
+    return AlignOptions(method, faces, dof, rps, transform, label).validate()
+
+
+def aligned(meas, nominal, ms, tip_radius=0.0):
+    """``(measurement set, Alignment or None)``: ``ms`` (in the nominal's coordinates) with
+    its points aligned as ``meas`` says."""
+    from .alignment import align_set
+
+    opts = options_of(meas)
+    if opts is None:
+        return ms, None
+    return align_set(opts, nominal, ms, tip_radius, source=meas.Label)
+
+
+def store(obj, alignment):
+    """Write an alignment's result to a compensation object (empty without one)."""
+    if not hasattr(obj, "AlignMatrix"):
+        return
+    d = None if alignment is None else alignment.as_dict()
+    obj.AlignMatrix = [] if d is None else [float(x) for row in d["matrix"] for x in row]
+    obj.AlignSummary = [] if d is None else summary_lines(d) + list(alignment.warnings)
