@@ -48,6 +48,7 @@ from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
 from . import preview as preview_cache
+from . import result_cache
 from .nominal import trim_warning
 from .progress import freecad_progress
 from .properties import (
@@ -412,8 +413,18 @@ def _compute(obj):
     nominal, placement = nominal_of(obj)
     ms = local_measurements(measurement_set(obj.Measurement), placement)
     options = options_of(obj)
-    base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
+    if preview:
+        return _computed(obj, nominal, placement, ms, options, preview, len(links))
+    # the same inputs give the same result: kept from the last recompute
+    return result_cache.result(obj, result_cache.key(obj, nominal, placement, ms, options),
+                               lambda: _computed(obj, nominal, placement, ms, options, preview,
+                                                 len(links)))
+
+
+def _computed(obj, nominal, placement, ms, options, preview, rounds):
+    """The :class:`_Result` of :func:`_compute`, computed."""
+    base = obj.Base
     # a preview (the filter panel's live maps, a fraction of a second) runs without the
     # progress indicator: it would grab the keyboard and swallow the keys typed meanwhile
     with (contextlib.nullcontext() if preview else
@@ -430,11 +441,11 @@ def _compute(obj):
             comp = _build(nominal, prepared, comp, total, build=not preview,
                           progress=sub(progress, 0.3, 1.0))
     if preview:
-        return _Result(comp, nominal, increment, None, len(links))
+        return _Result(comp, nominal, increment, None, rounds)
     output = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     output.shape.Placement = placement
     comp.prepared.warnings.extend(output.warnings(obj.Label))
-    return _Result(comp, nominal, increment, output, len(links))
+    return _Result(comp, nominal, increment, output, rounds)
 
 
 def _prepared(obj, nominal, placement, ms, options, preview, progress):
@@ -570,7 +581,8 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
 
 def compensation_result(obj):
     """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
-    recomputed from its properties and links (nothing is cached on the proxy).
+    computed from its properties and links (nothing is cached on the proxy; the last
+    result is reused while those stay the same, :mod:`surfcomp.app.result_cache`).
 
     For an iteration, ``correction.delta`` is the accumulated correction and
     ``statistics['increment']`` describes this round's own correction.
