@@ -8,13 +8,7 @@ import pytest
 from surfcomp.core import bspline
 from surfcomp.core.bspline import Surface
 from surfcomp.core.trimmed import correction_integral, domain_integral, knots_of
-
-
-def _circle(c, r, n=800, reverse=False):
-    t = np.linspace(0.0, 2 * np.pi, n)
-    if reverse:
-        t = t[::-1]
-    return np.stack([c[0] + r * np.cos(t), c[1] + r * np.sin(t)], axis=1)
+from tests.pure.test_trimmed import _circle, _plane
 
 
 def _square(n=400):
@@ -26,14 +20,6 @@ def _square(n=400):
 def _knots(spans, degree=3):
     inner = np.linspace(0.0, 1.0, spans + 1)
     return np.concatenate([[0.0] * degree, inner, [1.0] * degree])
-
-
-def _plane(size=20.0):
-    P = np.zeros((2, 2, 3))
-    P[1, :, 0] = size
-    P[:, 1, 1] = size
-    k = np.array([0.0, 0.0, 1.0, 1.0])
-    return Surface(P, k, k, 1, 1)
 
 
 def _bumped_plane(size=20.0, spans=40, seed=5):
@@ -62,7 +48,8 @@ def test_the_grid_gives_the_pointwise_rule():
     def grid(us, vs):
         return bspline.evaluate_grid(surf, us, vs)[..., 2] + us[:, None] * vs[None, :]
 
-    pieces = [_circle((0.5, 0.5), 0.4), _circle((0.55, 0.45), 0.1, reverse=True)]
+    pieces = [_circle((0.5, 0.5), 0.4, n=800),
+              _circle((0.55, 0.45), 0.1, n=800, reverse=True)]
     knots = knots_of(surf)
     plain = domain_integral(func, pieces, knots=knots, panels=16)
     fast = domain_integral(func, pieces, knots=knots, panels=16, grid=grid)
