@@ -18,6 +18,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 from ..errors import GeometryError, InputError
 
@@ -48,6 +49,8 @@ def timeout():
         raise InputError("SURFCOMP_CAD_TIMEOUT=%r is not a time limit (expected seconds "
                          "above 0 and at most %d, e.g. 900)" % (text, MAX_TIMEOUT))
     return value
+#: the files read in the child (the nominal's CAD formats)
+CAD_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
 #: exit code of the child for a file OCCT refused without crashing
 _REFUSED = 3
 
@@ -61,6 +64,95 @@ def _python():
     return shutil.which("python3") or "/usr/bin/python3"
 
 
+class _Reader:
+    """The reader child of one file, started at once; :meth:`shape` waits for it."""
+
+    def __init__(self, path):
+        self.path = path
+        self.limit = timeout()
+        self.started = time.monotonic()
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        self.tmp = tempfile.mkdtemp(prefix="surfcomp-read-")
+        self.out = os.path.join(self.tmp, "shape.brep")
+        # the reader gets an ASCII name linked to the file: OpenCASCADE takes file names
+        # as UTF-8, and a name that is not (bytes of another encoding) cannot be passed
+        src = os.path.join(self.tmp, "input" + os.path.splitext(path)[1].lower())
+        try:
+            os.symlink(os.path.abspath(path), src)
+            env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+                [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+            self.proc = subprocess.Popen([_python(), "-m", "surfcomp.app.cadread", src, self.out],
+                                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                         stdin=subprocess.DEVNULL, text=True, env=env,
+                                         cwd=self.tmp)
+        except BaseException:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            raise
+
+    def close(self):
+        """Stop the child if it still runs and remove its folder."""
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.communicate()
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def shape(self, label):
+        """The shape the child read (see :func:`read_cad`)."""
+        import Part
+
+        path = self.path
+        try:
+            left = max(0.0, self.limit - (time.monotonic() - self.started))
+            try:
+                stderr = self.proc.communicate(timeout=left)[1]
+            except subprocess.TimeoutExpired:
+                raise GeometryError("could not read %s: OpenCASCADE took more than %d s (raise "
+                                    "SURFCOMP_CAD_TIMEOUT for very large files)"
+                                    % (label, self.limit), file=path) from None
+            code = self.proc.returncode
+            if code < 0 or code > 128:
+                raise GeometryError("could not read %s: the file is damaged (OpenCASCADE "
+                                    "crashed while reading it)" % label, file=path)
+            if code == _REFUSED:
+                raise GeometryError(stderr.strip().splitlines()[-1], file=path)
+            if code != 0 or not os.path.isfile(self.out):
+                raise GeometryError("could not read %s: the reader failed (%s)"
+                                    % (label, (stderr.strip().splitlines() or ["?"])[-1]),
+                                    file=path)
+            shape = Part.Shape()
+            shape.read(self.out)
+        finally:
+            self.close()
+        if shape.isNull() or not shape.Faces:
+            raise GeometryError("the file contains no faces", file=path)
+        return shape
+
+
+#: readers started ahead by :func:`prefetch`, by the file's absolute path
+_STARTED = {}
+
+
+def prefetch(path):
+    """Start reading the CAD file ``path`` now, in the child, so that the caller's own
+    start (its imports, the measurement file) runs beside it; :func:`read_cad` of the same
+    path takes the result. Anything not a readable CAD file is left to :func:`read_cad`
+    (which then says what is wrong, in its turn); :func:`discard` stops what nobody took."""
+    key = os.path.abspath(path)
+    if key in _STARTED or not os.path.isfile(path) or \
+            os.path.splitext(path)[1].lower() not in CAD_EXTENSIONS:
+        return
+    try:
+        _STARTED[key] = _Reader(path)
+    except (InputError, OSError):
+        return
+
+
+def discard():
+    """Stop the readers :func:`prefetch` started that :func:`read_cad` did not take."""
+    while _STARTED:
+        _STARTED.popitem()[1].close()
+
+
 def read_cad(path, label="NOMINAL"):
     """The shape in the CAD file ``path``, read by OCCT in a child process.
 
@@ -69,40 +161,8 @@ def read_cad(path, label="NOMINAL"):
     GeometryError
         The reader crashed, refused the file, timed out, or the file has no faces.
     """
-    import Part
-
-    limit = timeout()
-    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-    with tempfile.TemporaryDirectory(prefix="surfcomp-read-") as tmp:
-        out = os.path.join(tmp, "shape.brep")
-        # the reader gets an ASCII name linked to the file: OpenCASCADE takes file names
-        # as UTF-8, and a name that is not (bytes of another encoding) cannot be passed
-        src = os.path.join(tmp, "input" + os.path.splitext(path)[1].lower())
-        os.symlink(os.path.abspath(path), src)
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
-            [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
-        try:
-            child = subprocess.run([_python(), "-m", "surfcomp.app.cadread", src, out],
-                                   capture_output=True, text=True, timeout=limit, env=env,
-                                   cwd=tmp)
-        except subprocess.TimeoutExpired:
-            raise GeometryError("could not read %s: OpenCASCADE took more than %d s (raise "
-                                "SURFCOMP_CAD_TIMEOUT for very large files)"
-                                % (label, limit), file=path) from None
-        if child.returncode < 0 or child.returncode > 128:
-            raise GeometryError("could not read %s: the file is damaged (OpenCASCADE crashed "
-                                "while reading it)" % label, file=path)
-        if child.returncode == _REFUSED:
-            raise GeometryError(child.stderr.strip().splitlines()[-1], file=path)
-        if child.returncode != 0 or not os.path.isfile(out):
-            raise GeometryError("could not read %s: the reader failed (%s)"
-                                % (label, (child.stderr.strip().splitlines() or ["?"])[-1]),
-                                file=path)
-        shape = Part.Shape()
-        shape.read(out)
-    if shape.isNull() or not shape.Faces:
-        raise GeometryError("the file contains no faces", file=path)
-    return shape
+    reader = _STARTED.pop(os.path.abspath(path), None) or _Reader(path)
+    return reader.shape(label)
 
 
 def _fatal_signals_kill():

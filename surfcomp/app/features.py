@@ -47,7 +47,7 @@ from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
-from . import align_doc
+from . import align_doc, result_cache
 from . import preview as preview_cache
 from .nominal import trim_warning
 from .progress import freecad_progress
@@ -416,8 +416,18 @@ def _compute(obj):
     ms = local_measurements(measurement_set(obj.Measurement), placement)
     options = options_of(obj)
     ms, alignment = align_doc.aligned(obj.Measurement, nominal, ms, options.tip_radius)
-    base = obj.Base
     preview = bool(getattr(obj, "Preview", False))
+    if preview:
+        return _computed(obj, nominal, placement, ms, options, preview, len(links), alignment)
+    # the same inputs give the same result: kept from the last recompute
+    return result_cache.result(obj, result_cache.key(obj, nominal, placement, ms, options),
+                               lambda: _computed(obj, nominal, placement, ms, options, preview,
+                                                 len(links), alignment))
+
+
+def _computed(obj, nominal, placement, ms, options, preview, rounds, alignment):
+    """The :class:`_Result` of :func:`_compute`, computed."""
+    base = obj.Base
     # a preview (the filter panel's live maps, a fraction of a second) runs without the
     # progress indicator: it would grab the keyboard and swallow the keys typed meanwhile
     with (contextlib.nullcontext() if preview else
@@ -436,11 +446,11 @@ def _compute(obj):
     if alignment is not None:
         comp.prepared.warnings.extend(alignment.warnings)
     if preview:
-        return _Result(comp, nominal, increment, None, len(links), alignment)
+        return _Result(comp, nominal, increment, None, rounds, alignment)
     output = corrected_shape(nominal, comp.corrected, obj.Output, obj.Label)
     output.shape.Placement = placement
     comp.prepared.warnings.extend(output.warnings(obj.Label))
-    return _Result(comp, nominal, increment, output, len(links), alignment)
+    return _Result(comp, nominal, increment, output, rounds, alignment)
 
 
 def _prepared(obj, nominal, placement, ms, options, preview, progress):
@@ -576,7 +586,8 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
 
 def compensation_result(obj):
     """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
-    recomputed from its properties and links (nothing is cached on the proxy).
+    computed from its properties and links (nothing is cached on the proxy; the last
+    result is reused while those stay the same, :mod:`surfcomp.app.result_cache`).
 
     For an iteration, ``correction.delta`` is the accumulated correction and
     ``statistics['increment']`` describes this round's own correction.

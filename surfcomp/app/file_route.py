@@ -20,8 +20,6 @@ from ..errors import InputError
 from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
-from ..io.html_report import render_html
-from ..io.jobfile import read_job_file
 from ..io.outpath import shown
 from ..io.readers import read_any
 from ..io.step_face import write_natural_face
@@ -230,6 +228,8 @@ def _texts(job, comp, rep):
     if job.points:
         texts["points"] = corrected_points_csv(comp)
     if job.html:
+        from ..io.html_report import render_html  # only here: its import is not free
+
         texts["html"] = render_html(rep)
     return texts
 
@@ -349,6 +349,8 @@ def load_job_file(path):
     """Read a JSON job file (see README, 'freecadcmd'): a regular UTF-8 file of bounded
     size and nesting whose known keys hold values of their type
     (:func:`surfcomp.io.jobfile.read_job_file`)."""
+    from ..io.jobfile import read_job_file
+
     data = read_job_file(path)
     try:
         return Job.from_dict(data, os.path.dirname(os.path.abspath(path)))

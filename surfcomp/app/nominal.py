@@ -13,11 +13,9 @@ from ..core.surface_checks import MAX_DEGREE, check_nominal
 from ..core.trimmed import inside
 from ..errors import GeometryError
 from . import fcenv
-from .cadread import read_cad
+from .cadread import CAD_EXTENSIONS, read_cad
 from .convert import surface_from_part
 from .documents import open_document
-
-CAD_EXTENSIONS = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
 
 
 @dataclass

@@ -22,7 +22,7 @@ FILTER_FIELDS = ("mask_size", "weights", "mask_kind", "sigma", "edge")
 _CACHE = {}
 
 
-def _digest(*parts):
+def digest(*parts):
     h = hashlib.sha1()
     for part in parts:
         if part is None:
@@ -51,7 +51,7 @@ def fingerprint(nominal, placement, ms, options):
             if f.name not in FILTER_FIELDS]
     arrays = [None if getattr(ms, name) is None else np.asarray(getattr(ms, name))
               for name in ("nominal", "measured", "normal", "deviation", "row", "col", "lines")]
-    return _digest(*surf, s.degree_u, s.degree_v, s.u_range, s.v_range, nominal.outward,
+    return digest(*surf, s.degree_u, s.degree_v, s.u_range, s.v_range, nominal.outward,
                    nominal.face_name, boundary, repr(placement), *arrays, ms.ids, ms.source,
                    ms.warnings, opts)
 

@@ -18,14 +18,12 @@ second order in the correction).
 import numpy as np
 
 from ..core import bspline
-from ..core.trimmed import correction_integral, domain_integral, knots_of
+from ..core.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
 from .nominal import boundary_polylines
 
 #: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
 _trapezoid = getattr(np, "trapezoid", None) or np.trapz
 
-#: knots per direction above which the volume change's panels ignore them
-_MAX_KNOTS = 400
 
 
 def correction_volume(nominal, corrected):
@@ -36,11 +34,19 @@ def correction_volume(nominal, corrected):
                                boundary_polylines(nominal.bspline_face))
 
 
+def _flux(s, su, sv, outward, centre):
+    return outward * np.einsum("...j,...j->...", s - centre, np.cross(su, sv)) / 3.0
+
+
 def _flux_density(surface, outward, centre):
+    """``(func, grid)`` of the flux density for :func:`domain_integral`: point by point
+    and on a tensor grid."""
     def func(u, v):
-        s, su, sv = bspline.derivatives(surface, u, v, order=1)
-        return outward * np.einsum("ij,ij->i", s - centre, np.cross(su, sv)) / 3.0
-    return func
+        return _flux(*bspline.derivatives(surface, u, v, order=1), outward, centre)
+
+    def grid(us, vs):
+        return _flux(*bspline.evaluate_grid(surface, us, vs, order=1), outward, centre)
+    return func, grid
 
 
 def _box(*polylines):
@@ -82,14 +88,14 @@ def volume_change(nominal, corrected, new_face, plan):
     centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
     knots = knots_of(nominal.surface, corrected)
     panels = 16
-    if max(len(k) for k in knots) > _MAX_KNOTS:      # very fine corrections: a fixed grid
+    if max(len(k) for k in knots) > MAX_KNOTS:      # very fine corrections: a fixed grid
         knots, panels = knots_of(nominal.surface), 256
     # one scan grid with panels broken at both surfaces' knots: the quadrature errors of
     # the two fluxes cancel to far below the change
-    change = (domain_integral(_flux_density(corrected, nominal.outward, centre), new_lines,
-                              box=box, knots=knots, panels=panels)
-              - domain_integral(_flux_density(nominal.surface, nominal.outward, centre),
-                                old_lines, box=box, knots=knots, panels=panels))
+    func, grid = _flux_density(corrected, nominal.outward, centre)
+    change = domain_integral(func, new_lines, box=box, knots=knots, panels=panels, grid=grid)
+    func, grid = _flux_density(nominal.surface, nominal.outward, centre)
+    change -= domain_integral(func, old_lines, box=box, knots=knots, panels=panels, grid=grid)
     for p in plan.edges:
         if p.samples is not None:
             change += _strip_flux(p, centre)

@@ -23,11 +23,22 @@ from .runner import Terminated  # noqa: F401  (the signal exception, for callers
 
 #: subcommand modules, in the order ``--help`` lists them
 COMMANDS = ("compensate", "inspect", "simulate", "gcode", "plan")
+#: each command's line in ``--help`` (here, so that the list needs no command module:
+#: they import the numerics)
+SUMMARIES = {
+    "compensate": "build the corrected face that pre-compensates the systematic error",
+    "inspect": "deviations and statistics only (nothing is built)",
+    "simulate": "virtual machining: predict what each compensation method achieves",
+    "gcode": "compensate a G-code program for the machine's axis errors",
+    "plan": "place the measurement points on the nominal face for on-machine probing",
+}
 
 
 def build_parser(only=None):
     """The argument parser; with ``only`` (a command name) just that command's subparser,
-    so a run imports one command module (and its dependencies), not all of them."""
+    so a run imports one command module (and its dependencies), not all of them; with
+    ``only=False`` the commands' names and summaries alone (for ``--help`` and a missing
+    or unknown command: no command module, so no numerics, is imported)."""
     parser = argparse.ArgumentParser(
         prog="python3 -m surfcomp",
         description="Compensate machining errors of free-form B-spline surfaces "
@@ -35,6 +46,10 @@ def build_parser(only=None):
     parser.add_argument("--version", action="version", version="surfcomp " + __version__)
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND")
     subparsers.required = True
+    if only is False:
+        for name in COMMANDS:
+            subparsers.add_parser(name, help=SUMMARIES[name])
+        return parser
     for name in (only,) if only in COMMANDS else COMMANDS:
         module = importlib.import_module("." + name, __name__)
         registry.add_plain_options(module.add_parser(subparsers), name)
@@ -48,7 +63,11 @@ class ArgumentError(SurfcompError):
 def main(argv=None):
     """Run the command line; return the process exit code (:mod:`surfcomp.cli.runner`)."""
     args = sys.argv[1:] if argv is None else list(argv)
-    parser = build_parser(args[0] if args else None)
+    if args and args[0] in COMMANDS:
+        only = args[0]
+    else:       # a leading option or no command: every parser only if a command is named
+        only = None if any(a in COMMANDS for a in args) else False
+    parser = build_parser(only)
     args = parser.parse_args(args)
 
     def body():

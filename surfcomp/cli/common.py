@@ -4,12 +4,8 @@
 import sys
 import time
 
-from ..core import plausibility
-from ..core.deviations import format_table
-from ..core.filters import EDGE_MODES
-from ..core.methods import METHODS
-from ..core.pipeline import Options
-from ..io.readers import FORMATS
+from ..core.choices import EDGE_MODES, METHODS
+from ..core.choices import MEASUREMENT_FORMATS as FORMATS
 from . import registry
 
 
@@ -105,11 +101,19 @@ def job_from_args(args, command):
 
 def run_job_command(args, command):
     """Run a job command line: progress on stderr, the summary, the files written."""
-    from ..app.file_route import run_job
+    from ..app import cadread
 
-    job = job_from_args(args, command)
-    comp, rep = run_job(job, progress=ProgressLine(args.quiet),
-                        inputs=registry.declared(args, command)[1], max_memory=args.max_memory)
+    # the nominal's reader child starts first and runs beside the imports of the numerics
+    cadread.prefetch(args.nominal)
+    try:
+        from ..app.file_route import run_job
+
+        job = job_from_args(args, command)
+        comp, rep = run_job(job, progress=ProgressLine(args.quiet),
+                            inputs=registry.declared(args, command)[1],
+                            max_memory=args.max_memory)
+    finally:
+        cadread.discard()
     print_summary(comp, rep)
     print_written(job)
     return 0
@@ -130,6 +134,8 @@ def wrote(path):
 
 
 def options_from_args(args):
+    from ..core.pipeline import Options
+
     return Options(method=getattr(args, "method", "filtered"), mask_size=getattr(args, "mask", 5),
                    weights=getattr(args, "weights", None),
                    mask_kind=getattr(args, "mask_kind", "box"), sigma=getattr(args, "sigma", None),
@@ -160,6 +166,9 @@ class ProgressLine:
 def print_summary(comp, rep, out=None):
     """The papers' table form, the correction applied and the corrected face's checks, on
     ``out`` (default: ``sys.stdout`` as it is at the call, so a redirection holds)."""
+    from ..core import plausibility
+    from ..core.deviations import format_table
+
     out = sys.stdout if out is None else out
     p = comp.prepared
     st = comp.statistics

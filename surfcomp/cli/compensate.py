@@ -2,7 +2,7 @@
 """``python3 -m surfcomp compensate``: nominal + measurements -> corrected face."""
 
 from ..errors import InputError
-from . import registry
+from . import SUMMARIES, registry
 from .common import (
     ProgressLine,
     add_job_parser,
@@ -14,8 +14,7 @@ from .common import (
 
 def add_parser(subparsers):
     p = add_job_parser(
-        subparsers, "compensate",
-        "build the corrected face that pre-compensates the systematic error",
+        subparsers, "compensate", SUMMARIES["compensate"],
         "Build a corrected B-spline face from a nominal face and a measurement file (Werner "
         "2022 raw/filtered, mirror method, uniform offset).")
     registry.add_options(p, "compensate", flags=("-o",))

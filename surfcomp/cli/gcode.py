@@ -23,7 +23,7 @@ from ..io.gcode import ProgramFile, compensate_stream
 from ..io.gcode.interpreter import MAX_POSITION
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
-from . import registry
+from . import SUMMARIES, registry
 from .common import wrote
 
 SCHEMA = "surfcomp-gcode-report/1"
@@ -31,7 +31,7 @@ SCHEMA = "surfcomp-gcode-report/1"
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "gcode", help="compensate a G-code program for the machine's axis errors",
+        "gcode", help=SUMMARIES["gcode"],
         description="Rewrite a 3-axis G-code program so that a machine with the measured "
                     "geometric axis errors (Dobariya 2015: scale, straightness, flatness, "
                     "squareness; linear or quadratic per axis) lands on the programmed "

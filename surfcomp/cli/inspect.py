@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp inspect``: deviations and statistics only."""
 
-from . import registry
+from . import SUMMARIES, registry
 from .common import add_job_parser, run_job_command
 
 
 def add_parser(subparsers):
     p = add_job_parser(
-        subparsers, "inspect", "deviations and statistics only (nothing is built)",
+        subparsers, "inspect", SUMMARIES["inspect"],
         "Compute deviations along the nominal normal, the 5x5 filtered (determined) and random "
         "components, and the papers' statistics.")
     p.add_argument("--mask", type=int, default=5, metavar="N",

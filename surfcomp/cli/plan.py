@@ -34,7 +34,7 @@ from ..core.planning import (
 from ..errors import InputError
 from ..io.atomic import Transaction
 from ..io.plan_file import PLAN_FORMATS, dropped_text, plan_text
-from . import plan_program, registry
+from . import SUMMARIES, plan_program, registry
 from .common import ProgressLine, wrote
 
 _DEFAULTS = PlanSettings()
@@ -44,7 +44,7 @@ _EXAMPLES = 3
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "plan", help="place the measurement points on the nominal face for on-machine probing",
+        "plan", help=SUMMARIES["plan"],
         description="Place measurement points on the nominal face (grid along the parameter "
                     "lines, grid in the machine's XY plane, or adaptive: denser where the slope "
                     "changes fast, mirror paper 2019), keep those a 3-axis probe reaches, order "

@@ -63,7 +63,7 @@ from ..errors import InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
-from . import registry, simulate_plan
+from . import SUMMARIES, registry, simulate_plan
 from .common import ProgressLine, wrote
 
 _DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
@@ -97,7 +97,7 @@ def _fmt(v):
 
 def add_parser(subparsers):
     p = subparsers.add_parser(
-        "simulate", help="virtual machining: predict what each compensation method achieves",
+        "simulate", help=SUMMARIES["simulate"],
         description="Virtual machining loop (Werner 2022, mirror paper 2019): machine parts with "
                     "a machining-process model (semi-finishing and finishing pass), measure, "
                     "compensate with each method, machine the corrected face, measure again; "

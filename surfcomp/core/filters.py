@@ -19,10 +19,8 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
+from .choices import EDGE_MODES
 
-#: edge handling choices: 'renormalize' (default, see module docstring),
-#: 'reflect' (mirror the grid at its border), 'nearest' (repeat the border nodes)
-EDGE_MODES = ("renormalize", "reflect", "nearest")
 #: Werner 2022's mask: 5 x 5 box (the default everywhere)
 WERNER_MASK_SIZE = 5
 #: the largest mask accepted (a window of 201 x 201 grid steps)

@@ -19,9 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from .choices import METHODS
 from .filters import make_mask, mask_filter
-
-METHODS = ("raw", "filtered", "mirror", "offset")
 
 
 @dataclass

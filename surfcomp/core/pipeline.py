@@ -22,7 +22,6 @@ from .memory import return_free_memory
 from .methods import METHODS, compute_correction
 from .progress import report, sub
 from .projection import project, tangent_lengths
-from .scattered import ScatteredField, smooth
 from .spline_field import ConstantField
 
 #: a given normal more than this many degrees off the face normal is reported
@@ -444,6 +443,8 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     fit = None
     if prepared.scattered:
         report(progress, 0.0, "smoothing fit of %d scattered points" % d.size)
+        from .scattered import smooth  # scattered layouts only: scipy.optimize
+
         fit = smooth(prepared.u, prepared.v, d, options.smoothing, scale=scale)
         corr = compute_correction(d, options.method, None, options.edge, options.stock,
                                   determined=fit.determined)
@@ -544,6 +545,8 @@ def _construction(result, surface, outward, U, V, delta, progress):
     if lean and fit is not None and fit.field is not None and \
             np.max(np.abs(fit.determined - np.ravel(delta))) <= SMOOTH_MATCH:
         return construct_smooth(surface, U, V, delta, fit.field, outward, progress), (du, dv)
+    from .scattered import ScatteredField
+
     factory = functools.partial(ScatteredField, scale=scale,
                                 box=(surface.u_range, surface.v_range))
     (u0, u1), (v0, v1) = surface.u_range, surface.v_range

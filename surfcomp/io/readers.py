@@ -9,13 +9,15 @@ none of the table's columns, as plain measured XYZ points.
 
 import dataclasses
 
+from ..core.choices import MEASUREMENT_FORMATS
 from ..errors import InputError, MeasurementFileError
 from .files import read_once
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
 from .units import unit_factor
 
-FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")
+#: measurement file formats (the choices, importable without numpy)
+FORMATS = MEASUREMENT_FORMATS
 
 
 def read_any(path, units="mm", fmt="auto", sample=None, deviation_units=None):

@@ -1,0 +1,17 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The choices of the options every front end offers, importable without numpy or scipy.
+
+The command line builds its parser from these (``python3 -m surfcomp --help`` and an
+argument error import no numerics); the modules that implement the choices re-export them
+(``surfcomp.core.methods.METHODS``, ``surfcomp.core.filters.EDGE_MODES``,
+``surfcomp.io.readers.FORMATS``).
+"""
+
+#: correction methods (:mod:`surfcomp.core.methods`)
+METHODS = ("raw", "filtered", "mirror", "offset")
+#: edge handling of the mask filter: 'renormalize' (default, see
+#: :mod:`surfcomp.core.filters`), 'reflect' (mirror the grid at its border), 'nearest'
+#: (repeat the border nodes)
+EDGE_MODES = ("renormalize", "reflect", "nearest")
+#: measurement file formats (:func:`surfcomp.io.readers.read_any`; auto: detected)
+MEASUREMENT_FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")
