@@ -187,6 +187,11 @@ def create_operation(kind, name, job=None):
     return module(kind).Create(name, parentJob=job)
 
 
+def add_operation(job, op):
+    """Put the operation ``op`` into ``job``'s Operations (the same call in every version)."""
+    job.Proxy.addOperation(op)
+
+
 def workbench_file(*parts):
     """A file shipped with the CAM workbench (e.g. ``('Tools', 'Bit', name)``)."""
     import FreeCAD
