@@ -29,7 +29,7 @@ import Path
 
 from ..errors import GCodeError, InputError
 from ..io.probe_path import WORK_OFFSETS, ProbeSettings, probe_path, travel_summary
-from . import cam, cam_job
+from . import cam, cam_job, progress
 from .proxies import Proxy
 
 PROBE_OP_TYPE = "SurfComp_ProbeOperation"
@@ -195,17 +195,34 @@ def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", **values):
     for key, val in values.items():
         setattr(op, key, val)
     cam.add_operation(job, op)
-    doc.recompute()
+    recompute_probing(op)
     check_recomputed(op)
     return op
 
 
+def recompute_probing(op):
+    """Recompute the plan and the tool controller (when they need it) and the operation, in
+    this order, and nothing else: a document whose unrelated objects fail to recompute
+    (FreeCAD 1.1 then leaves the objects after the failure touched) still gets the
+    operation's moves."""
+    mine = [o for o in (op.Plan, op.ToolController) if o is not None]
+    for obj in progress.pending(op.Document):
+        if any(obj is o for o in mine):
+            progress.recompute_one(obj)
+    progress.recompute_one(op)
+
+
 def check_recomputed(op):
-    """Raise InputError with the reason when ``op`` (or its plan) failed to recompute."""
+    """Raise InputError with the reason when ``op`` (or its plan) failed to recompute or is
+    out of date (its moves would be those of an older plan)."""
     for obj in (op.Plan, op):
-        if obj is not None and ("Invalid" in obj.State or "Error" in obj.State):
-            why = obj.getStatusString() if hasattr(obj, "getStatusString") else str(obj.State)
-            raise InputError("%s did not recompute: %s" % (obj.Label, why))
+        if obj is None:
+            continue
+        if "Invalid" in obj.State or "Error" in obj.State:
+            raise InputError("%s did not recompute: %s" % (obj.Label, progress.state_text(obj)))
+        if "Touched" in obj.State:
+            raise InputError("%s is out of date: recompute the document before posting "
+                             "(its probe moves would be those of an older plan)" % obj.Label)
     if op.Probes != len(op.Plan.PlanPoints):
         raise InputError("%s holds %d probe moves for %d plan points"
                          % (op.Label, op.Probes, len(op.Plan.PlanPoints)))

@@ -63,7 +63,7 @@ def test_the_jobs_post_processor_writes_the_plan(shop, tmp_path):
     job = shop.getObject("Job")
     plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
                                  Count="5x4", TipRadius=1.5)
-    shop.recompute()
+    progress.recompute_with_progress(shop, "test")
     assert plan.Kept == 20
     op = add_probe_operation(job, plan, tool=99, Overtravel=2.0)
     assert op in job.Operations.Group and is_probe_operation(op)
@@ -91,11 +91,15 @@ def test_the_operation_follows_the_plan(shop, tmp_path):
     job = shop.getObject("Job")
     plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
                                  Count="5x4")
-    shop.recompute()
+    progress.recompute_with_progress(shop, "test")
     op = add_probe_operation(job, plan)
     plan.Count = "3x3"
     plan.TipRadius = 2.0
-    shop.recompute()
+    # a plan changed but not recomputed: the operation's moves are the old plan's, and the
+    # post says so instead of writing them
+    with pytest.raises(InputError, match="MeasurementPlan is out of date"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    progress.recompute_with_progress(shop, "test")
     assert plan.Kept == 9 and op.Probes == 9
     _text, probes, worst = posted_probes(job, plan, op, tmp_path, "again.ngc")
     assert len(probes) == 9 and worst <= 0.01
@@ -122,7 +126,7 @@ def test_no_claim_without_moves(shop):
     job = shop.getObject("Job")
     plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
                                  Count="4x4")
-    shop.recompute()
+    progress.recompute_with_progress(shop, "test")
     op = add_probe_operation(job, plan)
     # a post that drops comments would probe and log nothing: refused
     with pytest.raises(GCodeError, match=r"wrote 16 G38.2, 0 PROBEOPEN, 0 PROBECLOSE where "
@@ -131,7 +135,7 @@ def test_no_claim_without_moves(shop):
     # a plan the probe cannot reach from above (all points dropped) fails, and so does the
     # post: the operation's old moves are never posted
     plan.MaxTilt = 0.001
-    shop.recompute()
+    progress.recompute_with_progress(shop, "test")
     with pytest.raises(InputError, match="did not recompute"):
         post_probe_job(job, "linuxcnc", POST_ARGS)
     assert op.Probes in (0, 16)
