@@ -30,6 +30,7 @@ import Path
 from ..errors import GCodeError, InputError
 from ..io.probe_path import WORK_OFFSETS, ProbeSettings, probe_path, travel_summary
 from . import cam, cam_job, progress
+from .features import _created, _restored
 from .proxies import Proxy
 
 PROBE_OP_TYPE = "SurfComp_ProbeOperation"
@@ -69,6 +70,10 @@ class ProbeOperation(Proxy):
     Type = PROBE_OP_TYPE
     PROPERTIES = PROBE_OP_PROPERTIES
     VERSION = PROBE_OP_VERSION
+
+    def onDocumentRestored(self, obj):
+        super().onDocumentRestored(obj)
+        _restored(obj)
 
     def execute(self, obj):
         compute_probe_operation(obj)
@@ -162,6 +167,7 @@ def probe_tool_controller(job, tool, tip_radius):
     bit = cam.create_tool_bit(job.Document, PROBE_BIT, "Probe")
     bit.Diameter = 2.0 * float(tip_radius)
     bit.Label = "Probe %g mm" % (2.0 * float(tip_radius))
+    bit.Visibility = False          # as CAM keeps its tool bits: not drawn at the origin
     tc = cam.create_tool_controller("TC: Probe", bit, int(tool))
     tc.Label = "TC: Probe T%d" % int(tool)
     tc.SpindleSpeed = 0.0
@@ -170,11 +176,12 @@ def probe_tool_controller(job, tool, tip_radius):
     return tc
 
 
-def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", **values):
+def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", check=True, **values):
     """Add the probing of ``plan`` to ``job`` as an operation and recompute.
 
     ``values``: property values (``WorkOffset``, ``Overtravel``, ``Feed``, ``TouchFeed``,
-    ``LogFile``). The work offset defaults to the Job's first fixture.
+    ``LogFile``). The work offset defaults to the Job's first fixture. ``check=False``
+    leaves :func:`check_recomputed` to the caller (the GUI's undo step).
 
     Raises
     ------
@@ -195,8 +202,10 @@ def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", **values):
     for key, val in values.items():
         setattr(op, key, val)
     cam.add_operation(job, op)
+    _created(op)
     recompute_probing(op)
-    check_recomputed(op)
+    if check:
+        check_recomputed(op)
     return op
 
 

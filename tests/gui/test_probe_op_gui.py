@@ -1,0 +1,57 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Add probe plan to Job in the real FreeCAD GUI (under Xvfb): on the shop document a 5 x 4
+plan made with the Plan measurement panel becomes, by a click on the toolbar button, an
+operation under the Job's Operations with 20 probe moves; the Job's post writes them; one
+undo step removes it."""
+
+import pytest
+
+from tests.gui.harness import read_image, run_session
+
+
+@pytest.fixture(scope="module")
+def session(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("gui_probeop")
+    res = run_session("probeop", tmp)
+    res["tmp"] = tmp
+    return res
+
+
+def test_session_ran_without_exceptions(session):
+    assert session["errors"] == [], session["errors"]
+    assert session["errors_at_end"] == []
+
+
+def test_command_needs_a_plan(session):
+    assert session["active_without_plan"] is False and session["active_with_plan"] is True
+    text, accepted, kept = session["plan"]
+    assert accepted is True and kept == 20 and text.startswith("20 of 20 points kept")
+
+
+def test_the_button_adds_the_operation_to_the_job(session):
+    assert session["buttons"] >= 1
+    count, probes, g38, state, added, tool = session["op"]
+    assert (count, probes, g38, tool) == (1, 20, 20, 99)
+    assert "Invalid" not in state and "Touched" not in state
+    assert added == 3                          # the operation, its tool controller and bit
+    assert session["bit_hidden"] == [False]
+    (mine,), (first,), folder = session["tree"]
+    assert mine == first and mine[0] == folder == "Operations"
+    assert session["posted_probes"] == 20
+    assert "ProbePlan: 20 probe moves added to Job" in session["status"]
+
+
+def test_probe_moves_drawn(session):
+    assert session["op_view"] == ["ViewProviderProbeOperation", "Waypoints"]
+    shown = read_image(session["tmp"] / "probeop.png")
+    hidden = read_image(session["tmp"] / "probeop_hidden.png")
+    # the moves: red rapids and green feeds above the grey block, gone when hidden
+    def coloured(img):
+        r, g, b = img[..., 0], img[..., 1], img[..., 2]
+        return int((((r > 0.6) & (g < 0.35) & (b < 0.35))
+                    | ((g > 0.5) & (r < 0.4) & (b < 0.4))).sum())
+    assert coloured(hidden) < 20 and coloured(shown) > 500
+
+
+def test_one_undo_step(session):
+    assert session["after_undo"] == [0, []]
