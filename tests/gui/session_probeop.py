@@ -36,7 +36,18 @@ for bar in mw.findChildren(QtGui.QToolBar):
         if action.text().replace("&", "") == "Add probe plan to Job" and bar.isVisible():
             buttons.append(bar.widgetForAction(action))
 RESULTS["buttons"] = len(buttons)
+# FreeCAD refreshes the commands' enabled state on a timer: wait for the button as a user
+# would see it enabled
+import time
+
+for _ in range(50):
+    Gui.updateGui()
+    if buttons[0].isEnabled():
+        break
+    time.sleep(0.1)
+RESULTS["button_enabled"] = buttons[0].isEnabled()
 click(buttons[0])
+RESULTS["command_errors"] = ERRORS[:]
 ops = [o for o in job.Operations.Group if probe_op.is_probe_operation(o)]
 op = ops[0] if ops else None
 RESULTS["op"] = [len(ops), op.Probes if op else None,
@@ -76,7 +87,6 @@ for o in others + [plan]:
 RESULTS["op_view"] = [type(op.ViewObject.Proxy).__name__, op.ViewObject.DisplayMode]
 RESULTS["bit_hidden"] = [o.Visibility for o in doc.Objects if o.Label.startswith("Probe ")]
 Gui.Selection.clearSelection()
-Gui.Selection.addSelection(doc.Name, op.Name)
 view = Gui.ActiveDocument.ActiveView
 view.viewIsometric()
 Gui.SendMsgToActiveView("ViewFit")

@@ -29,11 +29,13 @@ def test_command_needs_a_plan(session):
 
 
 def test_the_button_adds_the_operation_to_the_job(session):
-    assert session["buttons"] >= 1
+    assert session["buttons"] >= 1 and session["button_enabled"] is True
+    assert session["command_errors"] == []
     count, probes, g38, state, added, tool = session["op"]
     assert (count, probes, g38, tool) == (1, 20, 20, 99)
     assert "Invalid" not in state and "Touched" not in state
-    assert added == 3                          # the operation, its tool controller and bit
+    # the operation, its tool controller and bit (on 1.1 with the bit's shape objects)
+    assert added >= 3
     assert session["bit_hidden"] == [False]
     (mine,), (first,), folder = session["tree"]
     assert mine == first and mine[0] == folder == "Operations"
@@ -45,12 +47,10 @@ def test_probe_moves_drawn(session):
     assert session["op_view"] == ["ViewProviderProbeOperation", "Waypoints"]
     shown = read_image(session["tmp"] / "probeop.png")
     hidden = read_image(session["tmp"] / "probeop_hidden.png")
-    # the moves: red rapids and green feeds above the grey block, gone when hidden
-    def coloured(img):
-        r, g, b = img[..., 0], img[..., 1], img[..., 2]
-        return int((((r > 0.6) & (g < 0.35) & (b < 0.35))
-                    | ((g > 0.5) & (r < 0.4) & (b < 0.4))).sum())
-    assert coloured(hidden) < 20 and coloured(shown) > 500
+    # the moves' lines (their colours differ between versions): the pixels that change when
+    # the operation is hidden
+    changed = int((abs(shown - hidden).sum(axis=2) > 0.3).sum())
+    assert changed > 1000, changed
 
 
 def test_one_undo_step(session):
