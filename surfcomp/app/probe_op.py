@@ -237,10 +237,12 @@ def check_recomputed(op):
                          % (op.Label, op.Probes, len(op.Plan.PlanPoints)))
 
 
-def post_probe_job(job, post="linuxcnc", args="--no-show-editor"):
+def post_probe_job(job, post="linuxcnc", args="--no-show-editor", native=False):
     """Post ``job`` with its post-processor and check that every active probe operation's
     moves are in the program: ``G38.2`` lines and ``PROBEOPEN``/``PROBECLOSE`` comments, once
-    per fixture. Returns the program text.
+    per fixture. Returns the program text. ``native``: through FreeCAD's own Post Process
+    command (:func:`surfcomp.app.cam.native_post`) instead of
+    :func:`surfcomp.app.cam_job.post_process`.
 
     Raises
     ------
@@ -252,7 +254,7 @@ def post_probe_job(job, post="linuxcnc", args="--no-show-editor"):
            if is_probe_operation(op) and getattr(op, "Active", True)]
     for op in ops:
         check_recomputed(op)
-    text = cam_job.post_process(job, post, args)
+    text = cam.native_post(job, post, args) if native else cam_job.post_process(job, post, args)
     words = [ln.split() for ln in text.splitlines()]
     words = [w[1:] if w and w[0].startswith("N") else w for w in words]
     fixtures = max(1, len(job.Fixtures))

@@ -47,8 +47,8 @@ def plan_arrays(plan):
             np.array([tuple(n) for n in plan.PlanNormals]))
 
 
-def posted_probes(job, plan, op, tmp_path, name):
-    text = post_probe_job(job, "linuxcnc", POST_ARGS)
+def posted_probes(job, plan, op, tmp_path, name, native=False):
+    text = post_probe_job(job, "linuxcnc", POST_ARGS, native=native)
     ngc = tmp_path / name
     ngc.write_text(text)
     tools = [int(tc.ToolNumber) for tc in job.Tools.Group if int(tc.ToolNumber) != 99]
@@ -85,6 +85,12 @@ def test_the_jobs_post_processor_writes_the_plan(shop, tmp_path):
     assert sum(1 for ln in lines[:i] if ln.startswith("G1 ")) > 50
     # G38.2 feed: the touch feed in mm/min
     assert re.search(r"^G38\.2 X\S+ Y\S+ Z\S+ F100\.0+ *$", text, re.M)
+    # FreeCAD's own Post Process command writes the same probe moves
+    native, probes2, worst2 = posted_probes(job, plan, op, tmp_path, "native.ngc", native=True)
+    assert len(probes2) == 20 and worst2 <= 0.01
+    for a, b in zip(probes, probes2):
+        np.testing.assert_allclose(a[1], b[1], atol=1e-4, rtol=0)
+    assert "M6 T99" in native and "(PROBEOPEN probe.log)" in native
 
 
 def test_the_operation_follows_the_plan(shop, tmp_path):
