@@ -224,9 +224,9 @@ def recompute_probing(op):
 def check_recomputed(op):
     """Raise InputError with the reason when ``op`` (or its plan) failed to recompute or is
     out of date (its moves would be those of an older plan)."""
+    if op.Plan is None:
+        raise InputError("probe operation %s has no measurement plan (Plan)" % op.Label)
     for obj in (op.Plan, op):
-        if obj is None:
-            continue
         if "Invalid" in obj.State or "Error" in obj.State:
             raise InputError("%s did not recompute: %s" % (obj.Label, progress.state_text(obj)))
         if "Touched" in obj.State:
