@@ -2,9 +2,13 @@
 """View provider of the probe operation: FreeCAD draws a ``Path::FeaturePython``'s moves
 (rapids red, feeds green) only once a view provider proxy gives it a display mode.
 
-Registered as a creation and restore hook of :mod:`surfcomp.app.features`, so operations
-made by the command, by a script or headless (opened later in the GUI) all get it.
+Registered as a creation and restore hook of :mod:`surfcomp.app.features`, and a document
+observer gives the operations of an opened document theirs when it is activated (FreeCAD
+0.20 may restore the object before its view object), so operations made by the command, by
+a script or headless (opened later in the GUI) all get it.
 """
+
+import FreeCAD
 
 from .. import paths
 from ..app import features
@@ -64,6 +68,16 @@ def attach(obj):
     return True
 
 
+class _Observer:
+    def slotActivateDocument(self, doc):
+        for obj in doc.Objects:
+            attach(obj)
+
+
 for _hooks in (features.NEW_OBJECT_HOOKS, features.RESTORED_HOOKS):
     if attach not in _hooks:
         _hooks.append(attach)
+_OBSERVER = []
+if not _OBSERVER:
+    _OBSERVER.append(_Observer())
+    FreeCAD.addDocumentObserver(_OBSERVER[0])

@@ -102,4 +102,18 @@ doc.undo()
 Gui.updateGui()
 RESULTS["after_undo"] = [len(doc.Objects) - n0,
                          [o.Name for o in job.Operations.Group if probe_op.is_probe_operation(o)]]
+# a document made headless (no view provider saved): opened here, its operation is drawn
+import subprocess
+
+made = os.path.join(TMP, "headless.FCStd")
+maker = os.path.join(ROOT, "tests", "gui", "probeop_headless.py")
+run = subprocess.run(["/usr/bin/python3", maker, ROOT, made], capture_output=True, text=True,
+                     timeout=600, cwd=TMP)
+RESULTS["headless_made"] = [run.returncode, run.stderr[-600:]]
+other = FreeCAD.openDocument(made) if run.returncode == 0 else None
+assert other is not None, run.stderr[-600:]
+Gui.updateGui()
+hop = other.getObject("ProbePlan")
+RESULTS["headless_view"] = [type(hop.ViewObject.Proxy).__name__, hop.ViewObject.DisplayMode,
+                            hop.Probes]
 RESULTS["errors_at_end"] = ERRORS[:]

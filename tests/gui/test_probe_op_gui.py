@@ -53,5 +53,10 @@ def test_probe_moves_drawn(session):
     assert changed > 1000, changed
 
 
+def test_a_headless_operation_is_drawn_when_opened(session):
+    assert session["headless_made"][0] == 0, session["headless_made"]
+    assert session["headless_view"] == ["ViewProviderProbeOperation", "Waypoints", 9]
+
+
 def test_one_undo_step(session):
     assert session["after_undo"] == [0, []]
