@@ -22,14 +22,16 @@ _MOVE = re.compile(r"^\s*\d+\s+N\S*\s+(STRAIGHT_TRAVERSE|STRAIGHT_FEED|STRAIGHT_
 PRINTED = 0.5e-4
 
 
-def rs274_moves(program, tmp_path, tool=99, diameter=2.0):
+def rs274_moves(program, tmp_path, tool=99, diameter=2.0, other_tools=()):
     """The canonical moves of ``program``: list of ``(kind, start (3,), end (3,))`` in mm,
-    the first start being the machine's origin. The tool table holds ``tool``."""
+    the first start being the machine's origin. The tool table holds ``tool`` and the
+    numbers of ``other_tools``."""
     assert os.access(RS274, os.X_OK), (
         "%s is missing: install LinuxCNC's interpreter (Debian package linuxcnc-uspace)"
         % RS274)
     table = tmp_path / "probe.tbl"
-    table.write_text("T%d P%d Z0 D%g ;probe\n" % (tool, tool, diameter))
+    table.write_text("T%d P%d Z0 D%g ;probe\n" % (tool, tool, diameter)
+                     + "".join("T%d P%d Z0 D6 ;other\n" % (t, t) for t in other_tools))
     out = tmp_path / (os.path.basename(str(program)) + ".canon")
     run = subprocess.run([RS274, "-t", str(table), "-g", str(program), str(out)],
                          cwd=str(tmp_path), capture_output=True, text=True, timeout=300)

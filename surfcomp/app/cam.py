@@ -187,6 +187,11 @@ def create_operation(kind, name, job=None):
     return module(kind).Create(name, parentJob=job)
 
 
+def add_operation(job, op):
+    """Put the operation ``op`` into ``job``'s Operations (the same call in every version)."""
+    job.Proxy.addOperation(op)
+
+
 def workbench_file(*parts):
     """A file shipped with the CAM workbench (e.g. ``('Tools', 'Bit', name)``)."""
     import FreeCAD
@@ -277,6 +282,30 @@ def load_post(name):
                              "post-processors are supported" % (name, path))
         return script
     raise GCodeError("post-processor %r is listed but its file was not found" % name)
+
+
+def native_post(job, name, args):
+    """The program FreeCAD's own Post Process command writes for ``job`` with the post
+    ``name`` and arguments ``args`` (its object list, fixtures and tool changes, not
+    :func:`surfcomp.app.cam_job.post_list`'s): 1.x through ``PostProcessorFactory`` with the
+    Job's ``PostProcessorArgs`` set to ``args`` for the call; 0.20 through the Post command's
+    ``buildPostList`` and the script's ``export`` (``PathScripts.PathPost`` imports
+    FreeCADGui, which ``freecadcmd`` also has). Returns the text of every output file joined.
+    """
+    if api().modules == "Path":
+        from Path.Post.Processor import PostProcessorFactory
+
+        old = job.PostProcessorArgs
+        job.PostProcessorArgs = args
+        try:
+            sections = PostProcessorFactory.get_post_processor(job, name).export()
+        finally:
+            job.PostProcessorArgs = old
+        return "".join(text for _name, text in sections or ())
+    from PathScripts.PathPost import CommandPathPost
+
+    return "".join(load_post(name).export(objs, "-", args) or ""
+                   for objs in CommandPathPost().buildPostList(job))
 
 
 # --------------------------------------------------------------------------- 0.20 documents

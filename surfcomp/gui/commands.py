@@ -554,16 +554,18 @@ class PlanMeasurement(Command):
         FreeCADGui.Control.showDialog(plan_panel.PlanPanel(nom, face))
 
 
+from .probe_op_cmd import AddProbeOperation  # noqa: E402 (its base class is above)
+
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
             ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
-            RestoreNominal, Report, PlanMeasurement)
+            RestoreNominal, Report, PlanMeasurement, AddProbeOperation)
 #: command groups (toolbar drop-downs)
 GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
            "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
            "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report",
-           None, "SurfComp_PlanMeasurement")
+           None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation")
 
 
 def register():
