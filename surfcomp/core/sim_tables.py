@@ -14,8 +14,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .deviations import Statistics
-
 #: statistics shown in the papers' table form (key, label)
 TABLE_ROWS = (("max_negative", "Max. negative"), ("max_positive", "Max. positive"),
               ("mean", "Average value"), ("std", "Standard deviation (ddof=1)"),
@@ -217,7 +215,3 @@ def format_simulation_table(columns, replicas, unit="um"):
         out.append(lab.ljust(width) + "".join(col[k].rjust(colw) for col in cells))
     return "\n".join(out)
 
-
-def statistics_from_dict(d):
-    """Inverse of ``Statistics.as_dict`` (for readers of the JSON)."""
-    return Statistics(**{k: d[k] for k in STAT_KEYS})
