@@ -21,7 +21,8 @@ from scipy import ndimage
 from ..errors import InputError
 
 #: edge handling choices: 'renormalize' (default, see module docstring),
-#: 'reflect' (mirror the grid at its border), 'nearest' (repeat the border nodes)
+#: 'reflect' (the grid mirrored about its border node, which is not repeated: numpy.pad's
+#: 'reflect', the mode scipy.ndimage calls 'mirror'), 'nearest' (the border node repeated)
 EDGE_MODES = ("renormalize", "reflect", "nearest")
 #: Werner 2022's mask: 5 x 5 box (the default everywhere)
 WERNER_MASK_SIZE = 5
@@ -152,6 +153,7 @@ def mask_filter(d, mask, edge="renormalize"):
                          % (edge, ", ".join(EDGE_MODES)))
     valid = np.isfinite(d)
     values = np.where(valid, d, 0.0)
+    # ndimage's names: its 'reflect' repeats the border node, its 'mirror' is our 'reflect'
     mode = "constant" if edge == "renormalize" else ("mirror" if edge == "reflect" else "nearest")
     num = ndimage.correlate(values, mask, mode=mode, cval=0.0)
     den = ndimage.correlate(valid.astype(float), mask, mode=mode, cval=0.0)

@@ -18,7 +18,8 @@ import numpy as np
 TABLE_ROWS = (("max_negative", "Max. negative"), ("max_positive", "Max. positive"),
               ("mean", "Average value"), ("std", "Standard deviation (ddof=1)"),
               ("profile", "Profile error ISO 1101 (2 max|d|)"))
-STAT_KEYS = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile")
+STAT_KEYS = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile", "min",
+             "max")
 #: columns of the side-by-side table: (key in the row dicts, header)
 SIDE_COLUMNS = (("mean", "mean"), ("std", "std"), ("max", "max"), ("min", "min"),
                 ("profile", "ISO 1101"))
@@ -70,8 +71,8 @@ def side_values(stats_list):
     ``max``, ``min`` and ``profile`` averaged over the parts; ``replicas``, ``count``."""
     mean, std = pooled(stats_list)
     return {"mean": mean, "std": std,
-            "max": float(np.mean([s.max_positive for s in stats_list])),
-            "min": float(np.mean([s.max_negative for s in stats_list])),
+            "max": float(np.mean([s.max for s in stats_list])),
+            "min": float(np.mean([s.min for s in stats_list])),
             "profile": float(np.mean([s.profile for s in stats_list])),
             "replicas": len(stats_list), "count": int(stats_list[0].count)}
 

@@ -32,7 +32,7 @@ REPORT_COLUMNS = (("deviation", "Deviation"), ("determined", "Determined"),
 def statistics_columns(obj):
     """``[(header, Statistics)]`` of a computed compensation, in report order."""
     data = json.loads(obj.Statistics or "{}")
-    return [(head, Statistics(**data[key])) for key, head in REPORT_COLUMNS if key in data]
+    return [(head, Statistics.from_dict(data[key])) for key, head in REPORT_COLUMNS if key in data]
 
 
 def map_style(obj):

@@ -72,8 +72,9 @@ def test_model_options_reach_the_model(tmp_path):
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["model"]["offset"] == 0.01 and d["model"]["sigma"] == 0.0
     before = d["before"]["replicas"][0]["all"]
-    assert_allclose([before["mean"], before["max_negative"], before["max_positive"]], 0.01,
+    assert_allclose([before["mean"], before["min"], before["max"], before["max_positive"]], 0.01,
                     atol=1e-9)
+    assert before["max_negative"] == 0.0        # no point below the nominal
     for m in d["methods"][1:]:
         r = m["replicas"][0]
         # at the nodes within the residual iteration's target MATCH_TOL (0.02 um; measured
