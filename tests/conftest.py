@@ -24,3 +24,23 @@ def default_signals():
 
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, signal.SIG_DFL)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Work units for parallel runs (``pytest -n 2 --dist loadgroup``, tools/test.sh).
+
+    A module of ``tests/app`` stays on one worker, so its module-scoped fixtures (a solid
+    read once, a shop document regenerated once) are built once. Every ``tests/gui`` module
+    runs on the same worker, one FreeCAD GUI session after the other, so two sessions never
+    share the X server and the cores (their latency checks allow for the machine's load,
+    not for a second GUI). ``tests/pure`` and ``tests/fuzz`` are spread test by test.
+    Without xdist the marks are unused.
+    """
+    import pytest
+
+    for item in items:
+        parts = item.nodeid.split("/")
+        if len(parts) > 2 and parts[0] == "tests" and parts[1] == "gui":
+            item.add_marker(pytest.mark.xdist_group("gui"))
+        elif len(parts) > 2 and parts[0] == "tests" and parts[1] == "app":
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))

@@ -16,6 +16,7 @@ APT_PACKAGES=(
   chromium               # headless screenshot of the HTML report in tests
   git                    # the Addon Manager test clones the checkout
   python3-hypothesis     # property-based tests (tests/fuzz)
+  python3-pytest-xdist   # the tests in parallel on the machine's cores (tools/test.sh)
   linuxcnc-uspace        # rs274, LinuxCNC's own G-code interpreter, reads our G-code in tests
 )
 #: the linter, the same version everywhere (Debian's where the archive has ruff, else PyPI)

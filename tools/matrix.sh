@@ -153,7 +153,7 @@ command2() {
   grep -m1 -E '^bash tools/install.sh && bash tools/test.sh' "$repo/README.md"
 }
 
-# run_entry SUITE [FIRST X SERVER NUMBER]
+# run_entry SUITE [FIRST X SERVER NUMBER] [PYTEST WORKERS]
 run_entry() {
   local suite=$1 log="$logs/$1.test.log" rc=0 cmd versions result
   cmd=$(command2)
@@ -168,7 +168,9 @@ run_entry() {
     say "$suite: $cmd"
     # the roots share the host's network namespace, where X servers listen: each root's
     # Xvfb gets numbers of its own (tools/test.sh), as the roots run side by side
-    in_root "$root" bash -c "cd /root/surfcomp && export SURFCOMP_XVFB_FROM=${2:-99} && $cmd" \
+    # and its share of the cores for pytest's workers (tools/test.sh)
+    in_root "$root" bash -c "cd /root/surfcomp && export SURFCOMP_XVFB_FROM=${2:-99} \
+      SURFCOMP_TEST_WORKERS=${3:-1} && $cmd" \
       >"$log" 2>&1 || rc=$?
     versions=$(in_root "$root" /usr/bin/python3 /root/surfcomp/tools/versions.py --summary 2>/dev/null) || true
   fi
@@ -218,13 +220,16 @@ main() {
   if [ -n "$bg" ]; then
     wait "$bg" || { status=1; cat "$logs/prepare.log" >&2; }
   fi
-  # the roots run side by side (one pytest each, about one core each on 2 cores)
-  local pids=() n=0 p
+  # the roots run side by side, each pytest with its share of the cores (one worker each on
+  # 2 cores)
+  local pids=() n=0 p workers
+  workers=$(( $(nproc) / (${#roots[@]} > 0 ? ${#roots[@]} : 1) ))
+  [ "$workers" -ge 1 ] || workers=1
   for e in "${roots[@]}"; do
     grep -q "Debian $e: the root could not" "$logs/summary.txt" && continue
     mount_root "$cache/$e"           # here, so that the exit trap unmounts it
     n=$((n + 1))
-    run_entry "$e" $((100 + 20 * n)) &
+    run_entry "$e" $((100 + 20 * n)) "$workers" &
     pids+=("$!")
   done
   for p in "${pids[@]}"; do wait "$p" || status=1; done

@@ -308,7 +308,7 @@ def write_face(path, shape, output=None, name=None):
 
     ``output``: the :class:`surfcomp.app.shapes.Output` of ``shape``; a face bounded by its
     surface's knot domain (``output.natural``) goes to STEP from its pole net
-    (:mod:`surfcomp.io.step_face`, 5-7x faster than OpenCASCADE's writer), its product
+    (:mod:`surfcomp.io.step_face`, faster than OpenCASCADE's writer), its product
     named ``name`` (default: the file's name).
     """
     import Part

@@ -16,7 +16,6 @@ import importlib
 import sys
 
 from .. import __version__
-from ..errors import SurfcompError
 from ..io import atomic
 from . import registry, runner
 from .runner import Terminated  # noqa: F401  (the signal exception, for callers)
@@ -54,10 +53,6 @@ def build_parser(only=None):
         module = importlib.import_module("." + name, __name__)
         registry.add_plain_options(module.add_parser(subparsers), name)
     return parser
-
-
-class ArgumentError(SurfcompError):
-    exit_code = 2
 
 
 def main(argv=None):

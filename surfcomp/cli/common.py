@@ -221,8 +221,8 @@ def print_summary(comp, rep, out=None):
                  "  " + plausibility.residual_assumption(o.method, o.stock)]
     print("", file=out)
     print("Correction:   method %s%s; applied along the normal: %.2f .. %.2f um (mean %.2f um)"
-          % (o.method, extra, st["correction"].max_negative * 1e3,
-             st["correction"].max_positive * 1e3, st["correction"].mean * 1e3), file=out)
+          % (o.method, extra, st["correction"].min * 1e3,
+             st["correction"].max * 1e3, st["correction"].mean * 1e3), file=out)
     for line in notes:
         print(line, file=out)
     ch = comp.checks

@@ -442,8 +442,6 @@ class AxisErrorModel:
                       % tuple(self.offset_spread * 1e3)))
         return out
 
-    def fit_dicts(self):
-        return [f.as_dict() for f in self.fits]
 
 
 # ---------------------------------------------------------------------------- fitting

@@ -9,8 +9,29 @@ Book", 2nd ed. (algorithms A2.1-A2.3); de Boor, "A Practical Guide to Splines"
 (Greville abscissae).
 """
 
+import inspect
+
 import numpy as np
 import scipy.sparse as _sp
+from scipy.interpolate import BSpline as _BSpline
+
+
+def _scipy_design_matrix():
+    """scipy's compiled collocation matrix where the installed scipy has it with
+    extrapolation (``BSpline.design_matrix(x, t, k, extrapolate)``, scipy 1.10 and later),
+    else None. It gives the values of :func:`basis_functions` (to rounding: equal in
+    ``tests/pure/test_basis_scipy.py``) in less time; ``bench/bench_basis.py`` prints the
+    ratio."""
+    design = getattr(_BSpline, "design_matrix", None)
+    try:
+        takes_extrapolate = "extrapolate" in inspect.signature(design).parameters
+    except (TypeError, ValueError):
+        takes_extrapolate = False
+    return design if takes_extrapolate else None
+
+
+#: ``BSpline.design_matrix`` of the installed scipy, or None (see :func:`_scipy_design_matrix`)
+SCIPY_DESIGN_MATRIX = _scipy_design_matrix()
 
 
 def find_spans(knots, degree, n_poles, t):
@@ -139,6 +160,14 @@ def basis_matrix(knots, degree, n_poles, t, deriv=0):
     if knots.size != n_poles + degree + 1:
         raise ValueError("knot vector length %d does not match n_poles + degree + 1 = %d"
                          % (knots.size, n_poles + degree + 1))
+    if deriv == 0 and SCIPY_DESIGN_MATRIX is not None and np.isfinite(t).all():
+        return _sp.csr_matrix(SCIPY_DESIGN_MATRIX(t, knots, int(degree), extrapolate=True))
+    return _basis_matrix(knots, degree, n_poles, t, deriv)
+
+
+def _basis_matrix(knots, degree, n_poles, t, deriv=0):
+    """:func:`basis_matrix` from :func:`basis_functions` (every derivative order, any
+    scipy; non-finite parameters give non-finite rows)."""
     ders, span = basis_functions(knots, degree, t, deriv)
     cols = (span[:, None] - degree + np.arange(degree + 1)).ravel()
     indptr = np.arange(0, t.size * (degree + 1) + 1, degree + 1)

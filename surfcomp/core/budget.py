@@ -96,14 +96,14 @@ def check(needed, limit=None, what="this run", hint=""):
 # ----------------------------------------------------------------------------- estimates
 #: ``simulate``: bytes per point of the evaluation grid (nodes and between) and per node
 #: of the measurement grid (its compensations), and per replica and method (statistics).
-#: Measured peaks (2026-12-02, example face, one replica, see CONTRIBUTING.md): 100x100
+#: Measured peaks (2026-12-02, example face, one replica, see docs/benchmarks.md): 100x100
 #: 227 MB, 200x200 486 MB (313 MB with --between 1), 400x400 728 MB, 600x600 989 MB,
 #: 800x800 1622 MB; these costs estimate 355, 520 (384), 1183, 2289 and 3836 MB
 SIM_PER_EVAL_POINT = 1200
 SIM_PER_GRID_POINT = 1000
 SIM_PER_REPLICA_METHOD = 4000
 #: ``inspect``/``compensate``: bytes per measured point (inspect measured 2026-12-01:
-#: 561 MB peak for a million scattered points, CONTRIBUTING.md bench_scale.py)
+#: 561 MB peak for a million scattered points, docs/benchmarks.md bench_scale.py)
 JOB_PER_POINT = 1000
 JOB_PER_POINT_COMPENSATE = 6000
 #: ``gcode``: bytes per line of the block being compensated (parsed words, the block's

@@ -10,8 +10,9 @@ argument error import no numerics); the modules that implement the choices re-ex
 #: correction methods (:mod:`surfcomp.core.methods`)
 METHODS = ("raw", "filtered", "mirror", "offset")
 #: edge handling of the mask filter: 'renormalize' (default, see
-#: :mod:`surfcomp.core.filters`), 'reflect' (mirror the grid at its border), 'nearest'
-#: (repeat the border nodes)
+#: :mod:`surfcomp.core.filters`), 'reflect' (the grid mirrored about its border node, which
+#: is not repeated: numpy.pad's 'reflect', the mode scipy.ndimage calls 'mirror'),
+#: 'nearest' (the border node repeated)
 EDGE_MODES = ("renormalize", "reflect", "nearest")
 #: measurement file formats (:func:`surfcomp.io.readers.read_any`; auto: detected)
 MEASUREMENT_FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")

@@ -3,10 +3,9 @@
 
 The evaluations of millions of points (B-spline derivatives, field values) run in
 chunks that stay in cache; numpy releases the interpreter lock inside its kernels, so
-the chunks of one call can run on several threads at once (1.4x on 2 cores for the
-derivatives of 1M points). ``SURFCOMP_THREADS`` sets the number of threads (1: serial);
-the default is the number of cores, at most 4. A chunk that itself maps chunks runs
-them serially (no nested waiting on the same pool).
+the chunks of one call can run on several threads at once. ``SURFCOMP_THREADS`` sets
+the number of threads (1: serial); the default is the number of cores, at most 4. A
+chunk that itself maps chunks runs them serially (no nested waiting on the same pool).
 """
 
 import os

@@ -183,38 +183,6 @@ class _Sampling:
                                self.nominal.u_range, self.nominal.v_range)
 
 
-def build_corrected_surface(nominal, field, outward=1, spacing_u=None, spacing_v=None,
-                            refine=DEFAULT_REFINE, progress=None):
-    """Build the corrected surface ``S(u, v) - delta(u, v) n(u, v)`` over the face's work area.
-
-    Parameters
-    ----------
-    nominal : Surface
-        The nominal surface; ``u_range`` x ``v_range`` is the work area.
-    field : callable
-        ``field(u, v) -> delta`` (arrays of equal shape, mm): the correction field.
-    outward : {1, -1}
-        +1 when the face's outward normal is ``Su x Sv``, -1 when the face is reversed.
-    spacing_u, spacing_v : float, optional
-        Parameter spacing of the measurement grid; knot spans become at most
-        ``spacing / refine``. Default: no refinement beyond the nominal's knots.
-    refine : int
-        Knot spans per measurement grid step.
-
-    Returns
-    -------
-    Surface
-        Same degrees, u/v directions, parametrisation and weights as the nominal.
-    """
-    report(progress, 0.05, "sampling the nominal")
-    smp = _Sampling(nominal, outward, spacing_u, spacing_v, refine)
-    uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")
-    report(progress, 0.4, "evaluating the correction field")
-    delta = np.asarray(field(uu.ravel(), vv.ravel()), dtype=float).reshape(uu.shape)
-    report(progress, 0.7, "interpolating the corrected surface")
-    return smp.build(delta)
-
-
 @dataclass
 class Construction:
     """A corrected surface with what was built alongside it (see :func:`construct`)."""

@@ -58,6 +58,12 @@ class Statistics:
     papers report it; ``rms`` is the root mean square about zero (the nominal);
     ``profile`` is the ISO 1101 surface profile error for a tolerance zone
     centred on the nominal: the zone width ``2 * max|d|``.
+
+    ``max_negative`` is the largest deviation below the nominal (the most negative value)
+    and 0.0 when no value is below it; ``max_positive`` the largest above it, 0.0 when none
+    is above. ``min`` and ``max`` are the smallest and largest values whatever their signs
+    (an all-positive set: ``max_negative`` 0.0, ``min`` its smallest value). The JSON
+    report's keys are these field names.
     """
 
     count: int
@@ -67,9 +73,22 @@ class Statistics:
     std: float
     rms: float
     profile: float
+    min: float
+    max: float
 
     def as_dict(self):
         return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d):
+        """Inverse of :meth:`as_dict`; also reads the dict of a document or report made
+        before ``min`` and ``max`` existed, whose ``max_negative`` and ``max_positive``
+        were the extremes whatever their signs."""
+        d = dict(d)
+        if "min" not in d or "max" not in d:
+            d["min"], d["max"] = d["max_negative"], d["max_positive"]
+            d["max_negative"], d["max_positive"] = min(d["min"], 0.0), max(d["max"], 0.0)
+        return cls(**{f: d[f] for f in cls.__dataclass_fields__})
 
     def rows(self, unit="mm"):
         """Table rows ``(label, value)`` in ``unit`` (``mm`` or ``um``)."""
@@ -94,17 +113,19 @@ def statistics(d):
     Returns
     -------
     Statistics
-        ``max_negative`` is the smallest (most negative) value and
-        ``max_positive`` the largest, whatever their signs.
+        ``max_negative`` is the most negative value (0.0 when none is negative),
+        ``max_positive`` the most positive (0.0 when none is positive); ``min`` and
+        ``max`` the extremes whatever their signs.
     """
     a = np.asarray(d, dtype=float).ravel()
     a = a[np.isfinite(a)]
     if a.size == 0:
         raise ValueError("no finite deviations to summarise")
     std = float(np.std(a, ddof=1)) if a.size > 1 else 0.0
-    return Statistics(count=int(a.size), max_negative=float(a.min()), max_positive=float(a.max()),
+    lo, hi = float(a.min()), float(a.max())
+    return Statistics(count=int(a.size), max_negative=min(lo, 0.0), max_positive=max(hi, 0.0),
                       mean=float(a.mean()), std=std, rms=float(np.sqrt(np.mean(a * a))),
-                      profile=float(2.0 * np.abs(a).max()))
+                      profile=float(2.0 * np.abs(a).max()), min=lo, max=hi)
 
 
 def format_table(columns, unit="um", title=None):

@@ -150,6 +150,7 @@ def mask_filter(d, mask, edge="renormalize"):
                          % (edge, ", ".join(EDGE_MODES)))
     valid = np.isfinite(d)
     values = np.where(valid, d, 0.0)
+    # ndimage's names: its 'reflect' repeats the border node, its 'mirror' is our 'reflect'
     mode = "constant" if edge == "renormalize" else ("mirror" if edge == "reflect" else "nearest")
     num = ndimage.correlate(values, mask, mode=mode, cval=0.0)
     den = ndimage.correlate(valid.astype(float), mask, mode=mode, cval=0.0)

@@ -23,8 +23,8 @@ from .progress import report
 #: shortest accepted segment length (mm): 1 um, finer than any machine's resolution matters
 MIN_SEGMENT_LENGTH = 1e-3
 #: most points :func:`plan_moves` may sample. Measured on the 2-core development machine
-#: (23 GB): about 0.8 kB of memory and 26 us per output segment from planning to the
-#: written text, so 10 million segments take about 8 GB and 4-5 minutes.
+#: (23 GB): about 0.8 kB of memory per output segment from planning to the written text,
+#: so 10 million segments take about 8 GB (bench/bench_memory.py).
 MAX_SEGMENTS = 10_000_000
 
 

@@ -36,8 +36,9 @@ from .projection_newton import GenericEval, Newton, SpanTable, dot
 from .projection_regions import Regions, principal_curvatures
 
 #: points per vectorised Newton chunk: large enough that the two projection threads spend
-#: little time in the interpreter between numpy kernels (1M blade points: 16384 -> 65536
-#: is 3.1-3.9 s -> 2.6-3.0 s on 2 cores), small enough for the temporaries (~50 MB)
+#: little time in the interpreter between numpy kernels (a quarter of it was measurably
+#: slower on a million blade points, bench/bench_scale.py), small enough for the
+#: temporaries (~50 MB)
 CHUNK = 65536
 #: upper bound on the number of seed samples
 MAX_SAMPLES = 250_000

@@ -14,13 +14,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .deviations import Statistics
-
 #: statistics shown in the papers' table form (key, label)
 TABLE_ROWS = (("max_negative", "Max. negative"), ("max_positive", "Max. positive"),
               ("mean", "Average value"), ("std", "Standard deviation (ddof=1)"),
               ("profile", "Profile error ISO 1101 (2 max|d|)"))
-STAT_KEYS = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile")
+STAT_KEYS = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile", "min",
+             "max")
 #: columns of the side-by-side table: (key in the row dicts, header)
 SIDE_COLUMNS = (("mean", "mean"), ("std", "std"), ("max", "max"), ("min", "min"),
                 ("profile", "ISO 1101"))
@@ -72,8 +71,8 @@ def side_values(stats_list):
     ``max``, ``min`` and ``profile`` averaged over the parts; ``replicas``, ``count``."""
     mean, std = pooled(stats_list)
     return {"mean": mean, "std": std,
-            "max": float(np.mean([s.max_positive for s in stats_list])),
-            "min": float(np.mean([s.max_negative for s in stats_list])),
+            "max": float(np.mean([s.max for s in stats_list])),
+            "min": float(np.mean([s.min for s in stats_list])),
             "profile": float(np.mean([s.profile for s in stats_list])),
             "replicas": len(stats_list), "count": int(stats_list[0].count)}
 
@@ -217,7 +216,3 @@ def format_simulation_table(columns, replicas, unit="um"):
         out.append(lab.ljust(width) + "".join(col[k].rjust(colw) for col in cells))
     return "\n".join(out)
 
-
-def statistics_from_dict(d):
-    """Inverse of ``Statistics.as_dict`` (for readers of the JSON)."""
-    return Statistics(**{k: d[k] for k in STAT_KEYS})

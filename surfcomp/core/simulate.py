@@ -55,7 +55,6 @@ from .sim_tables import (  # noqa: F401
     side_by_side,
     side_values,
     spread,
-    statistics_from_dict,
 )
 
 #: method names of the simulation (``none`` = no compensation)

@@ -39,13 +39,6 @@ def ask_save_file(title, filters, default=""):
     return path or None
 
 
-def ask_float(title, label, value, minimum, maximum, decimals=4):
-    """A number, or None when the user cancels."""
-    val, ok = QtGui.QInputDialog.getDouble(_parent(), title, label, value, minimum, maximum,
-                                           decimals)
-    return float(val) if ok else None
-
-
 def ask_stock(title, value, deviation=None):
     """The mirror method's stock from the explained stock dialog, checked against the
     measured ``deviation`` (mm): ``(stock in mm, confirmed)``, or None when cancelled.

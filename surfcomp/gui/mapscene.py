@@ -250,7 +250,6 @@ class MapScene:
             self.labels.addChild(_text(pts[idx], text))
             if style.show_labels:
                 self.label_anchors.append((tuple(map(float, pts[idx])), text))
-        self.extreme_indices = (i_max, i_min)
 
     def set_flags(self, flags):
         """Flags: ``[(point (3,), text, leader (3,), justification)]`` in the map's

@@ -32,7 +32,7 @@ REPORT_COLUMNS = (("deviation", "Deviation"), ("determined", "Determined"),
 def statistics_columns(obj):
     """``[(header, Statistics)]`` of a computed compensation, in report order."""
     data = json.loads(obj.Statistics or "{}")
-    return [(head, Statistics(**data[key])) for key, head in REPORT_COLUMNS if key in data]
+    return [(head, Statistics.from_dict(data[key])) for key, head in REPORT_COLUMNS if key in data]
 
 
 def map_style(obj):
@@ -124,8 +124,8 @@ class FilterPanel:
     #: delay of the live preview after a change (ms). None: the update runs as soon as
     #: the events already queued are handled, so the keys of one burst (a paste, a held
     #: arrow key's repeats) and those typed while an update runs are taken together by one
-    #: update; the map should follow a key within 0.3 s (issue 24), and the 120 ms this
-    #: was took 40 % of that
+    #: update; the map should follow a key within 0.3 s (issue 24), and a fixed delay would
+    #: spend a large part of that (bench/bench_filter_panel.py measures it)
     DEBOUNCE = 0
 
     def __init__(self, obj):

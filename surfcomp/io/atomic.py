@@ -230,12 +230,6 @@ class Transaction:
                 fh.write(text)
         return self.write(path, put)
 
-    def stage_bytes(self, path, data):
-        def put(tmp):
-            with open(tmp, "wb") as fh:
-                fh.write(data)
-        return self.write(path, put)
-
     def commit(self):
         """Rename every staged file to its destination, then copy what goes to standard
         output there; all files or none. Signals wait until it is done."""

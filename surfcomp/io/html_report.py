@@ -40,6 +40,7 @@ import io
 import numpy as np
 
 from ..core import colormap
+from ..core.deviations import statistics
 from .atomic import write_text
 
 #: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
@@ -334,12 +335,9 @@ def _section_statistics(report, arrays):
     res = arrays["residual"][np.isfinite(arrays["residual"])]
     note = ""
     if res.size:
-        std = float(np.std(res, ddof=1)) if res.size > 1 else 0.0
-        rms_res = float(np.sqrt(np.mean(res ** 2)))
-        cols.append(("Predicted residual", {"count": res.size, "max_negative": res.min(),
-                                            "max_positive": res.max(), "mean": res.mean(),
-                                            "std": std, "rms": rms_res,
-                                            "profile": 2 * np.abs(res).max()}))
+        res_stats = statistics(res)
+        rms_res = res_stats.rms
+        cols.append(("Predicted residual", res_stats.as_dict()))
         rnd = arrays["random"][np.isfinite(arrays["random"])]
         rms_rnd = float(np.sqrt(np.mean(rnd ** 2))) if rnd.size else 0.0
         note = ("<p>Expected RMS of the next part (predicted residual plus a new random scatter "

@@ -2,13 +2,13 @@
 """STEP file (ISO 10303-21, AP214) of one B-spline face bounded by its surface's parameter
 range, written from the pole net directly.
 
-OpenCASCADE's writer makes an object per pole and formats each number on its own: 4.4 s
-for a 1008 x 1008 pole net and 11 s for 1599 x 1599. Here the poles are formatted as fixed-
-point numbers by array operations. The file has the entities OpenCASCADE writes for such a
-face, in its layout (an open shell of one ADVANCED_FACE, its four boundary iso-curves with
-their parameter lines as PCURVEs, millimetres, the uncertainty as the edge tolerance), so
-that a reader sees the same face. Faces of any other shape go through OpenCASCADE
-(:func:`surfcomp.app.file_route.write_face`).
+OpenCASCADE's writer makes an object per pole and formats each number on its own, which
+takes seconds for pole nets of a million poles (bench/run.py measures both writers). Here
+the poles are formatted as fixed-point numbers by array operations. The file has the
+entities OpenCASCADE writes for such a face, in its layout (an open shell of one
+ADVANCED_FACE, its four boundary iso-curves with their parameter lines as PCURVEs,
+millimetres, the uncertainty as the edge tolerance), so that a reader sees the same face.
+Faces of any other shape go through OpenCASCADE (:func:`surfcomp.app.file_route.write_face`).
 
 Numbers: the poles with 10^-12 mm resolution in fixed point (12 decimals while the largest
 coordinate is below 1000 mm, one fewer for each further digit, so that every number stays

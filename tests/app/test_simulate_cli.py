@@ -72,8 +72,9 @@ def test_model_options_reach_the_model(tmp_path):
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["model"]["offset"] == 0.01 and d["model"]["sigma"] == 0.0
     before = d["before"]["replicas"][0]["all"]
-    assert_allclose([before["mean"], before["max_negative"], before["max_positive"]], 0.01,
+    assert_allclose([before["mean"], before["min"], before["max"], before["max_positive"]], 0.01,
                     atol=1e-9)
+    assert before["max_negative"] == 0.0        # no point below the nominal
     for m in d["methods"][1:]:
         r = m["replicas"][0]
         # at the nodes within the residual iteration's target MATCH_TOL (0.02 um; measured
@@ -85,25 +86,31 @@ def test_model_options_reach_the_model(tmp_path):
         assert max(abs(every["max_negative"]), abs(every["max_positive"])) < 3e-5, m["label"]
 
 
-def _bad(tmp_path, *args):
-    out = run_cli(EXAMPLE_STEP, *args, "--json", tmp_path / "s.json", "--html", tmp_path / "s.html",
-                  "--quiet")
-    assert out.returncode == 2, (out.returncode, out.stderr)
-    assert "Traceback" not in out.stderr
+def _bad(tmp_path, capsys, *args):
+    """The command run in this process (the refusals need no fresh one: the options are
+    checked before any work; the real process is the other tests'): exit 2, a message,
+    nothing written."""
+    argv = ["simulate", EXAMPLE_STEP, *args, "--json", tmp_path / "s.json", "--html",
+            tmp_path / "s.html", "--quiet"]
+    rc = surfcomp.cli.main([str(a) for a in argv])
+    err = capsys.readouterr().err
+    assert rc == 2, (rc, err)
+    assert "Traceback" not in err
     assert os.listdir(tmp_path) == []
-    return out.stderr
+    return err
 
 
-def test_bad_options_exit_2_and_write_nothing(tmp_path):
-    assert "--grid '2x40': expected at least 3x3" in _bad(tmp_path, "--grid", "2x40")
-    assert "unknown method 'best'" in _bad(tmp_path, "--methods", "raw,best")
-    assert "--tilt '0.1': expected 2 comma-separated numbers" in _bad(tmp_path, "--tilt", "0.1")
-    assert "--report-method 'none'" in _bad(tmp_path, "--report-method", "none")
-    assert "sigma must be >= 0" in _bad(tmp_path, "--sigma", "-0.001")
-    assert "Face9" in _bad(tmp_path, "--face", "Face9")
+def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys):
+    assert "--grid '2x40': expected at least 3x3" in _bad(tmp_path, capsys, "--grid", "2x40")
+    assert "unknown method 'best'" in _bad(tmp_path, capsys, "--methods", "raw,best")
+    assert "--tilt '0.1': expected 2 comma-separated numbers" in _bad(tmp_path, capsys, "--tilt",
+                                                                      "0.1")
+    assert "--report-method 'none'" in _bad(tmp_path, capsys, "--report-method", "none")
+    assert "sigma must be >= 0" in _bad(tmp_path, capsys, "--sigma", "-0.001")
+    assert "Face9" in _bad(tmp_path, capsys, "--face", "Face9")
 
 
-def test_out_of_range_and_non_finite_options_name_the_option(tmp_path):
+def test_out_of_range_and_non_finite_options_name_the_option(tmp_path, capsys):
     """Issue 12: every option value that is not finite, negative where it cannot be, or
     beyond the limits is refused with exit 2 and a message naming the option."""
     for args, text in (
@@ -118,7 +125,7 @@ def test_out_of_range_and_non_finite_options_name_the_option(tmp_path):
             (("--correlation-length", "inf"), "--correlation-length 'inf'"),
             (("--offset", "nan"), "--offset 'nan'"),
             (("--preset", "werner"), "unknown preset 'werner'")):
-        assert text in _bad(tmp_path, *args), args
+        assert text in _bad(tmp_path, capsys, *args), args
     out = run_cli("--quiet")  # neither a face nor a preset
     assert out.returncode == 2 and "give NOMINAL" in out.stderr and "mirror2019-s1" in out.stderr
 

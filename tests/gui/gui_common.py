@@ -5,7 +5,7 @@
 # (surfcomp.gui.dialogs is the one place commands ask the user).
 import time  # noqa: F401  (for the sessions)
 
-import numpy as np
+import numpy as np  # noqa: F401  (for the sessions)
 
 Gui = FreeCADGui
 ROOT = os.environ["SURFCOMP_ROOT"]
@@ -189,23 +189,6 @@ def selection():
     object's shape: FreeCAD 1.x drops those the shape lacks, such as a map mesh's
     ``Vertex-1635``, which would make an element pick look like a whole-object one."""
     return [[s.ObjectName, list(s.SubElementNames)] for s in Gui.Selection.getSelectionEx("", 0)]
-
-
-def legend_pixel(img, layout, fraction, dx=0.5):
-    h, w = img.shape[:2]
-    x = layout["bar_x"][0] + dx * (layout["bar_x"][1] - layout["bar_x"][0])
-    y0, y1 = layout["bar_y"]
-    y = y0 + fraction * (y1 - y0)
-    return img[int(round((1 - (y + 1) / 2) * h)), int(round((x + 1) / 2 * w))].tolist()
-
-
-def read_png(path):
-    img = QtGui.QImage(path).convertToFormat(QtGui.QImage.Format_RGB888)
-    w, h = img.width(), img.height()
-    ptr = img.constBits()
-    data = bytes(ptr) if not hasattr(ptr, "asstring") else ptr.asstring(img.sizeInBytes())
-    arr = np.frombuffer(data, dtype=np.uint8)[: h * img.bytesPerLine()]
-    return arr.reshape(h, img.bytesPerLine())[:, : 3 * w].reshape(h, w, 3) / 255.0
 
 
 def legend_entries():

@@ -163,8 +163,8 @@ def test_method_specs_and_layout():
 
 
 def test_spread_and_table_by_hand():
-    a = Statistics(10, -0.002, 0.004, 0.001, 0.002, 0.0022, 0.008)
-    b = Statistics(10, -0.004, 0.002, 0.003, 0.001, 0.0031, 0.008)
+    a = Statistics(10, -0.002, 0.004, 0.001, 0.002, 0.0022, 0.008, -0.002, 0.004)
+    b = Statistics(10, -0.004, 0.002, 0.003, 0.001, 0.0031, 0.008, -0.004, 0.002)
     sp = sm.spread([a, b])
     assert_allclose([sp["mean"]["mean"], sp["mean"]["range"], sp["std"]["std"]],
                     [0.002, 0.002, np.sqrt(0.5e-6)], atol=1e-15)

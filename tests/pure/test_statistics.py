@@ -1,0 +1,59 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The statistics' words: ``max_negative`` is the largest deviation below the nominal (0.0
+when none is below), ``max_positive`` the largest above (0.0 when none is above), ``min``
+and ``max`` the extremes whatever their signs; the JSON keys only ever grow."""
+
+import json
+
+import numpy as np
+import pytest
+from numpy.testing import assert_allclose
+
+from surfcomp.core.deviations import Statistics, statistics
+
+#: the JSON report's statistics keys before ``min`` and ``max`` were added: a contract
+KEYS_BEFORE = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile")
+
+
+def test_an_all_positive_set_has_no_negative_deviation():
+    """The issue's case: every point above the nominal. max_negative printed the smallest
+    value (3.2 um) as if it were a negative deviation."""
+    st = statistics([0.0032, 0.0100, 0.0471])
+    assert st.max_negative == 0.0
+    assert st.max_positive == pytest.approx(0.0471, abs=1e-15)
+    assert (st.min, st.max) == (pytest.approx(0.0032, abs=1e-15), pytest.approx(0.0471, abs=1e-15))
+    assert st.profile == pytest.approx(2 * 0.0471, abs=1e-15)
+
+
+def test_an_all_negative_set_has_no_positive_deviation():
+    st = statistics([-0.03, -0.02, -0.005])
+    assert st.max_positive == 0.0
+    assert st.max_negative == pytest.approx(-0.03, abs=1e-15)
+    assert (st.min, st.max) == (pytest.approx(-0.03, abs=1e-15), pytest.approx(-0.005, abs=1e-15))
+
+
+def test_a_mixed_set_keeps_the_extremes_and_nan_is_ignored():
+    st = statistics([[-0.03, np.nan], [0.045, 0.01]])
+    assert st.count == 3
+    assert (st.max_negative, st.min) == (pytest.approx(-0.03, abs=1e-15),) * 2
+    assert (st.max_positive, st.max) == (pytest.approx(0.045, abs=1e-15),) * 2
+    assert st.mean == pytest.approx(0.025 / 3, abs=1e-15)
+
+
+def test_the_json_keys_only_grow_and_round_trip():
+    st = statistics([0.0032, 0.0100, 0.0471])
+    d = json.loads(json.dumps(st.as_dict()))
+    assert tuple(d)[:len(KEYS_BEFORE)] == KEYS_BEFORE
+    assert set(d) == set(KEYS_BEFORE) | {"min", "max"}
+    assert Statistics.from_dict(d) == st
+
+
+def test_a_dict_from_before_min_and_max_reads_with_the_meaning_of_today():
+    """A document's or report's statistics written before: max_negative was min()."""
+    old = {"count": 3, "max_negative": 0.0032, "max_positive": 0.0471, "mean": 0.0201,
+           "std": 0.023, "rms": 0.028, "profile": 0.0942}
+    st = Statistics.from_dict(old)
+    assert (st.min, st.max) == (0.0032, 0.0471)
+    assert (st.max_negative, st.max_positive) == (0.0, 0.0471)
+    assert_allclose([st.mean, st.std, st.rms, st.profile], [0.0201, 0.023, 0.028, 0.0942],
+                    rtol=0, atol=0)
