@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from surfcomp.core import bspline, chunks
-from surfcomp.core.corrected import _solve3
+from surfcomp.core.corrected_check import _solve3
 
 
 def _surface(n=40, seed=0):

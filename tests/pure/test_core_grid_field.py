@@ -132,7 +132,8 @@ def test_locate_grid_matches_pointwise_locate(distorted):
 def test_pole_net_is_capped_for_dense_grids():
     """Coarse grids: >= 120 spans; medium: 4 spans per grid step; dense: at most
     MAX_SPANS spans, but never fewer than 2 per grid step."""
-    from surfcomp.core.corrected import MAX_SPANS, _span, dense_parameters
+    from surfcomp.core.corrected import MAX_SPANS, _span
+    from surfcomp.core.corrected_check import dense_parameters
 
     assert _span(1.0, 1 / 6, 4) == pytest.approx(1 / 120)
     assert _span(1.0, 1 / 99, 4) == pytest.approx(1 / 396)

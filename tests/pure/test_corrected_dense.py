@@ -11,7 +11,7 @@ corrections: realised = intended within 0.1 um at the points, the nominal back w
 import numpy as np
 import pytest
 
-from surfcomp.core import bspline, corrected
+from surfcomp.core import bspline, corrected, corrected_check
 from surfcomp.core.corrected import aligned_lines, construct, node_line_knots, realised_correction
 
 UM = 1e-3
@@ -99,9 +99,9 @@ def test_check_figures_skip_a_degenerate_edge_not_the_whole_surface():
     nominal = bspline.Surface(poles, nominal.knots_u, nominal.knots_v, 3, 3)
     lifted = bspline.Surface(poles + [0.0, 0.0, 0.005], nominal.knots_u, nominal.knots_v, 3, 3)
     u = v = np.array([0.5])
-    figures = corrected.check_figures(nominal, lifted, nominal, u, v, np.array([0.0]), 1.0,
+    figures = corrected_check.check_figures(nominal, lifted, nominal, u, v, np.array([0.0]), 1.0,
                                       (5, 5), realised=np.array([0.0]))
-    us, vs = corrected.dense_parameters(nominal, (5, 5), 4)
+    us, vs = corrected_check.dense_parameters(nominal, (5, 5), 4)
     _, Su, Sv = bspline.evaluate_grid(nominal, us[1:], vs, order=1)
     n = np.cross(Su, Sv)
     nz = n[..., 2] / np.linalg.norm(n, axis=-1)
@@ -127,7 +127,7 @@ def test_intersections_stop_after_the_final_small_step(monkeypatch):
                         lambda *a, **k: (calls.append(a[1].size), ders(*a, **k))[1])
     fast = realised_correction(surf, moved, u, v)
     n_fast, calls[:] = sum(calls), []
-    monkeypatch.setattr(corrected, "FINAL_STEP", 0.0)
+    monkeypatch.setattr(corrected_check, "FINAL_STEP", 0.0)
     full = realised_correction(surf, moved, u, v)
     assert np.abs(fast - full).max() <= 1e-12
     assert np.abs(full).max() > 10 * UM
@@ -145,7 +145,7 @@ def test_realised_change_is_newtons_to_first_order():
     U, V = grid(41, True)
     rng = np.random.default_rng(4)
     delta = 0.03 * np.sin(3 * U) * np.cos(2 * V) + 0.01
-    frame = corrected._NodeFrame(surf, U.ravel(), V.ravel(), 1)
+    frame = corrected_check.NodeFrame(surf, U.ravel(), V.ravel(), 1)
     step = 0.96 / 40 * 0.68
     smp = corrected._Sampling(surf, 1, step, step, 4, per_step=1)
     uu, vv = np.meshgrid(smp.us, smp.vs, indexing="ij")

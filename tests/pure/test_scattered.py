@@ -14,7 +14,7 @@ from scipy.interpolate import CloughTocher2DInterpolator, RBFInterpolator
 from scipy.sparse.linalg import spsolve
 
 from examples.make_example import example_surface
-from surfcomp.core import bspline, corrected
+from surfcomp.core import bspline, corrected, corrected_check
 from surfcomp.core import scattered as sc
 from surfcomp.core import scattered_field as scf
 from surfcomp.core.pspline import PSplineSolver, tensor_rows
@@ -254,12 +254,12 @@ def test_mirror_layout_corrected_face_requirements(kind):
     surf, field, _ = corrected.build_matching_surface(nominal, U, V, delta, 1, 0.1, 0.15, 4,
                                                       field_factory=factory)
     assert isinstance(field, ScatteredField)
-    real = corrected.realised_correction(nominal, surf, U, V, 1, guess=delta)
+    real = corrected_check.realised_correction(nominal, surf, U, V, 1, guess=delta)
     assert_allclose(real, delta, atol=1e-4)          # within 0.1 um at the points
     # a check grid 4x denser than the 10 x 7 layout, over the whole face
-    us, vs = corrected.dense_parameters(nominal, (10, 7), 4)
+    us, vs = corrected_check.dense_parameters(nominal, (10, 7), 4)
     uu, vv = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
-    dense = corrected.realised_correction(nominal, surf, uu, vv, 1, guess=field(uu, vv))
+    dense = corrected_check.realised_correction(nominal, surf, uu, vv, 1, guess=field(uu, vv))
     assert np.max(np.abs(dense)) <= np.max(np.abs(delta)) + 1e-3   # no overshoot over 1 um
     if kind == "zero":
         S = bspline.evaluate(nominal, uu, vv)
