@@ -105,7 +105,7 @@ class ProgramOffset:
             return
         gap, lines = op.gap[cut], prog.line[cut] + 1
         k = int(np.argmin(gap))
-        if gap[k] < self.closest[0]:
+        if gap[k] < self.closest[0] or not self.closest[1]:
             self.closest = (float(gap[k]), int(lines[k]))
         self.contact.append((gap, op.tilt[cut], op.interior[cut], lines))
 
@@ -124,9 +124,10 @@ class ProgramOffset:
         off = self.offset
         r = off.radius
         if not self.closest[0] < off.blend:
-            where = ("the closest, line %d, is %.3f mm beyond the ball's contact"
-                     % (self.closest[1], self.closest[0]) if np.isfinite(self.closest[0])
-                     else "every cutting point is farther than %.3f mm from it" % off.reach)
+            where = ("the closest is %.3f mm beyond the ball's contact" % self.closest[0]
+                     if np.isfinite(self.closest[0]) else
+                     "every cutting point is farther than %.3f mm from it (this line has "
+                     "the first)" % off.reach)
             raise GCodeError("no cutting move of the program comes near the face (the ball of "
                              "radius %g mm within --blend %g mm of it): %s; expected the "
                              "finishing program of this face" % (r, off.blend, where),
