@@ -307,25 +307,27 @@ def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None)
     return _assemble(prog, owner, fb, db, end_d, start_d, still, checked + n_new, arcs)
 
 
-def _curvature_suspects(owner, pa, pb, da, db):
+def _curvature_suspects(owner, fa, fb, pa, pb, da, db):
     """Pieces whose moved path may leave its chord by more than a quarter of the
     tolerance: ``K L^2 / 8`` with ``K`` twice the largest second divided difference of the
-    displacement at the piece's ends (over the neighbouring pieces of the sequence)."""
+    displacement at the piece's ends (over the pieces joined to it: the next piece of the
+    same move, or the first piece of the next move), and the pieces joined to none."""
     n = owner.size
     L = np.linalg.norm(pb - pa, axis=1)
     slope = (db - da) / np.where(L > 0, L, 1.0)[:, None]
     K = np.zeros(n)
+    joined = np.zeros(max(n - 1, 0), dtype=bool)
     if n > 1:
+        joined = (owner[1:] == owner[:-1]) | ((owner[1:] == owner[:-1] + 1)
+                                              & (fb[:-1] == 1.0) & (fa[1:] == 0.0))
         h = 0.5 * (L[1:] + L[:-1])
         dd = np.linalg.norm(slope[1:] - slope[:-1], axis=1) / np.where(h > 0, h, np.inf)
+        dd = np.where(joined, dd, 0.0)
         K[1:] = np.maximum(K[1:], dd)
         K[:-1] = np.maximum(K[:-1], dd)
-    # a lone piece (no neighbour) and zero-length neighbours tell nothing: check them
     alone = np.ones(n, dtype=bool)
-    if n > 1:
-        same = owner[1:] == owner[:-1]
-        alone[1:] &= ~same
-        alone[:-1] &= ~same
+    alone[1:] &= ~joined
+    alone[:-1] &= ~joined
     return 2.0 * K * L * L / 8.0, alone
 
 
@@ -335,7 +337,7 @@ def _refine(prog, arcs, offset, owner, fa, fb, da, db, tolerance):
     added = 0
     pa = _points(prog, arcs, owner, fa)
     pb = _points(prog, arcs, owner, fb)
-    est, alone = _curvature_suspects(owner, pa, pb, da, db)
+    est, alone = _curvature_suspects(owner, fa, fb, pa, pb, da, db)
     moving = (np.abs(da).max(axis=1, initial=0) > 0) | (np.abs(db).max(axis=1, initial=0) > 0)
     # a moved piece is checked where the curvature estimate allows more than a quarter of
     # the tolerance, on arcs, and alone; an unmoved piece of a move near the face is

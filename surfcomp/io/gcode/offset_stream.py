@@ -20,8 +20,8 @@ from ...core.program_offset import CONTACT_TOL, fit_contact, plan_offset
 from ...errors import GCodeError
 from .emitter import DEFAULT_DECIMALS, _TextWriter
 from .interpreter import _Interpreter
-from .lexer import BOM, tokenize
-from .stream import program_blocks, program_style
+from .lexer import tokenize
+from .stream import stream_program
 
 
 class ProgramOffset:
@@ -189,12 +189,9 @@ def offset_stream(program, write, offset, block_lines=None, **settings):
     ProgramOffset
         Finished: :meth:`ProgramOffset.finish` raised nothing.
     """
-    sep, bom, eol = program_style(program, settings.get("source"))
-    po = ProgramOffset(offset, sep=sep, eol=eol, **settings)
-    if bom:
-        write(BOM)
-    for block in program_blocks(program, block_lines):
-        write(po.lines(block))
+    po = stream_program(program, write,
+                        lambda sep, eol: ProgramOffset(offset, sep=sep, eol=eol, **settings),
+                        block_lines, settings.get("source"))
     if not po.words:
         raise GCodeError("the program is empty (no G-code words, only blank lines, comments "
                          "or % lines; expected G0/G1/G2/G3 moves)", file=settings.get("source"))

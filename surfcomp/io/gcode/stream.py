@@ -240,14 +240,24 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
         Finished (:meth:`Compensator.finish` raised nothing); its ``words`` tell whether
         the program had any word, :meth:`Compensator.stats` and ``totals`` what was done.
     """
-    sep, bom, eol = program_style(program, settings.get("source"))
-    comp = Compensator(model, sep=sep, eol=eol, **settings)
+    comp = stream_program(program, write,
+                          lambda sep, eol: Compensator(model, sep=sep, eol=eol, **settings),
+                          block_lines, settings.get("source"))
+    comp.finish()
+    return comp
+
+
+def stream_program(program, write, make, block_lines=None, source=None):
+    """Feed a :class:`ProgramFile` a block at a time to the worker ``make(sep, eol)``
+    returns (its ``lines(block)`` gives each block's output text, passed to ``write``),
+    the byte-order mark first when the file has one; returns the worker."""
+    sep, bom, eol = program_style(program, source)
+    worker = make(sep, eol)
     if bom:
         write(BOM)
     for block in program_blocks(program, block_lines):
-        write(comp.lines(block))
-    comp.finish()
-    return comp
+        write(worker.lines(block))
+    return worker
 
 
 def program_style(program, source=None):
