@@ -171,3 +171,44 @@ def test_a_program_away_from_the_face_is_refused(tmp_path):
     with pytest.raises(GCodeError, match="no cutting move of the program comes near") as exc:
         run(text, wave, tmp_path)
     assert exc.value.line == 3
+
+
+def with_arcs(text):
+    """The raster program with one row's moves 10 and 30 as arcs through the same ends (R
+    format, 1 mm chords, 5 mm radius: in contact with the face) and a full circle at the
+    clearance height after it (far from the face)."""
+    lines = text.splitlines()
+    row = [k for k, ln in enumerate(lines) if ln.startswith("G1 X")][:48]
+    for k in (row[10], row[30]):
+        lines[k] = lines[k].replace("G1 ", "G2 ") + " R5"
+    up = lines.index("G0 Z20", row[-1]) + 1
+    lines[up:up] = ["G0 X10 Y10", "G2 X10 Y10 I5 J0 (circle at clearance)", "G1 X10 Y10"]
+    return "\n".join(lines) + "\n"
+
+
+def test_arcs_in_the_region_become_lines_and_arcs_away_stay(program, tmp_path):
+    text = with_arcs(program)
+    out, po = run(text, wave, tmp_path)
+    assert po.stats()["arcs_converted"] == 2
+    assert "G2 X10 Y10 I5 J0 (circle at clearance)" in out.splitlines()
+    assert sum(ln.startswith("G2 ") for ln in out.splitlines()) == 1
+    # the converted arcs follow the moved arc within the tolerance
+    prog, _ = parse_gcode(text)
+    off = BallOffset(SURF, 1, R, wave, 1.0)
+    plan = plan_offset(prog, off, 5e-4, 2.0, 0.5e-4).plan
+    from surfcomp.core.program_offset import _Arcs, _points
+
+    arcs_j = np.flatnonzero(prog.kind == 2)
+    arcs = _Arcs(prog, arcs_j)
+    fr = np.linspace(0, 1, 41)
+    for j in arcs_j[:2]:
+        pts = _points(prog, arcs, np.full(fr.size, j), fr)
+        Q = pts + off.displace(pts).move
+        poly = np.vstack([plan.compensated[plan.offsets[j] - 1],
+                          plan.compensated[plan.offsets[j]:plan.offsets[j + 1]]])
+        assert len(poly) > 2 and plan.split[j]
+        d = np.min([_seg_dist(Q, np.repeat(poly[i:i + 1], fr.size, 0),
+                              np.repeat(poly[i + 1:i + 2], fr.size, 0))
+                    for i in range(len(poly) - 1)], axis=0)
+        assert d.max() <= 5e-4 + 1e-9
+    assert plan.keep[arcs_j[2]]
