@@ -153,7 +153,7 @@ def _registry_pairs():
 
 #: a file for each input of the registry (by label)
 FILE_OF = {"NOMINAL": "nominal.step", "MEASUREMENTS": "m.csv", "--axis-errors": "e.csv",
-           "IN.ngc": "in.ngc"}
+           "IN.ngc": "in.ngc", "--program": "in.ngc"}
 
 
 @pytest.mark.parametrize("command, inp, out", _registry_pairs(),
