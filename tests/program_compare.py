@@ -22,31 +22,33 @@ def feed_points(moves):
     return np.array([m["end"] for m in moves if m["kind"] == "STRAIGHT_FEED"])
 
 
-def surface_distance(surface, outward, radius, a, b, carry=None, near=0.5, contact=1e-3):
+def surface_distance(surface, outward, radius, a, b, carry=None, near=0.5, window=0.02):
     """Distance (mm) along the normal of program A's tips ``a`` (N, 3) from program B's tip
-    surface (samples ``b``), at the points of A whose ball touches the face inside its
-    border (clearance within ``contact`` mm of the drop surface of ``carry``) and that
-    have a sample of B within ``near`` mm in XY. ``carry``: the surface B was cut on
-    (default ``surface``), whose drop surface carries B's samples to A's XY.
+    surface (samples ``b``), at A's points of the cut.
+
+    A's points of the cut: its ball touches the nominal inside its border (within 0.2 mm),
+    a sample of B lies within ``near`` mm in XY, and the tip is within ``window`` mm of the
+    drop-cutter height of ``carry`` there. The window (20 um, ten times what is tested)
+    leaves out the points a vertical plunge or retract gets when it is split in the blend
+    zone: they lie up to millimetres above the surface and are no samples of it. A route
+    that moved the cut wrongly would lose its points from the comparison, so callers check
+    their number as well. ``carry``: the surface B was cut on (default ``surface``), whose
+    drop surface carries B's samples to A's XY.
 
     Returns
     -------
     (distance, xy_shift)
         ``distance`` (k,) and the XY distance to the sample of B each was carried from.
     """
-    carry = surface if carry is None else carry
-    z_here, pr = drop_cutter(carry, outward, a[:, :2], a[:, 2], radius)
-    gap = pr.distance * outward - radius
-    dist, k = cKDTree(b[:, :2]).query(a[:, :2])
-    z_there, _ = drop_cutter(carry, outward, b[k, :2], b[k, 2], radius)
-    # clearance of A's own ball from the nominal: in contact where the drop surface is
-    # within the correction's reach of A's tip
-    centre = a + [0.0, 0.0, radius]
     from surfcomp.core.projection import project
 
-    own = project(surface, centre)
+    carry = surface if carry is None else carry
+    z_here, pr = drop_cutter(carry, outward, a[:, :2], a[:, 2], radius)
+    dist, k = cKDTree(b[:, :2]).query(a[:, :2])
+    z_there, _ = drop_cutter(carry, outward, b[k, :2], b[k, 2], radius)
+    own = project(surface, a + [0.0, 0.0, radius])
     touching = ~own.outside & (np.abs(own.distance * outward - radius) <= 0.2)
-    use = touching & ~pr.outside & (dist <= near) & (np.abs(gap) <= contact)
+    use = touching & ~pr.outside & (dist <= near) & (np.abs(a[:, 2] - z_here) <= window)
     zb = b[k, 2] + (z_here - z_there)
     nz = pr.normal[:, 2] * outward
     return ((a[:, 2] - zb) * nz)[use], dist[use]

@@ -14,7 +14,9 @@ CAM.ngc, along the normal. Stated tolerance: the operation's own (its mesh defle
 * The example face and its measurements, mesh deflection 1 um: measured max 0.71 um,
   median 0.12 um over 520 points (CAM.ngc vs the nominal program: 44.9 um).
 * The BladeX suction side turned so that its mean normal is +Z, a synthetic smooth error
-  of -10..30 um on a 60 x 13 grid, mesh deflection 4 um: see BLADE_FIGURES.
+  of 10..30 um on a 60 x 13 grid, mesh deflection 4 um: max 3.07 um, median 0.32 um over
+  2285 points (CAM.ngc vs the nominal program: up to 21 um at the 1399 points within the
+  comparison's 20 um window).
 
 A measurement file of zero deviations moves nothing: the output is the input, byte for
 byte, and rs274's moves are the same.
@@ -166,9 +168,9 @@ def test_direct_program_agrees_with_the_cam_route_on_the_blade(blade):
     print("blade: %d points, max %.3f um, median %.3f um; nominal program %.1f um"
           % (d.size, np.abs(d).max() * 1e3, np.median(np.abs(d)) * 1e3,
              np.abs(d0).max() * 1e3))
-    assert d.size > 500
+    assert d.size > 2000
     assert np.abs(d).max() <= BLADE_DEFLECTION + 0.001
-    assert np.abs(d0).max() > 0.02
+    assert np.abs(d0).max() > 0.01
 
 
 def test_direct_program_agrees_with_the_cam_route(programs):
