@@ -22,7 +22,7 @@ from ..core.program_offset import BallOffset
 from ..errors import InputError
 from ..io.gcode.offset_stream import offset_commands
 from . import cam
-from .proxies import Proxy
+from .dressups import DressupProxy, check_base, place
 
 QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
@@ -116,25 +116,11 @@ def move_path(obj):
     return Path.Path(out), (res, fit, op)
 
 
-class DressupSurfaceCorrection(Proxy):
+class DressupSurfaceCorrection(DressupProxy):
     """Proxy of the surface correction dressup (state lives in properties)."""
 
     PROPERTIES = PROPERTIES
     VERSION = VERSION
-
-    def __init__(self, obj, base):
-        super().__init__(obj)
-        obj.Base = base
-
-    def onDelete(self, obj, args):
-        if obj.Base:
-            job = cam.find_parent_job(obj)
-            if job:
-                job.Proxy.addOperation(obj.Base, obj)
-            if obj.Base.ViewObject:
-                obj.Base.ViewObject.Visibility = True
-            obj.Base = None
-        return True
 
     def execute(self, obj):
         path, result = move_path(obj)
@@ -154,9 +140,7 @@ def Create(base, compensation, name="DressupSurfaceCorrection"):
     ``Path::FeaturePython`` takes the base's place in its Job; recompute the document to
     compute its Path. Keep ``Dressup`` in ``name`` (Path finds the tool controller of
     dressups by that part of the name)."""
-    if not base.isDerivedFrom("Path::Feature"):
-        raise InputError("%s is not a Path object (expected an operation or a dressup)"
-                         % base.Label)
+    check_base(base)
     from .cam_job import tool_controller_of
 
     doc = base.Document
@@ -168,9 +152,5 @@ def Create(base, compensation, name="DressupSurfaceCorrection"):
     diameter = getattr(tool, "Diameter", None)
     if diameter is not None:
         obj.BallRadius = float(getattr(diameter, "Value", diameter)) / 2.0
-    job = cam.find_parent_job(base)
-    if job is not None:
-        job.Proxy.addOperation(obj, base, True)
-    if FreeCAD.GuiUp and base.ViewObject:
-        base.ViewObject.Visibility = False
+    place(obj, base)
     return obj
