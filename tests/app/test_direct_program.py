@@ -15,8 +15,7 @@ CAM.ngc, along the normal. Stated tolerance: the operation's own (its mesh defle
   median 0.12 um over 520 points (CAM.ngc vs the nominal program: 44.9 um).
 * The BladeX suction side turned so that its mean normal is +Z, a synthetic smooth error
   of 10..30 um on a 60 x 13 grid, mesh deflection 4 um: max 3.07 um, median 0.32 um over
-  2285 points (CAM.ngc vs the nominal program: up to 21 um at the 1399 points within the
-  comparison's 20 um window).
+  2285 points (CAM.ngc vs the nominal program: up to 30 um).
 
 A measurement file of zero deviations moves nothing: the output is the input, byte for
 byte, and rs274's moves are the same.
@@ -146,8 +145,9 @@ def agreement(tmp, step, csv, finish, regen, corrected):
     before = feed_points(rs274(finish, tmp)[0])
     d, _shift = surface_distance(nominal.surface, nominal.outward, R, direct, cam_pts,
                                  carry=corrected)
+    # the nominal program lies the whole correction off: a window of 0.1 mm takes it in
     d0, _ = surface_distance(nominal.surface, nominal.outward, R, before, cam_pts,
-                             carry=corrected)
+                             carry=corrected, window=0.1)
     return d, d0, run.stdout
 
 
@@ -170,7 +170,7 @@ def test_direct_program_agrees_with_the_cam_route_on_the_blade(blade):
              np.abs(d0).max() * 1e3))
     assert d.size > 2000
     assert np.abs(d).max() <= BLADE_DEFLECTION + 0.001
-    assert np.abs(d0).max() > 0.01
+    assert np.abs(d0).max() > 0.02
 
 
 def test_direct_program_agrees_with_the_cam_route(programs):
