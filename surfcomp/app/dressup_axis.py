@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..io.axis_csv import AxisErrorTable, read_axis_errors
 from ..io.gcode import compensate_commands
 from . import cam
-from .proxies import Proxy
+from .dressups import DressupProxy, check_base, place
 
 #: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
 #: context when it shows them)
@@ -206,25 +206,11 @@ def compensate_path(obj):
     return Path.Path(out), (model, prog_model, res)
 
 
-class DressupAxisErrors(Proxy):
+class DressupAxisErrors(DressupProxy):
     """Proxy of the axis-error compensation dressup (state lives in properties)."""
 
     PROPERTIES = PROPERTIES
     VERSION = VERSION
-
-    def __init__(self, obj, base):
-        super().__init__(obj)
-        obj.Base = base
-
-    def onDelete(self, obj, args):
-        if obj.Base:
-            job = cam.find_parent_job(obj)
-            if job:
-                job.Proxy.addOperation(obj.Base, obj)
-            if obj.Base.ViewObject:
-                obj.Base.ViewObject.Visibility = True
-            obj.Base = None
-        return True
 
     def execute(self, obj):
         path, result = compensate_path(obj)
@@ -259,16 +245,10 @@ def Create(base, model_csv_or_data, name="DressupAxisErrors"):
     The new ``Path::FeaturePython`` object (placed in the base's Job in place of the base,
     when there is one). Recompute the document to compute its Path.
     """
-    if not base.isDerivedFrom("Path::Feature"):
-        raise InputError("%s is not a Path object (expected an operation or a dressup)"
-                         % base.Label)
+    check_base(base)
     doc = base.Document
     obj = doc.addObject("Path::FeaturePython", name)
     DressupAxisErrors(obj, base)
     set_measurements(obj, model_csv_or_data)
-    job = cam.find_parent_job(base)
-    if job is not None:
-        job.Proxy.addOperation(obj, base, True)
-    if FreeCAD.GuiUp and base.ViewObject:
-        base.ViewObject.Visibility = False
+    place(obj, base)
     return obj

@@ -23,6 +23,9 @@ def add_parser(subparsers):
                         "shell")
     add_method_options(p)
     registry.add_options(p, "compensate", flags=("--points", "--curves", "--html"))
+    from .program import add_program_options
+
+    add_program_options(p)
     doc = p.add_argument_group(
         registry.DOCUMENT,
         "Add the compensation to the document, put it in the nominal's place so Path "
@@ -44,6 +47,10 @@ def add_parser(subparsers):
 
 
 def run(args):
+    if args.program:
+        from .program import run_program
+
+        return run_program(args)
     if args.replace or args.save or args.gcode:
         return run_document(args)
     return run_job_command(args, "compensate")

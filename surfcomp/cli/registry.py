@@ -57,6 +57,7 @@ def _memory_size(text):
 JOB = ("compensate", "inspect")
 DOCUMENT = "shop document (NOMINAL is an .FCStd)"
 SIM_MODEL = "machining-process model (mm)"
+PROGRAM = "direct program compensation (ball-end finishing program)"
 SIM_OUTPUT = "output"
 PROBE_PROGRAM = "probing program"
 _NOMINAL_HELP = "nominal face: STEP/IGES/BREP file or FreeCAD document (.FCStd)"
@@ -78,7 +79,13 @@ ENTRIES = (
           dict(metavar="OUT.step",
                help="the nominal's shape with the face replaced by the corrected face (its "
                     "neighbours re-trimmed), or the corrected face when the nominal is a "
-                    "lone face (STEP; .iges/.brep by extension)")),
+                    "lone face (STEP; .iges/.brep by extension); with --program the moved "
+                    "program (OUT.ngc)")),
+    Entry(("compensate",), ("--program",), "input", "--program",
+          dict(metavar="FINISH.ngc",
+               help="move this ball-end finishing program (G-code, mm, absolute) by the "
+                    "correction instead of writing the corrected face; -o names the moved "
+                    "program"), group=PROGRAM),
     Entry(JOB, ("--report",), "output", "--report",
           dict(metavar="OUT.json", help="write the JSON report (- for standard output)")),
     Entry(("compensate",), ("--points",), "output", "--points",

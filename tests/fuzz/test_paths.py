@@ -156,7 +156,7 @@ def _registry_pairs():
 
 #: a file for each input of the registry (by label)
 FILE_OF = {"NOMINAL": "nominal.step", "MEASUREMENTS": "m.csv", "--axis-errors": "e.csv",
-           "IN.ngc": "in.ngc", "--plan": "plan.csv"}
+           "IN.ngc": "in.ngc", "--plan": "plan.csv", "--program": "in.ngc"}
 
 
 @pytest.mark.parametrize("command, inp, out", _registry_pairs(),

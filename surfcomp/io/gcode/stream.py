@@ -240,8 +240,30 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
         Finished (:meth:`Compensator.finish` raised nothing); its ``words`` tell whether
         the program had any word, :meth:`Compensator.stats` and ``totals`` what was done.
     """
-    source = settings.get("source")
-    block_lines = BLOCK_LINES if block_lines is None else max(1, int(block_lines))
+    comp = stream_program(program, write,
+                          lambda sep, eol: Compensator(model, sep=sep, eol=eol, **settings),
+                          block_lines, settings.get("source"))
+    comp.finish()
+    return comp
+
+
+def stream_program(program, write, make, block_lines=None, source=None):
+    """Feed a :class:`ProgramFile` a block at a time to the worker ``make(sep, eol)``
+    returns (its ``lines(block)`` gives each block's output text, passed to ``write``),
+    the byte-order mark first when the file has one; returns the worker."""
+    sep, bom, eol = program_style(program, source)
+    worker = make(sep, eol)
+    if bom:
+        write(BOM)
+    for block in program_blocks(program, block_lines):
+        write(worker.lines(block))
+    return worker
+
+
+def program_style(program, source=None):
+    """``(sep, bom, eol)`` of a :class:`ProgramFile`: the word separator most lines use
+    (:func:`file_sep`), whether it starts with a UTF-8 byte-order mark, and its first line
+    ending (:func:`default_eol`)."""
     with program.open() as fh:
         sep = file_sep((c, tokenize(c, source, k + 1)[0])
                        for k, (c, _e) in enumerate(program.lines(fh)))
@@ -249,20 +271,22 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
         bom = next(program.lines(fh, raw=True), b"").startswith(_BOM_BYTES)
     with program.open() as fh:
         eol = default_eol(program.lines(fh))
-    comp = Compensator(model, sep=sep, eol=eol, **settings)
-    if bom:
-        write(BOM)
+    return sep, bom, eol
+
+
+def program_blocks(program, block_lines=None):
+    """The ``(content, ending)`` lines of a :class:`ProgramFile` in blocks of
+    ``block_lines`` (default :data:`BLOCK_LINES`)."""
+    block_lines = BLOCK_LINES if block_lines is None else max(1, int(block_lines))
     with program.open() as fh:
         block = []
         for pair in program.lines(fh):
             block.append(pair)
             if len(block) >= block_lines:
-                write(comp.lines(block))
+                yield block
                 block = []
         if block:
-            write(comp.lines(block))
-    comp.finish()
-    return comp
+            yield block
 
 
 def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e-3,

@@ -1,0 +1,123 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Direct program compensation: nominal + measurements + finishing program -> moved program.
+
+``compensate NOMINAL MEAS --program FINISH.ngc --tool ball:R -o FINISH_COMP.ngc``: the
+compensation is computed as for ``-o`` (:func:`surfcomp.core.pipeline.compensate`, the
+corrected surface built), and the finishing program is moved by the correction the
+corrected face realises at each cutter-location point's contact
+(:mod:`surfcomp.core.program_offset`, :mod:`surfcomp.io.gcode.offset_stream`) instead of
+regenerating the CAM operation on the corrected face. The program is written atomically,
+never over an input; nothing is written when it is refused.
+"""
+
+from dataclasses import dataclass
+
+from ..core import budget
+from ..core.corrected import realised_correction
+from ..core.pipeline import compensate, prepare
+from ..core.program_offset import BallOffset, parse_tool
+from ..core.progress import report, sub
+from ..io.atomic import Transaction
+from ..io.gcode import ProgramFile
+from ..io.gcode.offset_stream import offset_stream
+from ..io.readers import read_any
+from . import fcenv
+
+
+@dataclass
+class ProgramJob:
+    """What :func:`run_program_job` moves: the compensation job's inputs and options
+    (:class:`surfcomp.app.file_route.Job`), the program, the tool and the output.
+
+    ``tolerance``, ``segment_length`` (mm) and ``decimals``: as
+    :func:`surfcomp.core.program_offset.plan_offset` and
+    :class:`surfcomp.io.gcode.offset_stream.ProgramOffset` take them; ``blend`` (mm): of
+    :class:`surfcomp.core.program_offset.BallOffset`."""
+
+    job: object
+    program: str
+    output: str
+    tool: str
+    blend: float = 1.0
+    tolerance: float = 5e-4
+    segment_length: float = 2.0
+    decimals: int = None
+
+
+def correction_at(nominal, comp):
+    """``correction(u, v)``: the correction (mm, positive inwards) the corrected face of
+    ``comp`` realises along the nominal's normal at ``(u, v)``
+    (:func:`surfcomp.core.corrected.realised_correction`, from the intended field)."""
+    def correction(u, v):
+        return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward,
+                                   guess=comp.field(u, v))
+    return correction
+
+
+def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
+    """Compensate, move the program and write it; returns ``(compensation, ProgramOffset)``.
+
+    ``outputs`` and ``inputs`` as :class:`surfcomp.io.atomic.Transaction` takes them (the
+    command line's :func:`surfcomp.cli.registry.declared`)."""
+    _kind, radius = parse_tool(pj.tool)
+    job = pj.job
+    job.options.validate()
+    fcenv.import_freecad()
+    from .nominal import load_nominal
+
+    nominal = load_nominal(job.nominal, job.face, job.object)
+    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
+                  deviation_units=job.deviation_units)
+    budget.check_job(len(ms), True, max_memory)
+    program = ProgramFile(pj.program)
+    lines = program.count_lines()
+    budget.check(budget.gcode_bytes(lines), max_memory, "the program's %d lines" % lines,
+                 "split the program into parts")
+    prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
+                       progress=sub(progress, 0, 0.3))
+    comp = compensate(nominal.surface, nominal.outward, prepared, job.options,
+                      progress=sub(progress, 0.3, 0.7))
+    offset = BallOffset(nominal.surface, nominal.outward, radius, correction_at(nominal, comp),
+                        pj.blend)
+    report(progress, 0.7, "moving the program")
+    done = []
+    with Transaction(outputs, inputs) as tr:
+        def put(tmp):
+            with open(tmp, "wb") as fh:
+                done.append(offset_stream(
+                    program, lambda text: fh.write(text.encode("latin-1")), offset,
+                    tolerance=pj.tolerance, segment_length=pj.segment_length,
+                    decimals=pj.decimals, source=pj.program))
+
+        tr.write(pj.output, put)
+        tr.commit()
+    report(progress, 1.0, "done")
+    return comp, done[0]
+
+
+def summary_lines(comp, po, pj):
+    """What the run did, for standard output."""
+    st = po.stats()
+    corr = comp.statistics["correction"]
+    fit = po.fit
+    lines = ["Correction:   %s" % _range(corr),
+             "Program:      %s (%d lines, %d moves; ball radius %g mm)"
+             % (pj.program, st["lines_in"], st["moves"], po.offset.radius),
+             "Moved:        %d moves (%d lines changed, %d added, %d arcs turned into lines); "
+             "largest move %.2f um; %d points displaced (tolerance %g um, blend %g mm)"
+             % (st["moves_moved"], st["lines_changed"], st["lines_added"],
+                st["arcs_converted"], st["largest_move_mm"] * 1e3, st["points_displaced"],
+                pj.tolerance * 1e3, pj.blend),
+             "Contact:      %d cutter-location points on the face, %.2f um off the ball's "
+             "offset on average; %s"
+             % (fit.points, fit.stock * 1e3,
+                "the radius fits within %.1f um (slopes up to %.1f degrees)"
+                % (abs(fit.radius_error) * 1e3, fit.max_tilt)
+                if fit.radius_error is not None
+                else "the radius is not checked (slopes below 8 degrees)")]
+    return lines + ["warning: " + w for w in po.warnings()]
+
+
+def _range(stats):
+    return ("%.2f to %.2f um at the measured points (RMS %.2f um)"
+            % (stats.max_negative * 1e3, stats.max_positive * 1e3, stats.rms * 1e3))

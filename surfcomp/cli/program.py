@@ -1,0 +1,81 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""``compensate ... --program FINISH.ngc --tool ball:R -o OUT.ngc``: move the finishing
+program by the correction (:mod:`surfcomp.app.program_route`) instead of writing the face."""
+
+import math
+
+from ..errors import InputError
+from . import registry
+from .common import ProgressLine, job_from_args, wrote
+
+
+def add_program_options(p):
+    """The option group of direct program compensation (the ``gcode`` command's names
+    where they fit)."""
+    g = p.add_argument_group(
+        registry.PROGRAM,
+        "Move the cutter-location points of a ball-end finishing program by the correction "
+        "along the face normal at their contact (exact for a ball end) instead of "
+        "regenerating the CAM operation on the corrected face. Flat and bull-nose cutters "
+        "are refused.")
+    registry.add_options(p, "compensate", {registry.PROGRAM: g}, flags=("--program",))
+    g.add_argument("--tool", metavar="ball:R",
+                   help="the program's cutter: ball:R, a ball end mill of radius R mm (the "
+                        "program gives the tip, the ball's lowest point)")
+    g.add_argument("--tolerance", type=float, default=5e-4, metavar="MM",
+                   help="largest distance of the moved program from the exactly moved path: "
+                        "long moves are split until they stay within it (default 0.0005 mm)")
+    g.add_argument("--blend", type=float, default=1.0, metavar="MM",
+                   help="beyond the face (its edge plus the ball radius, or above it) the "
+                        "correction fades out over this clearance (default 1 mm; > 0)")
+    g.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
+                   help="long moves are first sampled at this spacing, so that nothing near "
+                        "the face between their ends is missed (default 2 mm)")
+    g.add_argument("--decimals", type=int, metavar="N",
+                   help="least decimals of rewritten numbers (default 4)")
+
+
+#: outputs and modes that do not go with --program
+_NOT_WITH = (("replace", "--replace"), ("save", "--save"), ("gcode", "--gcode"),
+             ("report", "--report"), ("points", "--points"), ("curves", "--curves"),
+             ("html", "--html"), ("face_only", "--face-only"))
+
+
+def _positive(value, option, minimum=0.0):
+    if not (math.isfinite(value) and value > minimum):
+        raise InputError("%s %r: expected a length in mm greater than %g"
+                         % (option, value, minimum))
+    return value
+
+
+def run_program(args):
+    """Run the direct program compensation of a command line."""
+    for dest, flag in _NOT_WITH:
+        if getattr(args, dest, None):
+            raise InputError("%s cannot be combined with --program (it writes the moved "
+                             "program only); run 'compensate' without --program for it" % flag)
+    if not args.output:
+        raise InputError("--program needs -o OUT.ngc, the moved program")
+    if not args.tool:
+        raise InputError("--program needs --tool ball:R, the ball end mill's radius in mm")
+    _positive(args.tolerance, "--tolerance")
+    _positive(args.blend, "--blend")
+    _positive(args.segment_length, "--segment-length", 1e-3)
+    if args.decimals is not None and not 3 <= args.decimals <= 9:
+        raise InputError("--decimals %d: expected 3 to 9" % args.decimals)
+    from ..core.program_offset import parse_tool
+
+    parse_tool(args.tool)
+    from ..app.program_route import ProgramJob, run_program_job, summary_lines
+
+    job = job_from_args(args, "compensate")
+    job.output = None
+    pj = ProgramJob(job, args.program, args.output, args.tool, blend=args.blend,
+                    tolerance=args.tolerance, segment_length=args.segment_length,
+                    decimals=args.decimals)
+    comp, po = run_program_job(pj, *registry.declared(args, "compensate"),
+                               progress=ProgressLine(args.quiet), max_memory=args.max_memory)
+    for line in summary_lines(comp, po, pj):
+        print(line)
+    print(wrote(args.output))
+    return 0

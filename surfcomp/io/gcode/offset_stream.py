@@ -1,0 +1,273 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""A ball-end program moved by a surface correction, a block of lines at a time (no FreeCAD).
+
+The same lexer, interpreter and writer as the axis-error compensation (:mod:`.stream`): the
+program is read :data:`surfcomp.io.gcode.stream.BLOCK_LINES` lines at a time, each block's
+moves are planned by :func:`surfcomp.core.program_offset.plan_offset` and written into the
+original lines; lines of moves nothing moves are written back byte for byte. A refusal found
+in a late block (or by the contact check over the whole program) is raised before anything
+is committed: the caller writes into a staged file.
+
+Refused besides what the interpreter refuses (G41/G42 among it, anywhere): moves in inch
+mode (G20) or incremental mode (G91); a program no cutting move of which comes near the
+face; cutting points that cut into the nominal (a larger ball than the program's) or sit
+off its ball offset (another radius, stock, or another face): see :meth:`ProgramOffset.finish`.
+"""
+
+import numpy as np
+
+from ...core.program_offset import CONTACT_TOL, fit_contact, plan_offset
+from ...errors import GCodeError
+from .commands import _CommandWriter, command_words
+from .emitter import DEFAULT_DECIMALS, _TextWriter
+from .interpreter import _Interpreter, interpret
+from .lexer import tokenize
+from .result import CommandsResult
+from .stream import stream_program
+
+
+class ProgramOffset:
+    """Moves consecutive blocks of one program and adds up what the whole decides.
+
+    Parameters
+    ----------
+    offset : surfcomp.core.program_offset.BallOffset
+    tolerance, segment_length : float
+        Of :func:`surfcomp.core.program_offset.plan_offset` (mm).
+    decimals : int, optional
+        Least decimals of rewritten numbers (default 4).
+    source : str, optional
+        File name for messages.
+    sep, eol : str
+        The file's word separator and first line ending.
+    """
+
+    def __init__(self, offset, tolerance=5e-4, segment_length=2.0, decimals=None, source=None,
+                 sep=" ", eol="\n"):
+        self.offset = offset
+        self.tolerance = tolerance
+        self.segment_length = segment_length
+        self.source = source
+        self.dmin = DEFAULT_DECIMALS["mm"] if decimals is None else int(decimals)
+        self.still = 0.5 * 10.0 ** -self.dmin * 0.999
+        self.interp = _Interpreter(source, None, False)
+        self.writer = _TextWriter(sep, eol, None, self.dmin, DEFAULT_DECIMALS["in"], source)
+        self.n_lines = self.n_moves = self.moved = self.checked = 0
+        self.words = False
+        self.largest = 0.0
+        self.start_move = None
+        self.closest = (np.inf, 0)          # smallest clearance of a cutting point, line
+        self.contact = []                    # (gap, tilt, interior, line) per block
+
+    def lines(self, lines):
+        """Read, interpret, move and write the next block of ``(content, ending)`` lines;
+        its output text."""
+        base = self.n_lines
+        toks = [tokenize(c, self.source, base + k + 1) for k, (c, _e) in enumerate(lines)]
+        infos = self.interp.lines(toks, base)
+        prog = self.interp.take_moves(infos, self.interp.warnings)
+        self.n_lines = base + len(lines)
+        self.words = self.words or not prog.is_empty()
+        self._check_modes(prog, base)
+        self.n_moves += prog.n_moves
+        op = plan_offset(prog, self.offset, self.tolerance, self.segment_length, self.still,
+                         self.start_move)
+        plan = op.plan
+        if prog.n_moves:
+            self.start_move = plan.compensated[-1] - plan.nominal[-1]
+        self.moved += int(op.moved.sum())
+        self.checked += op.checked
+        self._collect(prog, op)
+        w = self.writer
+        w.block(prog, plan, base)
+        out = "".join([w.line(base + k, c, e) for k, (c, e) in enumerate(lines)])
+        nominal, emitted, _known, _line = w.state.take_points()
+        if nominal.shape[0]:
+            self.largest = max(self.largest,
+                               float(np.linalg.norm(emitted - nominal, axis=1).max()))
+        return out
+
+    def _check_modes(self, prog, base):
+        """Refuse a move in inch or incremental mode (naming its line)."""
+        for j in range(prog.n_moves):
+            info = prog.lines[int(prog.line[j]) - base]
+            if info.factor != 1.0:
+                raise GCodeError("move in inch mode (G20): the correction is in mm and the "
+                                 "program is moved in mm; expected a program in mm (G21)",
+                                 file=self.source, line=int(prog.line[j]) + 1)
+            if not info.absolute:
+                raise GCodeError("move in incremental mode (G91): expected absolute "
+                                 "positions (G90), as CAM writes finishing programs",
+                                 file=self.source, line=int(prog.line[j]) + 1)
+
+    def _collect(self, prog, op):
+        """The cutting moves' end points for the contact check."""
+        got = contact_points(prog, op)
+        if got is None:
+            return
+        closest, points = got
+        if closest[0] < self.closest[0] or not self.closest[1]:
+            self.closest = closest
+        self.contact.append(points)
+
+    def finish(self):
+        """Refuse a program that does not fit the face and the tool
+        (:func:`check_contact`); ``fit`` is its contact fit."""
+        self.fit = check_contact(self.offset, self.closest, self.contact, self.source)
+
+    def warnings(self):
+        return self.interp.warnings + self.interp.unknown_warnings()
+
+    def stats(self):
+        st = self.writer.state
+        return {"lines_in": self.n_lines, "lines_out": self.n_lines + st.added,
+                "lines_changed": st.changed, "lines_added": st.added, "moves": self.n_moves,
+                "moves_moved": self.moved, "arcs_converted": st.converted,
+                "points_displaced": self.checked, "largest_move_mm": self.largest}
+
+
+def contact_points(prog, op):
+    """``((gap, line) of the closest cutting point, (gap, tilt, interior, line))`` of the
+    cutting moves' end points of a planned block (1-based lines), or None without any."""
+    cut = (prog.kind >= 1) & prog.known.all(axis=1)
+    if not cut.any():
+        return None
+    gap, lines = op.gap[cut], prog.line[cut] + 1
+    k = int(np.argmin(gap))
+    return (float(gap[k]), int(lines[k])), (gap, op.tilt[cut], op.interior[cut], lines)
+
+
+def check_contact(off, closest, contact, source=None):
+    """Refuse a program that does not fit the face and the tool.
+
+    Parameters
+    ----------
+    off : surfcomp.core.program_offset.BallOffset
+    closest : (float, int)
+        Smallest clearance (mm) of a cutting point and its line (the first cutting line
+        when none is within reach).
+    contact : list of (gap, tilt, interior, line)
+        The cutting moves' end points (:func:`contact_points`).
+    source : str, optional
+
+    Returns
+    -------
+    surfcomp.core.program_offset.ContactFit
+
+    Raises
+    ------
+    GCodeError
+        No cutting move comes within the ball radius plus the blend of the face; a
+        cutting point inside the face is more than
+        :data:`surfcomp.core.program_offset.CONTACT_TOL` inside the nominal; the
+        contact points fit another ball radius or sit off the ball's offset surface
+        (:func:`surfcomp.core.program_offset.fit_contact`).
+    """
+    r = off.radius
+    if not closest[0] < off.blend:
+        where = ("the closest is %.3f mm beyond the ball's contact" % closest[0]
+                 if np.isfinite(closest[0]) else
+                 "every cutting point is farther than %.3f mm from it (this line has "
+                 "the first)" % off.reach)
+        raise GCodeError("no cutting move of the program comes near the face (the ball of "
+                         "radius %g mm within --blend %g mm of it): %s; expected the "
+                         "finishing program of this face" % (r, off.blend, where),
+                         file=source, line=closest[1] or None)
+    gap, tilt, interior, lines = (np.concatenate(a) for a in zip(*contact))
+    fit = fit_contact(gap, tilt, interior, lines, r)
+    if fit.deepest < -CONTACT_TOL:
+        raise GCodeError("the ball of radius %g mm (--tool) at this cutter-location point "
+                         "cuts %.4f mm into the nominal face (more than %g mm): the program "
+                         "was made for a smaller ball or another face; expected the ball "
+                         "radius the program was made with" % (r, -fit.deepest, CONTACT_TOL),
+                         file=source, line=fit.deepest_line)
+    if fit.radius_error is not None:
+        effect = abs(fit.radius_error) * (1.0 - np.cos(np.radians(fit.max_tilt)))
+        if effect > CONTACT_TOL:
+            raise GCodeError("the program's cutter-location points fit a ball of radius "
+                             "%.3f mm, not %g mm (--tool; %d contact points on slopes up to "
+                             "%.1f degrees, %.4f mm off): expected the ball radius the "
+                             "program was made with"
+                             % (r + fit.radius_error, r, fit.points, fit.max_tilt, effect),
+                             file=source, line=fit.deepest_line or None)
+    if abs(fit.stock) > CONTACT_TOL:
+        raise GCodeError("the program's contact points lie %.4f mm %s the nominal face's "
+                         "ball offset on average (%d points; more than %g mm): a program "
+                         "with stock left, or for another face; expected the finishing "
+                         "program of this face" % (abs(fit.stock), "outside" if fit.stock > 0
+                                                   else "inside", fit.points, CONTACT_TOL),
+                         file=source)
+    return fit
+
+
+def offset_stream(program, write, offset, block_lines=None, **settings):
+    """Move a ball-end program by a surface correction, a block at a time.
+
+    Parameters
+    ----------
+    program : surfcomp.io.gcode.ProgramFile
+    write : callable
+        Called with each piece of output text (Latin-1).
+    offset : surfcomp.core.program_offset.BallOffset
+    block_lines : int, optional
+        Lines at a time (default :data:`surfcomp.io.gcode.stream.BLOCK_LINES`).
+    **settings
+        Of :class:`ProgramOffset` (``tolerance``, ``segment_length``, ``decimals``,
+        ``source``).
+
+    Returns
+    -------
+    ProgramOffset
+        Finished: :meth:`ProgramOffset.finish` raised nothing.
+    """
+    po = stream_program(program, write,
+                        lambda sep, eol: ProgramOffset(offset, sep=sep, eol=eol, **settings),
+                        block_lines, settings.get("source"))
+    if not po.words:
+        raise GCodeError("the program is empty (no G-code words, only blank lines, comments "
+                         "or % lines; expected G0/G1/G2/G3 moves)", file=settings.get("source"))
+    po.finish()
+    return po
+
+
+def offset_commands(commands, offset, tolerance=5e-4, segment_length=2.0, source=None):
+    """Move a FreeCAD-Path-style command list by a surface correction (the Path dressup).
+
+    Parameters
+    ----------
+    commands : sequence of (str, dict)
+        ``(Name, Parameters)`` of every command (mm, absolute unless ``G91``).
+    offset : surfcomp.core.program_offset.BallOffset
+    tolerance, segment_length : float
+        As :func:`surfcomp.core.program_offset.plan_offset` (mm).
+    source : str, optional
+        Label for messages (the "line" is the 1-based command number).
+
+    Returns
+    -------
+    (CommandsResult, ContactFit, OffsetPlan)
+        The output as :func:`surfcomp.io.gcode.compensate_commands` gives it (indices of
+        commands kept, ``(name, parameters)`` of new ones), the contact check and the plan.
+
+    Raises
+    ------
+    GCodeError
+        What :func:`check_contact` and the interpreter refuse; a move in incremental mode.
+    """
+    line_words = [(command_words(n, p, source, k + 1), False)
+                  for k, (n, p) in enumerate(commands)]
+    prog = interpret(line_words, source=source, path=True)
+    for j in range(prog.n_moves):
+        if not prog.lines[int(prog.line[j])].absolute:
+            raise GCodeError("move in incremental mode (G91): expected absolute positions",
+                             file=source, line=int(prog.line[j]) + 1)
+    op = plan_offset(prog, offset, tolerance, segment_length, 0.5e-6)
+    got = contact_points(prog, op)
+    closest, points = got if got is not None else ((np.inf, 0), None)
+    fit = check_contact(offset, closest, [points] if points is not None else [], source)
+    writer = _CommandWriter(prog, op.plan, None)
+    out = []
+    for idx, (name, params) in enumerate(commands):
+        out.extend(writer.command(idx, name, params))
+    res = writer.state.result(CommandsResult, out, len(commands), len(out), prog)
+    return res, fit, op
