@@ -50,9 +50,9 @@ def miters(n_a, n_b, inward_a, inward_b):
     edges, whose normals are opposite, the bisector is ``-(inward_a + inward_b)``).
     """
     c = np.einsum("ij,ij->i", n_a, n_b)
-    m = (n_a + n_b) / np.maximum(1.0 + c, 1e-300)[:, None]
     limit = 1.0 / math.cos(math.radians(0.5 * MITER_ANGLE))
-    clamped = np.linalg.norm(m, axis=1) > limit
+    clamped = 1.0 + c < 2.0 / limit ** 2         # |m|^2 = 2 / (1 + c)
+    m = (n_a + n_b) / np.where(clamped, 1.0, 1.0 + c)[:, None]
     s = n_a + n_b
     knife = np.linalg.norm(s, axis=1) < 0.1
     b = np.where(knife[:, None], _unit(-(inward_a + inward_b)), _unit(s))
@@ -208,6 +208,8 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     x = P.reshape(-1, 3)
     delta = field(x)
     D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
+    if not np.any(D):       # zero correction: the nominal itself, not a refined copy
+        return Built(surf, nominal, nominal, step)
     poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
                                      ref.degree_v)
     out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, None,

@@ -1,0 +1,127 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Region compensation (issue 30): a solid whose top is two B-spline faces meeting G1, with a
+field largest on their common edge, through the command line; bad input refused."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tests.app import region_parts as rp
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def g1_part(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("region")
+    solid, tops = rp.g1_top_solid()
+    step = str(tmp / "g1.step")
+    solid.exportStep(step)
+    faces = [solid.Faces[k] for k in tops]
+    pts, nrm, dev = rp.sample_faces(faces, 3000, rp.ridge_field, seed=1)
+    csv = str(tmp / "g1.csv")
+    rp.write_csv(csv, pts, nrm, dev)
+    return tmp, step, csv, solid, pts, nrm, dev
+
+
+def test_g1_top_continuity_fidelity_volume(g1_part):
+    import Part
+
+    tmp, step, csv, solid, _pts, _nrm, _dev = g1_part
+    out, rep = str(tmp / "out.step"), str(tmp / "out.json")
+    r = _cli(step, csv, "--faces", "auto", "-o", out, "--report", rep)
+    assert r.returncode == 0, r.stderr
+    assert "points per face: Face1 3000, Face2 3000; on no face: 0" in r.stdout
+    assert "edge Face1-Face2 (G1): largest gap" in r.stdout
+    data = json.load(open(rep))
+    (edge,) = data["edges"]
+    assert edge["g1"] and edge["nominal_angle_deg"] < 1e-6
+    assert edge["max_gap_um"] <= 0.1
+    assert edge["max_angle_deg"] <= 0.05
+    for f in data["faces"]:
+        assert f["points"] == 3000
+        assert f["max_realised_minus_intended_um"] <= 0.1
+        assert f["poles"][0] * f["poles"][1] <= 64 * 64
+    o = data["output"]
+    assert o["kind"] == "solid" and o["faces"] == 7
+    assert o["edge_tolerance_mm"] <= 1e-4
+    assert o["relative_error"] <= 0.02
+    # the largest correction, 20 um on the common edge, moved it
+    assert o["integral_mm3"] == pytest.approx(-0.64, abs=0.02)
+    back = Part.read(out)
+    assert len(back.Solids) == 1 and back.Solids[0].isValid()
+    assert len(back.Faces) == 7
+    assert back.Solids[0].Volume - solid.Volume == pytest.approx(o["change_mm3"], abs=1e-3)
+    # the common edge moved inwards by the ridge's top (20 um) at its middle
+    top = [f for f in back.Faces if f.Surface.TypeId == "Part::GeomBSplineSurface"]
+    face = solid.Faces[0]
+    p = np.array(tuple(face.Surface.value(10.0, 5.0)))
+    n = np.array(tuple(face.normalAt(10.0, 5.0)))
+    assert rp.ridge_field(p[None])[0] == pytest.approx(0.02, abs=1e-3)
+    moved = min(f.distToShape(Part.Vertex(*(p - 0.02 * n)))[0] for f in top)
+    # the mask filter and the 1.15 mm kernel flatten the 3 mm wide ridge by about 0.2 um
+    assert moved <= 0.5e-3
+
+
+def test_zero_correction_gives_the_nominal(g1_part):
+    import Part
+
+    tmp, step, csv, solid, pts, nrm, _dev = g1_part
+    zero = str(tmp / "zero.csv")
+    rp.write_csv(zero, pts, nrm, np.zeros(len(pts)))
+    out = str(tmp / "zero.step")
+    r = _cli(step, zero, "--faces", "Face1,Face2", "-o", out)
+    assert r.returncode == 0, r.stderr
+    back = Part.read(out)
+    assert back.Solids[0].Volume == pytest.approx(solid.Volume, abs=1e-9)
+    for a in solid.Faces[:2]:
+        b = min(back.Faces, key=lambda f: f.distToShape(a)[0] + abs(f.Area - a.Area))
+        assert b.Surface.NbUPoles == a.Surface.NbUPoles
+        assert b.Surface.NbVPoles == a.Surface.NbVPoles
+        np.testing.assert_allclose(np.array([tuple(p) for r in b.Surface.getPoles() for p in r]),
+                                   np.array([tuple(p) for r in a.Surface.getPoles() for p in r]),
+                                   atol=1e-12)
+
+
+def test_min_coverage_names_the_face(g1_part):
+    tmp, step, csv, _solid, pts, nrm, dev = g1_part
+    keep = ~((pts[:, 0] > 10) & (pts[:, 1] > 3))      # Face2 measured on its y < 3 strip
+    part = str(tmp / "part.csv")
+    rp.write_csv(part, pts[keep], nrm[keep], dev[keep])
+    out = str(tmp / "cov.step")
+    r = _cli(step, part, "--faces", "Face1,Face2", "-o", out, "--min-coverage", "0.6")
+    assert r.returncode == 2
+    assert "Face2: the points cover" in r.stderr and "--min-coverage 60 %" in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_straddling_step_refused(g1_part):
+    tmp, step, csv, _solid, pts, nrm, dev = g1_part
+    jump = dev + np.where(pts[:, 0] > 10, 0.5, 0.0)     # a 0.5 mm step at the common edge
+    bad = str(tmp / "step.csv")
+    rp.write_csv(bad, pts, nrm, jump)
+    out = str(tmp / "jump.step")
+    r = _cli(step, bad, "--faces", "auto", "-o", out, "--max-offset", "0.2")
+    assert r.returncode == 2
+    assert "straddling the edge between Face1 and Face2" in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_uncorrected_neighbour_moved_is_refused(g1_part):
+    tmp, step, csv, _solid, pts, nrm, _dev = g1_part
+    flat = str(tmp / "flat.csv")
+    rp.write_csv(flat, pts, nrm, np.full(len(pts), 0.01))
+    out = str(tmp / "flat.step")
+    r = _cli(step, flat, "--faces", "auto", "-o", out)
+    assert r.returncode == 2
+    assert "which is not in the region" in r.stderr and "add Face" in r.stderr
+    assert not os.path.exists(out)
