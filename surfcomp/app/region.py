@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core import region_build, region_field
-from ..core.bspline import derivatives
+from ..core.bspline import derivatives, evaluate, normals
 from ..core.projection import project
 from ..core.trimmed import inside
 from ..errors import GeometryError, InputError
@@ -29,7 +29,7 @@ from .convert import surface_from_part
 from .nominal import boundary_polylines, to_bspline_face, work_surface
 
 #: nominal edges of two faces closer than this (mm) are one shared edge
-SHARE_TOL = 0.02
+SHARE_TOL = 0.05
 #: samples along an edge for the continuity figures and the sharp-edge polylines
 EDGE_SAMPLES = 200
 #: nominal normals closer than this (degrees) along an edge: the faces meet G1
@@ -89,11 +89,9 @@ def region_face(shape, k):
         raise GeometryError("Face%d has a seam (a closed surface): split it first" % (k + 1))
     u0, u1, v0, v1 = bface.ParameterRange
     surf = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
-    if surf.weights is not None and surf.rational:
-        raise GeometryError("Face%d is a rational (NURBS) face: a region takes polynomial "
-                            "B-spline faces only (correct it alone)" % (k + 1))
-    surf = type(surf)(surf.poles, surf.knots_u, surf.knots_v, surf.degree_u, surf.degree_v,
-                      None, surf.u_range, surf.v_range)
+    if surf.weights is not None and not surf.rational:
+        surf = type(surf)(surf.poles, surf.knots_u, surf.knots_v, surf.degree_u,
+                          surf.degree_v, None, surf.u_range, surf.v_range)
     outward = -1 if bface.Orientation == "Reversed" else 1
     return RegionFace(k, "Face%d" % (k + 1), face, bface, surf, outward,
                       boundary_polylines(bface, 200))
@@ -113,7 +111,8 @@ def locate(faces, base, max_offset):
         res.append((idx, p))
         if p is None:
             continue
-        ok = p.converged & inside(f.polylines, p.u, p.v)
+        ok = p.converged.copy()
+        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
         dist[i, idx[ok]] = np.abs(p.distance[ok])
     owner = region_field.assign(dist, max_offset)
     u, v, normal, signed = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan),
@@ -146,10 +145,11 @@ def _edge_points(edge, n=EDGE_SAMPLES):
     return np.array([tuple(edge.valueAt(float(t))) for t in ts])
 
 
-def _normal_at(f, p):
-    u, v = f.bface.Surface.parameter(_vec(p))
-    n = f.bface.Surface.normal(u, v)
-    return np.array(tuple(n)) * f.outward, (u, v)
+def normals_at(f, pts):
+    """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
+    and their parameters."""
+    p = project(f.surface, np.asarray(pts, dtype=float))
+    return normals(f.surface, p.u, p.v) * f.outward, p.u, p.v
 
 
 def _vec(p):
@@ -209,17 +209,16 @@ def shared_edges(shape, faces, all_faces=False):
 
 
 def _nominal_angle(f, g, pts):
-    worst = 0.0
-    gf = g if isinstance(g, RegionFace) else None
-    for p in pts[::10]:
-        na, _ = _normal_at(f, p)
-        if gf is not None:
-            nb, _ = _normal_at(gf, p)
-        else:
+    na, _, _ = normals_at(f, pts[::10])
+    if isinstance(g, RegionFace):
+        nb, _, _ = normals_at(g, pts[::10])
+    else:
+        nb = []
+        for p in pts[::10]:
             u, v = g.Surface.parameter(_vec(p))
-            nb = np.array(tuple(g.normalAt(u, v)))
-        worst = max(worst, _angle(na, nb))
-    return worst
+            nb.append(tuple(g.normalAt(u, v)))
+        nb = np.array(nb)
+    return max(_angle(a, b) for a, b in zip(na, nb))
 
 
 def _angle(a, b):
@@ -235,16 +234,10 @@ def sharp_edges(faces, edges, band):
         if e.nominal_angle <= G1_ANGLE:
             continue
         fa, fb = faces[e.a], faces[e.b]
-        na, nb, ta, tb = [], [], [], []
         tang = np.gradient(e.samples, axis=0)
-        for p, t in zip(e.samples, tang):
-            a, _ = _normal_at(fa, p)
-            b, _ = _normal_at(fb, p)
-            na.append(a)
-            nb.append(b)
-            ta.append(_inward(fa, p, a, t))
-            tb.append(_inward(fb, p, b, t))
-        m, c = region_build.miters(*map(np.array, (na, nb, ta, tb)))
+        na, nb = normals_at(fa, e.samples)[0], normals_at(fb, e.samples)[0]
+        m, c = region_build.miters(na, nb, _inward(fa, e.samples, na, tang),
+                                   _inward(fb, e.samples, nb, tang))
         pts.append(e.samples)
         mit.append(m)
         cl.append(c)
@@ -256,37 +249,32 @@ def sharp_edges(faces, edges, band):
 
 
 def _inward(f, p, n, t):
-    """Unit direction in face ``f`` at edge point ``p``, normal to the edge, into the face."""
+    """Unit directions in face ``f`` at edge points ``p``, normal to the edge, into the face."""
     d = np.cross(n, t)
-    d /= max(np.linalg.norm(d), 1e-300)
-    probe = p + 1e-3 * d
-    uv = f.bface.Surface.parameter(_vec(probe))
-    inside_ = bool(inside(f.polylines, np.array([uv[0]]), np.array([uv[1]]))[0])
-    return d if inside_ else -d
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    probe = project(f.surface, p + 1e-3 * d)
+    ok = inside(f.polylines, probe.u, probe.v)
+    return np.where(ok[:, None], d, -d)
 
 
 def continuity(faces, edges):
     """Largest gap (um) and normal angle (degrees) along every shared edge, measured on the
-    corrected OpenCASCADE surfaces; fills ``edge.figures``."""
+    corrected surfaces at the nominal edge's points; fills ``edge.figures``."""
     for e in edges:
         fa, fb = faces[e.a], faces[e.b]
-        gaps, angles, nominal_gaps = [], [], []
-        for p in e.samples:
-            ua, va = fa.bface.Surface.parameter(_vec(p))
-            ub, vb = fb.bface.Surface.parameter(_vec(p))
-            pa = np.array(tuple(fa.part_surface.value(ua, va)))
-            pb = np.array(tuple(fb.part_surface.value(ub, vb)))
-            qa = np.array(tuple(fa.bface.Surface.value(ua, va)))
-            qb = np.array(tuple(fb.bface.Surface.value(ub, vb)))
-            gaps.append(np.linalg.norm(pa - pb))
-            nominal_gaps.append(np.linalg.norm(qa - qb))
-            na = np.array(tuple(fa.part_surface.normal(ua, va))) * fa.outward
-            nb = np.array(tuple(fb.part_surface.normal(ub, vb))) * fb.outward
-            angles.append(_angle(na, nb))
+        ma, ua, va = normals_at(fa, e.samples)
+        mb, ub, vb = normals_at(fb, e.samples)
+        pa, pb = evaluate(fa.built.surface, ua, va), evaluate(fb.built.surface, ub, vb)
+        qa, qb = evaluate(fa.surface, ua, va), evaluate(fb.surface, ub, vb)
+        na = normals(fa.built.surface, ua, va) * fa.outward
+        nb = normals(fb.built.surface, ub, vb) * fb.outward
+        angles = np.array([_angle(a, b) for a, b in zip(na, nb)])
+        nominal = np.array([_angle(a, b) for a, b in zip(ma, mb)])
         e.figures = {"faces": [fa.name, fb.name], "edge": "%s.Edge%d" % (fa.name, e.edge_a + 1),
                      "g1": e.nominal_angle <= G1_ANGLE,
                      "nominal_angle_deg": e.nominal_angle,
-                     "max_gap_um": float(max(gaps)) * 1e3,
-                     "nominal_gap_um": float(max(nominal_gaps)) * 1e3,
-                     "max_angle_deg": float(max(angles))}
+                     "max_gap_um": float(np.max(np.linalg.norm(pa - pb, axis=1))) * 1e3,
+                     "nominal_gap_um": float(np.max(np.linalg.norm(qa - qb, axis=1))) * 1e3,
+                     "max_angle_deg": float(np.max(angles)),
+                     "max_angle_change_deg": float(np.max(np.abs(angles - nominal)))}
     return [e.figures for e in edges]

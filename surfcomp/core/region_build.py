@@ -172,7 +172,8 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     Parameters
     ----------
     surf : Surface
-        The face's nominal (work) surface, polynomial.
+        The face's nominal (work) surface (rational: the corrected surface keeps the
+        weights of the refined nominal and its poles are fitted to the moved points).
     outward : {1, -1}
         Sign turning ``Su x Sv`` into the outward normal.
     field : callable
@@ -210,9 +211,13 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
     if not np.any(D):       # zero correction: the nominal itself, not a refined copy
         return Built(surf, nominal, nominal, step)
-    poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
-                                     ref.degree_v)
-    out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, None,
+    if ref.weights is None:
+        poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
+                                         ref.degree_v)
+    else:       # rational: the moved points, the weights kept
+        poles = fit_grid_lsq(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
+                             ref.degree_v, weights=ref.weights)
+    out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, ref.weights,
                   surf.u_range, surf.v_range)
     return Built(out, poles.shape[:2], nominal, step)
 

@@ -106,3 +106,45 @@ def write_csv(path, pts, nrm, dev):
         for p, n, d in zip(pts, nrm, dev):
             fh.write("%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % (tuple(p) + tuple(n) + (d,)))
 
+
+
+BLADE = ("upper", "lower", "tip", "root")
+
+
+def blade_faces(folder):
+    """The four faces of the BladeX blade (suction and pressure sides, tip and root caps),
+    as read from their IGES files: they meet within 9 um but OpenCASCADE's sewing does not
+    join the sides' knife edges, so the blade is a compound of faces, not a solid."""
+    import os
+
+    import Part
+
+    return [Part.read(os.path.join(folder, name + ".iges")).Faces[0] for name in BLADE]
+
+
+def leading_edge(faces, samples=400):
+    """Points along the spanwise edge the two sides share that is nearer the blade's
+    axis of rotation (its leading edge as BladeX builds it), shape (samples, 3)."""
+    upper, lower = faces[0], faces[1]
+    best = None
+    for e in upper.Edges:
+        mid = e.valueAt(0.5 * (e.FirstParameter + e.LastParameter))
+        if lower.distToShape(__import__("Part").Vertex(mid))[0] > 0.02:
+            continue
+        if best is None or e.Length < best.Length:
+            best = e
+    ts = np.linspace(best.FirstParameter, best.LastParameter, samples)
+    return np.array([tuple(best.valueAt(float(t))) for t in ts])
+
+
+def around_edge_field(edge_points, amplitude=0.03, width=12.0):
+    """A deviation largest along the edge and running around it onto both sides."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(edge_points)
+
+    def field(p):
+        d, _ = tree.query(p)
+        return amplitude * np.exp(-(d / width) ** 2)
+
+    return field
