@@ -130,11 +130,13 @@ def displacement(x, n, delta, sharp=None):
 
 
 def _refined(knots, degree, lo, hi, step):
-    """Knots to insert so no span of ``knots`` in ``(lo, hi)`` is wider than ``step``."""
+    """Knots to insert so no span of ``knots`` in ``(lo, hi)`` is wider than ``step`` and
+    every span is split at least once."""
     br = np.unique(knots[degree:len(knots) - degree])
     new = []
     for a, b in zip(br[:-1], br[1:]):
-        k = int(math.ceil((b - a) / step - 1e-9))
+        # every span at least halved: the nominal's own spans leave no room for the field
+        k = max(2, int(math.ceil((b - a) / step - 1e-9)))
         if k > 1:
             new.extend(a + (b - a) * np.arange(1, k) / k)
     return np.array(new)
