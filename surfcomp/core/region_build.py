@@ -152,6 +152,28 @@ def _lengths(surf):
     return lu, lv
 
 
+def _elevated_knots(knots, degree, to):
+    br, mult = np.unique(knots, return_counts=True)
+    mult[1:-1] += to - degree
+    mult[[0, -1]] = to + 1
+    return np.repeat(br, mult)
+
+
+def elevated(surf, to=3):
+    """The polynomial surface ``surf`` with its degrees raised to ``to`` where lower (a
+    ruled cap of degree 1 cannot follow a correction that varies across it); the same
+    surface, its poles fitted exactly (least squares on the elevated basis, which holds
+    the nominal). Rational surfaces are kept as they are."""
+    if surf.weights is not None or (surf.degree_u >= to and surf.degree_v >= to):
+        return surf
+    pu, pv = max(surf.degree_u, to), max(surf.degree_v, to)
+    ku = _elevated_knots(surf.knots_u, surf.degree_u, pu)
+    kv = _elevated_knots(surf.knots_v, surf.degree_v, pv)
+    us, vs = _samples(ku, pu, pu + 2), _samples(kv, pv, pv + 2)
+    poles = fit_grid_lsq(us, vs, evaluate_grid(surf, us, vs), ku, kv, pu, pv)
+    return Surface(poles, ku, kv, pu, pv, None, surf.u_range, surf.v_range)
+
+
 def _samples(knots, degree, per_span):
     br = np.unique(knots[degree:len(knots) - degree])
     t = [np.linspace(a, b, per_span + 1)[:-1] for a, b in zip(br[:-1], br[1:])]
@@ -192,6 +214,8 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     Built
     """
     nominal = surf.poles.shape[:2]
+    original = surf
+    surf = elevated(surf)
     lu, lv = _lengths(surf)
     budget = max(max_factor * nominal[0] * nominal[1], MIN_BUDGET)
     lo_u, hi_u = surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1]
@@ -200,13 +224,14 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     while True:
         nu = _refined(surf.knots_u, surf.degree_u, lo_u, hi_u, step / max(lu, 1e-12))
         nv = _refined(surf.knots_v, surf.degree_v, lo_v, hi_v, step / max(lv, 1e-12))
-        if (nominal[0] + len(nu)) * (nominal[1] + len(nv)) <= budget:
+        if (surf.poles.shape[0] + len(nu)) * (surf.poles.shape[1] + len(nv)) <= budget:
             break
         step *= 1.25
     ref = insert_knots(surf, nu, nv)
+    surf = original     # the zero correction returns it
     us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
     vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
-    P, Su, Sv = evaluate_grid(surf, us, vs, order=1)
+    P, Su, Sv = evaluate_grid(ref, us, vs, order=1)
     n = outward * _unit(np.cross(Su, Sv))
     x = P.reshape(-1, 3)
     delta = field(x)
