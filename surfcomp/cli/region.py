@@ -10,7 +10,9 @@ def run_region_command(args):
     for flag, value in (("--face", args.face), ("--replace", args.replace),
                         ("--save", args.save), ("--gcode", args.gcode),
                         ("--points", args.points), ("--curves", args.curves),
-                        ("--html", args.html), ("--weights", args.weights)):
+                        ("--html", args.html), ("--weights", args.weights),
+                        ("--face-only", args.face_only), ("--flip-normals", args.flip_normals),
+                        ("--tip-radius", args.tip_radius), ("--stock", args.stock)):
         if value:
             raise InputError("%s cannot be combined with --faces" % flag)
     if not 0.0 <= args.min_coverage <= 1.0:
@@ -21,7 +23,8 @@ def run_region_command(args):
     from ..app.region_route import run_region
 
     run_region(args.nominal, args.measurements, args.faces, args.output, args.report,
-               units=args.units or "mm", fmt=args.fmt, method=args.method, mask_size=args.mask,
+               units=args.units or "mm", fmt=args.fmt, sample=args.sample,
+               deviation_units=args.deviation_units, method=args.method, mask_size=args.mask,
                mask_kind=args.mask_kind, sigma=args.sigma, max_offset=args.max_offset,
                min_coverage=args.min_coverage, smoothing=args.smoothing)
     print("wrote %s" % args.output)

@@ -238,3 +238,22 @@ def test_faces_sharing_no_edge_are_corrected_apart(blade):
         # known limit: the caps collapse to a point at both ends (their normals turn by up
         # to 180 deg within a few mm there); the correction is realised within 1.3 um
         assert f["max_realised_minus_intended_um"] <= 1.5
+
+
+@pytest.mark.parametrize("extra, flag", [(["--flip-normals"], "--flip-normals"),
+                                         (["--tip-radius", "1"], "--tip-radius"),
+                                         (["--face", "Face1"], "--face")])
+def test_options_a_region_does_not_take_are_refused(g1_part, extra, flag):
+    tmp, step, csv, *_ = g1_part
+    out = str(tmp / "refused.step")
+    r = _cli(step, csv, "--faces", "auto", "-o", out, *extra)
+    assert r.returncode == 2
+    assert "%s cannot be combined with --faces" % flag in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_unknown_face_named(g1_part):
+    tmp, step, csv, *_ = g1_part
+    r = _cli(step, csv, "--faces", "Face1,Face9", "-o", str(tmp / "x.step"))
+    assert r.returncode == 2
+    assert "--faces: the shape has no Face9 (it has Face1 to Face7)" in r.stderr
