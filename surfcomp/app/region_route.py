@@ -38,7 +38,8 @@ def _deviation(ms, normal, signed):
 
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
                sample=None, deviation_units=None, method="filtered", mask_size=5,
-               mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None, max_factor=4.0, log=print):
+               mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
+               max_factor=4.0, log=print):
     """Run a region compensation; returns the report dict. Nothing is written on error."""
     outputs = [("output", output)] + ([("report", report)] if report else [])
     inputs = [("nominal", nominal), ("measurements", measurements)]
