@@ -159,7 +159,7 @@ def _elevated_knots(knots, degree, to):
     return np.repeat(br, mult)
 
 
-def elevated(surf, to=3):
+def elevated(surf, to=2):
     """The polynomial surface ``surf`` with its degrees raised to ``to`` where lower (a
     ruled cap of degree 1 cannot follow a correction that varies across it); the same
     surface, its poles fitted exactly (least squares on the elevated basis, which holds
@@ -215,7 +215,7 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     """
     nominal = surf.poles.shape[:2]
     original = surf
-    surf = elevated(surf)
+    surf = elevated(surf)       # degree 1 (a ruled cap) to 2; the sides keep theirs
     lu, lv = _lengths(surf)
     budget = max(max_factor * nominal[0] * nominal[1], MIN_BUDGET)
     lo_u, hi_u = surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1]
