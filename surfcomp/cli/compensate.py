@@ -22,6 +22,12 @@ def add_parser(subparsers):
                    help="write the corrected face alone, also when it is a face of a solid or "
                         "shell")
     add_method_options(p)
+    p.add_argument("--faces", metavar="F1,F2|auto",
+                   help="compensate a region of several faces at once, continuity kept "
+                        "(FaceN names, or auto: the faces the measurements cover)")
+    p.add_argument("--min-coverage", type=float, default=0.5, metavar="SHARE",
+                   help="with --faces: least share of every face's area with measured points "
+                        "near (default 0.5)")
     registry.add_options(p, "compensate", flags=("--points", "--curves", "--html"))
     from .program import add_program_options
 
@@ -47,10 +53,17 @@ def add_parser(subparsers):
 
 
 def run(args):
+    if args.program and args.faces:
+        raise InputError("--program moves a finishing program by the correction of one face "
+                         "and cannot be combined with --faces (expected --face F or no --faces)")
     if args.program:
         from .program import run_program
 
         return run_program(args)
+    if args.faces:
+        from .region import run_region_command
+
+        return run_region_command(args)
     if args.replace or args.save or args.gcode:
         return run_document(args)
     return run_job_command(args, "compensate")

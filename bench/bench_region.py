@@ -1,0 +1,108 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Region compensation of the 4-face BladeX blade (issue 30), whole process, beside
+FreeCAD's floor of reading and writing the same STEP file.
+
+    /usr/bin/python3 bench/bench_region.py [--points 200000] [--keep DIR]
+
+* the blade (tests/data/real/cad/BladeX: upper, lower, tip, root; a compound of faces, as
+  OpenCASCADE does not sew its knife edges) written as STEP, with N points spread over its
+  faces by area and a 30 um deviation largest along the leading edge and running around
+  it onto both sides;
+* ``python3 -m surfcomp compensate blade.step points.csv --faces auto -o out.step
+  --report out.json`` in a fresh process, timed whole (start-up, reading, locating the
+  points on the four faces, filter, field, four faces, continuity, STEP);
+* the reference: a fresh FreeCAD process that reads the same STEP file and writes it
+  again (the floor of any tool that reads and writes the part with OpenCASCADE).
+
+Prints both times, their ratio, and the continuity figures (largest gap and normal angle
+per shared edge) from the JSON report. Absolute seconds depend on the machine and its
+load; the ratio is the figure to compare.
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+FLOOR = """
+import sys
+sys.path.insert(0, '/usr/lib/freecad/lib'); sys.path.insert(0, '/usr/lib/freecad-python3/lib')
+import FreeCAD, Part
+s = Part.read(sys.argv[1])
+s.exportStep(sys.argv[2])
+"""
+
+
+def make_inputs(folder, points):
+    from surfcomp.app import fcenv
+
+    fcenv.import_freecad()
+    import Part
+
+    from tests.app import region_parts as rp
+
+    faces = rp.blade_faces(os.path.join(ROOT, "tests", "data", "real", "cad", "BladeX"))
+    step = os.path.join(folder, "blade.step")
+    Part.Compound(faces).exportStep(step)
+    field = rp.around_edge_field(rp.leading_edge(faces))
+    areas = np.array([f.Area for f in faces])
+    per = np.maximum((points * areas / areas.sum()).astype(int), 200)
+    parts = [rp.sample_faces([f], int(k), field, seed=i) for i, (f, k) in
+             enumerate(zip(faces, per))]
+    pts, nrm, dev = (np.concatenate([p[j] for p in parts]) for j in range(3))
+    csv = os.path.join(folder, "points.csv")
+    rp.write_csv(csv, pts, nrm, dev)
+    return step, csv, len(pts)
+
+
+def timed(cmd):
+    t = time.perf_counter()
+    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    return time.perf_counter() - t, r
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--points", type=int, default=200000)
+    ap.add_argument("--keep", metavar="DIR")
+    a = ap.parse_args(argv)
+    folder = a.keep or tempfile.mkdtemp(prefix="bench-region-")
+    os.makedirs(folder, exist_ok=True)
+    step, csv, n = make_inputs(folder, a.points)
+    out, rep = os.path.join(folder, "out.step"), os.path.join(folder, "out.json")
+    t_region, r = timed([sys.executable, "-m", "surfcomp", "compensate", step, csv,
+                         "--faces", "auto", "-o", out, "--report", rep, "--quiet"])
+    if r.returncode:
+        print(r.stdout + r.stderr)
+        return r.returncode
+    t_floor, f = timed([sys.executable, "-c", FLOOR, step, os.path.join(folder, "copy.step")])
+    if f.returncode:
+        print(f.stderr)
+        return f.returncode
+    data = json.load(open(rep))
+    print("blade, 4 faces, %d points" % n)
+    print("surfcomp compensate --faces auto: %.2f s (target 15 s)" % t_region)
+    print("FreeCAD read + write of the same STEP: %.2f s" % t_floor)
+    print("ratio: %.1f" % (t_region / t_floor))
+    for e in data["edges"]:
+        print("edge %s-%s: largest gap %.4f um (nominal %.4f um), largest normal angle change "
+              "%.4f deg (%s)" % (e["faces"][0], e["faces"][1], e["max_gap_um"],
+                                 e["nominal_gap_um"], e["max_angle_change_deg"],
+                                 "G1" if e["g1"] else "sharp"))
+    for fc in data["faces"]:
+        print("%s: poles %d x %d (nominal %d x %d), realised - intended %.4f um"
+              % (fc["face"], *fc["poles"], *fc["nominal_poles"],
+                 fc["max_realised_minus_intended_um"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

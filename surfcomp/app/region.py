@@ -1,0 +1,280 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Compensate a region of several faces of one shape at once (issue 30; app layer).
+
+The points are located on every face of the region and each is given to its nearest face
+(:func:`surfcomp.core.region_field.assign`); the filter and the correction field work over
+the whole region in space (:mod:`surfcomp.core.region_field`), and every face is rebuilt
+from one displacement (:mod:`surfcomp.core.region_build`), so faces that share an edge
+stay closed along it. The faces are then put back in the shape and sewn at
+:data:`surfcomp.app.retrim.PRECISION`; continuity (gap and normal angle along every shared
+edge), the volume change and the realised correction at the points are measured on the
+result, with OpenCASCADE.
+
+Not done for regions: re-trimming a face outside the region that meets a region face where
+the correction moves their edge (more than :data:`~surfcomp.app.retrim.PRECISION`); such a
+region is refused naming the two faces (add the neighbour to the region).
+"""
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core import region_build, region_field
+from ..core.bspline import derivatives, evaluate, normals
+from ..core.projection import project
+from ..core.trimmed import inside
+from ..errors import GeometryError, InputError
+from .convert import surface_from_part
+from .nominal import boundary_polylines, to_bspline_face, work_surface
+
+#: nominal edges of two faces closer than this (mm) are one shared edge
+SHARE_TOL = 0.05
+#: samples along an edge for the continuity figures and the sharp-edge polylines
+EDGE_SAMPLES = 200
+#: nominal normals closer than this (degrees) along an edge: the faces meet G1
+G1_ANGLE = 0.1
+#: field radius as a share of the shape's diagonal, at least 4 point spacings
+FIELD_SHARE = 0.05
+
+
+@dataclass
+class RegionFace:
+    index: int
+    name: str
+    face: object
+    bface: object
+    surface: object
+    outward: int
+    polylines: list
+    points: int = 0
+    coverage: float = 0.0
+    built: object = None
+    part_surface: object = None
+
+
+@dataclass
+class SharedEdge:
+    a: int
+    b: int
+    edge_a: int
+    edge_b: int
+    samples: np.ndarray
+    nominal_angle: float
+    figures: dict = field(default_factory=dict)
+
+
+def parse_faces(text, shape):
+    """``'Face1,Face3'`` -> 0-based indices (``'auto'`` -> None)."""
+    if text.strip().lower() == "auto":
+        return None
+    out = []
+    for name in (t.strip() for t in text.split(",")):
+        if not name.startswith("Face") or not name[4:].isdigit():
+            raise InputError("--faces: %r is not a face name (expected FaceN, N from 1 to %d, "
+                             "or auto)" % (name, len(shape.Faces)))
+        k = int(name[4:])
+        if not 1 <= k <= len(shape.Faces):
+            raise InputError("--faces: the shape has no %s (it has Face1 to Face%d)"
+                             % (name, len(shape.Faces)))
+        if k - 1 not in out:
+            out.append(k - 1)
+    return out
+
+
+def region_face(shape, k):
+    face = shape.Faces[k]
+    bface, _ = to_bspline_face(face)
+    if any(e.isSeam(bface) for e in bface.Edges):
+        raise GeometryError("Face%d has a seam (a closed surface): split it first" % (k + 1))
+    u0, u1, v0, v1 = bface.ParameterRange
+    surf = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
+    if surf.weights is not None and not surf.rational:
+        surf = type(surf)(surf.poles, surf.knots_u, surf.knots_v, surf.degree_u,
+                          surf.degree_v, None, surf.u_range, surf.v_range)
+    outward = -1 if bface.Orientation == "Reversed" else 1
+    return RegionFace(k, "Face%d" % (k + 1), face, bface, surf, outward,
+                      boundary_polylines(bface, 200))
+
+
+def locate(faces, base, max_offset):
+    """Project ``base`` (N, 3) on every face: (face index or -1, u, v, normal, distance)."""
+    n = len(base)
+    dist = np.full((len(faces), n), np.inf)
+    res = []
+    for i, f in enumerate(faces):
+        bb = f.face.BoundBox
+        near = np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset) &
+                      (base <= np.array([bb.XMax, bb.YMax, bb.ZMax]) + max_offset), axis=1)
+        idx = np.flatnonzero(near)
+        p = project(f.surface, base[idx], max_distance=max_offset) if len(idx) else None
+        res.append((idx, p))
+        if p is None:
+            continue
+        ok = p.converged.copy()
+        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
+        dist[i, idx[ok]] = np.abs(p.distance[ok])
+    owner = region_field.assign(dist, max_offset)
+    u, v, normal, signed = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan),
+                            np.full(n, np.nan))
+    for i, (idx, p) in enumerate(res):
+        if p is None:
+            continue
+        mine = owner[idx] == i
+        k = idx[mine]
+        u[k], v[k] = p.u[mine], p.v[mine]
+        normal[k] = p.normal[mine] * faces[i].outward
+        signed[k] = p.distance[mine] * faces[i].outward
+    return owner, u, v, normal, signed
+
+
+def face_samples(f, n=60):
+    """Points on the face (inside its trim) and the area each stands for."""
+    u0, u1, v0, v1 = f.bface.ParameterRange
+    us, vs = (np.linspace(u0, u1, n + 1)[:-1] + 0.5 * (u1 - u0) / n,
+              np.linspace(v0, v1, n + 1)[:-1] + 0.5 * (v1 - v0) / n)
+    U, V = np.meshgrid(us, vs, indexing="ij")
+    ok = inside(f.polylines, U.ravel(), V.ravel())
+    S, Su, Sv = derivatives(f.surface, U.ravel()[ok], V.ravel()[ok], order=1)
+    area = np.linalg.norm(np.cross(Su, Sv), axis=1) * (u1 - u0) * (v1 - v0) / n / n
+    return S, area
+
+
+def _edge_points(edge, n=EDGE_SAMPLES):
+    ts = np.linspace(edge.FirstParameter, edge.LastParameter, n)
+    return np.array([tuple(edge.valueAt(float(t))) for t in ts])
+
+
+def normals_at(f, pts):
+    """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
+    and their parameters."""
+    p = project(f.surface, np.asarray(pts, dtype=float))
+    return normals(f.surface, p.u, p.v) * f.outward, p.u, p.v
+
+
+def _vec(p):
+    import FreeCAD
+
+    return FreeCAD.Vector(*map(float, p))
+
+
+def _near_polyline(points, poly):
+    """Largest distance of ``points`` from the polyline ``poly`` (both (K, 3))."""
+    a, b = poly[:-1], poly[1:]
+    ab = b - a
+    worst = 0.0
+    for p in points:
+        t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(
+            np.einsum("ij,ij->i", ab, ab), 1e-300), 0, 1)
+        worst = max(worst, float(np.min(np.linalg.norm(a + t[:, None] * ab - p, axis=1))))
+    return worst
+
+
+def shared_edges(shape, faces, all_faces=False):
+    """Edges shared by two faces of the region (and, with ``all_faces``, by a region face
+    and any other face of ``shape``: ``b`` is then the shape's face index, negative-coded
+    as ``-1 - index``), found geometrically so unsewn shells count too."""
+    out = []
+    polys = {}
+
+    def poly(k, j, e):
+        if (k, j) not in polys:
+            polys[(k, j)] = _edge_points(e, 64)
+        return polys[(k, j)]
+
+    region = {f.index: i for i, f in enumerate(faces)}
+    for i, f in enumerate(faces):
+        others = range(len(shape.Faces)) if all_faces else [g.index for g in faces[i + 1:]]
+        for k in others:
+            if k == f.index or (all_faces and k in region):
+                continue
+            g = shape.Faces[k]
+            if not f.face.BoundBox.intersect(g.BoundBox):
+                continue
+            for ja, ea in enumerate(f.face.Edges):
+                if ea.Degenerated or ea.Length < 1e-6:
+                    continue
+                pa = poly(f.index, ja, ea)
+                for jb, eb in enumerate(g.Edges):
+                    if eb.Degenerated or abs(eb.Length - ea.Length) > 0.01 * ea.Length + \
+                            SHARE_TOL:
+                        continue
+                    if _near_polyline(pa[::8], poly(k, jb, eb)) > SHARE_TOL:
+                        continue
+                    pts = _edge_points(ea)
+                    b = region[k] if not all_faces else -1 - k
+                    ang = _nominal_angle(f, g, pts)
+                    out.append(SharedEdge(i, b, ja, jb, pts, ang))
+    return out
+
+
+def _nominal_angle(f, g, pts):
+    na, _, _ = normals_at(f, pts[::10])
+    if isinstance(g, RegionFace):
+        nb, _, _ = normals_at(g, pts[::10])
+    else:
+        nb = []
+        for p in pts[::10]:
+            u, v = g.Surface.parameter(_vec(p))
+            nb.append(tuple(g.normalAt(u, v)))
+        nb = np.array(nb)
+    return max(_angle(a, b) for a, b in zip(na, nb))
+
+
+def _angle(a, b):
+    c = float(np.dot(a, b) / (np.linalg.norm(a) * np.linalg.norm(b)))
+    return math.degrees(math.acos(max(-1.0, min(1.0, c))))
+
+
+def sharp_edges(faces, edges, band):
+    """The :class:`~surfcomp.core.region_build.SharpEdges` of the region's edges that are
+    not G1, with the normals and in-face directions at their samples."""
+    pts, mit, cl, eid = [], [], [], []
+    for k, e in enumerate(edges):
+        if e.nominal_angle <= G1_ANGLE:
+            continue
+        fa, fb = faces[e.a], faces[e.b]
+        tang = np.gradient(e.samples, axis=0)
+        na, nb = normals_at(fa, e.samples)[0], normals_at(fb, e.samples)[0]
+        m, c = region_build.miters(na, nb, _inward(fa, e.samples, na, tang),
+                                   _inward(fb, e.samples, nb, tang))
+        pts.append(e.samples)
+        mit.append(m)
+        cl.append(c)
+        eid.append(np.full(len(m), k))
+    if not pts:
+        return None
+    return region_build.SharpEdges(np.concatenate(pts), np.concatenate(mit), np.concatenate(cl),
+                                   np.concatenate(eid), band)
+
+
+def _inward(f, p, n, t):
+    """Unit directions in face ``f`` at edge points ``p``, normal to the edge, into the face."""
+    d = np.cross(n, t)
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+    probe = project(f.surface, p + 1e-3 * d)
+    ok = inside(f.polylines, probe.u, probe.v)
+    return np.where(ok[:, None], d, -d)
+
+
+def continuity(faces, edges):
+    """Largest gap (um) and normal angle (degrees) along every shared edge, measured on the
+    corrected surfaces at the nominal edge's points; fills ``edge.figures``."""
+    for e in edges:
+        fa, fb = faces[e.a], faces[e.b]
+        ma, ua, va = normals_at(fa, e.samples)
+        mb, ub, vb = normals_at(fb, e.samples)
+        pa, pb = evaluate(fa.built.surface, ua, va), evaluate(fb.built.surface, ub, vb)
+        qa, qb = evaluate(fa.surface, ua, va), evaluate(fb.surface, ub, vb)
+        na = normals(fa.built.surface, ua, va) * fa.outward
+        nb = normals(fb.built.surface, ub, vb) * fb.outward
+        angles = np.array([_angle(a, b) for a, b in zip(na, nb)])
+        nominal = np.array([_angle(a, b) for a, b in zip(ma, mb)])
+        e.figures = {"faces": [fa.name, fb.name], "edge": "%s.Edge%d" % (fa.name, e.edge_a + 1),
+                     "g1": e.nominal_angle <= G1_ANGLE,
+                     "nominal_angle_deg": e.nominal_angle,
+                     "max_gap_um": float(np.max(np.linalg.norm(pa - pb, axis=1))) * 1e3,
+                     "nominal_gap_um": float(np.max(np.linalg.norm(qa - qb, axis=1))) * 1e3,
+                     "max_angle_deg": float(np.max(angles)),
+                     "max_angle_change_deg": float(np.max(np.abs(angles - nominal)))}
+    return [e.figures for e in edges]

@@ -1,0 +1,33 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""``compensate SOLID MEAS --faces F1,F2,...|auto -o OUT``: a region of faces (issue 30)."""
+
+from ..errors import InputError
+
+
+def run_region_command(args):
+    if not args.output:
+        raise InputError("--faces needs -o OUT (the corrected shape)")
+    for flag, value in (("--face", args.face), ("--replace", args.replace),
+                        ("--save", args.save), ("--gcode", args.gcode),
+                        ("--points", args.points), ("--curves", args.curves),
+                        ("--html", args.html), ("--weights", args.weights),
+                        ("--face-only", args.face_only), ("--flip-normals", args.flip_normals),
+                        ("--tip-radius", args.tip_radius), ("--stock", args.stock)):
+        if value:
+            raise InputError("%s cannot be combined with --faces" % flag)
+    if not 0.0 <= args.min_coverage <= 1.0:
+        raise InputError("--min-coverage must be between 0 and 1 (got %g)" % args.min_coverage)
+    from ..app import fcenv
+
+    fcenv.import_freecad()
+    from ..app.region_route import run_region
+
+    run_region(args.nominal, args.measurements, args.faces, args.output, args.report,
+               units=args.units or "mm", fmt=args.fmt, sample=args.sample,
+               deviation_units=args.deviation_units, method=args.method, mask_size=args.mask,
+               mask_kind=args.mask_kind, sigma=args.sigma, max_offset=args.max_offset,
+               min_coverage=args.min_coverage, smoothing=args.smoothing)
+    print("wrote %s" % args.output)
+    if args.report:
+        print("wrote %s" % args.report)
+    return 0

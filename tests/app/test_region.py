@@ -1,0 +1,259 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Region compensation (issue 30): a solid whose top is two B-spline faces meeting G1, with a
+field largest on their common edge, through the command line; bad input refused."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from tests.app import region_parts as rp
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def _cli(*args):
+    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture(scope="module")
+def g1_part(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("region")
+    solid, tops = rp.g1_top_solid()
+    step = str(tmp / "g1.step")
+    solid.exportStep(step)
+    faces = [solid.Faces[k] for k in tops]
+    pts, nrm, dev = rp.sample_faces(faces, 3000, rp.ridge_field, seed=1)
+    csv = str(tmp / "g1.csv")
+    rp.write_csv(csv, pts, nrm, dev)
+    return tmp, step, csv, solid, pts, nrm, dev
+
+
+def test_g1_top_continuity_fidelity_volume(g1_part):
+    import Part
+
+    tmp, step, csv, solid, _pts, _nrm, _dev = g1_part
+    out, rep = str(tmp / "out.step"), str(tmp / "out.json")
+    r = _cli(step, csv, "--faces", "auto", "-o", out, "--report", rep)
+    assert r.returncode == 0, r.stderr
+    assert "points per face: Face1 3000, Face2 3000; on no face: 0" in r.stdout
+    assert "edge Face1-Face2 (G1): largest gap" in r.stdout
+    data = json.load(open(rep))
+    (edge,) = data["edges"]
+    assert edge["g1"] and edge["nominal_angle_deg"] < 1e-6
+    assert edge["max_gap_um"] <= 0.1
+    assert edge["max_angle_deg"] <= 0.05
+    for f in data["faces"]:
+        assert f["points"] == 3000
+        assert f["max_realised_minus_intended_um"] <= 0.1
+        assert f["poles"][0] * f["poles"][1] <= 64 * 64
+    o = data["output"]
+    assert o["kind"] == "solid" and o["faces"] == 7
+    assert o["edge_tolerance_mm"] <= 1e-4
+    assert o["relative_error"] <= 0.02
+    # the largest correction, 20 um on the common edge, moved it
+    assert o["integral_mm3"] == pytest.approx(-0.64, abs=0.02)
+    back = Part.read(out)
+    assert len(back.Solids) == 1 and back.Solids[0].isValid()
+    assert len(back.Faces) == 7
+    assert back.Solids[0].Volume - solid.Volume == pytest.approx(o["change_mm3"], abs=1e-3)
+    # the common edge moved inwards by the ridge's top (20 um) at its middle
+    top = [f for f in back.Faces if f.Surface.TypeId == "Part::GeomBSplineSurface"]
+    face = solid.Faces[0]
+    p = np.array(tuple(face.Surface.value(10.0, 5.0)))
+    n = np.array(tuple(face.normalAt(10.0, 5.0)))
+    assert rp.ridge_field(p[None])[0] == pytest.approx(0.02, abs=1e-3)
+    moved = min(f.distToShape(Part.Vertex(*(p - 0.02 * n)))[0] for f in top)
+    # the mask filter and the 1.15 mm kernel flatten the 3 mm wide ridge by about 0.2 um
+    assert moved <= 0.5e-3
+
+
+def test_zero_correction_gives_the_nominal(g1_part):
+    import Part
+
+    tmp, step, csv, solid, pts, nrm, _dev = g1_part
+    zero = str(tmp / "zero.csv")
+    rp.write_csv(zero, pts, nrm, np.zeros(len(pts)))
+    out = str(tmp / "zero.step")
+    r = _cli(step, zero, "--faces", "Face1,Face2", "-o", out)
+    assert r.returncode == 0, r.stderr
+    back = Part.read(out)
+    assert back.Solids[0].Volume == pytest.approx(solid.Volume, abs=1e-9)
+    for a in solid.Faces[:2]:
+        b = min(back.Faces, key=lambda f: f.distToShape(a)[0] + abs(f.Area - a.Area))
+        assert b.Surface.NbUPoles == a.Surface.NbUPoles
+        assert b.Surface.NbVPoles == a.Surface.NbVPoles
+        np.testing.assert_allclose(np.array([tuple(p) for r in b.Surface.getPoles() for p in r]),
+                                   np.array([tuple(p) for r in a.Surface.getPoles() for p in r]),
+                                   atol=1e-12)
+
+
+def test_min_coverage_names_the_face(g1_part):
+    tmp, step, csv, _solid, pts, nrm, dev = g1_part
+    keep = ~((pts[:, 0] > 10) & (pts[:, 1] > 3))      # Face2 measured on its y < 3 strip
+    part = str(tmp / "part.csv")
+    rp.write_csv(part, pts[keep], nrm[keep], dev[keep])
+    out = str(tmp / "cov.step")
+    r = _cli(step, part, "--faces", "Face1,Face2", "-o", out, "--min-coverage", "0.6")
+    assert r.returncode == 2
+    assert "Face2: the points cover" in r.stderr and "--min-coverage 60 %" in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_straddling_step_refused(g1_part):
+    tmp, step, csv, _solid, pts, nrm, dev = g1_part
+    jump = dev + np.where(pts[:, 0] > 10, 0.5, 0.0)     # a 0.5 mm step at the common edge
+    bad = str(tmp / "step.csv")
+    rp.write_csv(bad, pts, nrm, jump)
+    out = str(tmp / "jump.step")
+    r = _cli(step, bad, "--faces", "auto", "-o", out, "--max-offset", "0.2")
+    assert r.returncode == 2
+    assert "straddling the edge between Face1 and Face2" in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_uncorrected_neighbour_moved_is_refused(g1_part):
+    tmp, step, csv, _solid, pts, nrm, _dev = g1_part
+    flat = str(tmp / "flat.csv")
+    rp.write_csv(flat, pts, nrm, np.full(len(pts), 0.01))
+    out = str(tmp / "flat.step")
+    r = _cli(step, flat, "--faces", "auto", "-o", out)
+    assert r.returncode == 2
+    assert "which is not in the region" in r.stderr and "add Face" in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_boxed_sphere_corner_blends_and_their_fillets(tmp_path):
+    """Two adjacent corner blends of boxed_sphere.step (Face8 and Face20, 23 x 23 bicubic,
+    trimmed to 9 edges) and the two cylinder fillets joining them (Face12, Face24, rational),
+    as a compound of the four faces; a 10 um field with a 5 um wave along the fillet runs
+    across all four. The nominal blends meet the fillets at up to 0.24 deg (Rhino's
+    modelling tolerance), so those edges count as sharp; the fillets meet each other G1."""
+    import Part
+
+    from tests.conftest import REALDATA
+
+    solid = Part.read(os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")).Solids[0]
+    faces = [solid.Faces[k - 1] for k in (8, 12, 24, 20)]
+    brep = str(tmp_path / "blends.brep")
+    Part.Compound(faces).exportBrep(brep)
+    pts, nrm, dev = rp.sample_faces(faces, 1000, lambda p: 0.01 * (1 + 0.5 * np.sin(p[:, 1] / 3)))
+    csv = str(tmp_path / "blends.csv")
+    rp.write_csv(csv, pts, nrm, dev)
+    out, rep = str(tmp_path / "out.brep"), str(tmp_path / "out.json")
+    r = _cli(brep, csv, "--faces", "auto", "-o", out, "--report", rep)
+    assert r.returncode == 0, r.stderr
+    assert "points per face: Face1 1000, Face2 1000, Face3 1000, Face4 1000" in r.stdout
+    data = json.load(open(rep))
+    edges = {tuple(e["faces"]): e for e in data["edges"]}
+    assert set(edges) == {("Face1", "Face2"), ("Face2", "Face3"), ("Face3", "Face4")}
+    fillets = edges[("Face2", "Face3")]
+    assert fillets["g1"]
+    assert fillets["max_gap_um"] <= 0.1 and fillets["max_angle_change_deg"] <= 0.05
+    for key in (("Face1", "Face2"), ("Face3", "Face4")):
+        e = edges[key]
+        assert not e["g1"] and e["nominal_angle_deg"] == pytest.approx(0.24, abs=0.02)
+        assert e["max_angle_change_deg"] <= 0.05
+    # known limit: the blend Face1 (the solid's Face8) misses by up to 0.19 um at its points
+    # and opens its edge with Face2 by 0.12 um (0.09 um beyond the nominal's own gap); its
+    # mirror image Face4 stays within 0.03 um
+    assert edges[("Face3", "Face4")]["max_gap_um"] <= 0.1
+    assert edges[("Face1", "Face2")]["max_gap_um"] - \
+        edges[("Face1", "Face2")]["nominal_gap_um"] <= 0.1
+    fid = {f["face"]: f["max_realised_minus_intended_um"] for f in data["faces"]}
+    assert fid["Face2"] <= 0.1 and fid["Face3"] <= 0.1 and fid["Face4"] <= 0.1
+    assert fid["Face1"] <= 0.25
+    for f in data["faces"]:
+        assert f["poles"][0] * f["poles"][1] <= max(4 * f["nominal_poles"][0] *
+                                                    f["nominal_poles"][1], 64 * 64)
+    assert data["output"]["kind"] == "faces"
+    assert len(Part.read(out).Faces) == 4
+
+
+@pytest.fixture(scope="module")
+def blade(tmp_path_factory):
+    import Part
+
+    from tests.conftest import REALDATA
+
+    tmp = tmp_path_factory.mktemp("blade")
+    faces = rp.blade_faces(os.path.join(REALDATA, "cad", "BladeX"))
+    brep = str(tmp / "blade.brep")
+    Part.Compound(faces).exportBrep(brep)
+    return tmp, brep, faces
+
+
+def test_blade_points_on_their_nearest_face_and_shared_edges(blade):
+    """The BladeX blade's four faces: points sampled on each face are given to that face
+    (also next to the knife edges, where the other side is a few um away), and the six
+    edges the faces share are found although OpenCASCADE does not sew the sides."""
+    import Part
+
+    from surfcomp.app import region
+
+    _tmp, brep, faces = blade
+    shape = Part.read(brep)
+    le = rp.leading_edge(faces)
+    field = rp.around_edge_field(le)
+    parts = [rp.sample_faces([f], 400, field, seed=k) for k, f in enumerate(faces)]
+    pts = np.concatenate([p[0] for p in parts])
+    truth = np.repeat(np.arange(4), 400)
+    rf = [region.region_face(shape, k) for k in range(4)]
+    owner, _u, _v, normal, signed = region.locate(rf, pts, 1.0)
+    np.testing.assert_array_equal(owner, truth)
+    np.testing.assert_allclose(signed, 0.0, atol=1e-6)
+    edges = region.shared_edges(shape, rf)
+    pairs = sorted((e.a, e.b) for e in edges)
+    assert pairs == [(0, 1), (0, 1), (0, 2), (0, 3), (1, 2), (1, 3)]
+    # the sides meet at knife edges: their outward normals more than 120 deg apart
+    assert all(e.nominal_angle > 120.0 for e in edges if (e.a, e.b) == (0, 1))
+
+
+def test_faces_sharing_no_edge_are_corrected_apart(blade):
+    """The blade's tip and root caps (alone in their file) share no edge: the run says so
+    and corrects each."""
+    import Part
+
+    tmp, _brep, faces = blade
+    caps = faces[2:]
+    brep = str(tmp / "caps_nominal.brep")
+    Part.Compound(caps).exportBrep(brep)
+    pts, nrm, dev = rp.sample_faces(caps, 600, lambda p: np.full(len(p), 0.01), seed=3)
+    csv = str(tmp / "caps.csv")
+    rp.write_csv(csv, pts, nrm, dev)
+    out, rep = str(tmp / "caps.brep"), str(tmp / "caps.json")
+    r = _cli(brep, csv, "--faces", "Face1,Face2", "-o", out, "--report", rep)
+    assert r.returncode == 0, r.stderr
+    for name in ("Face1", "Face2"):
+        assert "%s shares no edge with the other faces of the region: corrected apart" % name \
+            in r.stdout
+    data = json.load(open(rep))
+    assert data["edges"] == []
+    for f in data["faces"]:
+        assert f["points"] == 600
+        # known limit: the caps collapse to a point at both ends (their normals turn by up
+        # to 180 deg within a few mm there); the correction is realised within 1.3 um
+        assert f["max_realised_minus_intended_um"] <= 1.5
+
+
+@pytest.mark.parametrize("extra, flag", [(["--flip-normals"], "--flip-normals"),
+                                         (["--tip-radius", "1"], "--tip-radius"),
+                                         (["--face", "Face1"], "--face")])
+def test_options_a_region_does_not_take_are_refused(g1_part, extra, flag):
+    tmp, step, csv, *_ = g1_part
+    out = str(tmp / "refused.step")
+    r = _cli(step, csv, "--faces", "auto", "-o", out, *extra)
+    assert r.returncode == 2
+    assert "%s cannot be combined with --faces" % flag in r.stderr
+    assert not os.path.exists(out)
+
+
+def test_unknown_face_named(g1_part):
+    tmp, step, csv, *_ = g1_part
+    r = _cli(step, csv, "--faces", "Face1,Face9", "-o", str(tmp / "x.step"))
+    assert r.returncode == 2
+    assert "--faces: the shape has no Face9 (it has Face1 to Face7)" in r.stderr
