@@ -12,13 +12,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..errors import GridError, InputError, MeasurementFileError
+from ..errors import ComputationError, GridError, InputError, MeasurementFileError
 from . import bspline, plausibility
 from .corrected import DEFAULT_REFINE, construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
 from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
-from .grid_check import unlocatable
+from .grid_check import as_scattered, unlocatable
 from .memory import return_free_memory
 from .methods import METHODS, compute_correction
 from .progress import report, sub
@@ -467,7 +467,13 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
                           fit=fit, scale=scale)
     if not build:
         return result
-    build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
+    try:
+        build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
+    except ComputationError as exc:
+        again = as_scattered(prepared, options, exc)
+        if again is None:
+            raise
+        return compensate(surface, outward, again, options, build, progress)
     report(progress, 1.0, "done")
     return result
 

@@ -63,22 +63,24 @@ def _measure(u, v):
 
 def _corrected(surf, outward, ms, layout):
     prep = prepare(surf, outward, ms, Options(layout=layout))
-    comp = compensate(surf, outward, prep)
+    comp = compensate(surf, outward, prep, Options(layout=layout))
     s = np.linspace(0.0, 1.0, 21)
     return prep, comp, bspline.evaluate_grid(comp.corrected, s, s)
 
 
 def test_staggered_rows_with_dropped_points_take_the_scattered_route():
-    """8 and 7 points in alternate rows of the s3 preset face (the last point of every
-    other row dropped): found as a 15 x 3 grid whose neighbouring rows lie 0.02 apart in u
-    and a row apart in v, whose map cannot be inverted over the face. It used to end in
-    'could not locate (u, v) = (0, 0.833333) on the measurement grid' (exit 1)."""
-    u, v = _staggered(0.009971, 0.990029, 8, 6, 0.020939)
-    assert u.size == 45 and grid_from_uv(u, v).shape == (15, 3)
+    """3 and 2 points in alternate rows of the s3 preset face (the third point of every
+    other row dropped, beyond the face): found as a 5 x 3 grid whose neighbouring rows lie
+    0.014 apart in u and a row apart in v. Its map passes the coarse check of prepare but
+    cannot be inverted at one of the corrected face's samples: it used to end in 'could not
+    locate (u, v) = (0, 0.833333) on the measurement grid' (exit 1); now the compensation
+    takes the scattered route, says why, and gives the scattered route's face."""
+    u, v = _staggered(0.013118, 0.986882, 3, 6, 0.013929)
+    assert u.size == 15 and grid_from_uv(u, v).shape == (5, 3)
     surf, outward, ms = _measure(u, v)
     prep, comp, auto = _corrected(surf, outward, ms, "auto")
-    assert prep.grid.rows_from == "scattered (grid too distorted)"
-    assert any("15 x 3 grid found in the points (rows of constant u on the face) is too "
+    assert comp.prepared.grid.rows_from == "scattered (grid too distorted)"
+    assert any("5 x 3 grid found in the points (rows of constant u on the face) is too "
                "distorted for the grid route: could not locate" in w and
                w.endswith("the points are used as a scattered layout") for w in prep.warnings)
     assert comp.checks.max_error_at_points < 1e-4     # mm, the intended correction met
@@ -86,7 +88,21 @@ def test_staggered_rows_with_dropped_points_take_the_scattered_route():
     assert_allclose(auto, scattered, rtol=0, atol=1e-12)
     with pytest.raises(GridError, match=r"too distorted for the grid route.*--layout "
                                         r"scattered uses the points as they are"):
-        prepare(surf, outward, ms, Options(layout="grid"))
+        _corrected(surf, outward, ms, "grid")
+
+
+def test_staggered_rows_too_sheared_for_prepare_take_the_scattered_route():
+    """8 and 7 points in alternate rows, found as a 15 x 3 grid (rows 0.018 apart in u):
+    the coarse check in prepare already fails; the warning says so, the face is the
+    scattered route's."""
+    u, v = _staggered(0.017004, 0.982996, 8, 6, 0.017979)
+    assert u.size == 45 and grid_from_uv(u, v).shape == (15, 3)
+    surf, outward, ms = _measure(u, v)
+    prep, comp, auto = _corrected(surf, outward, ms, "auto")
+    assert prep.grid.rows_from == "scattered (grid too distorted)"
+    assert any("too distorted for the grid route" in w for w in prep.warnings)
+    _, _, scattered = _corrected(surf, outward, ms, "scattered")
+    assert_allclose(auto, scattered, rtol=0, atol=1e-12)
 
 
 def test_hexagonal_points_stay_on_the_grid_route_and_agree_with_the_scattered_one():
@@ -108,7 +124,7 @@ def test_hexagonal_points_stay_on_the_grid_route_and_agree_with_the_scattered_on
 def test_simulate_measures_near_grid_plan_points_by_the_auto_layout(points):
     """The loop measured at near-grid plan points (no longer forced onto the scattered
     route, as compensate --layout auto takes them): the 25 staggered points as their 5 x 5
-    grid, the 45 with dropped points as a scattered layout; both compensate. (The sparse
+    grid, the 45 in rows of 8 and 7 as their 15 x 3 grid; both compensate. (The sparse
     grid's mask filter leaves more than the scattered route's smoothing fit would: 2.34
     against 1.97 um with these draws.)"""
     from surfcomp.core import simulate as sim
@@ -124,3 +140,24 @@ def test_simulate_measures_near_grid_plan_points_by_the_auto_layout(points):
     none, filtered = res.values("none", "std")[0], res.values("filtered", "std")[0]
     assert filtered < (0.8 if points == "hexagonal" else 0.5) * none
     assert max(res.checks["filtered"]) < 1e-4      # mm, the correction met at the points
+
+
+def test_sheared_grid_that_fails_one_sample_of_the_face_falls_back_at_build_time():
+    """15 points in staggered rows of 3 and 2 (found as a 5 x 3 grid, neighbouring rows
+    0.05 apart in u and half a row apart in v): prepare's coarse check passes, but Newton
+    cycles between two cells at the face sample (0.214286, 0.375) while the corrected face
+    is built. It used to end there with exit 1; now the compensation is made again on the
+    scattered route and the warning names the sample."""
+    u, v = _staggered(0.003688, 0.996312, 3, 6, 0.050439)
+    assert u.size == 15
+    surf, outward, ms = _measure(u, v)
+    prep, comp, auto = _corrected(surf, outward, ms, "auto")
+    assert prep.grid.shape == (5, 3)
+    assert comp.prepared.grid.rows_from == "scattered (grid too distorted)"
+    assert prep.warnings == comp.prepared.warnings == [
+        "the 5 x 3 grid found in the points (rows of constant u on the face) is too distorted "
+        "for the grid route: could not locate (u, v) = (0.214286, 0.375) on the measurement "
+        "grid; the points are used as a scattered layout"]
+    assert comp.checks.max_error_at_points < 1e-4
+    _, _, scattered = _corrected(surf, outward, ms, "scattered")
+    assert_allclose(auto, scattered, rtol=0, atol=1e-12)
