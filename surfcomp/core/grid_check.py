@@ -55,6 +55,7 @@ def as_scattered(prepared, options, exc):
         raise GridError("%s (expected a grid whose map to the face can be inverted; --layout "
                         "scattered uses the points as they are)" % why, file=prepared.source)
     # the warning goes into the caller's list too (the reports read it from there)
-    prepared.warnings.append("%s; the points are used as a scattered layout" % why)
+    where = "%s: " % prepared.source if prepared.source else ""
+    prepared.warnings.append("%s%s; the points are used as a scattered layout" % (where, why))
     return replace(prepared, grid=Scattered(np.arange(prepared.u.size),
                                             "scattered (grid too distorted)"))

@@ -361,7 +361,8 @@ def _arrange(ms, proj, options, warnings, surface=None):
             raise GridError("%s (expected a grid whose map to the face can be inverted; "
                             "--layout scattered uses the points as they are)" % why,
                             file=ms.source)
-        warnings.append("%s; the points are used as a scattered layout" % why)
+        warnings.append("%s%s; the points are used as a scattered layout"
+                        % ("%s: " % ms.source if ms.source else "", why))
         grid = Scattered(np.arange(proj.u.size), "scattered (grid too distorted)")
     if isinstance(grid, Scattered) and proj.u.size < MIN_SCATTERED:
         raise InputError("%d measured point(s): too few to compensate (expected a grid of at "

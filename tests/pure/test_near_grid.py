@@ -155,7 +155,8 @@ def test_sheared_grid_that_fails_one_sample_of_the_face_falls_back_at_build_time
     assert prep.grid.shape == (5, 3)
     assert comp.prepared.grid.rows_from == "scattered (grid too distorted)"
     assert prep.warnings == comp.prepared.warnings == [
-        "the 5 x 3 grid found in the points (rows of constant u on the face) is too distorted "
+        "<simulated measurement>: the 5 x 3 grid found in the points (rows of constant u on the "
+        "face) is too distorted "
         "for the grid route: could not locate (u, v) = (0.214286, 0.375) on the measurement "
         "grid; the points are used as a scattered layout"]
     assert comp.checks.max_error_at_points < 1e-4
