@@ -90,6 +90,18 @@ def _pchip_slopes(F, axis):
     return np.moveaxis(d, 0, axis)
 
 
+def _position_ends(F, d, axis):
+    """End slopes ``d`` of the (u, v) channels (0 and 1) made the end secant where PCHIP
+    gives zero: rows of uneven spacing (a staggered, near-grid layout: secants 0.1, 0.4,
+    0.1, ...) make the three-point end slope change sign, and a zero slope of both
+    channels leaves the map's linear continuation beyond that border flat, so no point
+    beyond it can be located. The secant keeps the ends monotone (at most 3 times it)."""
+    F, d = np.moveaxis(F, axis, 0), np.moveaxis(d, axis, 0)
+    for end, m0 in ((0, F[1, ..., :2] - F[0, ..., :2]), (-1, F[-1, ..., :2] - F[-2, ..., :2])):
+        d[end, ..., :2] = np.where(d[end, ..., :2] == 0.0, m0, d[end, ..., :2])
+    return np.moveaxis(d, 0, axis)
+
+
 class GridField:
     """C1 interpolant of values given on an n x m measurement grid, evaluated at (u, v).
 
@@ -127,7 +139,8 @@ class GridField:
         """PCHIP node slopes (d/ds, d/dt) of every channel, made on first use."""
         got = self.__dict__.get("_slope_cache")
         if got is None:
-            got = self._slope_cache = (_pchip_slopes(self._F, 0), _pchip_slopes(self._F, 1))
+            got = self._slope_cache = tuple(_position_ends(self._F, _pchip_slopes(self._F, a), a)
+                                            for a in (0, 1))
         return got
 
     def _kd(self):

@@ -12,12 +12,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..errors import GridError, InputError, MeasurementFileError
+from ..errors import ComputationError, GridError, InputError, MeasurementFileError
 from . import bspline, plausibility
 from .corrected import DEFAULT_REFINE, construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
 from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
 from .grid import Scattered, grid_from_indices, grid_from_uv
+from .grid_check import as_scattered, unlocatable
 from .memory import return_free_memory
 from .methods import METHODS, compute_correction
 from .progress import report, sub
@@ -237,7 +238,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
     _check_units(surface, d, warnings, ms.source)
     nominal = ms.nominal if ms.nominal is not None else proj.foot
     report(progress, 0.85, "arranging the points on their grid")
-    grid = _arrange(ms, proj, options, warnings)
+    grid = _arrange(ms, proj, options, warnings, surface)
     report(progress, 1.0, "%s layout" % ("scattered" if isinstance(grid, Scattered)
                                          else "%d x %d grid" % grid.shape))
     return Prepared(u=proj.u, v=proj.v, nominal=np.asarray(nominal, dtype=float), normal=normal,
@@ -349,9 +350,19 @@ def _check_units(surface, d, warnings, source):
 MIN_SCATTERED = 4
 
 
-def _arrange(ms, proj, options, warnings):
+def _arrange(ms, proj, options, warnings, surface=None):
     """The points' grid (from row/col columns or the (u, v) pattern) or a scattered layout."""
     grid = _grid_or_scattered(ms, proj, options, warnings)
+    why = None if isinstance(grid, Scattered) or surface is None else unlocatable(
+        grid, proj.u, proj.v, surface.u_range, surface.v_range)
+    if why is not None:
+        if options.layout == "grid":
+            raise GridError("%s (expected a grid whose map to the face can be inverted; "
+                            "--layout scattered uses the points as they are)" % why,
+                            file=ms.source)
+        warnings.append("%s%s; the points are used as a scattered layout"
+                        % ("%s: " % ms.source if ms.source else "", why))
+        grid = Scattered(np.arange(proj.u.size), "scattered (grid too distorted)")
     if isinstance(grid, Scattered) and proj.u.size < MIN_SCATTERED:
         raise InputError("%d measured point(s): too few to compensate (expected a grid of at "
                          "least 2 x 2 points or at least %d scattered points)"
@@ -458,7 +469,13 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
                           fit=fit, scale=scale)
     if not build:
         return result
-    build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
+    try:
+        build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
+    except ComputationError as exc:
+        again = as_scattered(prepared, options, exc)
+        if again is None:
+            raise
+        return compensate(surface, outward, again, options, build, progress)
     report(progress, 1.0, "done")
     return result
 

@@ -353,7 +353,8 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
         (``SimulationResult.compensations[label]``) for reports.
     points : ndarray (P, 3), optional
         Measure at these nominal points (a measurement plan, in its order) instead of the
-        grid nodes, compensated as a scattered layout; ``grid`` then sets the evaluation
+        grid nodes, compensated as ``compensate --layout auto`` would (a grid when they form
+        one, else a scattered layout); ``grid`` then sets the evaluation
         grid only, and the statistics' ``'grid'`` are those at the points. (Not with
         ``keep``.)
 
@@ -376,9 +377,9 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     nodes = layout.node_mask()
     b = layout.between
     ms = _measurement_set(surface, outward, layout, points)
-    # a plan's points are a scattered layout (the smoothing fit), even when nearly in rows
-    prepared = prepare(surface, outward, ms, Options(
-        max_offset=100.0, layout="auto" if points is None else "scattered"))
+    # a plan's points take the layout compensate would give them (a grid when they form
+    # one whose map covers the face, else the scattered route), as a measured plan's do
+    prepared = prepare(surface, outward, ms, Options(max_offset=100.0, layout="auto"))
     nrm = ms.normal
     if points is not None:
         shop.probe_uv = (prepared.u, prepared.v)
