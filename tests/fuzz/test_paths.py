@@ -23,6 +23,7 @@ BOX = "box"
 INPUTS = I.setup(I.copy("nominal.step", EXAMPLE_STEP), I.put("m.csv", I.csv),
                  I.put("in.ngc", I.SMALL_PROGRAM), I.put("e.csv", I.AXIS_CSV),
                  I.put("plan.csv", I.csv),
+                 I.put("t.txt", "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"),
                  I.folder("v/sub"), I.link("vlink", "v/sub"), I.put("afile", "a file"))
 DOC_INPUTS = I.setup(INPUTS, I.put("d.FCStd", I.document_bytes))
 
@@ -156,7 +157,8 @@ def _registry_pairs():
 
 #: a file for each input of the registry (by label)
 FILE_OF = {"NOMINAL": "nominal.step", "MEASUREMENTS": "m.csv", "--axis-errors": "e.csv",
-           "IN.ngc": "in.ngc", "--plan": "plan.csv", "--program": "in.ngc"}
+           "IN.ngc": "in.ngc", "--plan": "plan.csv", "--program": "in.ngc",
+           "--transform": "t.txt"}
 
 
 @pytest.mark.parametrize("command, inp, out", _registry_pairs(),
