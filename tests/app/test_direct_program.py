@@ -162,6 +162,7 @@ def blade(tmp_path_factory):
     return (tmp, step, csv) + cam_programs(tmp, step, csv, BLADE_DEFLECTION)
 
 
+@pytest.mark.scale
 def test_direct_program_agrees_with_the_cam_route_on_the_blade(blade):
     tmp, step, csv, finish, regen, corrected = blade
     d, d0, _out = agreement(tmp, step, csv, finish, regen, corrected)
