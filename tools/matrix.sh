@@ -174,9 +174,12 @@ run_entry() {
       >"$log" 2>&1 || rc=$?
     versions=$(in_root "$root" /usr/bin/python3 /root/surfcomp/tools/versions.py --summary 2>/dev/null) || true
   fi
-  # pytest's last line: "560 passed in 347.38s (0:05:47)" or "2 failed, 558 passed in ..."
-  result=$(grep -E '[0-9]+ (passed|failed|errors?)\b.* in [0-9.]+s' "$log" | tail -1 | sed -E 's/^=+ //; s/ =+$//')
-  if [ "$rc" != 0 ] || [ -z "$result" ] || grep -qE '[0-9]+ (failed|errors?|skipped)' <<<"$result"; then
+  # pytest's result lines: "560 passed in 347.38s (0:05:47)" or "2 failed, 558 passed in
+  # ..." (a full parallel run has two: the rest, then the GUI sessions); every one counts
+  local results
+  results=$(grep -E '[0-9]+ (passed|failed|errors?)\b.* in [0-9.]+s' "$log" | sed -E 's/^=+ //; s/ =+$//')
+  result=$(tr '\n' ';' <<<"$results" | sed -E 's/;$//; s/;/; /g')
+  if [ "$rc" != 0 ] || [ -z "$result" ] || grep -qE '[0-9]+ (failed|errors?|skipped)' <<<"$results"; then
     [ "$rc" = 0 ] && rc=1
     say "$suite: FAILED (exit $rc); the end of $log:"
     tail -60 "$log" >&2

@@ -3,7 +3,7 @@
 
 The settings are properties of the measurement object (``AlignMethod``, ``AlignFaces``,
 ``AlignDof``, ``AlignRps``, ``AlignTransform``: the measurement knows its frame); the
-result goes to the compensation (``AlignMatrix``, ``AlignSummary``). Messages name those
+result goes to the compensation (``AlignMatrix``, ``Alignment``). Messages name those
 properties.
 """
 
@@ -55,4 +55,4 @@ def store(obj, alignment):
         return
     d = None if alignment is None else alignment.as_dict()
     obj.AlignMatrix = [] if d is None else [float(x) for row in d["matrix"] for x in row]
-    obj.AlignSummary = [] if d is None else summary_lines(d) + list(alignment.warnings)
+    obj.Alignment = [] if d is None else summary_lines(d) + list(alignment.warnings)

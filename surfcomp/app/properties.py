@@ -144,7 +144,7 @@ ALIGNMENT_RESULTS = (
      QT_TRANSLATE_NOOP("App::Property", "The measured points' alignment: 4x4 matrix row-major, "
                                         "measured -> nominal (empty: none)"),
      None, _RO),
-    ("App::PropertyStringList", "AlignSummary", _RES,
+    ("App::PropertyStringList", "Alignment", _RES,
      QT_TRANSLATE_NOOP("App::Property", "The alignment: transform, RMS before and after per "
                                         "face, iterations, what it absorbed"),
      None, _RO),

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Alignment in the document (issue 28): the measurement object's Align* properties, the
-compensation's AlignMatrix and AlignSummary, recomputed headless."""
+compensation's AlignMatrix and Alignment, recomputed headless."""
 
 import numpy as np
 import Part
@@ -24,7 +24,7 @@ def test_transform_and_bestfit_properties(tmp_path, fresh_doc):
     doc = fresh_doc
     meas, comp = _doc(doc, tmp_path, np.eye(4))
     doc.recompute()
-    assert comp.AlignMatrix == [] and comp.AlignSummary == []
+    assert comp.AlignMatrix == [] and comp.Alignment == []
     unmoved = np.array(comp.Deviation)
     (tmp_path / "moved").mkdir()
     meas2, comp2 = _doc(doc, tmp_path / "moved", MOVE)
@@ -34,7 +34,7 @@ def test_transform_and_bestfit_properties(tmp_path, fresh_doc):
     assert_allclose(np.array(comp2.Deviation), unmoved, atol=1e-4)
     meas2.AlignMethod = "bestfit"
     doc.recompute()
-    summary = "\n".join(comp2.AlignSummary)
+    summary = "\n".join(comp2.Alignment)
     assert "Alignment:    bestfit" in summary and "absorbed on the compensated face" in summary
     assert any("absorbed a mean offset" in w for w in comp2.Warnings)
     assert abs(np.mean(comp2.Deviation)) < abs(np.mean(unmoved))
