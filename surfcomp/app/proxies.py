@@ -49,18 +49,9 @@ def migrate(obj, table, version, renamed=None):
     return added
 
 
-class Proxy:
-    """No state on the proxy (``dumps``/``loads`` for FreeCAD 1.x, ``__getstate__``/
-    ``__setstate__`` for 0.20 return None); properties upgraded on restore."""
-
-    PROPERTIES = ()
-    VERSION = 1
-    #: ``{old name: new name}`` of renamed properties (moved on restore)
-    RENAMED = {}
-
-    def __init__(self, obj):
-        add_properties(obj, self.PROPERTIES)
-        obj.Proxy = self
+class Stateless:
+    """A proxy with nothing to save: FreeCAD's pickling hooks, in both spellings (0.20 calls
+    ``dumps``/``loads``, 1.x ``__getstate__``/``__setstate__``)."""
 
     def dumps(self):
         return None
@@ -73,6 +64,20 @@ class Proxy:
 
     def __setstate__(self, state):
         return None
+
+
+class Proxy(Stateless):
+    """No state on the proxy (``dumps``/``loads`` for FreeCAD 1.x, ``__getstate__``/
+    ``__setstate__`` for 0.20 return None); properties upgraded on restore."""
+
+    PROPERTIES = ()
+    VERSION = 1
+    #: ``{old name: new name}`` of renamed properties (moved on restore)
+    RENAMED = {}
+
+    def __init__(self, obj):
+        add_properties(obj, self.PROPERTIES)
+        obj.Proxy = self
 
     def onDocumentRestored(self, obj):
         migrate(obj, self.PROPERTIES, self.VERSION, self.RENAMED)

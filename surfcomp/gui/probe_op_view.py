@@ -13,11 +13,12 @@ import FreeCAD
 from .. import paths
 from ..app import features
 from ..app.probe_op import is_probe_operation
+from ..app.proxies import Stateless
 
 MODE = "Waypoints"
 
 
-class ViewProviderProbeOperation:
+class ViewProviderProbeOperation(Stateless):
     """No state: ``dumps``/``loads`` return None."""
 
     def __init__(self, vobj):
@@ -37,18 +38,6 @@ class ViewProviderProbeOperation:
 
     def getIcon(self):
         return paths.icon("SurfComp_AddProbeOperation.svg")
-
-    def dumps(self):
-        return None
-
-    def loads(self, state):
-        return None
-
-    def __getstate__(self):
-        return None
-
-    def __setstate__(self, state):
-        return None
 
 
 def attach(obj):
