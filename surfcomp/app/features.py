@@ -86,8 +86,6 @@ def migrate(obj, table):
 
 
 # -- measurement object --------------------------------------------------------------------
-
-
 class MeasurementFeature(_Proxy):
     """Proxy of ``SurfComp_Measurement``: a measurement set stored in the document."""
 
@@ -242,8 +240,6 @@ def _restored(obj):
 
 
 # -- compensation feature -----------------------------------------------------------------
-
-
 def is_type(obj, typ):
     """True when ``obj`` is a surfcomp feature of ``typ`` (``MEASUREMENT_TYPE`` ...)."""
     return getattr(getattr(obj, "Proxy", None), "Type", None) == typ
