@@ -89,6 +89,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError, MeasurementFileError
+from .columns import ALIASES, GROUP_TEXT, GROUPS, HINTS, LENGTH_ROLES, norm, role_of
 from .files import clip, read_bytes
 from .measurement_set import (  # noqa: F401  (MeasurementSet: the readers' result)
     _EXPECTED_COMBOS,
@@ -104,58 +105,9 @@ from .measurement_set import (  # noqa: F401  (MeasurementSet: the readers' resu
     ignored_column_warnings,
     listed_names,
 )
-from .units import SUFFIX_BRACKET, UNIT_FACTORS, split_unit_suffix, unit_factor
+from .pointfile_rows import _NONFINITE, _NUMBER
+from .units import UNIT_FACTORS, unit_factor
 
-_AXES = (("x", "a", "alpha", "i"), ("y", "b", "beta", "j"), ("z", "c", "gamma", "k"))
-
-
-def _build_aliases():
-    nominal, measured, normal = {}, {}, {}
-    for x, a, greek, ijk in _AXES:
-        nominal[x + "_nom"] = [f % x for f in ("%s_nom", "nom_%s", "%s_nominal", "nominal_%s",
-                                                "%snom", "nom%s", "%sn")]
-        measured[x + "_meas"] = [f % x for f in (
-            "%s_meas", "meas_%s", "%s_measured", "measured_%s", "%s_mes", "mes_%s", "%s_act",
-            "act_%s", "%s_actual", "actual_%s", "%smeas", "meas%s", "%sact", "act%s", "%sm")]
-        normal[ijk] = [ijk, "n" + x, "n_" + x, "normal_" + x, "cos" + x, "cos_" + x,
-                       "cos" + a, "cos_" + a, "cos" + greek, "cos_" + greek]
-    return {**nominal, **measured, **normal,
-            "dev": ["dev", "deviation", "d", "t", "error", "err"],
-            "row": ["row", "row_index", "row_idx"],
-            "col": ["col", "column", "col_index", "col_idx", "column_index"],
-            "id": ["id", "name", "point", "point_id", "point_name", "pt", "label"]}
-
-
-#: role -> accepted (normalised) column names; the module docstring lists the same
-ALIASES = _build_aliases()
-_ROLE_OF = {name: role for role, names in ALIASES.items() for name in names}
-
-#: groups of roles that come together
-GROUPS = {
-    "nominal": ("x_nom", "y_nom", "z_nom"),
-    "measured": ("x_meas", "y_meas", "z_meas"),
-    "normal": ("i", "j", "k"),
-    "deviation": ("dev",),
-    "grid": ("row", "col"),
-}
-_GROUP_TEXT = {
-    "nominal": "nominal point (x_nom y_nom z_nom)",
-    "measured": "measured point (x_meas y_meas z_meas)",
-    "normal": "normal (i j k)",
-    "deviation": "deviation (dev)",
-}
-_LENGTH_ROLES = GROUPS["nominal"] + GROUPS["measured"] + GROUPS["deviation"]
-
-_AMBIGUOUS = ("x, y, z alone are ambiguous (nominal or measured?): name the columns "
-              "x_nom y_nom z_nom or x_meas y_meas z_meas")
-_COMPONENTS = ("dx, dy, dz (deviation components) are not read: give the deviation along the "
-               "normal as dev with i j k, or the measured point x_meas y_meas z_meas")
-#: normalised names that are not accepted -> why
-_HINTS = {"x": _AMBIGUOUS, "y": _AMBIGUOUS, "z": _AMBIGUOUS,
-          "dx": _COMPONENTS, "dy": _COMPONENTS, "dz": _COMPONENTS}
-
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_NONFINITE = re.compile(r"[+-]?(?:nan|inf|infinity)", re.IGNORECASE)
 #: white space other than blanks, tabs and newlines (ASCII; str.isspace's others)
 _OTHER_SPACE = "\r\x0b\x0c\x1c\x1d\x1e\x1f"
 _EXPECTED_PLAN = "expected a plan: id, nominal x_nom y_nom z_nom and normal i j k"
@@ -227,26 +179,6 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm", plan=False):
         parser = _Parser(text, source, default_factor)
         parser.plan = plan
         return parser.run(hashlib.sha256(raw).hexdigest())
-
-
-def _norm(name):
-    return re.sub(r"[^0-9a-z]+", "_", name.lower()).strip("_")
-
-
-def _role_of(name):
-    """(role or None, unit or None, bracket unit not understood or None) of a header name."""
-    base, unit = split_unit_suffix(name)
-    if unit is not None:
-        role = _ROLE_OF.get(_norm(base))
-        if role is not None:
-            return role, unit, None
-    role = _ROLE_OF.get(_norm(name))
-    if role is not None:
-        return role, None, None
-    m = SUFFIX_BRACKET.match(name)
-    if m and _ROLE_OF.get(_norm(m.group("base"))):
-        return _ROLE_OF[_norm(m.group("base"))], None, m.group("unit")
-    return None, None, None
 
 
 def _unquote(text):
@@ -369,7 +301,7 @@ class _Parser:
                 ms.deviation = computed
             else:
                 self._check_deviation(ms.deviation, computed, data)
-        used = [factors[col_of[r]] for r in _LENGTH_ROLES if r in col_of]
+        used = [factors[col_of[r]] for r in LENGTH_ROLES if r in col_of]
         ms.units = _UNIT_NAMES.get(used[0], "mixed") if len(set(used)) == 1 else "mixed"
         return ms
 
@@ -381,7 +313,7 @@ class _Parser:
                 continue
             body = s[2:] if s.startswith("//") else s.lstrip("#")
             names = [_unquote(f) for f in _splitter(_detect_separator(body))(body)]
-            if any(_role_of(n)[0] for n in names):
+            if any(role_of(n)[0] for n in names):
                 return "; line %d looks like the header but is a comment" % (k + 1)
             return ""
         return ""
@@ -389,14 +321,14 @@ class _Parser:
     def _header(self, names, h):
         roles, factors, ignored, first = {}, {}, [], {}
         for c, name in enumerate(names):
-            role, unit, bad_unit = _role_of(name)
+            role, unit, bad_unit = role_of(name)
             if role is None:
                 ignored.append(c)
                 continue
             if bad_unit is not None:
                 raise self.error("column '%s' has the unit %r, which is not known (expected a "
                                  "suffix [mm], [um] or [in], or none)" % (name, bad_unit), h, c + 1)
-            if unit is not None and role not in _LENGTH_ROLES:
+            if unit is not None and role not in LENGTH_ROLES:
                 raise self.error("column '%s' (%s) takes no unit (expected the name without "
                                  "the [%s] suffix)" % (name, role, unit), h, c + 1)
             if role in first:
@@ -406,7 +338,7 @@ class _Parser:
             first[role] = c
             roles[c] = role
             factors[c] = UNIT_FACTORS[unit] if unit is not None else self.default_factor
-        hints = sorted({_HINTS[_norm(names[c])] for c in ignored if _norm(names[c]) in _HINTS})
+        hints = sorted({HINTS[norm(names[c])] for c in ignored if norm(names[c]) in HINTS})
         hint = "".join("; " + t for t in hints)
         if not roles:
             shown = listed_names(names)
@@ -430,11 +362,11 @@ class _Parser:
             lost = listed_names([names[c] for c in ignored])
             raise self.error("the header has %sno %s (%s)%s%s"
                              % (got + " but " if got else "",
-                                " and no ".join(_GROUP_TEXT[g] for g in need),
+                                " and no ".join(GROUP_TEXT[g] for g in need),
                                 _EXPECTED_PLAN if self.plan else _EXPECTED_COMBOS,
                                 "; ignored columns: " + lost if lost else "", hint), h)
         self.warnings.extend(ignored_column_warnings(self.source, h + 1, [
-            (c + 1, names[c], _HINTS.get(_norm(names[c]), "not a known column name")
+            (c + 1, names[c], HINTS.get(norm(names[c]), "not a known column name")
              if names[c] else "it has no name") for c in ignored]))
         if "deviation" in have and "measured" in have and "normal" not in have:
             c = first["dev"]

@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose, assert_array_equal
 
 from surfcomp.errors import InputError, MeasurementFileError
-from surfcomp.io import measurements
+from surfcomp.io import columns, measurements
 from surfcomp.io.measurements import MeasurementSet, parse_measurements, read_measurements
 from tests.conftest import ROOT
 
@@ -190,8 +190,8 @@ SPEC_ALIASES = {
 
 @pytest.mark.parametrize("role, name", [(r, n) for r, ns in SPEC_ALIASES.items() for n in ns])
 def test_aliases_of_the_spec(role, name):
-    assert measurements._role_of(name.upper())[0] == role
-    assert measurements._role_of(name)[0] == role
+    assert columns.role_of(name.upper())[0] == role
+    assert columns.role_of(name)[0] == role
 
 
 def test_every_alias_in_mixed_case_reads_the_same_data():
@@ -203,11 +203,11 @@ def test_every_alias_in_mixed_case_reads_the_same_data():
     dev = np.array([0.01, -0.02, 0.005])
     meas = nom + dev[:, None] * nrm
     rows = np.column_stack([nom, meas, nrm, dev, [0, 0, 1], [0, 1, 0]])
-    longest = max(len(v) for v in measurements.ALIASES.values())
+    longest = max(len(v) for v in columns.ALIASES.values())
     for pick in range(longest):
         names = []
         for r in roles:
-            alias = measurements.ALIASES[r][pick % len(measurements.ALIASES[r])]
+            alias = columns.ALIASES[r][pick % len(columns.ALIASES[r])]
             names.append("".join(ch.upper() if q % 2 else ch for q, ch in enumerate(alias)))
         body = [",".join([repr(v) for v in r] + ["p%d" % q]) for q, r in enumerate(rows.tolist())]
         ms = parse_measurements("\n".join([",".join(names)] + body))
@@ -222,7 +222,7 @@ def test_every_alias_in_mixed_case_reads_the_same_data():
                                         ("Nominal.X", "x_nom"), ("Actual X", "x_meas"),
                                         ("cos(alpha)", "i"), ("Point #", "id"), ("temp[C]", None)])
 def test_name_normalisation(name, role):
-    assert measurements._role_of(name)[0] == role
+    assert columns.role_of(name)[0] == role
 
 
 def test_alias_table_in_docstring_matches_the_code():
@@ -230,7 +230,7 @@ def test_alias_table_in_docstring_matches_the_code():
     section = doc[doc.index("Alias table"):doc.index("``x``, ``y``, ``z`` alone")]
     entries = re.findall(r"^- ``(\w+)``: (.*?)(?=^- |\Z)", section, re.M | re.S)
     table = {role: [n.strip() for n in names.split(",")] for role, names in entries}
-    assert table == measurements.ALIASES
+    assert table == columns.ALIASES
     every = [n for names in table.values() for n in names]
     assert len(set(every)) == len(every), "an alias names two roles"
 
