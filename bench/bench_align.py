@@ -4,11 +4,11 @@
 Run: /usr/bin/python3 bench/bench_align.py [--points N] [--grid G] [--workers W] [--sigma MM]
 
 Data: N points (default 1,000,000) spread over the bundled example face
-(:func:`surfcomp.core.presets.werner_surface`, 45 x 45 mm), 2 um normal noise (``--sigma 0``:
-exact points), moved by a known rigid transform (3 degrees about a skew axis, 5 mm). Ours: the
-whole :func:`surfcomp.core.align.best_fit` call (projection engines built, pre-alignment, the fit
-on a subsample, then on all points, exact point-to-surface distance, Tukey weights).
-Baseline in the same run on the same points: point-to-plane ICP (Chen & Medioni 1992)
+(:func:`surfcomp.core.simulation.presets.werner_surface`, 45 x 45 mm), 2 um normal noise (``--sigma
+0``: exact points), moved by a known rigid transform (3 degrees about a skew axis, 5 mm). Ours: the
+whole :func:`surfcomp.core.measurement.align.best_fit` call (projection engines built,
+pre-alignment, the fit on a subsample, then on all points, exact point-to-surface distance, Tukey
+weights). Baseline in the same run on the same points: point-to-plane ICP (Chen & Medioni 1992)
 against a G x G tessellation of the face (vertex normals), nearest vertex by scipy's
 cKDTree, least squares, iterated until a step moves no point more than 1e-9 mm (at most
 100 iterations). Both are compared with the known transform: rotation error and the
@@ -27,8 +27,9 @@ from scipy.spatial.transform import Rotation
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core import align, bspline  # noqa: E402
-from surfcomp.core.presets import werner_surface  # noqa: E402
+from surfcomp.core.measurement import align  # noqa: E402
+from surfcomp.core.simulation.presets import werner_surface  # noqa: E402
+from surfcomp.core.surface import bspline  # noqa: E402
 
 
 def data(surf, n, sigma=2e-3, seed=28):

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The B-spline collocation matrix: scipy's ``BSpline.design_matrix`` (what
-``surfcomp.core.bspline_basis.basis_matrix`` uses where the installed scipy has it with
+``surfcomp.core.surface.bspline_basis.basis_matrix`` uses where the installed scipy has it with
 extrapolation, 1.10 and later) beside the hand-written basis (NURBS book A2.2), in the
 same run.
 
@@ -21,7 +21,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core import bspline_basis as bb  # noqa: E402
+from surfcomp.core.surface import bspline_basis as bb  # noqa: E402
 
 
 def best(fn, repeat):

@@ -27,7 +27,7 @@ sys.path.insert(0, os.environ["SURFCOMP_ROOT"])
 from examples.make_example import deviation_field
 from surfcomp.app import features
 from surfcomp.app.nominal import load_nominal
-from surfcomp.core import bspline
+from surfcomp.core.surface import bspline
 from surfcomp.io.measurements import MeasurementSet
 from surfcomp.gui import viewproviders
 import Part

@@ -96,7 +96,7 @@ def raster_program(keep, moves):
     """A drop-cutter raster program of about ``moves`` moves on the example face."""
     import numpy as np
 
-    from surfcomp.core.presets import werner_surface
+    from surfcomp.core.simulation.presets import werner_surface
     from tests.toolpath_checks import drop_cutter
 
     path = os.path.join(keep, "raster_%d.ngc" % moves)

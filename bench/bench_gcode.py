@@ -17,7 +17,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core.axis_errors import AxisErrorModel  # noqa: E402
+from surfcomp.core.axis.axis_errors import AxisErrorModel  # noqa: E402
 from surfcomp.io.gcode import compensate_gcode, parse_gcode, read_gcode  # noqa: E402
 
 BEAR = os.path.join(ROOT, "tests", "data", "real", "gcode", "CAMotics_GPL", "bear.nc")

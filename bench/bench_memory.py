@@ -60,7 +60,7 @@ def inspect_case(n, folder):
 #: the reference the block-by-block peak is measured beside
 WHOLE = """
 import sys
-from surfcomp.core.axis_errors import fit_axis_errors
+from surfcomp.core.axis.axis_errors import fit_axis_errors
 from surfcomp.io.axis_csv import read_axis_errors
 from surfcomp.io.gcode import compensate_gcode, read_gcode
 model = fit_axis_errors(read_axis_errors(sys.argv[2]).data)

@@ -38,7 +38,7 @@ def make_case(n, folder, rotated=False):
 
     from examples.make_example import deviation_field, nominal_surface
     from surfcomp.app.convert import surface_from_part
-    from surfcomp.core.bspline import derivatives
+    from surfcomp.core.surface.bspline import derivatives
 
     surf = surface_from_part(nominal_surface())
     t = np.linspace(0.01, 0.99, n)

@@ -74,7 +74,7 @@ def main(argv=None):
     from surfcomp.app import fcenv
 
     fcenv.import_freecad()
-    from surfcomp.core.planning import PlanSettings, parse_count
+    from surfcomp.core.measurement.planning import PlanSettings, parse_count
 
     cases = [("example face, grid %s" % args.example_count, EXAMPLE, "grid",
               parse_count(args.example_count), PlanSettings(), 1.0),

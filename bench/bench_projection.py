@@ -21,8 +21,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from surfcomp.core import bspline  # noqa: E402
-from surfcomp.core.projection import Projector  # noqa: E402
+from surfcomp.core.surface import bspline  # noqa: E402
+from surfcomp.core.surface.projection import Projector  # noqa: E402
 
 
 def bench_face():

@@ -47,7 +47,7 @@ def scattered_points(n, seed=None):
     """N measured points (mm) scattered uniformly over the example face's (u, v) in
     [0.01, 0.99]^2, each off the face by the example's deviation field plus 1.5 um noise."""
     from examples.make_example import deviation_field, example_surface
-    from surfcomp.core import bspline
+    from surfcomp.core.surface import bspline
 
     surf = example_surface()
     rng = np.random.default_rng(n if seed is None else seed)
@@ -80,7 +80,7 @@ def blade_face():
 def blade_points(surf, n, offset, seed=7):
     """N points off the face by a distance uniform in [-offset, offset] mm along the
     normal, at parameters uniform over the face; also the feet and distances."""
-    from surfcomp.core import bspline
+    from surfcomp.core.surface import bspline
 
     rng = np.random.default_rng(seed)
     u = rng.uniform(*surf.u_range, n)
@@ -167,7 +167,7 @@ def _run_child(kind, *args):
         n, offset, workers = int(args[0]), float(args[1]), int(args[2]) or None
         _, surf = blade_face()
         X = blade_points(surf, n, offset)
-        from surfcomp.core.projection import Projector
+        from surfcomp.core.surface.projection import Projector
 
         t, c = time.perf_counter(), time.process_time()
         r = Projector(surf, workers=workers, min_samples=n // 16).project(X)
@@ -179,7 +179,7 @@ def _run_child(kind, *args):
         import FreeCAD
         import Part
 
-        from surfcomp.core.projection import project
+        from surfcomp.core.surface.projection import project
 
         X = blade_points(surf, n, offset, seed=seed)
         t, c = time.perf_counter(), time.process_time()

@@ -5,8 +5,9 @@ then the papers' table on the bundled example's face.
     /usr/bin/python3 bench/bench_simulate.py [--presets [NAME ...]] [--grid [N ...]]
         [--replicas 4] [--sigma 0.0015 ...] [--maps OUT.png [--maps-preset NAME]]
 
-Per preset: the wall seconds of the simulation itself (``surfcomp.core.presets.run_preset``,
-seed 0) and of the whole command ``python3 -m surfcomp simulate --preset NAME`` in a fresh
+Per preset: the wall seconds of the simulation itself
+(``surfcomp.core.simulation.presets.run_preset``, seed 0) and of the whole command ``python3 -m
+surfcomp simulate --preset NAME`` in a fresh
 process (imports included), the load average of the machine, and the side-by-side table.
 Per example case: wall seconds and the before/after table (mean (range) over replicas)
 for the default model, and the per-replica standard deviations (mirror paper Tab. 2
@@ -25,8 +26,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from examples.make_example import example_surface  # noqa: E402
-from surfcomp.core import presets  # noqa: E402
-from surfcomp.core import simulate as sm  # noqa: E402
+from surfcomp.core.simulation import presets  # noqa: E402
+from surfcomp.core.simulation import simulate as sm  # noqa: E402
 
 
 def bench_presets(names, maps=None, maps_preset=None):

@@ -74,7 +74,7 @@ def face_build(meas):
     import Part
 
     from surfcomp.app.nominal import load_nominal
-    from surfcomp.core.pipeline import Options, build_surface, compensate, prepare
+    from surfcomp.core.compensation.pipeline import Options, build_surface, compensate, prepare
     from surfcomp.io.readers import read_any
 
     nom = load_nominal(NOMINAL)

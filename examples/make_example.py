@@ -21,16 +21,17 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
 from surfcomp.app import fcenv  # noqa: E402
-from surfcomp.core.presets import werner_surface  # noqa: E402
+from surfcomp.core.simulation.presets import werner_surface  # noqa: E402
 
 SEED = 20221
 GRID = 45
 
 
 def example_surface():
-    """The example face as a core :class:`surfcomp.core.bspline.Surface` (no FreeCAD):
+    """The example face as a core :class:`surfcomp.core.surface.bspline.Surface` (no FreeCAD):
     7 x 7 poles, bicubic, interior knots 0.25, 0.5, 0.75; built by
-    :func:`surfcomp.core.presets.werner_surface` (the ``werner2022`` preset's surface)."""
+    :func:`surfcomp.core.simulation.presets.werner_surface` (the ``werner2022`` preset's
+    surface)."""
     return werner_surface()
 
 

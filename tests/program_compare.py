@@ -40,7 +40,7 @@ def surface_distance(surface, outward, radius, a, b, carry=None, near=0.5, windo
     (distance, xy_shift)
         ``distance`` (k,) and the XY distance to the sample of B each was carried from.
     """
-    from surfcomp.core.projection import project
+    from surfcomp.core.surface.projection import project
 
     carry = surface if carry is None else carry
     z_here, pr = drop_cutter(carry, outward, a[:, :2], a[:, 2], radius)

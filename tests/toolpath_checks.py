@@ -9,9 +9,9 @@ by ``-t / n_z`` (``n_z`` the normal's Z component there).
 
 import numpy as np
 
-from surfcomp.core.bspline import Surface
-from surfcomp.core.corrected import realised_correction
-from surfcomp.core.projection import project
+from surfcomp.core.compensation.corrected import realised_correction
+from surfcomp.core.surface.bspline import Surface
+from surfcomp.core.surface.projection import project
 
 
 def drop_cutter(surface, outward, xy, z_guess, r, iterations=8):

@@ -9,8 +9,8 @@ properties.
 
 import numpy as np
 
-from ..core.align import check_rigid, parse_dof
-from ..core.align_report import AlignOptions, summary_lines
+from ..core.measurement.align import check_rigid, parse_dof
+from ..core.measurement.align_report import AlignOptions, summary_lines
 from ..errors import InputError
 from ..io.align_files import read_rps
 

@@ -3,7 +3,7 @@
 
 Builds the reference faces from the nominal's shape (``--align-faces``; default the
 compensated face itself), reads the transform and 3-2-1 files, and calls
-:func:`surfcomp.core.align_report.align` on the measurement set's points.
+:func:`surfcomp.core.measurement.align_report.align` on the measurement set's points.
 """
 
 import dataclasses
@@ -11,8 +11,8 @@ import os
 
 import numpy as np
 
-from ..core.align import Reference
-from ..core.align_report import AlignOptions, align
+from ..core.measurement.align import Reference
+from ..core.measurement.align_report import AlignOptions, align
 from ..errors import InputError
 from ..io.align_files import face_column, read_rps, read_transform
 

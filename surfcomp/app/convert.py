@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Conversion between ``Part.BSplineSurface`` and :class:`surfcomp.core.bspline.Surface`."""
+"""Conversion between ``Part.BSplineSurface`` and :class:`surfcomp.core.surface.bspline.Surface`."""
 
 import gc
 from contextlib import contextmanager
 
 import numpy as np
 
-from ..core.bspline import Surface, compress_knots
+from ..core.surface.bspline import Surface, compress_knots
 
 
 @contextmanager

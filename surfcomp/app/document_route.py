@@ -24,7 +24,7 @@ import os
 from dataclasses import dataclass, field
 
 from ..core import budget
-from ..core.pipeline import Options
+from ..core.compensation.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
@@ -109,7 +109,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Units of measurement columns without a unit suffix.
     deviation_units : str, optional
         Unit of a deviation column without a suffix when it is not ``units``.
-    options : surfcomp.core.pipeline.Options, optional
+    options : surfcomp.core.compensation.pipeline.Options, optional
         Method, mask, edge, stock, refine (default: Werner's filtered 5x5).
     output : {'face', 'solid'}, optional
         The feature's output; default ``solid`` when the object has several faces

@@ -3,7 +3,7 @@
 
 A thin proxy in the manner of Path's own dressups (``PathDressupPathBoundary``): the proxy
 turns properties into arrays, calls :func:`surfcomp.io.gcode.compensate_commands` (which
-uses :mod:`surfcomp.core.axis_errors`, Dobariya 2015 eq. 6-16), and writes ``Path`` and a
+uses :mod:`surfcomp.core.axis.axis_errors`, Dobariya 2015 eq. 6-16), and writes ``Path`` and a
 few result properties back. No FreeCADGui, no PySide: it recomputes in ``freecadcmd``.
 
 Unlike Path's Z-correct dressup it keeps every parameter of a move (feed rates included,
@@ -26,7 +26,7 @@ import FreeCAD
 import numpy as np
 import Path
 
-from ..core.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors
+from ..core.axis.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors
 from ..errors import InputError
 from ..io.axis_csv import AxisErrorTable, read_axis_errors
 from ..io.gcode import compensate_commands

@@ -4,7 +4,7 @@
 Beside the axis-error dressup (:mod:`surfcomp.app.dressup_axis`), in the same thin manner:
 the proxy reads the base operation's commands, the compensation object's nominal and
 corrected faces, and calls :func:`surfcomp.io.gcode.offset_stream.offset_commands` (the
-direct program compensation of :mod:`surfcomp.core.program_offset`); the Job then posts
+direct program compensation of :mod:`surfcomp.core.compensation.program_offset`); the Job then posts
 the moved program without re-running the 3D Surface operation. It is parametric: a new
 measurement, another method or a next iteration round (a compensation whose ``Base`` is the
 previous round: its corrected face carries every round's correction) recomputes it, and
@@ -17,8 +17,8 @@ dressup is created. No FreeCADGui, no PySide: it recomputes in ``freecadcmd``.
 import FreeCAD
 import Path
 
-from ..core.corrected import realised_correction
-from ..core.program_offset import BallOffset
+from ..core.compensation.corrected import realised_correction
+from ..core.compensation.program_offset import BallOffset
 from ..errors import InputError
 from ..io.gcode.offset_stream import offset_commands
 from . import cam
@@ -72,8 +72,8 @@ PROPERTIES = (
 
 
 def ball_offset(obj):
-    """The :class:`~surfcomp.core.program_offset.BallOffset` of the dressup's compensation
-    (nominal and corrected face in document coordinates)."""
+    """The :class:`~surfcomp.core.compensation.program_offset.BallOffset` of the dressup's
+    compensation (nominal and corrected face in document coordinates)."""
     from .features import nominal_of
     from .reports import corrected_surface
 

@@ -3,9 +3,9 @@
 
 Both are thin proxies (see docs/architecture.md, "Document objects"): every input and
 result lives in properties, ``execute`` turns properties into arrays, calls the core
-pipeline (:func:`surfcomp.core.pipeline.prepare` / :func:`~surfcomp.core.pipeline.compensate`)
-and writes the results back. No FreeCADGui, no PySide: everything recomputes in
-``freecadcmd``.
+pipeline (:func:`surfcomp.core.compensation.pipeline.prepare` /
+:func:`~surfcomp.core.compensation.pipeline.compensate`) and writes the results back. No
+FreeCADGui, no PySide: everything recomputes in ``freecadcmd``.
 
 ``SurfComp_Measurement`` (``App::FeaturePython``)
     The parsed measurement set kept inside the document (float/int list properties, mm),
@@ -39,10 +39,16 @@ from dataclasses import replace as _dc_replace
 import FreeCAD
 import numpy as np
 
-from ..core.deviations import statistics
-from ..core.filters import EDGE_MODES
-from ..core.methods import METHODS
-from ..core.pipeline import Options, build_surface, compensate, parameter_scale, prepare
+from ..core.compensation.deviations import statistics
+from ..core.compensation.filters import EDGE_MODES
+from ..core.compensation.methods import METHODS
+from ..core.compensation.pipeline import (
+    Options,
+    build_surface,
+    compensate,
+    parameter_scale,
+    prepare,
+)
 from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
@@ -279,7 +285,7 @@ class CompensationFeature(_Proxy):
 
 
 def options_of(obj):
-    """The core :class:`~surfcomp.core.pipeline.Options` of a compensation object."""
+    """The core :class:`~surfcomp.core.compensation.pipeline.Options` of a compensation object."""
     weights = obj.Weights.strip() or None
     return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
                    mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
@@ -305,7 +311,7 @@ def check_filter(obj, **values):
     Raises
     ------
     InputError
-        The message of :meth:`surfcomp.core.pipeline.Options.validate`.
+        The message of :meth:`surfcomp.core.compensation.pipeline.Options.validate`.
     """
     kw = {}
     for name, value in values.items():
@@ -469,7 +475,7 @@ def _prepared(obj, nominal, placement, ms, options, preview, progress):
 
 def _build(nominal, prepared, comp, total, build=True, progress=None):
     """Build the corrected surface for an accumulated correction ``total`` (n, m) the
-    way :func:`surfcomp.core.pipeline.compensate` builds it for its own correction."""
+    way :func:`surfcomp.core.compensation.pipeline.compensate` builds it for its own correction."""
     corr = _dc_replace(comp.correction, delta=total)
     comp = _dc_replace(comp, correction=corr)
     comp.statistics = dict(comp.statistics)
@@ -539,7 +545,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
         ``FaceN`` of ``nominal`` (None: the only B-spline face).
     measurement : ``SurfComp_Measurement`` object
     method, mask_size, weights, edge, stock, accept_stock
-        As :class:`surfcomp.core.pipeline.Options` (``stock`` in mm, mirror method;
+        As :class:`surfcomp.core.compensation.pipeline.Options` (``stock`` in mm, mirror method;
         ``accept_stock`` uses a stock inconsistent with the measured mean).
     base : ``SurfComp_Compensation``, optional
         The previous round of an iteration.
@@ -581,7 +587,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered", mask_s
 
 
 def compensation_result(obj):
-    """The core :class:`~surfcomp.core.pipeline.Compensation` of a compensation object,
+    """The core :class:`~surfcomp.core.compensation.pipeline.Compensation` of a compensation object,
     computed from its properties and links (nothing is cached on the proxy; the last
     result is reused while those stay the same, :mod:`surfcomp.app.result_cache`).
 

@@ -12,8 +12,8 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from ..core import budget
+from ..core.compensation.pipeline import Options, compensate, prepare
 from ..core.memory import return_free_memory
-from ..core.pipeline import Options, compensate, prepare
 from ..core.progress import report as report_progress
 from ..core.progress import sub
 from ..errors import InputError

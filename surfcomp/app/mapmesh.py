@@ -14,8 +14,9 @@
 
 import numpy as np
 
-from ..core import bspline, colormap
-from ..core.trimmed import inside
+from ..core import colormap
+from ..core.surface import bspline
+from ..core.surface.trimmed import inside
 from .nominal import boundary_polylines, outside_trim
 
 #: the map lies this fraction of the face's size (its bounding box diagonal) plus

@@ -9,8 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.surface_checks import MAX_DEGREE, check_nominal
-from ..core.trimmed import inside
+from ..core.surface.surface_checks import MAX_DEGREE, check_nominal
+from ..core.surface.trimmed import inside
 from ..errors import GeometryError
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
@@ -29,7 +29,7 @@ class Nominal:
     bspline_face : Part.Face
         The same face (geometry, boundary, orientation) as a B-spline face: ``face`` itself,
         or its ``toNurbs`` form; its pcurves are in the parametrisation of ``surface``.
-    surface : surfcomp.core.bspline.Surface
+    surface : surfcomp.core.surface.bspline.Surface
         Core arrays of ``bspline_face.Surface`` made non-periodic and cut to the face's UV
         bounds (:func:`work_surface`, same parametrisation); ``u_range``/``v_range`` = those
         bounds.

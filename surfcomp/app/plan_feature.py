@@ -12,7 +12,7 @@ permanent once documents exist.
 
 import FreeCAD
 
-from ..core.planning import (
+from ..core.measurement.planning import (
     LAYOUTS,
     POINT_LAYOUTS,
     REASONS,

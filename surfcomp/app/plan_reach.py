@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Reach of planned points against the whole part, with OpenCASCADE (app layer, headless).
 
-The core (:mod:`surfcomp.core.planning_reach`) checks the probe's paths against the planned
-face itself; when the nominal face is a face of a solid (or of a shell with other faces),
+The core (:mod:`surfcomp.core.measurement.planning_reach`) checks the probe's paths against the
+planned face itself; when the nominal face is a face of a solid (or of a shell with other faces),
 the stylus ball must also stay clear of every other face: on the approach along the normal
 (stand-off to touch) and on the descent from the safe height to the stand-off. Each path is
 a segment; a face whose bounding box, widened by the ball radius, misses the segment's is
@@ -11,9 +11,9 @@ skipped, the others are measured with ``distToShape`` (exact, OCCT's BRepExtrema
 
 import numpy as np
 
-from ..core.planning_reach import CLEAR_TOL
+from ..core.measurement.planning_reach import CLEAR_TOL
 
-#: the reasons added to :data:`surfcomp.core.planning.REASONS`
+#: the reasons added to :data:`surfcomp.core.measurement.planning.REASONS`
 REASONS = {
     "part-approach": "the stylus meets another face of the part on the approach along the "
                      "normal",
@@ -79,7 +79,7 @@ def blocked_by_faces(a, b, faces, boxes, radius, tol=CLEAR_TOL):
 
 
 def part_check(shape, face_name, tip_radius):
-    """The ``extra_check`` of :func:`surfcomp.core.planning.plan_points` for the face
+    """The ``extra_check`` of :func:`surfcomp.core.measurement.planning.plan_points` for the face
     ``face_name`` (``FaceN``) of ``shape`` (None when the shape has no other face: a lone
     face)."""
     faces = other_faces(shape, face_name)
@@ -100,8 +100,8 @@ def plan_face(nominal, layout, count, settings, order="auto", progress=None):
     """``(plan, checked_part)``: plan on a :class:`surfcomp.app.nominal.Nominal` face with
     its trim boundary, the part's top and, when the shape has other faces, the paths checked
     against them (``checked_part`` True then)."""
-    from ..core.planning import plan_points
-    from ..core.planning_face import FaceDomain
+    from ..core.measurement.planning import plan_points
+    from ..core.measurement.planning_face import FaceDomain
     from .nominal import boundary_polylines
 
     domain = FaceDomain(nominal.surface, nominal.outward,

@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The measured points against a nominal face before they enter the document (the import
 preview): the same location and plausibility checks the deviation map runs
-(:func:`surfcomp.core.pipeline.prepare`: distance from the face within the max offset,
+(:func:`surfcomp.core.compensation.pipeline.prepare`: distance from the face within the max offset,
 inside its border, normals on the outward side, deviations within the max offset), so a
 unit choice that puts the points off the face is shown in the preview, not by a failed
 map later.
 """
 
-from ..core.pipeline import Options, prepare
+from ..core.compensation.pipeline import Options, prepare
 from ..errors import SurfcompError
 from .features import is_compensation, is_measurement, local_measurements, nominal_in
 

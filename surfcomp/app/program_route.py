@@ -2,20 +2,20 @@
 """Direct program compensation: nominal + measurements + finishing program -> moved program.
 
 ``compensate NOMINAL MEAS --program FINISH.ngc --tool ball:R -o FINISH_COMP.ngc``: the
-compensation is computed as for ``-o`` (:func:`surfcomp.core.pipeline.compensate`, the
+compensation is computed as for ``-o`` (:func:`surfcomp.core.compensation.pipeline.compensate`, the
 corrected surface built), and the finishing program is moved by the correction the
 corrected face realises at each cutter-location point's contact
-(:mod:`surfcomp.core.program_offset`, :mod:`surfcomp.io.gcode.offset_stream`) instead of
-regenerating the CAM operation on the corrected face. The program is written atomically,
+(:mod:`surfcomp.core.compensation.program_offset`, :mod:`surfcomp.io.gcode.offset_stream`) instead
+of regenerating the CAM operation on the corrected face. The program is written atomically,
 never over an input; nothing is written when it is refused.
 """
 
 from dataclasses import dataclass
 
 from ..core import budget
-from ..core.corrected import realised_correction
-from ..core.pipeline import compensate, prepare
-from ..core.program_offset import BallOffset, parse_tool
+from ..core.compensation.corrected import realised_correction
+from ..core.compensation.pipeline import compensate, prepare
+from ..core.compensation.program_offset import BallOffset, parse_tool
 from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
@@ -30,9 +30,9 @@ class ProgramJob:
     (:class:`surfcomp.app.file_route.Job`), the program, the tool and the output.
 
     ``tolerance``, ``segment_length`` (mm) and ``decimals``: as
-    :func:`surfcomp.core.program_offset.plan_offset` and
+    :func:`surfcomp.core.compensation.program_offset.plan_offset` and
     :class:`surfcomp.io.gcode.offset_stream.ProgramOffset` take them; ``blend`` (mm): of
-    :class:`surfcomp.core.program_offset.BallOffset`."""
+    :class:`surfcomp.core.compensation.program_offset.BallOffset`."""
 
     job: object
     program: str
@@ -47,7 +47,7 @@ class ProgramJob:
 def correction_at(nominal, comp):
     """``correction(u, v)``: the correction (mm, positive inwards) the corrected face of
     ``comp`` realises along the nominal's normal at ``(u, v)``
-    (:func:`surfcomp.core.corrected.realised_correction`, from the intended field)."""
+    (:func:`surfcomp.core.compensation.corrected.realised_correction`, from the intended field)."""
     def correction(u, v):
         return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward,
                                    guess=comp.field(u, v))

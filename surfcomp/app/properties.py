@@ -11,9 +11,9 @@ Import this module where FreeCAD is importable.
 
 import FreeCAD
 
-from ..core.filters import EDGE_MODES
-from ..core.methods import METHODS
-from ..core.pipeline import LAYOUTS
+from ..core.compensation.filters import EDGE_MODES
+from ..core.compensation.methods import METHODS
+from ..core.compensation.pipeline import LAYOUTS
 
 #: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
 #: context when it shows them)

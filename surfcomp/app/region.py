@@ -2,10 +2,10 @@
 """Compensate a region of several faces of one shape at once (issue 30; app layer).
 
 The points are located on every face of the region and each is given to its nearest face
-(:func:`surfcomp.core.region_field.assign`); the filter and the correction field work over
-the whole region in space (:mod:`surfcomp.core.region_field`), and every face is rebuilt
-from one displacement (:mod:`surfcomp.core.region_build`), so faces that share an edge
-stay closed along it. The faces are then put back in the shape and sewn at
+(:func:`surfcomp.core.compensation.region_field.assign`); the filter and the correction field work
+over the whole region in space (:mod:`surfcomp.core.compensation.region_field`), and every face is
+rebuilt from one displacement (:mod:`surfcomp.core.compensation.region_build`), so faces that share
+an edge stay closed along it. The faces are then put back in the shape and sewn at
 :data:`surfcomp.app.retrim.PRECISION`; continuity (gap and normal angle along every shared
 edge), the volume change and the realised correction at the points are measured on the
 result, with OpenCASCADE.
@@ -20,10 +20,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..core import region_build, region_field
-from ..core.bspline import derivatives, evaluate, normals
-from ..core.projection import project
-from ..core.trimmed import inside
+from ..core.compensation import region_build, region_field
+from ..core.surface.bspline import derivatives, evaluate, normals
+from ..core.surface.projection import project
+from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError
 from .convert import surface_from_part
 from .nominal import boundary_polylines, to_bspline_face, work_surface
@@ -227,8 +227,8 @@ def _angle(a, b):
 
 
 def sharp_edges(faces, edges, band):
-    """The :class:`~surfcomp.core.region_build.SharpEdges` of the region's edges that are
-    not G1, with the normals and in-face directions at their samples."""
+    """The :class:`~surfcomp.core.compensation.region_build.SharpEdges` of the region's edges that
+    are not G1, with the normals and in-face directions at their samples."""
     pts, mit, cl, eid = [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:

@@ -1,14 +1,15 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``compensate SOLID MEAS --faces F1,F2|auto -o OUT``: a region of faces, files in and out
-(issue 30). The numerics are in :mod:`surfcomp.core.region_field` and
-:mod:`surfcomp.core.region_build`, the OpenCASCADE side in :mod:`surfcomp.app.region`."""
+(issue 30). The numerics are in :mod:`surfcomp.core.compensation.region_field` and
+:mod:`surfcomp.core.compensation.region_build`, the OpenCASCADE side in
+:mod:`surfcomp.app.region`."""
 
 import json
 import os
 
 import numpy as np
 
-from ..core import region_build, region_field
+from ..core.compensation import region_build, region_field
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
@@ -171,7 +172,7 @@ def _fidelity(faces, owner, u, v, fld, base):
 
 
 def realised(f, u, v, guess):
-    from ..core.corrected import realised_correction
+    from ..core.compensation.corrected import realised_correction
 
     return realised_correction(f.surface, f.built.surface, u, v, f.outward, guess)
 

@@ -8,8 +8,8 @@ import hashlib
 
 import numpy as np
 
-from ..core.field import GridField
-from ..core.scattered import ScatteredField
+from ..core.compensation.field import GridField
+from ..core.compensation.scattered import ScatteredField
 from ..errors import InputError
 
 #: quantities of :func:`quantity_values` and :func:`deviation_field`
@@ -77,7 +77,7 @@ def deviation_field(obj, quantity):
 
     Returns
     -------
-    surfcomp.core.field.GridField
+    surfcomp.core.compensation.field.GridField
         Callable on arrays of u, v (face parameters); values in mm. Unmeasured nodes
         take the value of their nearest measured node.
     """
@@ -142,7 +142,7 @@ def write_html_report(obj, path, style=None):
 
 def corrected_surface(obj):
     """The corrected surface of a computed compensation object as a core
-    :class:`~surfcomp.core.bspline.Surface` (from its Shape, in document coordinates:
+    :class:`~surfcomp.core.surface.bspline.Surface` (from its Shape, in document coordinates:
     the feature's Placement applied)."""
     from .convert import surface_from_part
 

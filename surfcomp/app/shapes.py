@@ -19,7 +19,7 @@ import FreeCAD  # noqa: F401  (Part needs FreeCAD imported first)
 import numpy as np
 import Part
 
-from ..core.bspline import clamped
+from ..core.surface.bspline import clamped
 from ..errors import GeometryError
 from . import retrim
 from .convert import surface_to_part
@@ -48,7 +48,7 @@ class Output:
     correction_volume: float = 0.0
     volume_change: float = None
     retrimmed: list = field(default_factory=list)
-    #: the corrected surface (surfcomp.core.bspline.Surface) when ``shape`` is the face
+    #: the corrected surface (surfcomp.core.surface.bspline.Surface) when ``shape`` is the face
     #: bounded by its knot domain, which surfcomp.io.step_face writes from the pole net
     natural: object = None
 
@@ -294,7 +294,7 @@ def corrected_shape(nominal, corrected, output="face", label="compensation"):
     ----------
     nominal : surfcomp.app.nominal.Nominal
         ``nominal.face`` is the face ``nominal.face_name`` of ``nominal.shape``.
-    corrected : surfcomp.core.bspline.Surface
+    corrected : surfcomp.core.surface.bspline.Surface
     output : {'face', 'solid'}
         ``face``: the nominal face's boundary on the corrected surface. ``solid``:
         ``nominal.shape`` with the face replaced and its neighbours re-trimmed

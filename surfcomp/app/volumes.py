@@ -9,7 +9,7 @@ changed: with ``F(x) = (x - c) / 3`` (``div F = 1``),
     dV = [flux of F through the corrected face - through the nominal face]
          + sum over re-trimmed neighbours of the flux through the strip they gained or lost,
 
-the first term by :func:`surfcomp.core.trimmed.domain_integral` over both faces' (u, v)
+the first term by :func:`surfcomp.core.surface.trimmed.domain_integral` over both faces' (u, v)
 regions on one scan grid broken at the knots of both surfaces, the strips from the re-trimmed
 edges' samples (strip width times the flux density, along the edge; their error is of
 second order in the correction).
@@ -17,8 +17,8 @@ second order in the correction).
 
 import numpy as np
 
-from ..core import bspline
-from ..core.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
+from ..core.surface import bspline
+from ..core.surface.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
 from .nominal import boundary_polylines
 
 #: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
@@ -28,7 +28,7 @@ _trapezoid = getattr(np, "trapezoid", None) or np.trapz
 
 def correction_volume(nominal, corrected):
     """The integral of the correction over the (trimmed) nominal face (mm^3, positive =
-    material removed): :func:`surfcomp.core.trimmed.correction_integral` inside the face's
+    material removed): :func:`surfcomp.core.surface.trimmed.correction_integral` inside the face's
     boundary in (u, v)."""
     return correction_integral(nominal.surface, corrected, nominal.outward,
                                boundary_polylines(nominal.bspline_face))

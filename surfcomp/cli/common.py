@@ -134,7 +134,7 @@ def wrote(path):
 
 
 def options_from_args(args):
-    from ..core.pipeline import Options
+    from ..core.compensation.pipeline import Options
 
     return Options(method=getattr(args, "method", "filtered"), mask_size=getattr(args, "mask", 5),
                    weights=getattr(args, "weights", None),
@@ -166,8 +166,8 @@ class ProgressLine:
 def print_summary(comp, rep, out=None):
     """The papers' table form, the correction applied and the corrected face's checks, on
     ``out`` (default: ``sys.stdout`` as it is at the call, so a redirection holds)."""
-    from ..core import plausibility
-    from ..core.deviations import format_table
+    from ..core.compensation import plausibility
+    from ..core.compensation.deviations import format_table
 
     out = sys.stdout if out is None else out
     p = comp.prepared
@@ -186,7 +186,7 @@ def print_summary(comp, rep, out=None):
         print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
     else:
         print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
-    from ..core.align_report import summary_lines
+    from ..core.measurement.align_report import summary_lines
 
     for line in summary_lines(rep.get("alignment")):
         print(line, file=out)

@@ -14,9 +14,9 @@ import numpy as np
 
 from .. import __version__
 from ..core import budget
-from ..core.axis_checks import volumetric_map
-from ..core.axis_errors import MODEL_CHOICES, fit_axis_errors
-from ..core.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH
+from ..core.axis.axis_checks import volumetric_map
+from ..core.axis.axis_errors import MODEL_CHOICES, fit_axis_errors
+from ..core.axis.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH
 from ..errors import GCodeError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors

@@ -2,7 +2,7 @@
 """``python3 -m surfcomp plan NOMINAL [--face F] -o PLAN.csv``: where to probe the face.
 
 Places measurement points on the nominal face (``--layout grid|xy|adaptive``,
-:mod:`surfcomp.core.planning`), keeps those a 3-axis probe reaches (margin to the trim
+:mod:`surfcomp.core.measurement.planning`), keeps those a 3-axis probe reaches (margin to the trim
 boundary and holes, ``--max-tilt``, the stylus' paths clear of the face and, for a face of a
 solid, of the part: :mod:`surfcomp.app.plan_reach`), orders them for a short travel and
 writes the plan: the measurement-file contract (``id,x_nom,y_nom,z_nom,i,j,k``, mm) or, with
@@ -21,7 +21,7 @@ text, the tip radius and the dialect.
 import hashlib
 import os
 
-from ..core.planning import (
+from ..core.measurement.planning import (
     LAYOUTS,
     MAX_POINTS,
     ORDERS,

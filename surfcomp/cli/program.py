@@ -63,7 +63,7 @@ def run_program(args):
     _positive(args.segment_length, "--segment-length", 1e-3)
     if args.decimals is not None and not 3 <= args.decimals <= 9:
         raise InputError("--decimals %d: expected 3 to 9" % args.decimals)
-    from ..core.program_offset import parse_tool
+    from ..core.compensation.program_offset import parse_tool
 
     parse_tool(args.tool)
     from ..app.program_route import ProgramJob, run_program_job, summary_lines

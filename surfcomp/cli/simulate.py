@@ -8,12 +8,12 @@ and measure it against the nominal at the grid nodes and between them. Prints th
 papers' table (max negative, max positive, mean, std, ISO 1101 profile; mean and range
 over the replicas) and the per-replica standard deviations (mirror paper Tab. 2).
 
-``--preset NAME`` runs a case that imitates a paper (``surfcomp.core.presets``:
+``--preset NAME`` runs a case that imitates a paper (``surfcomp.core.simulation.presets``:
 werner2022, mirror2019-s1, -s2, -s3) on its own surface, so NOMINAL may be left out,
 and prints the paper's table beside the simulated one. Given a NOMINAL too, the preset's
 process runs on that face instead; options given explicitly override the preset's.
 
-Machining-process model (``surfcomp.core.process_model``; lengths in mm, defaults in
+Machining-process model (``surfcomp.core.simulation.process_model``; lengths in mm, defaults in
 brackets), error ``e`` of a pass along the outward normal, positive = material left::
 
     e = offset + slope_gain * s + abs_slope_gain * |s|
@@ -55,10 +55,10 @@ from dataclasses import fields
 import numpy as np
 
 from ..core import budget
-from ..core import presets as presets_
-from ..core import simulate as sim
-from ..core.filters import EDGE_MODES
+from ..core.compensation.filters import EDGE_MODES
 from ..core.progress import sub
+from ..core.simulation import presets as presets_
+from ..core.simulation import simulate as sim
 from ..errors import InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
@@ -226,7 +226,7 @@ def model_from_args(args, preset=None):
     if args.stock is not None:
         kw["stock"] = float(args.stock)
     if args.axis_errors:
-        from ..core.axis_errors import fit_axis_errors
+        from ..core.axis.axis_errors import fit_axis_errors
         from ..io.axis_csv import read_axis_errors
 
         if not (np.isfinite(args.max_error) and args.max_error > 0):
@@ -260,7 +260,7 @@ def _nominal(args, preset):
     if args.nominal is None:
         surface, outward = preset.surface()
         info = {"preset": preset.name, "surface": "BSplineSurface",
-                "built_by": "surfcomp.core.presets (%s)" % preset.imitates}
+                "built_by": "surfcomp.core.simulation.presets (%s)" % preset.imitates}
         name = "preset %s surface (%s)" % (preset.name, preset.imitates)
     else:
         from ..app.nominal import load_nominal

@@ -3,7 +3,7 @@
 (``--plan PLAN.csv``, or ``--layout``/``--count``/``--points`` planned on the face as
 ``python3 -m surfcomp plan`` does, with its default probe), and ``--compare-layouts N``:
 N adaptive against N uniform points on the same parts
-(:mod:`surfcomp.core.sim_layouts`). ``--grid`` then sets the evaluation grid only (the
+(:mod:`surfcomp.core.simulation.sim_layouts`). ``--grid`` then sets the evaluation grid only (the
 corrected parts are evaluated on it, nodes and points between them)."""
 
 import json
@@ -11,7 +11,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.planning import LAYOUTS, POINT_LAYOUTS, PlanSettings, check_points, parse_count
+from ..core.measurement.planning import (
+    LAYOUTS,
+    POINT_LAYOUTS,
+    PlanSettings,
+    check_points,
+    parse_count,
+)
 from ..errors import InputError, MeasurementFileError
 from . import registry
 
@@ -82,7 +88,7 @@ def _layout_count(args):
 
 def domain_of(args, surface, outward):
     """The face for planning: the file's face with its trim boundary, or the preset's."""
-    from ..core.planning_face import FaceDomain
+    from ..core.measurement.planning_face import FaceDomain
 
     if args.nominal is None:
         return FaceDomain(surface, outward)
@@ -98,7 +104,7 @@ def resolve(args, surface, outward):
         return _read_plan(args.plan, surface)
     if args.plan_layout is None:
         return None
-    from ..core.planning import plan_points
+    from ..core.measurement.planning import plan_points
 
     count = _layout_count(args)
     plan = plan_points(domain_of(args, surface, outward), args.plan_layout, count,
@@ -112,7 +118,7 @@ def resolve(args, surface, outward):
 
 
 def _read_plan(path, surface):
-    from ..core.projection import Projector
+    from ..core.surface.projection import Projector
     from ..io.hashing import sha256_file
     from ..io.measurements import read_measurements
 
@@ -131,7 +137,7 @@ def _read_plan(path, surface):
 
 def run_compare(args, surface, outward, model, loop, inputs, progress):
     """``--compare-layouts N``: both loops, their tables, the comparison; JSON if asked."""
-    from ..core.sim_layouts import compare_layouts
+    from ..core.simulation.sim_layouts import compare_layouts
     from ..io.atomic import Transaction
     from .common import wrote
 

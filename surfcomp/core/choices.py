@@ -3,14 +3,15 @@
 
 The command line builds its parser from these (``python3 -m surfcomp --help`` and an
 argument error import no numerics); the modules that implement the choices re-export them
-(``surfcomp.core.methods.METHODS``, ``surfcomp.core.filters.EDGE_MODES``,
+(``surfcomp.core.compensation.methods.METHODS``, ``surfcomp.core.compensation.filters.EDGE_MODES``,
 ``surfcomp.io.readers.FORMATS``).
 """
 
-#: correction methods (:mod:`surfcomp.core.methods`)
+#: correction methods (:mod:`surfcomp.core.compensation.methods`)
 METHODS = ("raw", "filtered", "mirror", "offset")
 #: edge handling of the mask filter: 'renormalize' (default, see
-#: :mod:`surfcomp.core.filters`), 'reflect' (the grid mirrored about its border node, which
+#: :mod:`surfcomp.core.compensation.filters`), 'reflect' (the grid mirrored about its border node,
+# which
 #: is not repeated: numpy.pad's 'reflect', the mode scipy.ndimage calls 'mirror'),
 #: 'nearest' (the border node repeated)
 EDGE_MODES = ("renormalize", "reflect", "nearest")

@@ -12,7 +12,7 @@ Colours are floats in [0, 1], arrays of shape (N, 3).
 import numpy as np
 
 from ..errors import lookup
-from .bspline import evaluate_grid
+from .surface.bspline import evaluate_grid
 
 #: colour schemes: control colours at equally spaced positions from the range's low
 #: end (first row) to its high end (last row), interpolated linearly in RGB
@@ -315,7 +315,7 @@ def uv_grid_mesh(surface, samples=(80, 80)):
 
     Parameters
     ----------
-    surface : surfcomp.core.bspline.Surface
+    surface : surfcomp.core.surface.bspline.Surface
         The face's surface; its ``u_range``/``v_range`` are the face's bounds (the
         mesh ignores trimming curves inside them).
     samples : (int, int)

@@ -15,9 +15,10 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 
 from ..app import reports
 from ..app.undo import UndoStep
-from ..core import colormap, plausibility
-from ..core.deviations import Statistics, format_table
-from ..core.filters import EDGE_MODES
+from ..core import colormap
+from ..core.compensation import plausibility
+from ..core.compensation.deviations import Statistics, format_table
+from ..core.compensation.filters import EDGE_MODES
 from ..errors import SurfcompError
 from . import dialogs, prefs
 
@@ -378,8 +379,8 @@ class StockDrawing(QtGui.QWidget):
 
 class StockDialog(QtGui.QDialog):
     """The mirror method's stock, explained: tooltip, text and drawing; checked against
-    the measured deviations (:func:`surfcomp.core.plausibility.stock_check`). OK refuses
-    an inconsistent stock, showing the measured mean, and offers a button that confirms
+    the measured deviations (:func:`surfcomp.core.compensation.plausibility.stock_check`). OK
+    refuses an inconsistent stock, showing the measured mean, and offers a button that confirms
     it; :meth:`answer` is ``(stock, confirmed)``."""
 
     def __init__(self, title, value, deviation=None, parent=None):

@@ -15,7 +15,7 @@ from PySide import QtGui
 
 from ..app import features
 from ..app.undo import UndoStep
-from ..core.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
+from ..core.measurement.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
 
 translate = FreeCAD.Qt.translate
 

@@ -10,8 +10,8 @@ the GUI passes every value as an argument.
 import FreeCAD
 
 from ..core.colormap import SCHEMES
-from ..core.filters import EDGE_MODES
-from ..core.methods import METHODS
+from ..core.compensation.filters import EDGE_MODES
+from ..core.compensation.methods import METHODS
 
 GROUP = "User parameter:BaseApp/Preferences/Mod/SurfComp"
 

@@ -3,8 +3,8 @@
 
 Sample rows, the value ranges in the units chosen for columns without a unit of their own
 (one selector for the coordinates, one for the deviation column; each reads the file
-again), and the plausibility checks of :mod:`surfcomp.core.plausibility` (the same as the
-command line's): a deviation larger than the max offset is an error that keeps OK
+again), and the plausibility checks of :mod:`surfcomp.core.compensation.plausibility` (the same as
+the command line's): a deviation larger than the max offset is an error that keeps OK
 disabled; deviations all far beyond the face's size tolerance are a warning. With a
 nominal face at hand the points are also located on it as the deviation map will locate
 them (:mod:`surfcomp.app.precheck`): points off the face, beyond its border or farther
@@ -15,7 +15,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from ..core import plausibility
+from ..core.compensation import plausibility
 from ..errors import SurfcompError
 from ..io.units import UNIT_FACTORS
 from . import prefs

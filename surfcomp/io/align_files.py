@@ -45,7 +45,7 @@ def _text(path):
 
 def read_transform(path):
     """The 4 x 4 matrix of a transform file (see the module docstring); not yet checked
-    for rigidity (:func:`surfcomp.core.align.check_rigid` does that)."""
+    for rigidity (:func:`surfcomp.core.measurement.align.check_rigid` does that)."""
     text = _text(path)
     if text.lstrip().startswith("{"):
         try:
@@ -75,7 +75,7 @@ def read_transform(path):
 
 
 def _from_json(data, path):
-    from ..core.align import work_offset
+    from ..core.measurement.align import work_offset
 
     if isinstance(data, dict) and "matrix" in data:
         M = data["matrix"]

@@ -70,7 +70,7 @@ class AxisErrorTable:
     ----------
     data : dict
         ``{'x': (positions (n,), errors (n, 3))}`` in mm, the input of
-        :func:`surfcomp.core.axis_errors.fit_axis_errors`.
+        :func:`surfcomp.core.axis.axis_errors.fit_axis_errors`.
     lines : dict
         ``{'x': ndarray (n,) int}``: the 1-based file line of every row.
     path : str or None

@@ -3,7 +3,7 @@
 
 Input: the JSON report dict of :func:`surfcomp.io.report.build_report` (schema
 ``surfcomp-report/1``) and optionally the virtual-machining result
-(:meth:`surfcomp.core.simulate.SimulationResult.as_dict`, schema
+(:meth:`surfcomp.core.simulation.simulate.SimulationResult.as_dict`, schema
 ``surfcomp-simulation/1``). Output: one HTML file, images embedded as base64 PNG
 (matplotlib's Agg canvas, no pyplot state, so it is safe inside a Qt application),
 no external resources. Sections carry stable ids for tools and tests:
@@ -40,7 +40,7 @@ import io
 import numpy as np
 
 from ..core import colormap
-from ..core.deviations import statistics
+from ..core.compensation.deviations import statistics
 from .atomic import write_text
 
 #: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
@@ -408,7 +408,7 @@ def simulation_maps(result):
 
     Parameters
     ----------
-    result : surfcomp.core.simulate.SimulationResult
+    result : surfcomp.core.simulation.simulate.SimulationResult
         Run with ``keep=True``.
 
     Returns

@@ -10,14 +10,14 @@ last one the measurement) is the tip centre ``c`` at the contact with point ``k`
 joined set holds the plan's nominal points and normals and the log's centres as measured
 points; the pipeline's tip-radius compensation then takes the contact point as
 ``c - R n`` along the plan's normal ``n`` and the deviation as ``(c - p) . n - R``
-(:func:`surfcomp.core.pipeline.prepare`).
+(:func:`surfcomp.core.compensation.pipeline.prepare`).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..core.pipeline import Options, option_name
+from ..core.compensation.pipeline import Options, option_name
 from ..errors import InputError, MeasurementFileError
 from .files import read_bytes
 from .measurement_set import MeasurementSet
@@ -77,7 +77,7 @@ def join_plan(plan, ms, options=None, touches=1):
     ms : MeasurementSet
         Measured points only (a LinuxCNC probe log or the Fanuc program's DPRNT output,
         read by :func:`surfcomp.io.readers.read_any`).
-    options : surfcomp.core.pipeline.Options
+    options : surfcomp.core.compensation.pipeline.Options
         ``tip_radius`` (R, mm) and ``max_offset`` (mm) are used.
     touches : int
         Probe moves per point in the log (2 for a LinuxCNC program with a second touch);

@@ -23,7 +23,7 @@ without a normal.
 The deviation is the point-profile ``Value`` the file carries (signed, positive on the
 side the nominal normal points to). It is cross-checked against
 ``(actual - nominal) . normal`` (the same convention as
-:func:`surfcomp.core.deviations.signed_deviation`); differences above ``deviation_tol``
+:func:`surfcomp.core.compensation.deviations.signed_deviation`); differences above ``deviation_tol``
 are warnings. A point without a point-profile value gets the computed deviation (a
 warning says so). When several point-profile values refer to one measured point (the
 CheckMate sample files carry the deviation and a second value 0 for every point) the

@@ -10,7 +10,7 @@ import json
 import numpy as np
 
 from .. import __version__
-from ..core import plausibility
+from ..core.compensation import plausibility
 
 SCHEMA = "surfcomp-report/1"
 
@@ -48,7 +48,7 @@ def build_report(command, inputs, comp, warnings=(), outputs=None, points=True,
     command : {'compensate', 'inspect'}
     inputs : dict
         ``{'nominal': {...}, 'measurements': {...}}`` with paths and SHA-256.
-    comp : surfcomp.core.pipeline.Compensation
+    comp : surfcomp.core.compensation.pipeline.Compensation
     warnings : list of str
     outputs : dict, optional
         Paths of the files written.

@@ -22,8 +22,8 @@ import os
 
 import numpy as np
 
-from ..core.bspline import clamped, compress_knots
 from ..core.chunks import for_chunks
+from ..core.surface.bspline import clamped, compress_knots
 from ..errors import InputError
 
 #: poles per line of a B_SPLINE_SURFACE_WITH_KNOTS list of references
@@ -200,7 +200,7 @@ def natural_face_parts(surface, reversed_face=False, tolerance=1e-7, name="surfc
 
     Parameters
     ----------
-    surface : surfcomp.core.bspline.Surface
+    surface : surfcomp.core.surface.bspline.Surface
         Polynomial and clamped (each end knot ``degree + 1`` times), in mm.
     reversed_face : bool
         The face's normal opposes the surface's ``Su x Sv``.

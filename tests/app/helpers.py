@@ -6,7 +6,7 @@ import os
 import numpy as np
 
 from surfcomp.app.nominal import nominal_from_face
-from surfcomp.core import bspline
+from surfcomp.core.surface import bspline
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 EXAMPLE_STEP = os.path.join(ROOT, "examples", "nominal.step")

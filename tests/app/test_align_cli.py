@@ -9,7 +9,7 @@ import numpy as np
 from numpy.testing import assert_allclose
 from scipy.spatial.transform import Rotation
 
-from surfcomp.core import align
+from surfcomp.core.measurement import align
 from surfcomp.io.readers import read_any
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT
 

@@ -10,7 +10,7 @@ import pytest
 from numpy.testing import assert_allclose
 
 from surfcomp.app.convert import surface_from_part, surface_to_part
-from surfcomp.core import bspline as bs
+from surfcomp.core.surface import bspline as bs
 from tests.conftest import REALDATA
 from tests.pure.test_bspline import quarter_cylinder, random_surface
 

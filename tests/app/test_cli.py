@@ -277,7 +277,7 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
         U.append(u0 + (u1 - u0) * (c + 0.05 * np.sin(6 * t)))
         V.append(v0 + (v1 - v0) * t)
     U, V = np.concatenate(U), np.concatenate(V)
-    from surfcomp.core import bspline
+    from surfcomp.core.surface import bspline
 
     P = bspline.evaluate(nom.surface, U, V)
     N = bspline.normals(nom.surface, U, V) * nom.outward
@@ -313,7 +313,7 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
 #: so the interrupt lands there however loaded the machine is
 HOLD_IN_BUILD = r"""
 import sys, time
-import surfcomp.core.corrected as corrected
+import surfcomp.core.compensation.corrected as corrected
 from surfcomp.cli import main
 report = corrected.report
 def held(progress, fraction, message=""):

@@ -13,7 +13,7 @@ import pytest
 from surfcomp.app import cam, cam_job, documents, features
 from surfcomp.app.document_route import run_document_job
 from surfcomp.app.nominal import nominal_from_face
-from surfcomp.core.pipeline import Options
+from surfcomp.core.compensation.pipeline import Options
 from surfcomp.errors import InputError, MeasurementFileError
 from tests.app.helpers import grid_on_face, write_cmm_csv
 from tests.app.test_features import add_part, block_solid, error_model

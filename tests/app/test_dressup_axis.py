@@ -12,7 +12,7 @@ import Path
 import pytest
 
 from surfcomp.app import cam, dressup_axis
-from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine
+from surfcomp.core.axis.axis_errors import AxisErrorModel, SimulatedMachine
 from surfcomp.errors import GCodeError
 from surfcomp.io.axis_csv import write_axis_errors
 from tests.conftest import ROOT
@@ -200,7 +200,7 @@ sys.path.insert(0, ROOT)
 import FreeCAD, Path
 import numpy as np
 from surfcomp.app import cam, dressup_axis
-from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine
+from surfcomp.core.axis.axis_errors import AxisErrorModel, SimulatedMachine
 doc = FreeCAD.newDocument("cmd")
 box = doc.addObject("Part::Box", "Box")
 doc.recompute()

@@ -14,9 +14,9 @@ import pytest
 from surfcomp.app import features, reports
 from surfcomp.app.file_route import corrected_face
 from surfcomp.app.nominal import load_nominal, nominal_from_face
-from surfcomp.core.corrected import realised_correction
-from surfcomp.core.filters import make_mask, mask_filter
-from surfcomp.core.pipeline import Options, compensate, prepare
+from surfcomp.core.compensation.corrected import realised_correction
+from surfcomp.core.compensation.filters import make_mask, mask_filter
+from surfcomp.core.compensation.pipeline import Options, compensate, prepare
 from surfcomp.errors import GeometryError, InputError
 from surfcomp.io.readers import read_any
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, grid_on_face, write_cmm_csv
@@ -314,7 +314,7 @@ def test_solid_output_replaces_the_face_in_the_block(doc):
     np.testing.assert_allclose(poles(out.Faces[1]), poles(c_face.Shape), atol=0)
     # the block lost the volume of the correction layer: sum of delta dA
     # (midpoint rule over the face's parameters with the area element |Su x Sv|)
-    from surfcomp.core import bspline
+    from surfcomp.core.surface import bspline
     (u0, u1), (v0, v1) = nominal.surface.u_range, nominal.surface.v_range
     k = 200
     us = u0 + (u1 - u0) * (np.arange(k) + 0.5) / k
@@ -350,7 +350,7 @@ def test_face_output_of_a_solid_is_the_face(doc):
     np.testing.assert_allclose(c.Correction, 0.0, atol=0)
     s = reports.corrected_surface(c)
     u = np.linspace(0.1, 0.9, 5)
-    from surfcomp.core import bspline
+    from surfcomp.core.surface import bspline
     np.testing.assert_allclose(bspline.evaluate(s, u, u), bspline.evaluate(nominal.surface, u, u),
                                atol=1e-12)
 

@@ -14,9 +14,11 @@ import pytest
 from numpy.testing import assert_allclose
 from PIL import Image
 
-from surfcomp.core import bspline, colormap, presets
-from surfcomp.core import simulate as sm
-from surfcomp.core.pipeline import Options, compensate, prepare
+from surfcomp.core import colormap
+from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+from surfcomp.core.simulation import presets
+from surfcomp.core.simulation import simulate as sm
+from surfcomp.core.surface import bspline
 from surfcomp.io import report as report_io
 from surfcomp.io.html_report import (
     SECTIONS,

@@ -12,8 +12,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from surfcomp.app import features, mapmesh
-from surfcomp.core import bspline
-from surfcomp.core.pipeline import Options, option_name
+from surfcomp.core.compensation.pipeline import Options, option_name
+from surfcomp.core.surface import bspline
 from surfcomp.errors import MeasurementFileError
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
 

@@ -22,7 +22,7 @@ import pytest
 
 from surfcomp.app import cam, cam_job, features, replace, reports
 from surfcomp.app.nominal import nominal_from_face
-from surfcomp.core.corrected import realised_correction
+from surfcomp.core.compensation.corrected import realised_correction
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
 from tests.toolpath_checks import drop_cutter
 
@@ -33,7 +33,7 @@ POST_ARGS = "--no-show-editor --no-header --precision=4"
 def test_drop_cutter_reference_on_a_tilted_plane():
     """Analytic reference: on the plane z = a x + b y + c the ball's tip sits at
     a x + b y + c + r (sqrt(1 + a^2 + b^2) - 1)."""
-    from surfcomp.core.bspline import Surface
+    from surfcomp.core.surface.bspline import Surface
 
     a, b, c = 0.3, -0.2, 1.5
     P = np.array([[[x, y, a * x + b * y + c] for y in (0.0, 40.0)] for x in (0.0, 40.0)])

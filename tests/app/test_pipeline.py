@@ -18,8 +18,8 @@ from numpy.testing import assert_allclose
 
 from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import load_nominal
-from surfcomp.core.corrected_check import dense_parameters, realised_correction
-from surfcomp.core.pipeline import Options
+from surfcomp.core.compensation.corrected_check import dense_parameters, realised_correction
+from surfcomp.core.compensation.pipeline import Options
 from tests.app.helpers import (
     EXAMPLE_CSV,
     EXAMPLE_STEP,

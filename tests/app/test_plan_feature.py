@@ -8,7 +8,7 @@ from numpy.testing import assert_allclose
 from surfcomp.app.nominal import load_nominal
 from surfcomp.app.plan_feature import make_measurement_plan, plan_file_text
 from surfcomp.app.plan_reach import plan_face
-from surfcomp.core.planning import PlanSettings
+from surfcomp.core.measurement.planning import PlanSettings
 from surfcomp.io.measurements import parse_measurements
 from tests.app.helpers import EXAMPLE_STEP
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Point projection (surfcomp.core.projection) against OCCT's ``face.distToShape``.
+"""Point projection (surfcomp.core.surface.projection) against OCCT's ``face.distToShape``.
 
 OCCT's BRepExtrema answer is the reference: the closest point on the trimmed face
 (interior, edge or vertex), its distance, and for interior hits the (u, v).
@@ -16,8 +16,8 @@ import pytest
 from numpy.testing import assert_allclose
 
 from surfcomp.app.convert import surface_from_part, surface_to_part
-from surfcomp.core import bspline as bs
-from surfcomp.core.projection import Projector, project
+from surfcomp.core.surface import bspline as bs
+from surfcomp.core.surface.projection import Projector, project
 from tests.conftest import REALDATA
 from tests.pure.test_bspline import random_surface
 

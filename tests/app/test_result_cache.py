@@ -111,7 +111,7 @@ def test_the_document_route_fits_once(shop, tmp_path, fits):  # noqa: F811
     raises with its file and line), the object's recompute and the document's after the
     replace are one fit."""
     from surfcomp.app.document_route import run_document_job
-    from surfcomp.core.pipeline import Options
+    from surfcomp.core.compensation.pipeline import Options
 
     result_cache.forget()
     res = run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",

@@ -13,9 +13,9 @@ from numpy.testing import assert_allclose
 
 import surfcomp.cli
 from surfcomp.app.nominal import load_nominal
-from surfcomp.core import presets
-from surfcomp.core import simulate as sm
-from surfcomp.core.corrected import MATCH_TOL
+from surfcomp.core.compensation.corrected import MATCH_TOL
+from surfcomp.core.simulation import presets
+from surfcomp.core.simulation import simulate as sm
 from tests.app.helpers import EXAMPLE_STEP, ROOT
 
 #: until the command is listed in surfcomp.cli.COMMANDS the tests register it for the child

@@ -10,7 +10,7 @@ import pytest
 from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.shapes import natural_face, rebuild_face
-from surfcomp.core.bspline import Surface
+from surfcomp.core.surface.bspline import Surface
 from surfcomp.io.step_face import write_natural_face
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
 from tests.pure.test_bspline import quarter_cylinder, random_surface

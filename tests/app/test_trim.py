@@ -23,9 +23,9 @@ from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import boundary_polylines, nominal_from_face
 from surfcomp.app.shapes import corrected_shape
-from surfcomp.core import bspline
-from surfcomp.core.pipeline import Options
-from surfcomp.core.trimmed import domain_integral, knots_of
+from surfcomp.core.compensation.pipeline import Options
+from surfcomp.core.surface import bspline
+from surfcomp.core.surface.trimmed import domain_integral, knots_of
 from surfcomp.errors import GeometryError
 from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt, write_cmm_csv
 from tests.conftest import REALDATA
@@ -687,7 +687,7 @@ def test_corrected_face_builder_is_the_one_for_every_route(circle_solid):
     top has the same corrected surface (one builder, two boundaries)."""
     case = circle_solid
     nominal = case["nominal"]
-    from surfcomp.core.pipeline import compensate, prepare
+    from surfcomp.core.compensation.pipeline import compensate, prepare
     from surfcomp.io.readers import read_any
 
     prep = prepare(nominal.surface, nominal.outward, read_any(str(case["tmp"] / "meas.csv")),

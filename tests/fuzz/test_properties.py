@@ -298,7 +298,7 @@ def axis_files(draw):
 def test_axis_error_files(text, max_error):
     """Read and fit: a refusal, or finite values (errors within ``max_error``) and a model
     whose errors are finite across its travel."""
-    from surfcomp.core.axis_errors import fit_axis_errors
+    from surfcomp.core.axis.axis_errors import fit_axis_errors
     from surfcomp.io.axis_csv import read_axis_errors
 
     def check_table(table):
@@ -352,20 +352,20 @@ def programs(draw):
 
 
 def _zero_model():
-    from surfcomp.core.axis_errors import AxisErrorModel
+    from surfcomp.core.axis.axis_errors import AxisErrorModel
 
     return AxisErrorModel.from_components()
 
 
 def _bent_model():
-    from surfcomp.core.axis_errors import AxisErrorModel
+    from surfcomp.core.axis.axis_errors import AxisErrorModel
 
     return AxisErrorModel.from_components(
         scale={"x": 1e-4}, straightness={"y(x)": (0, 2e-6), "z(y)": (0, 1e-6)})
 
 
 def _compensate(data, model, max_segments=20000):
-    from surfcomp.core.moves import check_segments
+    from surfcomp.core.axis.moves import check_segments
     from surfcomp.io.gcode import compensate_gcode, parse_gcode
 
     parsed = parse_gcode(data, source="<fuzz>")
@@ -419,7 +419,7 @@ OPTIONAL = ("sigma", "stock", "smoothing")
                                              "1 1; 1 1", "1e300 1e300 1e300; " * 2
                                              + "1e300 1e300 1e300", "-1 2 -1; 2 -4 2; -1 2 -1"])))
 def test_options_accepted_are_in_their_domains(values, method, kind, edge, weights):
-    from surfcomp.core.pipeline import Options
+    from surfcomp.core.compensation.pipeline import Options
 
     opts = Options(method=method, mask_kind=kind, edge=edge, weights=weights, **{
         k: (v if v is not None or k in OPTIONAL else 0) for k, v in values.items()})
@@ -449,7 +449,7 @@ def test_options_accepted_are_in_their_domains(values, method, kind, edge, weigh
      "5x5x5", "x", "nanxnan", " 7 x 7 ", "0x0"])))
 def test_simulate_grid_option(text):
     from surfcomp.cli.simulate import parse_grid
-    from surfcomp.core.simulate import MAX_GRID
+    from surfcomp.core.simulation.simulate import MAX_GRID
 
     def check(nm):
         assert all(isinstance(k, int) and 3 <= k <= MAX_GRID for k in nm)
@@ -477,8 +477,8 @@ def model_values(draw):
 @functools.lru_cache(maxsize=None)
 def _preset_grid():
     """A preset's surface (pure numpy) and its 5 x 5 CAM points and normals."""
-    from surfcomp.core import presets
-    from surfcomp.core.process_model import cam_grid
+    from surfcomp.core.simulation import presets
+    from surfcomp.core.simulation.process_model import cam_grid
 
     surface, outward = presets.get_preset("mirror2019-s3").surface()
     us, vs = np.linspace(*surface.u_range, 5), np.linspace(*surface.v_range, 5)
@@ -490,7 +490,7 @@ def _preset_grid():
 def test_machining_model_values(kw):
     """An accepted machining model machines the preset surface with finite pass errors of
     at most 100 mm (the largest deviation a compensation accepts), or refuses."""
-    from surfcomp.core.process_model import MachiningModel, machine_pass
+    from surfcomp.core.simulation.process_model import MachiningModel, machine_pass
 
     surface, S, n = _preset_grid()
 

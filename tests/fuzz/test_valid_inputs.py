@@ -42,7 +42,7 @@ def test_gcode_with_a_byte_order_mark(name, text, tmp_path):
 
 def test_gcode_with_a_byte_order_mark_under_a_zero_model():
     """No error: the output is the input, byte for byte, mark included."""
-    from surfcomp.core.axis_errors import AxisErrorModel
+    from surfcomp.core.axis.axis_errors import AxisErrorModel
     from surfcomp.io.gcode import compensate_gcode
 
     for text in (I.SMALL_PROGRAM, I.SMALL_PROGRAM.replace("\n", "\r\n")):

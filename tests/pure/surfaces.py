@@ -3,7 +3,7 @@
 
 import numpy as np
 
-from surfcomp.core import bspline
+from surfcomp.core.surface import bspline
 
 
 def wavy_patch():

@@ -5,11 +5,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from surfcomp.core import align, bspline
-from surfcomp.core.align_report import AlignOptions, absorbed
-from surfcomp.core.align_report import align as run_align
-from surfcomp.core.align_rps import rps_fit
-from surfcomp.core.pipeline import Options, prepare
+from surfcomp.core.compensation.pipeline import Options, prepare
+from surfcomp.core.measurement import align
+from surfcomp.core.measurement.align_report import AlignOptions, absorbed
+from surfcomp.core.measurement.align_report import align as run_align
+from surfcomp.core.measurement.align_rps import rps_fit
+from surfcomp.core.surface import bspline
 from surfcomp.errors import InputError
 from surfcomp.io.measurement_set import MeasurementSet
 from tests.pure.surfaces import wavy_patch

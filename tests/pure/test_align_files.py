@@ -6,8 +6,8 @@ import json
 import numpy as np
 import pytest
 
-from surfcomp.core.align import check_rigid
-from surfcomp.core.align_report import AlignOptions
+from surfcomp.core.measurement.align import check_rigid
+from surfcomp.core.measurement.align_report import AlignOptions
 from surfcomp.errors import InputError
 from surfcomp.io.align_files import read_rps, read_transform
 from surfcomp.io.jobfile import check_values

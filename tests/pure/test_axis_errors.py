@@ -8,8 +8,8 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy import optimize, stats
 
-from surfcomp.core.axis_checks import error_stats, validate, volumetric_map
-from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine, fit_axis_errors
+from surfcomp.core.axis.axis_checks import error_stats, validate, volumetric_map
+from surfcomp.core.axis.axis_errors import AxisErrorModel, SimulatedMachine, fit_axis_errors
 from surfcomp.errors import ComputationError, InputError, MeasurementFileError
 from surfcomp.io.axis_csv import format_axis_errors, read_axis_errors, write_axis_errors
 from surfcomp.io.gcode import parse_gcode, read_gcode

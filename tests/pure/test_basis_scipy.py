@@ -8,7 +8,7 @@ import pytest
 import scipy
 from numpy.testing import assert_allclose
 
-from surfcomp.core import bspline_basis as bb
+from surfcomp.core.surface import bspline_basis as bb
 
 
 def _version():

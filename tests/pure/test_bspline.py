@@ -11,8 +11,8 @@ import pytest
 from numpy.testing import assert_allclose
 from scipy.interpolate import BSpline
 
-from surfcomp.core import bspline as bs
-from surfcomp.core.bspline import Surface
+from surfcomp.core.surface import bspline as bs
+from surfcomp.core.surface.bspline import Surface
 from surfcomp.errors import GeometryError, GridError
 
 # --------------------------------------------------------------------------- helpers
@@ -373,11 +373,11 @@ def test_fit_errors():
 
 
 # --------------------------------------------------------------------------- projection
-# (surfcomp.core.projection; its OCCT comparison is tests/app/test_projection_occt.py)
+# (surfcomp.core.surface.projection; its OCCT comparison is tests/app/test_projection_occt.py)
 
 from scipy.optimize import least_squares  # noqa: E402
 
-from surfcomp.core import projection as pj  # noqa: E402
+from surfcomp.core.surface import projection as pj  # noqa: E402
 from surfcomp.errors import Cancelled  # noqa: E402
 
 
@@ -678,8 +678,8 @@ def test_band_factor_equals_sparse_lu_and_names_a_singular_matrix():
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
-    from surfcomp.core import bspline_fit
-    from surfcomp.core.bspline_basis import basis_matrix, greville
+    from surfcomp.core.surface import bspline_fit
+    from surfcomp.core.surface.bspline_basis import basis_matrix, greville
 
     n = 300
     knots = np.r_[[0.0] * 4, np.linspace(0, 1, n - 2)[1:-1], [1.0] * 4]

@@ -5,7 +5,7 @@ refusal. Real peak figures are measured by bench/bench_memory.py, not here."""
 import pytest
 
 from surfcomp.core import budget
-from surfcomp.core import simulate as sim
+from surfcomp.core.simulation import simulate as sim
 from surfcomp.errors import InputError
 
 GB = 1024 ** 3

@@ -6,8 +6,9 @@ import os
 import numpy as np
 import pytest
 
-from surfcomp.core import bspline, chunks
-from surfcomp.core.corrected_check import _solve3
+from surfcomp.core import chunks
+from surfcomp.core.compensation.corrected_check import _solve3
+from surfcomp.core.surface import bspline
 
 
 def _surface(n=40, seed=0):

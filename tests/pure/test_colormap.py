@@ -7,7 +7,7 @@ from matplotlib.colors import LinearSegmentedColormap
 from numpy.testing import assert_allclose
 
 from surfcomp.core import colormap as cm
-from surfcomp.core.bspline import Surface, evaluate_grid
+from surfcomp.core.surface.bspline import Surface, evaluate_grid
 from surfcomp.errors import InputError
 
 

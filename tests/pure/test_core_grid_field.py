@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.field import GridField
-from surfcomp.core.grid import grid_from_indices, grid_from_uv
+from surfcomp.core.compensation.field import GridField
+from surfcomp.core.surface.grid import grid_from_indices, grid_from_uv
 from surfcomp.errors import GridError
 
 
@@ -132,8 +132,8 @@ def test_locate_grid_matches_pointwise_locate(distorted):
 def test_pole_net_is_capped_for_dense_grids():
     """Coarse grids: >= 120 spans; medium: 4 spans per grid step; dense: at most
     MAX_SPANS spans, but never fewer than 2 per grid step."""
-    from surfcomp.core.corrected import MAX_SPANS, _span
-    from surfcomp.core.corrected_check import dense_parameters
+    from surfcomp.core.compensation.corrected import MAX_SPANS, _span
+    from surfcomp.core.compensation.corrected_check import dense_parameters
 
     assert _span(1.0, 1 / 6, 4) == pytest.approx(1 / 120)
     assert _span(1.0, 1 / 99, 4) == pytest.approx(1 / 396)
@@ -202,7 +202,7 @@ def test_pchip_slopes_are_scipys(axis):
     changes, flat stretches, zero secants, both ends), to rounding."""
     from scipy.interpolate import PchipInterpolator
 
-    from surfcomp.core.field import _pchip_slopes
+    from surfcomp.core.compensation.field import _pchip_slopes
 
     rng = np.random.default_rng(3)
     cases = [rng.normal(size=(40, 30, 3)), np.round(rng.normal(size=(25, 20, 2))),
@@ -291,7 +291,7 @@ def test_locate_grid_in_blocks_and_dropped_caches_give_the_same_field(monkeypatc
     """locate_grid's Newton runs in blocks of points (bounded temporaries) and the
     field's caches (patch coefficients, slopes, seed tree) can be dropped after the
     samples are placed: both leave every located point and field value as they were."""
-    from surfcomp.core import field as field_module
+    from surfcomp.core.compensation import field as field_module
 
     n = 30
     U, V = _turned_grid(n)

@@ -5,9 +5,15 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.deviations import deviation_components, signed_deviation, statistics
-from surfcomp.core.filters import box_mask, gaussian_mask, make_mask, mask_filter, parse_weights
-from surfcomp.core.methods import compute_correction
+from surfcomp.core.compensation.deviations import deviation_components, signed_deviation, statistics
+from surfcomp.core.compensation.filters import (
+    box_mask,
+    gaussian_mask,
+    make_mask,
+    mask_filter,
+    parse_weights,
+)
+from surfcomp.core.compensation.methods import compute_correction
 from surfcomp.errors import InputError
 
 

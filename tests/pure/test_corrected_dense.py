@@ -11,8 +11,14 @@ corrections: realised = intended within 0.1 um at the points, the nominal back w
 import numpy as np
 import pytest
 
-from surfcomp.core import bspline, corrected, corrected_check
-from surfcomp.core.corrected import aligned_lines, construct, node_line_knots, realised_correction
+from surfcomp.core.compensation import corrected, corrected_check
+from surfcomp.core.compensation.corrected import (
+    aligned_lines,
+    construct,
+    node_line_knots,
+    realised_correction,
+)
+from surfcomp.core.surface import bspline
 
 UM = 1e-3
 

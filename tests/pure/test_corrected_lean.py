@@ -8,8 +8,13 @@ zero field, no overshoot over max|intended| + 1 um); otherwise the refined space
 import numpy as np
 import pytest
 
-from surfcomp.core import corrected
-from surfcomp.core.corrected import construct, grid_lines, meets_limits, node_line_knots
+from surfcomp.core.compensation import corrected
+from surfcomp.core.compensation.corrected import (
+    construct,
+    grid_lines,
+    meets_limits,
+    node_line_knots,
+)
 
 from .test_corrected_dense import bicubic
 
@@ -93,7 +98,7 @@ def test_lines_on_the_border_make_no_empty_span():
 def test_lean_off_builds_refine_spans_per_step():
     """``lean=False`` (documents made before the lean face, job files) skips the lean space:
     4 spans per grid step as before; the option takes true or false only."""
-    from surfcomp.core.pipeline import Options
+    from surfcomp.core.compensation.pipeline import Options
     from surfcomp.errors import InputError
 
     surf = bicubic()

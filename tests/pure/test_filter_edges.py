@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.filters import mask_filter
+from surfcomp.core.compensation.filters import mask_filter
 
 
 def _padded_filter(d, mask, mode):

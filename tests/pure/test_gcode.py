@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine, fit_axis_errors
+from surfcomp.core.axis.axis_errors import AxisErrorModel, SimulatedMachine, fit_axis_errors
 from surfcomp.errors import GCodeError
 from surfcomp.io.gcode import (
     _fmt,

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core import axis_errors, machine
-from surfcomp.core.arcs import arc_steps
-from surfcomp.core.axis_errors import AxisErrorModel, fit_axis_errors
-from surfcomp.core.moves import (
+from surfcomp.core.axis import axis_errors, machine
+from surfcomp.core.axis.arcs import arc_steps
+from surfcomp.core.axis.axis_errors import AxisErrorModel, fit_axis_errors
+from surfcomp.core.axis.moves import (
     MAX_SEGMENTS,
     MIN_SEGMENT_LENGTH,
     check_segments,
@@ -317,5 +317,5 @@ def test_model_input_errors_are_input_errors():
     with pytest.raises(InputError, match="axis x: 2 positions but 1 error rows") as exc:
         fit_axis_errors({"x": ([0.0, 1.0], [[0.0, 0.0, 0.0]])}, source="e.csv")
     assert exc.value.file == "e.csv"
-    # SimulatedMachine moved to core/machine.py; the old import still works
+    # SimulatedMachine moved to core/axis/machine.py; the old import still works
     assert axis_errors.SimulatedMachine is machine.SimulatedMachine

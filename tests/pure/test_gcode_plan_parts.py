@@ -8,8 +8,8 @@ import os
 import numpy as np
 import pytest
 
-from surfcomp.core import moves
-from surfcomp.core.axis_errors import AxisErrorModel
+from surfcomp.core.axis import moves
+from surfcomp.core.axis.axis_errors import AxisErrorModel
 from surfcomp.io.gcode import compensate_gcode
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))

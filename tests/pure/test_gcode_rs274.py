@@ -5,7 +5,7 @@
 RS274/NGC interpreter without a machine and prints the canonical moves a controller would
 make: ``STRAIGHT_TRAVERSE(x, y, z, a, b, c)``, ``STRAIGHT_FEED(...)`` and
 ``ARC_FEED(first_end, second_end, first_centre, second_centre, rotation, axis_end, a, b,
-c)`` with the plane's axes in the order of :data:`surfcomp.core.arcs.PLANES`, all in the
+c)`` with the plane's axes in the order of :data:`surfcomp.core.axis.arcs.PLANES`, all in the
 program's units with 4 decimals. These tests fail (they do not skip) without it.
 
 For the output of ``python3 -m surfcomp gcode`` with a non-trivial error model, rs274 must
@@ -24,9 +24,9 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.arcs import PLANES
-from surfcomp.core.axis_errors import AxisErrorModel, fit_axis_errors
-from surfcomp.core.machine import SimulatedMachine
+from surfcomp.core.axis.arcs import PLANES
+from surfcomp.core.axis.axis_errors import AxisErrorModel, fit_axis_errors
+from surfcomp.core.axis.machine import SimulatedMachine
 from surfcomp.io.axis_csv import read_axis_errors, write_axis_errors
 from surfcomp.io.gcode import compensate_gcode, parse_gcode
 from tests.conftest import REALDATA, ROOT

@@ -10,7 +10,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from surfcomp.core.axis_errors import AxisErrorModel
+from surfcomp.core.axis.axis_errors import AxisErrorModel
 from surfcomp.errors import GCodeError, InputError
 from surfcomp.io.gcode import ProgramFile, compensate_gcode, compensate_stream, stream
 from tests.conftest import REALDATA, ROOT
@@ -114,7 +114,7 @@ def test_a_refusal_on_the_last_line_writes_nothing(last, says, tmp_path, capsys,
     rc, _o, err = _cli(["gcode", str(prog), "--axis-errors", str(tmp_path / "e.csv"), "-o",
                         str(out)], capsys)
     assert rc == 0, err
-    from surfcomp.core.axis_errors import fit_axis_errors
+    from surfcomp.core.axis.axis_errors import fit_axis_errors
     from surfcomp.io.axis_csv import read_axis_errors
     model = fit_axis_errors(read_axis_errors(str(tmp_path / "e.csv")).data)
     expected = compensate_gcode(body.encode(), model, max_error=1.0)

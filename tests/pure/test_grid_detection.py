@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Grid detection at scale (surfcomp.core.grid): scattered points are told apart without
+"""Grid detection at scale (surfcomp.core.surface.grid): scattered points are told apart without
 the per-row-count search, and the search finds the same rows as the exhaustive one
 (every row count dividing N split at its largest gaps) that it replaced."""
 
 import numpy as np
 import pytest
 
-from surfcomp.core import grid
-from surfcomp.core.grid import grid_from_uv
+from surfcomp.core.surface import grid
+from surfcomp.core.surface.grid import grid_from_uv
 from surfcomp.errors import GridError
 
 

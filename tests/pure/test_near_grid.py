@@ -7,12 +7,13 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core import bspline, presets
-from surfcomp.core.field import GridField
-from surfcomp.core.grid import grid_from_uv
-from surfcomp.core.pipeline import Options, compensate, prepare
-from surfcomp.core.projection import Projector
-from surfcomp.core.simulate import GridMeasurements
+from surfcomp.core.compensation.field import GridField
+from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+from surfcomp.core.simulation import presets
+from surfcomp.core.simulation.simulate import GridMeasurements
+from surfcomp.core.surface import bspline
+from surfcomp.core.surface.grid import grid_from_uv
+from surfcomp.core.surface.projection import Projector
 from surfcomp.errors import GridError
 
 
@@ -127,7 +128,7 @@ def test_simulate_measures_near_grid_plan_points_by_the_auto_layout(points):
     grid, the 45 in rows of 8 and 7 as their 15 x 3 grid; both compensate. (The sparse
     grid's mask filter leaves more than the scattered route's smoothing fit would: 2.34
     against 1.97 um with these draws.)"""
-    from surfcomp.core import simulate as sim
+    from surfcomp.core.simulation import simulate as sim
 
     u, v = _hexagonal() if points == "hexagonal" else _staggered(0.009971, 0.990029, 8, 6,
                                                                   0.020939)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.pipeline import Options
+from surfcomp.core.compensation.pipeline import Options
 from surfcomp.errors import InputError, MeasurementFileError
 from surfcomp.io.plan_join import join_plan, read_plan
 from surfcomp.io.readers import read_any

@@ -5,23 +5,23 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core import bspline
-from surfcomp.core.bspline import Surface
-from surfcomp.core.planning import (
+from surfcomp.core.measurement.planning import (
     MAX_POINTS,
     PlanSettings,
     check_points,
     parse_count,
     plan_points,
 )
-from surfcomp.core.planning_adaptive import turning_rate
-from surfcomp.core.planning_face import FaceDomain
-from surfcomp.core.planning_reach import (
+from surfcomp.core.measurement.planning_adaptive import turning_rate
+from surfcomp.core.measurement.planning_face import FaceDomain
+from surfcomp.core.measurement.planning_reach import (
     nearest_neighbour,
     serpentine,
     travel_length,
 )
-from surfcomp.core.presets import mirror_surface, werner_surface
+from surfcomp.core.simulation.presets import mirror_surface, werner_surface
+from surfcomp.core.surface import bspline
+from surfcomp.core.surface.bspline import Surface
 from surfcomp.errors import InputError
 from tests.pure.test_trimmed import _circle, _square_pieces
 
@@ -284,9 +284,9 @@ def test_simulate_at_plan_points_and_the_layout_comparison():
     'all' the evaluation grid's; the uniform and adaptive runs share the evaluation grid's
     random draws, so the parts machined from the nominal are the same to the last bit, and
     the comparison's figures are the runs' own."""
-    from surfcomp.core import presets
-    from surfcomp.core import simulate as sim
-    from surfcomp.core.sim_layouts import compare_layouts
+    from surfcomp.core.simulation import presets
+    from surfcomp.core.simulation import simulate as sim
+    from surfcomp.core.simulation.sim_layouts import compare_layouts
 
     pr = presets.get_preset("mirror2019-s2")
     surf, outward = pr.surface()

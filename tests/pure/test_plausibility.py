@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from surfcomp.core import plausibility as pl
+from surfcomp.core.compensation import plausibility as pl
 
 
 @pytest.mark.parametrize("size, tol", [(2.0, 0.05), (6.0, 0.05), (6.1, 0.1), (30.0, 0.1),
@@ -44,8 +44,8 @@ def test_largest_dimension_and_ranges_ignore_nan():
 
 def test_prepare_warns_when_every_deviation_is_far_beyond_the_size_tolerance():
     """The command line's report carries the warning (prepare's warnings)."""
-    from surfcomp.core.bspline import Surface
-    from surfcomp.core.pipeline import Options, prepare
+    from surfcomp.core.compensation.pipeline import Options, prepare
+    from surfcomp.core.surface.bspline import Surface
     from surfcomp.io.measurements import MeasurementSet
 
     # a flat 100 x 100 mm face: size tolerance +-0.15 mm, flagged beyond 15 mm

@@ -14,15 +14,15 @@ example face, moved by analytic corrections, checked against the exact geometry.
 import numpy as np
 import pytest
 
-from surfcomp.core.presets import werner_surface
-from surfcomp.core.program_offset import (
+from surfcomp.core.compensation.program_offset import (
     BallOffset,
     _seg_dist,
     blend_weight,
     parse_tool,
     plan_offset,
 )
-from surfcomp.core.projection import project
+from surfcomp.core.simulation.presets import werner_surface
+from surfcomp.core.surface.projection import project
 from surfcomp.errors import GCodeError, InputError
 from surfcomp.io.gcode import ProgramFile, parse_gcode
 from surfcomp.io.gcode.offset_stream import offset_stream
@@ -196,7 +196,7 @@ def test_arcs_in_the_region_become_lines_and_arcs_away_stay(program, tmp_path):
     prog, _ = parse_gcode(text)
     off = BallOffset(SURF, 1, R, wave, 1.0)
     plan = plan_offset(prog, off, 5e-4, 2.0, 0.5e-4).plan
-    from surfcomp.core.program_offset import _Arcs, _points
+    from surfcomp.core.compensation.program_offset import _Arcs, _points
 
     arcs_j = np.flatnonzero(prog.kind == 2)
     arcs = _Arcs(prog, arcs_j)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The per-region certificate of projected feet (surfcomp.core.projection_regions): it
+"""The per-region certificate of projected feet (surfcomp.core.surface.projection_regions): it
 follows the curvature towards the point, refuses where another part of the face is
 within reach, and never changes a projection (same feet as the point-by-point search
 for other minima on every point)."""
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core import bspline as bs
-from surfcomp.core import projection as pj
+from surfcomp.core.surface import bspline as bs
+from surfcomp.core.surface import projection as pj
 from tests.pure.test_bspline import hairpin, quarter_cylinder, random_surface
 
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The P-spline smoothing fit (surfcomp.core.pspline) against dense reference solves of
+"""The P-spline smoothing fit (surfcomp.core.compensation.pspline) against dense reference solves of
 the same penalised least-squares problem, and its GCV choice against the former
 implementation (sparse N-row product B^T B), whose results are recorded below."""
 
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.pspline import PSplineSolver, tensor_rows
-from surfcomp.core.scattered import smooth
+from surfcomp.core.compensation.pspline import PSplineSolver, tensor_rows
+from surfcomp.core.compensation.scattered import smooth
 
 
 def field_data(n, seed, box):

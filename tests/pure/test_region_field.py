@@ -4,7 +4,7 @@
 import numpy as np
 import pytest
 
-from surfcomp.core import region_build, region_field
+from surfcomp.core.compensation import region_build, region_field
 from surfcomp.errors import MeasurementFileError
 
 

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Scattered deviation fields (surfcomp.core.scattered): the smoothing fit against scipy's
-thin-plate RBF and brute-force leave-one-out, its transfer function against the analytic
+"""Scattered deviation fields (surfcomp.core.compensation.scattered): the smoothing fit against
+scipy's thin-plate RBF and brute-force leave-one-out, its transfer function against the analytic
 one, the Clough-Tocher field against scipy's, bounds, and the corrected face on a 7 x 10
 adaptive layout like the mirror-method paper's (mirror-compensation-onmachine.txt: seven
 curves along u, ten unevenly spaced points on each, denser where the slope changes)."""
@@ -14,11 +14,12 @@ from scipy.interpolate import CloughTocher2DInterpolator, RBFInterpolator
 from scipy.sparse.linalg import spsolve
 
 from examples.make_example import example_surface
-from surfcomp.core import bspline, corrected, corrected_check
-from surfcomp.core import scattered as sc
-from surfcomp.core import scattered_field as scf
-from surfcomp.core.pspline import PSplineSolver, tensor_rows
-from surfcomp.core.scattered import ScatteredField, smooth
+from surfcomp.core.compensation import corrected, corrected_check
+from surfcomp.core.compensation import scattered as sc
+from surfcomp.core.compensation import scattered_field as scf
+from surfcomp.core.compensation.pspline import PSplineSolver, tensor_rows
+from surfcomp.core.compensation.scattered import ScatteredField, smooth
+from surfcomp.core.surface import bspline
 from surfcomp.errors import InputError
 
 

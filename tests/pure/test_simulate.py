@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Virtual machining (surfcomp.core.simulate, process_model, sim_tables, presets): model
+"""Virtual machining (surfcomp.core.simulation.simulate, process_model, sim_tables, presets): model
 equations with hand-computed numbers, the random field's statistics, the papers' orderings
 over replicas on a Werner-like case, and the presets that imitate the papers' tables."""
 
@@ -11,11 +11,12 @@ import pytest
 from numpy.testing import assert_allclose
 
 from examples.make_example import example_surface
-from surfcomp.core import bspline, presets
-from surfcomp.core import sim_tables as tables
-from surfcomp.core import simulate as sm
-from surfcomp.core.axis_errors import AxisErrorModel
-from surfcomp.core.deviations import Statistics, statistics
+from surfcomp.core.axis.axis_errors import AxisErrorModel
+from surfcomp.core.compensation.deviations import Statistics, statistics
+from surfcomp.core.simulation import presets
+from surfcomp.core.simulation import sim_tables as tables
+from surfcomp.core.simulation import simulate as sm
+from surfcomp.core.surface import bspline
 from surfcomp.errors import InputError
 
 

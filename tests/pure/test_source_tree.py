@@ -17,7 +17,7 @@ def tree_block(text):
 
 
 def tree_paths(block):
-    """Paths the tree names, from its two-space indentation: ``surfcomp/core/arcs.py``,
+    """Paths the tree names, from its two-space indentation: ``surfcomp/core/axis/arcs.py``,
     ``surfcomp/core/`` (folders end in '/')."""
     stack, out = [], []
     for number, line in enumerate(block.splitlines(), 1):
@@ -69,5 +69,5 @@ def test_the_check_sees_a_missing_and_a_stale_line():
     assert paths == ["surfcomp/", "surfcomp/errors.py", "surfcomp/core/",
                      "surfcomp/core/arcs9.py", "Init.py"]
     missing, gone = problems(paths)
-    assert "surfcomp/core/grid.py" in missing and "surfcomp/errors.py" not in missing
+    assert "surfcomp/core/surface/grid.py" in missing and "surfcomp/errors.py" not in missing
     assert gone == ["surfcomp/core/arcs9.py"]

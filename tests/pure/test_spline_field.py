@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The smoothing fit's spline as a correction field (surfcomp.core.spline_field) and the
-corrected face built from it (surfcomp.core.corrected.construct_smooth): the field equals
-the fit at the points, continues C1 and bounded beyond them, and the face realises it
+"""The smoothing fit's spline as a correction field (surfcomp.core.compensation.spline_field) and
+the corrected face built from it (surfcomp.core.compensation.corrected.construct_smooth): the field
+equals the fit at the points, continues C1 and bounded beyond them, and the face realises it
 everywhere with the nominal's knots and the field's only."""
 
 import numpy as np
@@ -9,10 +9,16 @@ import pytest
 from numpy.testing import assert_allclose
 
 from examples.make_example import deviation_field, example_surface
-from surfcomp.core import bspline, corrected, corrected_check
-from surfcomp.core.pipeline import SMOOTH_MATCH, Options, compensate
-from surfcomp.core.scattered import ScatteredField, smooth
-from surfcomp.core.spline_field import SOFT_LIMIT, ConstantField, SplineField, soft_limit
+from surfcomp.core.compensation import corrected, corrected_check
+from surfcomp.core.compensation.pipeline import SMOOTH_MATCH, Options, compensate
+from surfcomp.core.compensation.scattered import ScatteredField, smooth
+from surfcomp.core.compensation.spline_field import (
+    SOFT_LIMIT,
+    ConstantField,
+    SplineField,
+    soft_limit,
+)
+from surfcomp.core.surface import bspline
 
 SCALE = (45.0, 45.0)   # mm per unit parameter of the example face (45 x 45 mm)
 
@@ -150,9 +156,9 @@ def test_pipeline_uses_the_field_for_filtered_only():
 
 
 def _prepared(nominal, u, v, d):
-    """A scattered :class:`~surfcomp.core.pipeline.Prepared` of measured points off the
+    """A scattered :class:`~surfcomp.core.compensation.pipeline.Prepared` of measured points off the
     nominal by ``d`` along its normal."""
-    from surfcomp.core.pipeline import prepare
+    from surfcomp.core.compensation.pipeline import prepare
     from surfcomp.io.measurement_set import MeasurementSet
 
     P = bspline.evaluate(nominal, u, v)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.deviations import Statistics, statistics
+from surfcomp.core.compensation.deviations import Statistics, statistics
 
 #: the JSON report's statistics keys before ``min`` and ``max`` were added: a contract
 KEYS_BEFORE = ("count", "max_negative", "max_positive", "mean", "std", "rms", "profile")

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from surfcomp.core.bspline import Surface
+from surfcomp.core.surface.bspline import Surface
 from surfcomp.io import step_face
 from tests.pure.test_bspline import quarter_cylinder, random_surface
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core import bspline
-from surfcomp.core import plausibility as pl
-from surfcomp.core import simulate as sm
-from surfcomp.core.pipeline import Options, compensate, prepare
+from surfcomp.core.compensation import plausibility as pl
+from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+from surfcomp.core.simulation import simulate as sm
+from surfcomp.core.surface import bspline
 from surfcomp.errors import InputError
 from tests.pure.surfaces import wavy_patch
 

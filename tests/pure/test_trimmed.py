@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
-from surfcomp.core.bspline import Surface
-from surfcomp.core.trimmed import correction_integral, domain_integral, inside, knots_of
+from surfcomp.core.surface.bspline import Surface
+from surfcomp.core.surface.trimmed import correction_integral, domain_integral, inside, knots_of
 
 
 def _circle(c, r, n=2000, reverse=False):

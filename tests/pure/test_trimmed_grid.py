@@ -5,9 +5,9 @@ correction integral against an analytic B-spline integral."""
 import numpy as np
 import pytest
 
-from surfcomp.core import bspline
-from surfcomp.core.bspline import Surface
-from surfcomp.core.trimmed import correction_integral, domain_integral, knots_of
+from surfcomp.core.surface import bspline
+from surfcomp.core.surface.bspline import Surface
+from surfcomp.core.surface.trimmed import correction_integral, domain_integral, knots_of
 from tests.pure.test_trimmed import _circle, _plane
 
 

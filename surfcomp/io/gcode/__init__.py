@@ -6,7 +6,7 @@ Modules: :mod:`.lexer` (lines and words), :mod:`.interpreter` (modal state, move
 lines at a time, or whole), :mod:`.totals` (whole-program figures added up over blocks),
 :mod:`.commands` (FreeCAD Path command lists),
 :mod:`.result` (what a compensation returns); the arc geometry and the move planning
-are compensation maths in :mod:`surfcomp.core.arcs` and :mod:`surfcomp.core.moves`.
+are compensation maths in :mod:`surfcomp.core.axis.arcs` and :mod:`surfcomp.core.axis.moves`.
 
 Every line the compensation does not change is written back byte for byte (the file is
 handled as Latin-1 text, which maps every byte to one character and back); a zero error
@@ -43,7 +43,7 @@ is not known, arcs whose end is not on the circle.
 How moves are compensated
 -------------------------
 Each programmed point ``X`` (mm) is replaced by the command ``X'`` with ``X' + E(X') = X``
-(:meth:`surfcomp.core.axis_errors.AxisErrorModel.compensate`).
+(:meth:`surfcomp.core.axis.axis_errors.AxisErrorModel.compensate`).
 
 - ``G0``: only the end point is compensated (rapid moves do not cut).
 - ``G1``: a move longer than ``segment_length`` is split into equal pieces no longer than
@@ -69,8 +69,8 @@ Each programmed point ``X`` (mm) is replaced by the command ``X'`` with ``X' + E
   input word had more; trailing zeros are dropped down to the input word's own decimals.
 """
 
-from ...core.arcs import ARC_RADIUS_TOL, FULL_CIRCLE_TOL, PLANES, arc_points, arc_steps
-from ...core.moves import MovePlan, plan_moves
+from ...core.axis.arcs import ARC_RADIUS_TOL, FULL_CIRCLE_TOL, PLANES, arc_points, arc_steps
+from ...core.axis.moves import MovePlan, plan_moves
 from .commands import command_words, compensate_commands
 from .emitter import DEFAULT_DECIMALS, _fmt
 from .interpreter import LineInfo, Program, interpret, parse_gcode, read_gcode

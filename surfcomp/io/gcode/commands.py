@@ -7,7 +7,7 @@ FreeCAD itself. Path coordinates are always mm and absolute unless ``G91``.
 
 import re
 
-from ...core.moves import plan_moves
+from ...core.axis.moves import plan_moves
 from ...errors import GCodeError
 from .interpreter import interpret
 from .lexer import AXIS_LETTERS, Word
@@ -46,7 +46,7 @@ def compensate_commands(commands, model, segment_length=2.0, tolerance=1e-4,
     ----------
     commands : sequence of (str, dict)
         ``(Name, Parameters)`` of every command, e.g. ``('G1', {'X': 1.0, 'F': 5.0})``.
-    model : surfcomp.core.axis_errors.AxisErrorModel
+    model : surfcomp.core.axis.axis_errors.AxisErrorModel
         In the commands' coordinates (mm).
     segment_length, tolerance, arc_tolerance, start, source
         As in :func:`surfcomp.io.gcode.compensate_gcode`.

@@ -11,7 +11,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...core.arcs import PLANES, centre_from_radius, check_centre
+from ...core.axis.arcs import PLANES, centre_from_radius, check_centre
 from ...errors import GCodeError, InputError
 from ..files import clip
 from .lexer import AXIS_LETTERS, decode, split_lines, tokenize
@@ -126,7 +126,7 @@ class Program:
 
 
 def _arc_geometry(fn, source, line, *args):
-    """``fn(*args)`` of :mod:`surfcomp.core.arcs`, its refusal located at ``source:line``."""
+    """``fn(*args)`` of :mod:`surfcomp.core.axis.arcs`, its refusal located at ``source:line``."""
     try:
         return fn(*args)
     except InputError as exc:

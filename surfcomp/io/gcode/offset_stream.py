@@ -3,8 +3,8 @@
 
 The same lexer, interpreter and writer as the axis-error compensation (:mod:`.stream`): the
 program is read :data:`surfcomp.io.gcode.stream.BLOCK_LINES` lines at a time, each block's
-moves are planned by :func:`surfcomp.core.program_offset.plan_offset` and written into the
-original lines; lines of moves nothing moves are written back byte for byte. A refusal found
+moves are planned by :func:`surfcomp.core.compensation.program_offset.plan_offset` and written into
+the original lines; lines of moves nothing moves are written back byte for byte. A refusal found
 in a late block (or by the contact check over the whole program) is raised before anything
 is committed: the caller writes into a staged file.
 
@@ -16,7 +16,7 @@ off its ball offset (another radius, stock, or another face): see :meth:`Program
 
 import numpy as np
 
-from ...core.program_offset import CONTACT_TOL, fit_contact, plan_offset
+from ...core.compensation.program_offset import CONTACT_TOL, fit_contact, plan_offset
 from ...errors import GCodeError
 from .commands import _CommandWriter, command_words
 from .emitter import DEFAULT_DECIMALS, _TextWriter
@@ -31,9 +31,9 @@ class ProgramOffset:
 
     Parameters
     ----------
-    offset : surfcomp.core.program_offset.BallOffset
+    offset : surfcomp.core.compensation.program_offset.BallOffset
     tolerance, segment_length : float
-        Of :func:`surfcomp.core.program_offset.plan_offset` (mm).
+        Of :func:`surfcomp.core.compensation.program_offset.plan_offset` (mm).
     decimals : int, optional
         Least decimals of rewritten numbers (default 4).
     source : str, optional
@@ -142,7 +142,7 @@ def check_contact(off, closest, contact, source=None):
 
     Parameters
     ----------
-    off : surfcomp.core.program_offset.BallOffset
+    off : surfcomp.core.compensation.program_offset.BallOffset
     closest : (float, int)
         Smallest clearance (mm) of a cutting point and its line (the first cutting line
         when none is within reach).
@@ -152,16 +152,16 @@ def check_contact(off, closest, contact, source=None):
 
     Returns
     -------
-    surfcomp.core.program_offset.ContactFit
+    surfcomp.core.compensation.program_offset.ContactFit
 
     Raises
     ------
     GCodeError
         No cutting move comes within the ball radius plus the blend of the face; a
         cutting point inside the face is more than
-        :data:`surfcomp.core.program_offset.CONTACT_TOL` inside the nominal; the
+        :data:`surfcomp.core.compensation.program_offset.CONTACT_TOL` inside the nominal; the
         contact points fit another ball radius or sit off the ball's offset surface
-        (:func:`surfcomp.core.program_offset.fit_contact`).
+        (:func:`surfcomp.core.compensation.program_offset.fit_contact`).
     """
     r = off.radius
     if not closest[0] < off.blend:
@@ -208,7 +208,7 @@ def offset_stream(program, write, offset, block_lines=None, **settings):
     program : surfcomp.io.gcode.ProgramFile
     write : callable
         Called with each piece of output text (Latin-1).
-    offset : surfcomp.core.program_offset.BallOffset
+    offset : surfcomp.core.compensation.program_offset.BallOffset
     block_lines : int, optional
         Lines at a time (default :data:`surfcomp.io.gcode.stream.BLOCK_LINES`).
     **settings
@@ -237,9 +237,9 @@ def offset_commands(commands, offset, tolerance=5e-4, segment_length=2.0, source
     ----------
     commands : sequence of (str, dict)
         ``(Name, Parameters)`` of every command (mm, absolute unless ``G91``).
-    offset : surfcomp.core.program_offset.BallOffset
+    offset : surfcomp.core.compensation.program_offset.BallOffset
     tolerance, segment_length : float
-        As :func:`surfcomp.core.program_offset.plan_offset` (mm).
+        As :func:`surfcomp.core.compensation.program_offset.plan_offset` (mm).
     source : str, optional
         Label for messages (the "line" is the 1-based command number).
 

@@ -80,7 +80,7 @@ class CompensationResult:
 
         Parameters
         ----------
-        model : surfcomp.core.axis_errors.AxisErrorModel
+        model : surfcomp.core.axis.axis_errors.AxisErrorModel
             The model the output was compensated with.
         resolution : float
             Largest rounding (mm) of one point: half a unit of the last decimal written

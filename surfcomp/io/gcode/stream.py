@@ -23,7 +23,7 @@ import stat
 
 import numpy as np
 
-from ...core.moves import (
+from ...core.axis.moves import (
     MAX_SEGMENTS,
     SegmentEstimate,
     check_lengths,
@@ -228,7 +228,7 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
         the line ending, then the lines).
     write : callable
         Called with each piece of output text (Latin-1: one character per byte).
-    model : surfcomp.core.axis_errors.AxisErrorModel
+    model : surfcomp.core.axis.axis_errors.AxisErrorModel
     block_lines : int, optional
         Lines compensated at a time (default :data:`BLOCK_LINES`).
     **settings
@@ -298,7 +298,7 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
     ----------
     data : bytes or str
         The program.
-    model : surfcomp.core.axis_errors.AxisErrorModel
+    model : surfcomp.core.axis.axis_errors.AxisErrorModel
         Error model in program coordinates (mm).
     segment_length : float
         Longest piece (mm) of a split G1 move or converted arc.
@@ -335,7 +335,7 @@ def compensate_gcode(data, model, segment_length=2.0, tolerance=1e-4, arc_tolera
         (:meth:`CompensationResult.check_bounds`): then nothing should be written.
     InputError
         Settings outside their domain, or more segments than
-        :data:`surfcomp.core.moves.MAX_SEGMENTS` (:func:`surfcomp.core.moves.plan_moves`).
+        :data:`surfcomp.core.axis.moves.MAX_SEGMENTS` (:func:`surfcomp.core.axis.moves.plan_moves`).
     """
     text = decode(data)
     bom = (data.decode("latin-1") if isinstance(data, (bytes, bytearray))

@@ -39,7 +39,7 @@ class _Norms:
         self.comp = np.maximum(self.comp, np.abs(vectors).max(axis=0))
 
     def as_dict(self):
-        """As :func:`surfcomp.core.axis_checks.error_stats`."""
+        """As :func:`surfcomp.core.axis.axis_checks.error_stats`."""
         if not self.n:
             return {"n": 0, "max_mm": 0.0, "mean_mm": 0.0, "rms_mm": 0.0,
                     "max_component_mm": [0.0, 0.0, 0.0]}

@@ -40,7 +40,7 @@ import numpy as np  # noqa: E402
 
 from surfcomp.app import cam, dressup_axis, features, cam_job, replace  # noqa: E402
 from surfcomp.app.nominal import nominal_from_face  # noqa: E402
-from surfcomp.core.axis_errors import AxisErrorModel, SimulatedMachine  # noqa: E402
+from surfcomp.core.axis.axis_errors import AxisErrorModel, SimulatedMachine  # noqa: E402
 from tests.app.helpers import grid_on_face, write_cmm_csv  # noqa: E402
 from tests.app.test_features import add_part, block_solid, error_model  # noqa: E402
 

@@ -1,0 +1,198 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""Plausibility of measured deviations before they reach a compensation (no FreeCAD).
+
+Two checks, shared by the command line (through :func:`surfcomp.core.compensation.pipeline.prepare`)
+and the GUI's import preview:
+
+- **max offset** (an error): a deviation larger than ``max_offset`` (default 1 mm, the
+  ``--max-offset`` option and the compensation's ``MaxOffset``) is a unit or file
+  mistake, not a machining error. :func:`offset_errors` names every such line.
+- **size tolerance** (a warning): the *size tolerance* of a face is the general
+  tolerance of ISO 2768-1, class *fine* (f), for its largest dimension (the longest
+  edge of its axis-aligned bounding box): +-0.05 mm up to 6 mm, +-0.1 mm up to 30 mm,
+  +-0.15 mm up to 120 mm, +-0.2 mm up to 400 mm, +-0.3 mm up to 1000 mm, +-0.5 mm
+  beyond (ISO 2768-1:1989, table 1; the class stops at 2000 mm, larger faces keep
+  +-0.5 mm). A file whose deviations are *all* larger than :data:`UNITS_FACTOR` times
+  that tolerance describes no part that passed a machining process: its deviations are
+  almost certainly in another unit. :func:`units_warning` says so.
+- **mirror stock** (refused unless confirmed): the mirror method measures the part after
+  a semi-finishing pass that left the stock ``s``, so in surfcomp's sign convention
+  (deviation along the outward normal, + = material left) every measured deviation is
+  ``d = s + e`` with ``e`` the semi-finishing error (Huang et al. 2019, Sec. 2.4; the
+  mirror surface lies at ``s/2``, half-way between the ideal semi-finished and finished
+  surfaces). The measured mean is therefore expected near ``s``, not near ``s/2``
+  (``mean - s/2`` is the mean distance from the mirror surface, ``s/2 + mean(e)`` for a
+  right stock). :func:`stock_check` calls a stock *inconsistent* when the mean deviation
+  lies farther from ``s`` than the larger of ``s/2`` (beyond the mirror surface: nearer
+  the finished than the semi-finished surface, or as far on the other side) and
+  :data:`STOCK_SPREADS` times the spread (sample standard deviation) of the
+  deviations (small stocks, where the error is as large as the stock). The paper's
+  semi-finished parts (stock 0.2 mm, mean error 15.1-17.2 um, spread 3.1-6.2 um, Tab. 3)
+  pass; a finished part (mean 15.7 um, spread 19.1 um) with the default stock 0.1 mm
+  does not: its face would move out by up to 0.13 mm.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: ISO 2768-1 class f: (largest dimension up to, mm) -> permissible deviation (+- mm)
+ISO2768_FINE = ((6.0, 0.05), (30.0, 0.1), (120.0, 0.15), (400.0, 0.2), (1000.0, 0.3),
+                (np.inf, 0.5))
+#: deviations all larger than this many size tolerances: flagged as a units mistake
+UNITS_FACTOR = 100.0
+#: default largest accepted deviation (mm), as ``--max-offset``
+DEFAULT_MAX_OFFSET = 1.0
+#: lines named one by one before "and N more"
+MAX_LISTED = 20
+#: a stock is consistent while the mean deviation is within this many spreads of it
+#: (or within half the stock, whichever is larger)
+STOCK_SPREADS = 3.0
+
+
+def size_tolerance(largest_dimension):
+    """ISO 2768-1 fine general tolerance (+- mm) for a dimension (mm), see module doc."""
+    size = float(largest_dimension)
+    for upto, tol in ISO2768_FINE:
+        if size <= upto:
+            return tol
+    return ISO2768_FINE[-1][1]
+
+
+def largest_dimension(points):
+    """Longest edge (mm) of the axis-aligned bounding box of ``points`` (N, 3); NaN
+    rows are ignored; 0 for no finite point."""
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    p = p[np.all(np.isfinite(p), axis=1)]
+    if not len(p):
+        return 0.0
+    return float(np.max(p.max(axis=0) - p.min(axis=0)))
+
+
+def offset_errors(deviation, lines=None, max_offset=DEFAULT_MAX_OFFSET, source="",
+                  limit=MAX_LISTED):
+    """Messages for every deviation larger than ``max_offset`` (NaN and inf too).
+
+    Parameters
+    ----------
+    deviation : array_like, shape (N,)
+        Deviations along the normal (mm).
+    lines : array_like of int, shape (N,), optional
+        Line of every point in its file (1-based); else the point number.
+    max_offset : float
+        Largest accepted deviation (mm).
+    source : str
+        File name put in front of every message (``file:line: ...``).
+    limit : int
+        Lines named one by one; one more message counts the rest.
+
+    Returns
+    -------
+    list of str
+        Empty when every deviation is plausible. The first message carries the units
+        hint.
+    """
+    d = np.asarray(deviation, dtype=float).ravel()
+    bad = np.flatnonzero(~(np.abs(d) <= max_offset))
+    if not bad.size:
+        return []
+    where = np.asarray(lines, dtype=int).ravel() if lines is not None else np.arange(d.size) + 1
+    prefix = (source + ":") if source else "line "
+    out = []
+    for k in bad[:limit]:
+        out.append("%s%d: deviation %s mm is larger than the max offset %g mm"
+                   % (prefix, where[k], "%+.4f" % d[k] if np.isfinite(d[k]) else d[k],
+                      max_offset))
+    if bad.size > limit:
+        out.append("... and %d more point(s) larger than %g mm" % (bad.size - limit, max_offset))
+    finite = np.isfinite(d[bad])
+    if finite.any() and np.max(np.abs(d[bad][finite])) < 1e5 * max_offset:
+        out[0] += " (%d of %d points): are the deviations in um? Choose the file's unit, or " \
+                  "name the column like 'dev [um]'" % (bad.size, d.size)
+    return out
+
+
+def units_warning(deviation, dimension, factor=UNITS_FACTOR):
+    """A warning when every finite deviation is larger than ``factor`` times the size
+    tolerance of a face of ``dimension`` mm (see module doc), else None."""
+    d = np.abs(np.asarray(deviation, dtype=float).ravel())
+    d = d[np.isfinite(d)]
+    if not d.size or dimension <= 0:
+        return None
+    tol = size_tolerance(dimension)
+    if float(d.min()) <= factor * tol:
+        return None
+    return ("every deviation is larger than %g x the size tolerance of the face (ISO 2768-1 "
+            "fine: +-%g mm for its largest dimension %.1f mm; smallest |deviation| %.4g mm): "
+            "check the units of the file" % (factor, tol, dimension, float(d.min())))
+
+
+def value_ranges(columns):
+    """``{name: (min, max)}`` of the finite values of each named array (mm), for a
+    preview; names whose array is None or has no finite value are left out."""
+    out = {}
+    for name, values in columns.items():
+        if values is None:
+            continue
+        a = np.asarray(values, dtype=float)
+        a = a[np.isfinite(a)]
+        if a.size:
+            out[name] = (float(a.min()), float(a.max()))
+    return out
+
+
+@dataclass
+class StockCheck:
+    """The mirror method's stock against the measured deviations (mm), see module doc.
+
+    ``mean`` and ``spread`` (sample standard deviation, ddof=1; 0 for one point) of the
+    finite deviations; a part measured with ``stock`` should have its mean within
+    ``tolerance`` = max(stock/2, :data:`STOCK_SPREADS` x spread) of ``stock``.
+    """
+
+    stock: float
+    mean: float
+    spread: float
+    tolerance: float
+    consistent: bool
+
+    def describe(self):
+        """One line: the measured mean and spread against what the stock expects (um)."""
+        return ("measured mean deviation %.1f um (spread %.1f um); a part measured with the "
+                "stock %g mm should have a mean of %g mm +- %.1f um (the larger of stock/2 and "
+                "%g x the spread)" % (1e3 * self.mean, 1e3 * self.spread, self.stock,
+                                      self.stock, 1e3 * self.tolerance, STOCK_SPREADS))
+
+
+def stock_check(deviation, stock, spreads=STOCK_SPREADS):
+    """Is ``stock`` (mm) consistent with the measured ``deviation`` (mm, NaN ignored)?
+
+    Returns
+    -------
+    StockCheck
+        ``consistent`` is False when ``|mean(d) - stock| > max(stock / 2, spreads *
+        std(d))`` (module doc: a semi-finished part measures ``d = stock + e``); True
+        when there is no finite deviation.
+    """
+    d = np.asarray(deviation, dtype=float).ravel()
+    d = d[np.isfinite(d)]
+    s = float(stock)
+    if not d.size:
+        return StockCheck(stock=s, mean=float("nan"), spread=float("nan"), tolerance=s / 2,
+                          consistent=True)
+    mean = float(d.mean())
+    spread = float(d.std(ddof=1)) if d.size > 1 else 0.0
+    tol = max(s / 2.0, spreads * spread)
+    return StockCheck(stock=s, mean=mean, spread=spread, tolerance=tol,
+                      consistent=bool(abs(mean - s) <= tol))
+
+
+def residual_assumption(method, stock=None):
+    """What the predicted residual ``d_f - stock - delta`` of ``method`` assumes (one
+    sentence), or "" where it assumes nothing beyond the method."""
+    if method != "mirror":
+        return ""
+    return ("the mirror method's predicted residual assumes the measured part carries the "
+            "stock %g mm (d = stock + e): it is -(the random part) whatever the stock, so "
+            "it cannot show a wrong stock; the stock check against the measured mean can"
+            % float(stock or 0.0))

@@ -1,0 +1,250 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The corrected faces of a region: one displacement for every face (issue 30; numpy only).
+
+Each corrected surface is ``S_c(u, v) = S(u, v) + D(S(u, v))`` fitted on the nominal's knots
+refined to the field's length scale. The displacement ``D`` is one function of the 3D
+position for the whole region, so two faces that share an edge move the edge's points
+alike and the corrected edges coincide up to the fit (:func:`corrected_surface`):
+
+* away from sharp edges ``D = -delta(x) n_F(x)`` (``n_F`` the outward unit normal): where two
+  faces meet tangentially (G1) their normals agree along the edge, so D does too, and the
+  corrected faces meet G1 again;
+* near an edge where two corrected faces meet at an angle (:class:`SharpEdges`) a normal
+  move would open the edge (the two normals differ), so the displacement turns, within a
+  band around the edge, towards the edge's miter vector ``m = (n_A + n_B) / (1 + n_A.n_B)``:
+  ``D = -delta ((1 - w) n_F + w (m + n_F (1 - m.n_F)))``, ``w`` 1 on the edge and 0 beyond
+  the band. Its normal component is ``-delta`` on every face (the correction is realised;
+  the rest slides the face along itself, which is how the intersection of two offset faces
+  moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
+  :data:`MITER_ANGLE` (a blade's knife edges) get a shortened miter along their bisector:
+  there the edge stays closed and the realised correction falls short of ``delta`` within
+  half the band (reported per point).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..surface.bspline import Surface, evaluate_grid, fit_grid_lsq, insert_knots
+
+#: largest angle (degrees) between the two normals of an edge that gets its full miter
+MITER_ANGLE = 120.0
+#: samples of the fit per knot span, each direction
+PER_SPAN = 3
+#: the smallest pole budget of a corrected face (64 x 64)
+MIN_BUDGET = 64 * 64
+
+
+def _unit(a):
+    n = np.linalg.norm(a, axis=-1, keepdims=True)
+    return a / np.where(n > 0, n, 1.0)
+
+
+def miters(n_a, n_b, inward_a, inward_b):
+    """Miter vectors of edge samples and whether they were shortened.
+
+    ``n_a``, ``n_b``: outward unit normals of the two faces (K, 3); ``inward_a``, ``inward_b``:
+    unit directions in each face, normal to the edge, pointing into the face (for knife
+    edges, whose normals are opposite, the bisector is ``-(inward_a + inward_b)``).
+    """
+    c = np.einsum("ij,ij->i", n_a, n_b)
+    limit = 1.0 / math.cos(math.radians(0.5 * MITER_ANGLE))
+    clamped = 1.0 + c < 2.0 / limit ** 2         # |m|^2 = 2 / (1 + c)
+    m = (n_a + n_b) / np.where(clamped, 1.0, 1.0 + c)[:, None]
+    s = n_a + n_b
+    knife = np.linalg.norm(s, axis=1) < 0.1
+    b = np.where(knife[:, None], _unit(-(inward_a + inward_b)), _unit(s))
+    m[clamped] = limit * b[clamped]
+    return m, clamped
+
+
+@dataclass
+class SharpEdges:
+    """Polylines along the edges where corrected faces meet at an angle.
+
+    Attributes
+    ----------
+    points : ndarray, shape (K, 3)
+    miter : ndarray, shape (K, 3)
+    clamped : ndarray of bool, shape (K,)
+    edge : ndarray of int, shape (K,)
+        Which edge each sample belongs to (consecutive samples of one edge are neighbours).
+    band : float
+        Width (mm) of the band in which the displacement turns to the miter.
+    """
+
+    points: np.ndarray
+    miter: np.ndarray
+    clamped: np.ndarray
+    edge: np.ndarray
+    band: float
+
+    def __post_init__(self):
+        self._tree = cKDTree(self.points)
+
+    def nearest(self, x):
+        """Distance to the nearest edge polyline, the miter and the clamp there."""
+        _, j = self._tree.query(x, k=1)
+        best_d = np.full(len(x), np.inf)
+        best_m = np.zeros((len(x), 3))
+        best_c = np.zeros(len(x), bool)
+        for k0, k1 in ((j - 1, j), (j, j + 1)):
+            ok = (k0 >= 0) & (k1 < len(self.points))
+            k0c, k1c = np.clip(k0, 0, len(self.points) - 1), np.clip(k1, 0, len(self.points) - 1)
+            ok &= self.edge[k0c] == self.edge[k1c]
+            a, b = self.points[k0c], self.points[k1c]
+            ab = b - a
+            t = np.einsum("ij,ij->i", x - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
+                                                              1e-300)
+            t = np.clip(t, 0.0, 1.0)
+            p = a + t[:, None] * ab
+            d = np.linalg.norm(x - p, axis=1)
+            d = np.where(ok, d, np.linalg.norm(x - self.points[j], axis=1))
+            m = np.where(ok[:, None], (1 - t)[:, None] * self.miter[k0c]
+                         + t[:, None] * self.miter[k1c], self.miter[j])
+            c = np.where(ok, self.clamped[k0c] | self.clamped[k1c], self.clamped[j])
+            better = d < best_d
+            best_d[better], best_m[better], best_c[better] = d[better], m[better], c[better]
+        return best_d, best_m, best_c
+
+
+def _smoothstep(s):
+    s = np.clip(s, 0.0, 1.0)
+    return s * s * s * (s * (6 * s - 15) + 10)
+
+
+def displacement(x, n, delta, sharp=None):
+    """``D`` at points ``x`` (M, 3) of one face with outward unit normals ``n`` and
+    corrections ``delta`` (M,) in mm (see the module docstring)."""
+    if sharp is None or len(sharp.points) == 0:
+        return -delta[:, None] * n
+    d, m, clamped = sharp.nearest(x)
+    s = d / sharp.band
+    w = 1.0 - _smoothstep((s - 0.1) / 0.9)
+    lam = np.where(clamped, _smoothstep(s / 0.5), 1.0)
+    mn = np.einsum("ij,ij->i", m, n)
+    turned = m + (lam * (1.0 - mn))[:, None] * n
+    return -delta[:, None] * ((1.0 - w)[:, None] * n + w[:, None] * turned)
+
+
+def _refined(knots, degree, lo, hi, step):
+    """Knots to insert so no span of ``knots`` in ``(lo, hi)`` is wider than ``step`` and
+    every span is split at least once."""
+    br = np.unique(knots[degree:len(knots) - degree])
+    new = []
+    for a, b in zip(br[:-1], br[1:]):
+        # every span at least halved: the nominal's own spans leave no room for the field
+        k = max(2, int(math.ceil((b - a) / step - 1e-9)))
+        if k > 1:
+            new.extend(a + (b - a) * np.arange(1, k) / k)
+    return np.array(new)
+
+
+def _lengths(surf):
+    """Largest length (mm) of the surface per unit of u and of v."""
+    us = np.linspace(surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1], 41)
+    vs = np.linspace(surf.knots_v[surf.degree_v], surf.knots_v[-surf.degree_v - 1], 41)
+    P = evaluate_grid(surf, us, vs)
+    lu = np.max(np.sum(np.linalg.norm(np.diff(P, axis=0), axis=2), axis=0)) / (us[-1] - us[0])
+    lv = np.max(np.sum(np.linalg.norm(np.diff(P, axis=1), axis=2), axis=1)) / (vs[-1] - vs[0])
+    return lu, lv
+
+
+def _elevated_knots(knots, degree, to):
+    br, mult = np.unique(knots, return_counts=True)
+    mult[1:-1] += to - degree
+    mult[[0, -1]] = to + 1
+    return np.repeat(br, mult)
+
+
+def elevated(surf, to=2):
+    """The polynomial surface ``surf`` with its degrees raised to ``to`` where lower (a
+    ruled cap of degree 1 cannot follow a correction that varies across it); the same
+    surface, its poles fitted exactly (least squares on the elevated basis, which holds
+    the nominal). Rational surfaces are kept as they are."""
+    if surf.weights is not None or (surf.degree_u >= to and surf.degree_v >= to):
+        return surf
+    pu, pv = max(surf.degree_u, to), max(surf.degree_v, to)
+    ku = _elevated_knots(surf.knots_u, surf.degree_u, pu)
+    kv = _elevated_knots(surf.knots_v, surf.degree_v, pv)
+    us, vs = _samples(ku, pu, pu + 2), _samples(kv, pv, pv + 2)
+    poles = fit_grid_lsq(us, vs, evaluate_grid(surf, us, vs), ku, kv, pu, pv)
+    return Surface(poles, ku, kv, pu, pv, None, surf.u_range, surf.v_range)
+
+
+def _samples(knots, degree, per_span):
+    br = np.unique(knots[degree:len(knots) - degree])
+    t = [np.linspace(a, b, per_span + 1)[:-1] for a, b in zip(br[:-1], br[1:])]
+    return np.concatenate(t + [br[-1:]])
+
+
+@dataclass
+class Built:
+    """A corrected surface and its pole count beside the nominal's."""
+
+    surface: Surface
+    poles: tuple
+    nominal_poles: tuple
+    knot_step: float
+
+
+def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=4.0):
+    """The corrected surface of one face of a region.
+
+    Parameters
+    ----------
+    surf : Surface
+        The face's nominal (work) surface (rational: the corrected surface keeps the
+        weights of the refined nominal and its poles are fitted to the moved points).
+    outward : {1, -1}
+        Sign turning ``Su x Sv`` into the outward normal.
+    field : callable
+        ``field(x)`` -> corrections (mm, positive inwards) at points (M, 3).
+    sharp : SharpEdges, optional
+    knot_step : float
+        Largest knot span (mm) of the corrected surface (the field's length scale / 3).
+    max_factor : float
+        Pole budget: at most this many times the nominal's poles (at least MIN_BUDGET);
+        the knot step grows until the budget holds.
+
+    Returns
+    -------
+    Built
+    """
+    nominal = surf.poles.shape[:2]
+    original = surf
+    surf = elevated(surf)       # degree 1 (a ruled cap) to 2; the sides keep theirs
+    lu, lv = _lengths(surf)
+    budget = max(max_factor * nominal[0] * nominal[1], MIN_BUDGET)
+    lo_u, hi_u = surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1]
+    lo_v, hi_v = surf.knots_v[surf.degree_v], surf.knots_v[-surf.degree_v - 1]
+    step = float(knot_step)
+    while True:
+        nu = _refined(surf.knots_u, surf.degree_u, lo_u, hi_u, step / max(lu, 1e-12))
+        nv = _refined(surf.knots_v, surf.degree_v, lo_v, hi_v, step / max(lv, 1e-12))
+        if (surf.poles.shape[0] + len(nu)) * (surf.poles.shape[1] + len(nv)) <= budget:
+            break
+        step *= 1.25
+    ref = insert_knots(surf, nu, nv)
+    surf = original     # the zero correction returns it
+    us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
+    vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
+    P, Su, Sv = evaluate_grid(ref, us, vs, order=1)
+    n = outward * _unit(np.cross(Su, Sv))
+    x = P.reshape(-1, 3)
+    delta = field(x)
+    D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
+    if not np.any(D):       # zero correction: the nominal itself, not a refined copy
+        return Built(surf, nominal, nominal, step)
+    if ref.weights is None:
+        poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
+                                         ref.degree_v)
+    else:       # rational: the moved points, the weights kept
+        poles = fit_grid_lsq(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
+                             ref.degree_v, weights=ref.weights)
+    out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, ref.weights,
+                  surf.u_range, surf.v_range)
+    return Built(out, poles.shape[:2], nominal, step)
+
