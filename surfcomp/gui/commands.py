@@ -554,18 +554,20 @@ class PlanMeasurement(Command):
         FreeCADGui.Control.showDialog(plan_panel.PlanPanel(nom, face))
 
 
+from .align_panel import AlignMeasurements  # noqa: E402 (its base class is above)
 from .probe_op_cmd import AddProbeOperation  # noqa: E402 (its base class is above)
 
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
             ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
-            RestoreNominal, Report, PlanMeasurement, AddProbeOperation)
+            RestoreNominal, Report, PlanMeasurement, AddProbeOperation, AlignMeasurements)
 #: command groups (toolbar drop-downs)
 GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
            "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
            "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report",
-           None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation")
+           None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation", None,
+           "SurfComp_AlignMeasurements")
 
 
 def register():
