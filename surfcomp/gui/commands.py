@@ -554,12 +554,11 @@ class PlanMeasurement(Command):
         FreeCADGui.Control.showDialog(plan_panel.PlanPanel(nom, face))
 
 
-from .align_panel import AlignMeasurements  # noqa: E402 (its base class is above)
 from .probe_op_cmd import AddProbeOperation  # noqa: E402 (its base class is above)
 
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
             ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
-            RestoreNominal, Report, PlanMeasurement, AddProbeOperation, AlignMeasurements)
+            RestoreNominal, Report, PlanMeasurement, AddProbeOperation)
 #: command groups (toolbar drop-downs)
 GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
@@ -572,8 +571,12 @@ TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfCom
 
 def register():
     """Add every command and command group to FreeCAD (idempotent)."""
+    # its module imports this one (so it can be imported first), hence here
+    from .align_panel import AlignMeasurements
+
+    every = COMMANDS + (AlignMeasurements,) + GROUPS
     known = set(FreeCADGui.listCommands())
-    for cls in COMMANDS + GROUPS:
+    for cls in every:
         if cls.ID not in known:
             FreeCADGui.addCommand(cls.ID, cls())
-    return [c.ID for c in COMMANDS + GROUPS]
+    return [c.ID for c in every]
