@@ -156,3 +156,21 @@ def test_bad_alignment_exits_2_and_saves_nothing(shop, tmp_path, case):
     assert expected in run.stderr, run.stderr
     assert not out.exists() and _sha(shop / "d.FCStd") == digest
     assert sorted(p.name for p in tmp_path.iterdir()) == (["t.txt"] if case == "scaled" else [])
+
+
+def test_rps_groups_naming_a_face_are_kept_as_json():
+    """A 3-2-1 group naming its face cannot be written inline: the property keeps the JSON
+    object, which reads back to the same groups; bad JSON names the property."""
+    from surfcomp.app import align_doc
+    from surfcomp.errors import InputError
+
+    groups = {"primary": {"points": ["A", "B", "C"], "face": "Face1"},
+              "secondary": ["D", "E"], "tertiary": ["F"]}
+    text = align_doc.rps_text(groups)
+    assert text.startswith("{") and align_doc.rps_groups(text, "M") == groups
+    assert align_doc.rps_text({"primary": [1, 2, 3], "secondary": [4, 5],
+                               "tertiary": [6]}) == "1,2,3;4,5;6"
+    opts = align_doc.options_from("M", "rps", "", "all", text, [])
+    assert opts.rps == groups and opts.method == "rps"
+    with pytest.raises(InputError, match="M: AlignRps is not valid JSON"):
+        align_doc.rps_groups("{primary", "M")
