@@ -30,7 +30,7 @@ from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.outpath import shown
 from ..io.readers import read_any
-from . import cam, cam_job, features, toolpaths
+from . import align_doc, cam, cam_job, features, toolpaths
 from .documents import open_document, restore_failures
 
 
@@ -54,6 +54,8 @@ class DocumentJobResult:
     output: str = "face"                               # the feature's Output
     volume_change: float = 0.0                         # mm^3 (solid output)
     correction_volume: float = 0.0                     # mm^3, integral of the correction
+    alignment: list = field(default_factory=list)      # the compensation's Alignment lines
+    alignment_warnings: list = field(default_factory=list)
 
 
 def _find_object(doc, name, source):
@@ -80,7 +82,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
                      gcode=None, post="linuxcnc", post_args="--no-show-editor", job_name=None,
                      units="mm", options=None, output=None, overwrite_input=False,
                      fmt="auto", sample=None,
-                     progress=None, deviation_units=None, max_memory=None):
+                     progress=None, deviation_units=None, max_memory=None, align=None):
     """Compensate face ``face`` of ``object_name`` in the FreeCAD document ``document``.
 
     Parameters
@@ -122,6 +124,10 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Bytes: the compensation's estimated peak memory (from the number of points read,
         :mod:`surfcomp.core.budget`) above it is refused before the work (None: the
         machine's memory). FreeCAD's own recompute of the CAM Job is not estimated.
+    align : surfcomp.core.measurement.align_report.AlignOptions, optional
+        How to align the measured points to the nominal; written to the measurement
+        object's Align* properties, so the document's recompute aligns the same way
+        (:mod:`surfcomp.app.align_doc`). None: the properties keep their defaults.
 
     Returns
     -------
@@ -159,6 +165,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         comp, meas = _add_compensation(doc, nominal, face, measurements,
                                        (units, deviation_units), fmt, sample, options, output,
                                        max_memory)
+        if align is not None:
+            align_doc.settle(meas, align)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
         # computed once outside the recompute so bad input raises with file and line
         features.compensation_result(comp)
@@ -184,6 +192,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         result.warnings = list(comp.Warnings)
         result.output = comp.Output
         result.volume_change = float(comp.VolChange)
+        result.alignment = list(comp.Alignment)
+        result.alignment_warnings = [w for w in result.warnings if w in result.alignment]
         result.correction_volume = float(comp.CorrVol)
         report(progress, 0.95, "saving")
         _write(doc, result, save, gcode, text, _declared(document, measurements, save, gcode,
@@ -283,6 +293,7 @@ def summary_lines(result):
         lines.append("output: the nominal's shape with the face replaced; volume change %.4f "
                      "mm^3, the correction integrates to %.4f mm^3"
                      % (result.volume_change, -result.correction_volume))
+    lines += [a for a in result.alignment if a not in result.alignment_warnings]
     if result.replaced:
         lines.append("replaced the nominal in: %s"
                      % ", ".join("%s.%s" % pair for pair in result.replaced))

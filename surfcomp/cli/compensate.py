@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``python3 -m surfcomp compensate``: nominal + measurements -> corrected face."""
 
+import sys
+
 from ..errors import InputError
 from . import SUMMARIES, registry
 from .common import (
@@ -77,9 +79,8 @@ def run_document(args):
     if not args.object:
         raise InputError("--object NAME is required with --replace/--save/--gcode (the object "
                          "holding the nominal face)", file=args.nominal)
-    other = [o for o in ("output", "report", "points", "curves", "html", "plan", "transform",
-                         "align_faces", "align_dof", "rps") if getattr(args, o)]
-    other += ["align"] if args.align != "none" else []
+    other = [o for o in ("output", "report", "points", "curves", "html", "plan")
+             if getattr(args, o)]
     if other:
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
                          "'compensate' without them for the files"
@@ -87,7 +88,12 @@ def run_document(args):
     from ..app import fcenv
 
     fcenv.import_freecad()
+    from ..app.alignment import align_options
     from ..app.document_route import run_document_job, summary_lines
+
+    # the files are read and the transform checked before the document is opened
+    align = align_options(args) if (args.align != "none" or args.transform or args.rps
+                                    or args.align_faces or args.align_dof) else None
 
     res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,
                            save=args.save, replace=args.replace, gcode=args.gcode,
@@ -96,7 +102,10 @@ def run_document(args):
                            output="face" if args.face_only else None,
                            overwrite_input=args.overwrite_input, fmt=args.fmt,
                            sample=args.sample, progress=ProgressLine(args.quiet),
-                           deviation_units=args.deviation_units, max_memory=args.max_memory)
+                           deviation_units=args.deviation_units, max_memory=args.max_memory,
+                           align=align)
     for line in summary_lines(res):
         print(line)
+    for w in res.alignment_warnings:
+        print("warning: " + w, file=sys.stderr)
     return 0

@@ -102,13 +102,13 @@ ENTRIES = (
                help="post the regenerated program of the Job using the compensation"),
           group=DOCUMENT),
     # ------------------------------------------------------------------ alignment (job commands)
-    Entry(JOB, ("--transform",), "input", "--transform",
+    Entry(JOB + ("simulate",), ("--transform",), "input", "--transform",
           dict(metavar="FILE",
                help="known rigid transform applied to the measured points before anything "
                     "else: a 4x4 matrix (text or JSON {\"matrix\": ...}) or a work offset "
                     "(JSON {\"translation\": [x,y,z], \"rotation_z_deg\": a}); see README "
                     "'Alignment'")),
-    Entry(JOB, ("--align",), "option", "--align",
+    Entry(JOB + ("simulate",), ("--align",), "option", "--align",
           dict(choices=("none", "bestfit", "rps"), default="none",
                help="align the measured points to the nominal before the deviations: none "
                     "(default: they are in the nominal's frame), bestfit (robust least "
@@ -119,11 +119,11 @@ ENTRIES = (
                help="reference faces of the nominal shape for the alignment (datum faces); "
                     "default the compensated face itself, which absorbs the machining "
                     "error's mean and tilt (reported)")),
-    Entry(JOB, ("--align-dof",), "option", "--align-dof",
+    Entry(JOB + ("simulate",), ("--align-dof",), "option", "--align-dof",
           dict(metavar="DOF", default=None,
                help="degrees of freedom the best fit may move: all (default) or a "
                     "combination of x y z rx ry rz, e.g. xyz, z, rz, xy,rz")),
-    Entry(JOB, ("--rps",), "option", "--rps",
+    Entry(JOB + ("simulate",), ("--rps",), "option", "--rps",
           dict(metavar="FILE|IDS", default=None,
                help="3-2-1 point ids for --align rps: a JSON file {\"primary\": [3 ids], "
                     "\"secondary\": [2], \"tertiary\": [1]} or inline P1,P2,P3;P4,P5;P6")),

@@ -50,6 +50,7 @@ extent (-1 .. 1). With the defaults the bundled example face spans about
 
 import json
 import os
+import sys
 from dataclasses import fields
 
 import numpy as np
@@ -87,6 +88,9 @@ _MODEL_OPTIONS = (
     ("semi-engagement", "MM", "depth the semi-finishing pass removes", 1, False),
 )
 _LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4, "between": 2}
+
+
+ALIGN_GROUP = "alignment of the simulated measurements"
 
 
 def _fmt(v):
@@ -158,6 +162,13 @@ def add_parser(subparsers):
     m.add_argument("--reference", default="0,0,0", metavar="X,Y,Z",
                    help="reference point of the axis error measurements (default 0,0,0)")
     simulate_plan.add_options(p)
+    a = p.add_argument_group(
+        ALIGN_GROUP, "Align every simulated measurement before its compensation, as "
+        "compensate --align aligns a file (--align, --align-dof, --rps below; README "
+        "'Alignment'): the points are first moved by the inverse of --transform when it is "
+        "given. The corrected parts are judged in the nominal's frame, so the tables show "
+        "what the alignment absorbed.")
+    registry.add_options(p, "simulate", {ALIGN_GROUP: a}, flags=("--transform",))
     o = p.add_argument_group(registry.SIM_OUTPUT)
     registry.add_options(p, "simulate", {registry.SIM_OUTPUT: o}, flags=("--json", "--html"))
     o.add_argument("--report-method", metavar="LABEL",
@@ -314,8 +325,14 @@ def run(args):
     simulate_plan.check(args)
     model = model_from_args(args, preset)
     check_outputs(*_declared(args))
+    align = _align_options(args)
     progress = ProgressLine(args.quiet)
     surface, outward, info, name = _nominal(args, preset)
+    aligner = None
+    if align is not None:
+        from ..core.simulation.sim_align import SimAligner
+
+        aligner = SimAligner(surface, outward, align, args.face or "Face1")
     loop = dict(grid=grid, specs=specs, replicas=replicas, seed=args.seed, margin=args.margin,
                 between=between)
     if args.compare_layouts is not None:
@@ -325,7 +342,7 @@ def run(args):
     plan = simulate_plan.resolve(args, surface, outward)
     res = sim.simulate(surface, outward, model, keep=bool(args.html),
                        progress=sub(progress, 0, 0.95),
-                       points=None if plan is None else plan.points, **loop)
+                       points=None if plan is None else plan.points, aligner=aligner, **loop)
     res.preset = preset
     inputs = {"nominal": info}
     if plan is not None:
@@ -334,9 +351,37 @@ def run(args):
     if preset is not None and args.nominal is not None:
         data["preset"]["surface_replaced_by"] = info["path"]
     data = dict({"command": "simulate", "inputs": inputs}, **data)
+    if aligner is not None:
+        data["alignment"] = aligner.as_dict()
     _write(args, res, data, inputs, report_label)
     _print(args, res, grid, name, preset, plan)
+    for line in aligner.summary() if aligner is not None else ():
+        print(line)
+    for line in _align_warnings(aligner):
+        print("warning: " + line, file=sys.stderr)
     return 0
+
+
+def _align_options(args):
+    """The :class:`AlignOptions` of ``--align``/``--transform``/``--rps`` (files read and
+    checked before the work), or None without them."""
+    if args.align == "none" and not (args.transform or args.rps or args.align_dof):
+        return None
+    if args.compare_layouts is not None:
+        raise InputError("--align/--transform do not go with --compare-layouts (expected a "
+                         "single loop: --grid, --plan or --layout)")
+    from ..core.measurement.align_report import AlignOptions
+    from ..io.align_files import read_rps, read_transform
+
+    transform = read_transform(args.transform) if args.transform else None
+    rps = read_rps(args.rps)[0] if args.rps else None
+    return AlignOptions(args.align, (), args.align_dof or "all", rps, transform,
+                        args.transform).validate()
+
+
+def _align_warnings(aligner):
+    """The first fit's warnings (every fit warns alike)."""
+    return list(aligner.records[0][2].warnings) if aligner and aligner.records else []
 
 
 def _declared(args):
@@ -361,6 +406,7 @@ def _write(args, res, data, inputs, report_label):
             rep = report_io.build_report("simulate", dict(inputs, measurements=meas), comp,
                                          comp.prepared.warnings,
                                          {"html": shown(args.html)})
+            rep["alignment"] = data.get("alignment")
             tx.stage_text(args.html, render_html(rep, dict(data, maps=simulation_maps(res))))
         tx.commit()
 

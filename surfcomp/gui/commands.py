@@ -565,13 +565,18 @@ GROUPS = (ShowMaps,)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
            "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
            "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report",
-           None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation")
+           None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation", None,
+           "SurfComp_AlignMeasurements")
 
 
 def register():
     """Add every command and command group to FreeCAD (idempotent)."""
+    # its module imports this one (so it can be imported first), hence here
+    from .align_panel import AlignMeasurements
+
+    every = COMMANDS + (AlignMeasurements,) + GROUPS
     known = set(FreeCADGui.listCommands())
-    for cls in COMMANDS + GROUPS:
+    for cls in every:
         if cls.ID not in known:
             FreeCADGui.addCommand(cls.ID, cls())
-    return [c.ID for c in COMMANDS + GROUPS]
+    return [c.ID for c in every]

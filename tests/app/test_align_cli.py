@@ -163,16 +163,3 @@ def test_face_column_assigns_the_points(tmp_path):
     assert out.returncode == 2 and "f.csv:6: face 'Face9' is not a reference face" in out.stderr
     assert not (tmp_path / "r2.json").exists()
 
-
-def test_shop_document_route_refuses_alignment(tmp_path, fresh_doc):
-    import Part
-
-    nom = fresh_doc.addObject("Part::Feature", "Nominal")
-    nom.Shape = Part.read(EXAMPLE_STEP)
-    fresh_doc.recompute()
-    fresh_doc.saveAs(str(tmp_path / "d.FCStd"))
-    out = run_cli("compensate", tmp_path / "d.FCStd", _points(tmp_path, np.eye(4)), "--object",
-                  "Nominal", "--save", tmp_path / "out.FCStd", "--align", "bestfit", "--quiet")
-    assert out.returncode == 2
-    assert "--align cannot be combined with --replace/--save/--gcode" in out.stderr
-    assert not (tmp_path / "out.FCStd").exists()

@@ -47,6 +47,7 @@ from .process_model import (  # noqa: F401 (the simulation's public names)
     machine_pass,
 )
 from .process_model import SUMMARY as MODEL_SUMMARY
+from .sim_points import GridMeasurements, file_order, measurement_set  # noqa: F401
 from .sim_tables import (  # noqa: F401
     STAT_KEYS,
     TABLE_ROWS,
@@ -142,31 +143,6 @@ def method_specs(methods=("none", "offset", "raw", "filtered", "mirror"), masks=
 
 
 # ---------------------------------------------------------------------- the loop
-@dataclass
-class GridMeasurements:
-    """A measurement set built in memory, with the attributes of
-    :class:`surfcomp.io.measurements.MeasurementSet` that :func:`pipeline.prepare` reads
-    (core does not import io): nominal points and outward normals (N, 3), deviations
-    (N,), grid indices ``row``/``col`` (N,)."""
-
-    nominal: np.ndarray
-    normal: np.ndarray
-    deviation: np.ndarray
-    row: np.ndarray
-    col: np.ndarray
-    measured: np.ndarray = None
-    source: str = "<simulated measurement>"
-    warnings: list = field(default_factory=list)
-    lines: np.ndarray = None
-
-    def __post_init__(self):
-        if self.lines is None:
-            self.lines = np.arange(1, len(self.nominal) + 1, dtype=np.int64)
-
-    def __len__(self):
-        return len(self.lines)
-
-
 @dataclass
 class Layout:
     """Measurement grid (n, m) and the denser evaluation grid over the same area.
@@ -324,7 +300,7 @@ def _with_stock(spec, stock):
 
 
 def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4, seed=0,
-             margin=0.02, between=2, keep=False, progress=None, points=None):
+             margin=0.02, between=2, keep=False, progress=None, points=None, aligner=None):
     """Run the virtual machining loop (module docstring) for every method and replica.
 
     Parameters
@@ -357,6 +333,10 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
         one, else a scattered layout); ``grid`` then sets the evaluation
         grid only, and the statistics' ``'grid'`` are those at the points. (Not with
         ``keep``.)
+    aligner : callable, optional
+        ``aligner(label, nominal (P, 3), normals (P, 3), deviations)``: the deviations a
+        compensation uses after the measured points were aligned (same shape as given; the
+        points are ``nominal + deviation * normal``, :mod:`surfcomp.core.simulation.sim_align`).
 
     Returns
     -------
@@ -376,7 +356,7 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     shop = _Shop(model, model.frame(surface), surface, outward, layout, Projector(surface))
     nodes = layout.node_mask()
     b = layout.between
-    ms = _measurement_set(surface, outward, layout, points)
+    ms = measurement_set(surface, outward, layout, points)
     # a plan's points take the layout compensate would give them (a grid when they form
     # one whose map covers the face, else the scattered route), as a measured plan's do
     prepared = prepare(surface, outward, ms, Options(max_offset=100.0, layout="auto"))
@@ -409,8 +389,10 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
                     result.add_semi(spec.label, d_grid, model.stock)
                 else:
                     d_grid = first_at
+                if aligner is not None:
+                    d_grid = aligner(spec.label, ms.nominal, ms.normal, d_grid)
                 prep = replace(prepared, deviation=d_grid if points is not None
-                               else _file_order(prepared, d_grid))
+                               else file_order(prepared, d_grid))
                 comp = compensate(surface, outward, prep, spec.options,
                                   progress=sub(progress, k / steps, (k + 0.9) / steps))
                 given, delta = comp.corrected, comp.correction.delta
@@ -428,30 +410,6 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
             result.points = bspline.evaluate_grid(surface, layout.us, layout.vs)
     report(progress, 1.0, "done")
     return result
-
-
-def _measurement_set(surface, outward, layout, points=None):
-    """The measurement set (deviations zero) of the grid nodes, or of ``points`` (P, 3)."""
-    b = layout.between
-    if points is not None:
-        P = np.asarray(points, dtype=float).reshape(-1, 3)
-        proj = Projector(surface).project(P)
-        return GridMeasurements(nominal=P, normal=proj.normal * outward,
-                                deviation=np.zeros(len(P)), row=None, col=None)
-    n, m = layout.grid
-    S, Su, Sv = bspline.evaluate_grid(surface, layout.us[::b], layout.vs[::b], order=1)
-    nrm = np.cross(Su, Sv)
-    nrm *= outward / np.linalg.norm(nrm, axis=-1, keepdims=True)
-    rows, cols = np.indices((n, m))
-    return GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                            deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
-
-
-def _file_order(prepared, grid_values):
-    """Grid (n, m) values back in the measurement set's point order (N,)."""
-    out = np.empty(prepared.u.size)
-    out[prepared.grid.index.ravel()] = np.asarray(grid_values, dtype=float).ravel()
-    return out
 
 
 # ---------------------------------------------------------------------- results
