@@ -40,7 +40,7 @@ import FreeCAD
 import numpy as np
 
 from ..core.deviations import statistics
-from ..core.filters import EDGE_MODES
+from ..core.filters import EDGE_MODES, WERNER_MASK_SIZE
 from ..core.methods import METHODS
 from ..core.pipeline import Options, build_surface, compensate, parameter_scale, prepare
 from ..core.progress import sub
@@ -526,9 +526,9 @@ def _write_results(obj, r):
         _put(obj, name, value)
 
 
-def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
-                      weights="", edge="renormalize", stock=0.0, base=None,
-                      name="Compensation", output="face", accept_stock=False):
+def make_compensation(doc, nominal, face, measurement, method="filtered",
+                      mask_size=WERNER_MASK_SIZE, weights="", edge="renormalize", stock=0.0,
+                      base=None, name="Compensation", output="face", accept_stock=False):
     """Create a ``SurfComp_Compensation`` feature (recompute the document to compute it).
 
     Parameters
