@@ -34,7 +34,14 @@ def test_a_new_object_holds_the_registry_defaults(fresh_doc):
     assert features.options_of(obj) == Options(stock=0.0, context="document")
 
 
-def test_make_compensation_defaults_are_the_registry_defaults():
+def test_the_app_functions_default_to_the_registry():
+    from surfcomp.app import precheck, region_route
+
     params = inspect.signature(features.make_compensation).parameters
     for name in ("method", "mask_size", "edge"):
         assert params[name].default == OPTIONS[name].default, name
+    params = inspect.signature(region_route.run_region).parameters
+    for name in ("method", "mask_size", "mask_kind", "sigma", "max_offset", "smoothing"):
+        assert params[name].default == OPTIONS[name].default, name
+    params = inspect.signature(precheck.check_on_face).parameters
+    assert params["max_offset"].default == OPTIONS["max_offset"].default

@@ -143,3 +143,28 @@ def test_the_job_file_checks_each_option_by_its_registry_type():
         else:
             assert what == expected[o.type], name
             assert ok(o.default) and not ok(None if o.type is bool else 2.5)
+
+
+def test_the_core_functions_default_to_the_registry():
+    """Functions below Options keep their own keyword defaults; they must be the
+    registry's (the issue's make_mask(5) and --refine 4 copies)."""
+    import inspect
+
+    from surfcomp.core import methods, plausibility, region_field, simulate
+
+    def defaults(fn):
+        return {k: p.default for k, p in inspect.signature(fn).parameters.items()}
+
+    reg = {n: o.default for n, o in OPTIONS.items()}
+    assert defaults(filters.make_mask)["size"] == reg["mask_size"]
+    assert defaults(filters.make_mask)["kind"] == reg["mask_kind"]
+    assert defaults(filters.mask_filter)["edge"] == reg["edge"]
+    got = defaults(methods.compute_correction)
+    assert (got["method"], got["edge"]) == (reg["method"], reg["edge"])
+    got = defaults(region_field.mask_filter_3d)
+    assert (got["mask_size"], got["kind"]) == (reg["mask_size"], reg["mask_kind"])
+    got = defaults(simulate.method_specs)
+    assert (got["mask_kind"], got["edge"]) == (reg["mask_kind"], reg["edge"])
+    assert got["masks"] == (reg["mask_size"],)
+    assert plausibility.DEFAULT_MAX_OFFSET == reg["max_offset"] == 1.0
+    assert defaults(corrected.construct)["refine"] == reg["refine"]
