@@ -42,6 +42,7 @@ import numpy as np
 from ..core.deviations import statistics
 from ..core.filters import EDGE_MODES, WERNER_MASK_SIZE
 from ..core.methods import METHODS
+from ..core.options import OPTIONS
 from ..core.pipeline import Options, build_surface, compensate, parameter_scale, prepare
 from ..core.progress import sub
 from ..errors import GeometryError, InputError
@@ -293,8 +294,7 @@ def options_of(obj):
 
 
 #: compensation property -> core option of the filter (the task panel's fields)
-FILTER_OPTIONS = {"MaskSize": "mask_size", "Weights": "weights", "MaskKind": "mask_kind",
-                  "Edge": "edge"}
+FILTER_OPTIONS = {OPTIONS[n].prop: n for n in ("mask_size", "weights", "mask_kind", "edge")}
 
 
 def check_filter(obj, **values):

@@ -399,7 +399,7 @@ class StockDialog(QtGui.QDialog):
         row = QtGui.QFormLayout()
         self.spin = QtGui.QDoubleSpinBox()
         self.spin.setDecimals(4)
-        self.spin.setRange(0.0, 10.0)
+        self.spin.setRange(OPTIONS["stock"].low, OPTIONS["stock"].high)
         self.spin.setSingleStep(0.05)
         self.spin.setSuffix(" mm")
         self.spin.setValue(float(value))

@@ -124,7 +124,8 @@ dlg.resize(520, 420)
 dlg.show()
 Gui.updateGui()
 RESULTS["stock_dialog"] = {"tooltip": dlg.spin.toolTip(), "suffix": dlg.spin.suffix(),
-                           "value": dlg.value(), "png": os.path.join(TMP, "stock.png")}
+                           "value": dlg.value(), "png": os.path.join(TMP, "stock.png"),
+                           "range": [dlg.spin.minimum(), dlg.spin.maximum()]}
 dlg.grab().save(RESULTS["stock_dialog"]["png"])
 dlg.close()
 Gui.runCommand("SurfComp_Mirror")

@@ -127,3 +127,5 @@ def test_panel_and_property_view_show_the_option_registry(session):
         if items is not None:
             assert items == list(props[prop].choices), prop
     assert "0: MaskSize / 4" in session["property_options"]["Sigma"][0]
+    stock = OPTIONS["stock"]                # the stock dialog's spin box: the stock's domain
+    assert session["stock_dialog"]["range"] == [stock.low, stock.high] == [0.0, 10.0]
