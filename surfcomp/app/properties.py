@@ -139,6 +139,19 @@ _IN, _RES = "Compensation", "Result"
 _UNSET = {float: 0.0, str: "", int: 0}
 
 
+def store_options(obj, options):
+    """Set every option property of compensation ``obj`` from core ``options`` (the inverse
+    of :func:`surfcomp.app.features.options_of`): an unset option becomes 0 or empty, and
+    weights given as rows of numbers the property's text."""
+    for name, o in OPTIONS.items():
+        value = getattr(options, name)
+        if value is None:
+            value = _UNSET[o.type]
+        elif name == "weights" and not isinstance(value, str):
+            value = "; ".join(" ".join("%.17g" % w for w in row) for row in value)
+        setattr(obj, o.prop, value)
+
+
 def _option(typ, name):
     """The row of the compensation option ``name`` of the option registry: its property,
     tooltip and default (an enumeration: the choices, the first one set)."""
