@@ -96,7 +96,7 @@ class Options:
                 ok = lo <= float(value) <= hi           # False for NaN
             except (TypeError, ValueError):
                 ok = False
-            if ok and name in ("mask_size", "refine"):
+            if ok and OPTIONS[name].type is int:
                 ok = float(value).is_integer()
             if not ok:
                 raise InputError("%s %r: expected %s from %g to %g (%s in the document)"

@@ -98,7 +98,8 @@ def test_validation_refuses_just_outside_the_registry_domain(name):
     Options(**{name: ok}).validate()
     Options(**{name: o.low}).validate()
     step = 1 if o.type is int else 1e-9 * max(1.0, abs(o.high))
-    for bad in (o.low - step, o.high + step, float("nan")):
+    fraction = (o.low + 0.5,) if o.type is int else ()     # whole numbers only
+    for bad in (o.low - step, o.high + step, float("nan")) + fraction:
         with pytest.raises(InputError) as exc:
             Options(**{name: bad}).validate()
         assert exc.value.message.startswith(o.flag) and o.prop in exc.value.message
