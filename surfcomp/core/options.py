@@ -71,8 +71,7 @@ OPTIONS = {o.name: o for o in (
                 "{stock}), offset (uniform tool-radius baseline)"),
     Option("mask_size", int, 5, "MaskSize", flag="--mask", low=1, high=limits.MAX_MASK_SIZE,
            what="an odd whole number", metavar="N", note="as in Werner 2022",
-           help="odd number of grid nodes across the filter mask (Werner 2022: 5); custom "
-                "{weights} set it"),
+           help="odd number of grid nodes across the filter mask; custom {weights} set it"),
     Option("weights", str, None, "Weights", flag="--weights", metavar="W",
            unset="{mask_kind} and {mask_size}",
            help="custom mask weights, rows separated by ';', e.g. \"1 2 1; 2 4 2; 1 2 1\": "
@@ -89,7 +88,7 @@ OPTIONS = {o.name: o for o in (
     Option("stock", float, None, "Stock", flag="--stock", low=0.0, high=limits.MAX_STOCK,
            what="a length in mm", metavar="MM",
            help="semi-finishing allowance of the mirror method (mm; DH = stock / 2); a stock "
-                "that does not fit the measured mean deviation is refused"),
+                "that does not fit the measured mean deviation is refused unless {accept_stock}"),
     Option("accept_stock", bool, False, "StockOk", flag="--accept-stock",
            help="use the mirror method's {stock} although the measured mean deviation does not "
                 "fit it (a part measured with stock s has its mean within max(s/2, 3 x the "
