@@ -31,8 +31,7 @@ RENAMED = {"ToleranceBand": "TolBand", "ToleranceLower": "TolLow", "ToleranceUpp
            "LegendUnit": "Unit", "ShowLegend": "Legend", "ShowPoints": "Points",
            "ShowLabels": "Labels"}
 
-#: the quantities a map shows (the reports' node values)
-QUANTITIES = reports.QUANTITIES
+QUANTITIES = reports.QUANTITIES  # the quantities a map shows (the reports')
 TITLES = {"deviation": "Deviation", "determined": "Determined component",
           "random": "Random component", "correction": "Correction",
           "increment": "Correction of this round", "residual": "Predicted residual"}
