@@ -32,6 +32,7 @@ from ..io.outpath import shown
 from ..io.readers import read_any
 from . import align_doc, cam, cam_job, features, toolpaths
 from .documents import open_document, restore_failures
+from .properties import store_options
 
 
 @dataclass
@@ -237,17 +238,9 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
                   deviation_units=units[1])
     budget.check_job(len(ms), True, max_memory)
     meas = features.make_measurement_from_set(doc, ms)
-    comp = features.make_compensation(
-        doc, nominal, face, meas, method=options.method, mask_size=options.mask_size,
-        weights=options.weights if isinstance(options.weights, str) else "",
-        edge=options.edge, stock=options.stock or 0.0, output=output,
-        accept_stock=bool(options.accept_stock))
-    comp.MaskKind = options.mask_kind
-    comp.Sigma = float(options.sigma or 0.0)
-    comp.MaxOffset = float(options.max_offset)
-    comp.Flip = bool(options.flip_normals)
-    comp.Refine = int(options.refine)
-    comp.Lean = bool(options.lean)
+    comp = features.make_compensation(doc, nominal, face, meas, method=options.method,
+                                      output=output)
+    store_options(comp, options)     # every option, so none is left at its default unsaid
     return comp, meas
 
 

@@ -40,7 +40,7 @@ import FreeCAD
 import numpy as np
 
 from ..core.compensation.deviations import statistics
-from ..core.compensation.filters import EDGE_MODES
+from ..core.compensation.filters import EDGE_MODES, WERNER_MASK_SIZE
 from ..core.compensation.methods import METHODS
 from ..core.compensation.pipeline import (
     Options,
@@ -49,6 +49,7 @@ from ..core.compensation.pipeline import (
     parameter_scale,
     prepare,
 )
+from ..core.options import OPTIONS
 from ..core.progress import sub
 from ..errors import GeometryError, InputError
 from ..io.measurements import MeasurementSet
@@ -299,8 +300,7 @@ def options_of(obj):
 
 
 #: compensation property -> core option of the filter (the task panel's fields)
-FILTER_OPTIONS = {"MaskSize": "mask_size", "Weights": "weights", "MaskKind": "mask_kind",
-                  "Edge": "edge"}
+FILTER_OPTIONS = {OPTIONS[n].prop: n for n in ("mask_size", "weights", "mask_kind", "edge")}
 
 
 def check_filter(obj, **values):
@@ -532,9 +532,9 @@ def _write_results(obj, r):
         _put(obj, name, value)
 
 
-def make_compensation(doc, nominal, face, measurement, method="filtered", mask_size=5,
-                      weights="", edge="renormalize", stock=0.0, base=None,
-                      name="Compensation", output="face", accept_stock=False):
+def make_compensation(doc, nominal, face, measurement, method="filtered",
+                      mask_size=WERNER_MASK_SIZE, weights="", edge="renormalize", stock=0.0,
+                      base=None, name="Compensation", output="face", accept_stock=False):
     """Create a ``SurfComp_Compensation`` feature (recompute the document to compute it).
 
     Parameters

@@ -11,9 +11,7 @@ Import this module where FreeCAD is importable.
 
 import FreeCAD
 
-from ..core.compensation.filters import EDGE_MODES
-from ..core.compensation.methods import METHODS
-from ..core.compensation.pipeline import LAYOUTS
+from ..core.options import OPTIONS, tooltip
 
 #: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
 #: context when it shows them)
@@ -30,7 +28,6 @@ MEASUREMENT_TYPE = "SurfComp_Measurement"
 COMPENSATION_TYPE = "SurfComp_Compensation"
 
 OUTPUTS = ("face", "solid")
-MASK_KINDS = ("box", "gaussian")
 
 _RO = 1      # editor mode: read-only
 _HIDDEN = 2  # editor mode: hidden
@@ -138,6 +135,32 @@ MEASUREMENT_PROPERTIES = (
 )
 
 _IN, _RES = "Compensation", "Result"
+#: the property value of an unset option (:mod:`surfcomp.core.options`)
+_UNSET = {float: 0.0, str: "", int: 0}
+
+
+def store_options(obj, options):
+    """Set every option property of compensation ``obj`` from core ``options`` (the inverse
+    of :func:`surfcomp.app.features.options_of`): an unset option becomes 0 or empty, and
+    weights given as rows of numbers the property's text."""
+    for name, o in OPTIONS.items():
+        value = getattr(options, name)
+        if value is None:
+            value = _UNSET[o.type]
+        elif name == "weights" and not isinstance(value, str):
+            value = "; ".join(" ".join("%.17g" % w for w in row) for row in value)
+        setattr(obj, o.prop, value)
+
+
+def _option(typ, name):
+    """The row of the compensation option ``name`` of the option registry: its property,
+    tooltip and default (an enumeration: the choices, the first one set)."""
+    o = OPTIONS[name]
+    default = (list(o.choices) if o.choices is not None else
+               _UNSET[o.type] if o.default is None else o.default)
+    return (typ, o.prop, _IN, QT_TRANSLATE_NOOP("App::Property", tooltip(name)), default, 0)
+
+
 #: the results of an alignment on the compensation (its settings are the measurement's)
 ALIGNMENT_RESULTS = (
     ("App::PropertyFloatList", "AlignMatrix", _RES,
@@ -164,70 +187,26 @@ COMPENSATION_PROPERTIES = (
                                         "of the part machined from its corrected face; corrections"
                                         " accumulate"),
      None, 0),
-    ("App::PropertyEnumeration", "Method", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "raw (Werner eq. 2), filtered (eq. 3-5), mirror (needs "
-                                        "Stock), offset"),
-     list(METHODS), 0),
-    ("App::PropertyInteger", "MaskSize", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Odd size of the filter mask"),
-     5, 0),
-    ("App::PropertyString", "Weights", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Custom mask weights, rows separated by ';' (empty: "
-                                        "MaskKind and MaskSize)"),
-     "", 0),
-    ("App::PropertyEnumeration", "MaskKind", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Mask shape without custom weights"),
-     list(MASK_KINDS), 0),
-    ("App::PropertyFloat", "Sigma", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Gaussian sigma in grid steps (0: MaskSize / 4)"),
-     0.0, 0),
-    ("App::PropertyEnumeration", "Edge", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Edge handling of the filter"),
-     list(EDGE_MODES), 0),
-    ("App::PropertyLength", "Stock", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Semi-finishing allowance of the mirror method (mm; DH = "
-                                        "Stock / 2)"),
-     0.0, 0),
-    ("App::PropertyBool", "StockOk", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Use a mirror Stock although it does not fit the "
-                                        "measured mean deviation (a part measured with stock s "
-                                        "has its mean near s); false refuses such a stock"),
-     False, 0),
-    ("App::PropertyLength", "MaxOffset", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Largest accepted distance of a measured point from the "
-                                        "face"),
-     1.0, 0),
-    ("App::PropertyBool", "Flip", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "The file's normals point into the material: flip them and"
-                                        " the deviations' sign"),
-     False, 0),
-    ("App::PropertyInteger", "Refine", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Knot spans of the corrected surface per measurement grid "
-                                        "step at most (one where that meets the limits)"),
-     4, 0),
-    ("App::PropertyBool", "Lean", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Grids along the face's parameter lines: one knot span "
-                                        "per grid step first, kept when it meets the limits "
-                                        "(off in documents made before it: Refine spans)"),
-     True, 0),
+    _option("App::PropertyEnumeration", "method"),
+    _option("App::PropertyInteger", "mask_size"),
+    _option("App::PropertyString", "weights"),
+    _option("App::PropertyEnumeration", "mask_kind"),
+    _option("App::PropertyFloat", "sigma"),
+    _option("App::PropertyEnumeration", "edge"),
+    _option("App::PropertyLength", "stock"),
+    _option("App::PropertyBool", "accept_stock"),
+    _option("App::PropertyLength", "max_offset"),
+    _option("App::PropertyBool", "flip_normals"),
+    _option("App::PropertyInteger", "refine"),
+    _option("App::PropertyBool", "lean"),
     ("App::PropertyEnumeration", "Output", _IN,
      QT_TRANSLATE_NOOP("App::Property", "face: the corrected face; solid: the nominal's shape with"
                                         " the face replaced and its neighbours re-trimmed to meet"
                                         " it"),
      list(OUTPUTS), 0),
-    ("App::PropertyEnumeration", "Layout", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "auto: a complete grid if the points form one, else "
-                                        "scattered; grid: refuse others"),
-     list(LAYOUTS), 0),
-    ("App::PropertyLength", "Smoothing", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Scattered points: smoothing length of the fit that "
-                                        "replaces the mask filter (0: chosen by generalized "
-                                        "cross-validation)"),
-     0.0, 0),
-    ("App::PropertyLength", "TipRadius", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "Stylus ball radius when the measured points are tip "
-                                        "centres (probe logs)"),
-     0.0, 0),
+    _option("App::PropertyEnumeration", "layout"),
+    _option("App::PropertyLength", "smoothing"),
+    _option("App::PropertyLength", "tip_radius"),
     ("App::PropertyBool", "Preview", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Filter preview (task panel): compute deviations and "
                                         "components only and keep the last corrected shape; the "

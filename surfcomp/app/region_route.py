@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from ..core.compensation import region_build, region_field
+from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
@@ -38,7 +39,7 @@ def _deviation(ms, normal, signed):
 
 
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
-               sample=None, deviation_units=None, method="filtered", mask_size=5,
+               sample=None, deviation_units=None, method="filtered", mask_size=WERNER_MASK_SIZE,
                mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
                max_factor=4.0, log=print):
     """Run a region compensation; returns the report dict. Nothing is written on error."""

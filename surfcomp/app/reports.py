@@ -51,7 +51,7 @@ def quantity_values(obj, quantity):
     unmeasured nodes.
 
     ``residual`` is the predicted residual ``determined - stock - increment``: what this
-    round's correction leaves of the repeatable (determined) error when the next part is
+    round's correction leaves of the systematic (determined) error when the next part is
     cut (its new random scatter comes on top). It is defined for every method: zero for
     ``filtered``, ``-random`` for ``raw`` and ``mirror`` (they copy this part's random
     scatter into the face), ``determined - mean`` for ``offset``.

@@ -4,9 +4,9 @@
 import sys
 import time
 
-from ..core.choices import EDGE_MODES, METHODS
 from ..core.choices import MEASUREMENT_FORMATS as FORMATS
 from . import registry
+from .options import add_arguments
 
 
 def add_job_parser(subparsers, name, summary, description):
@@ -34,54 +34,16 @@ def add_input_options(p, command):
     p.add_argument("--sample", metavar="N|ID",
                    help="which measured part of a QIF file holding several: 0-based index, "
                         "serial number or MeasurementResults id (default the first)")
-    p.add_argument("--max-offset", type=float, default=1.0, metavar="MM",
-                   help="largest accepted distance of a point from the face (default 1 mm)")
-    p.add_argument("--flip-normals", action="store_true",
-                   help="the file's normals point into the material: flip them (and the sign "
-                        "of its deviations)")
-    p.add_argument("--layout", choices=("auto", "grid", "scattered"), default="auto",
-                   help="arrangement of the points: auto (a complete grid if they form one, "
-                        "else scattered, with a warning), grid (refuse anything else) or "
-                        "scattered")
-    p.add_argument("--tip-radius", type=float, default=0.0, metavar="MM",
-                   help="stylus ball radius when the measured points are tip centres (probe "
-                        "logs): each contact point is the centre moved by it against the "
-                        "outward normal (default 0)")
+    add_arguments(p, ("max_offset", "flip_normals", "layout", "tip_radius"))
     registry.add_options(p, command, flags=("--plan",))
     registry.add_options(p, command, flags=("--report", "--transform"))
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
 
 
 def add_method_options(p):
-    p.add_argument("--method", choices=METHODS, default="filtered",
-                   help="raw (Werner eq. 2), filtered (eq. 3-5, default), mirror (needs --stock), "
-                        "offset (uniform tool-radius baseline)")
-    p.add_argument("--mask", type=int, default=5, metavar="N",
-                   help="odd mask size of the filter (default 5, as in Werner 2022)")
-    p.add_argument("--weights", metavar="W",
-                   help="custom mask weights, rows separated by ';', e.g. \"1 2 1; 2 4 2; 1 2 1\"")
-    p.add_argument("--mask-kind", choices=("box", "gaussian"), default="box",
-                   help="mask shape when no --weights are given (default box)")
-    p.add_argument("--sigma", type=float, metavar="STEPS",
-                   help="Gaussian sigma in grid steps (default mask size / 4)")
-    p.add_argument("--edge", choices=EDGE_MODES, default="renormalize",
-                   help="filter edge handling (default renormalize: divide by the weights on "
-                        "measured points)")
-    p.add_argument("--stock", type=float, metavar="MM",
-                   help="semi-finishing allowance for --method mirror (DH = stock / 2); a "
-                        "stock that does not fit the measured mean deviation is refused")
-    p.add_argument("--accept-stock", action="store_true",
-                   help="use the --stock although the measured mean deviation does not fit it "
-                        "(a part measured with stock s has its mean within max(s/2, 3 x the "
-                        "spread) of s; see docs/method.md)")
-    p.add_argument("--smoothing", type=float, metavar="MM",
-                   help="scattered layouts: smoothing length of the fit that takes the mask "
-                        "filter's place (the wavelength damped to half; default chosen by "
-                        "generalized cross-validation)")
-    p.add_argument("--refine", type=int, default=4, metavar="K",
-                   help="knot spans of the corrected surface per measurement grid step at most "
-                        "(default 4): a grid along the face's parameter lines first gets one "
-                        "span per step, kept when it meets the 0.1 um / 1 um limits")
+    """The correction method and its filter, stock and surface options (registry order)."""
+    add_arguments(p, ("method", "mask_size", "weights", "mask_kind", "sigma", "edge", "stock",
+                      "accept_stock", "smoothing", "refine"))
 
 
 def job_from_args(args, command):
@@ -134,17 +96,14 @@ def wrote(path):
 
 
 def options_from_args(args):
+    """The core :class:`~surfcomp.core.compensation.pipeline.Options` of a command line: every
+    option of the registry with a flag, its default where the command has no such flag."""
     from ..core.compensation.pipeline import Options
+    from ..core.options import OPTIONS
 
-    return Options(method=getattr(args, "method", "filtered"), mask_size=getattr(args, "mask", 5),
-                   weights=getattr(args, "weights", None),
-                   mask_kind=getattr(args, "mask_kind", "box"), sigma=getattr(args, "sigma", None),
-                   edge=getattr(args, "edge", "renormalize"), stock=getattr(args, "stock", None),
-                   max_offset=args.max_offset, flip_normals=args.flip_normals,
-                   tip_radius=args.tip_radius, layout=args.layout,
-                   smoothing=getattr(args, "smoothing", None),
-                   refine=getattr(args, "refine", 4),
-                   accept_stock=bool(getattr(args, "accept_stock", False)))
+    kw = {name: getattr(args, o.flag[2:].replace("-", "_"), o.default)
+          for name, o in OPTIONS.items() if o.flag}
+    return Options(**kw)
 
 
 class ProgressLine:

@@ -3,6 +3,7 @@
 
 from . import SUMMARIES, registry
 from .common import add_job_parser, run_job_command
+from .options import add_arguments
 
 
 def add_parser(subparsers):
@@ -10,11 +11,7 @@ def add_parser(subparsers):
         subparsers, "inspect", SUMMARIES["inspect"],
         "Compute deviations along the nominal normal, the 5x5 filtered (determined) and random "
         "components, and the papers' statistics.")
-    p.add_argument("--mask", type=int, default=5, metavar="N",
-                   help="mask size of the filter used to split determined/random (default 5)")
-    p.add_argument("--weights", metavar="W", help="custom mask weights (see compensate)")
-    p.add_argument("--smoothing", type=float, metavar="MM",
-                   help="scattered layouts: smoothing length of the fit (default: GCV)")
+    add_arguments(p, ("mask_size", "weights", "smoothing"))
     registry.add_options(p, "inspect", flags=("--html",))
     p.set_defaults(run=run)
     return p

@@ -56,7 +56,7 @@ from dataclasses import fields
 import numpy as np
 
 from ..core import budget
-from ..core.compensation.filters import EDGE_MODES
+from ..core.options import OPTIONS
 from ..core.progress import sub
 from ..core.simulation import presets as presets_
 from ..core.simulation import simulate as sim
@@ -66,6 +66,7 @@ from ..io.hashing import sha256_file
 from ..io.outpath import shown
 from . import SUMMARIES, registry, simulate_plan
 from .common import ProgressLine, wrote
+from .options import add_arguments
 
 _DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
 #: model options: (option name, metavar, help, values per option, may be negative)
@@ -136,17 +137,14 @@ def add_parser(subparsers):
     g.add_argument("--methods", default="none,offset,raw,filtered,mirror", metavar="LIST",
                    help="comma-separated methods: none, offset, raw, filtered, mirror "
                         "(default all)")
-    g.add_argument("--mask", default="5", metavar="N[,N...]",
-                   help="odd mask size(s) of the filtered method; one column per size (default 5)")
-    g.add_argument("--mask-kind", choices=("box", "gaussian"), default="box",
-                   help="mask shape (default box)")
-    g.add_argument("--edge", choices=EDGE_MODES, default="renormalize", help="filter edge handling")
+    add_arguments(g, ("mask_size", "mask_kind", "edge"), mask_size=dict(
+        type=str, default=str(OPTIONS["mask_size"].default), metavar="N[,N...]",
+        help="odd mask size(s) of the filtered method; one column per size (default %d)"
+             % OPTIONS["mask_size"].default))
     g.add_argument("--stock", type=float, default=None, metavar="MM",
                    help="allowance the semi-finishing pass leaves, and the mirror method's stock "
                         "(default 0.3 mm, or the preset's)")
-    g.add_argument("--refine", type=int, default=4, metavar="K",
-                   help="knot spans of the corrected surface per grid step at most "
-                        "(default 4; one where that meets the limits)")
+    add_arguments(g, ("refine",))
     g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     m = p.add_argument_group(registry.SIM_MODEL)
     for name, metavar, text, _, _ in _MODEL_OPTIONS:

@@ -17,3 +17,9 @@ METHODS = ("raw", "filtered", "mirror", "offset")
 EDGE_MODES = ("renormalize", "reflect", "nearest")
 #: measurement file formats (:func:`surfcomp.io.readers.read_any`; auto: detected)
 MEASUREMENT_FORMATS = ("auto", "table", "xyz", "xyzijk", "probe", "qif")
+#: shapes of the filter mask without custom weights
+# (:func:`surfcomp.core.compensation.filters.make_mask`)
+MASK_KINDS = ("box", "gaussian")
+#: how the measured points are arranged: found automatically (a complete grid, else
+#: scattered), or forced (:func:`surfcomp.core.compensation.pipeline.prepare`)
+LAYOUTS = ("auto", "grid", "scattered")

@@ -86,7 +86,7 @@ TEXTS = {
                           "compensation's map (+ = material left)")),
     "SurfComp_ShowDetermined": (
         QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Determined component"),
-        QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Show the determined (filtered, repeatable) "
+        QT_TRANSLATE_NOOP("SurfComp_ShowDetermined", "Show the determined (filtered, systematic) "
                           "component of the deviation")),
     "SurfComp_ShowRandom": (
         QT_TRANSLATE_NOOP("SurfComp_ShowRandom", "Random component"),

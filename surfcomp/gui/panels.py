@@ -18,7 +18,7 @@ from ..app.undo import UndoStep
 from ..core import colormap
 from ..core.compensation import plausibility
 from ..core.compensation.deviations import Statistics, format_table
-from ..core.compensation.filters import EDGE_MODES
+from ..core.options import OPTIONS, tooltip
 from ..errors import SurfcompError
 from . import dialogs, prefs
 
@@ -112,6 +112,16 @@ class ReportDialog(QtGui.QDialog):
         return path
 
 
+def _choices(name, current):
+    """A combo box of option ``name``'s choices (the option registry), ``current`` chosen,
+    with the property's tooltip."""
+    box = QtGui.QComboBox()
+    box.addItems(list(OPTIONS[name].choices))
+    box.setCurrentIndex(list(OPTIONS[name].choices).index(current))
+    box.setToolTip(translate("App::Property", tooltip(name)))
+    return box
+
+
 class FilterPanel:
     """Task panel: mask size, kind, weights, edge handling, with live maps of the
     determined and random components and their RMS. Every change is checked first (no
@@ -130,30 +140,23 @@ class FilterPanel:
     DEBOUNCE = 0
 
     def __init__(self, obj):
-        from ..app.properties import MASK_KINDS
-
         FilterPanel.instance = self
         self.obj = obj
         self.doc = obj.Document
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("SurfComp", "Filter"))
         lay = QtGui.QFormLayout(self.form)
+        size = OPTIONS["mask_size"]
         self.mask = QtGui.QSpinBox()
-        self.mask.setRange(1, 99)
+        self.mask.setRange(size.low, size.high)
         self.mask.setSingleStep(2)
         self.mask.setValue(int(obj.MaskSize))
-        self.mask.setToolTip(translate("SurfComp", "Odd number of grid nodes across the mask "
-                                                   "(Werner 2022: 5); custom weights set it"))
-        self.kind = QtGui.QComboBox()
-        self.kind.addItems(list(MASK_KINDS))
-        self.kind.setCurrentIndex(list(MASK_KINDS).index(obj.MaskKind))
+        self.kind = _choices("mask_kind", obj.MaskKind)
         self.weights = QtGui.QLineEdit(obj.Weights)
         self.weights.setPlaceholderText(translate("SurfComp", "e.g. 1 2 1; 2 4 2; 1 2 1"))
-        self.weights.setToolTip(translate("SurfComp", "Custom mask weights, rows separated by "
-                                                      "';': they set the mask size and kind"))
-        self.edge = QtGui.QComboBox()
-        self.edge.addItems(list(EDGE_MODES))
-        self.edge.setCurrentIndex(list(EDGE_MODES).index(obj.Edge))
+        self.edge = _choices("edge", obj.Edge)
+        for widget, name in ((self.mask, "mask_size"), (self.weights, "weights")):
+            widget.setToolTip(translate("App::Property", tooltip(name)))
         self.show = QtGui.QComboBox()
         self.show.addItems(["determined", "random", "deviation", "residual"])
         self.status = QtGui.QLabel("")
@@ -397,7 +400,7 @@ class StockDialog(QtGui.QDialog):
         row = QtGui.QFormLayout()
         self.spin = QtGui.QDoubleSpinBox()
         self.spin.setDecimals(4)
-        self.spin.setRange(0.0, 10.0)
+        self.spin.setRange(OPTIONS["stock"].low, OPTIONS["stock"].high)
         self.spin.setSingleStep(0.05)
         self.spin.setSuffix(" mm")
         self.spin.setValue(float(value))

@@ -10,8 +10,7 @@ the GUI passes every value as an argument.
 import FreeCAD
 
 from ..core.colormap import SCHEMES
-from ..core.compensation.filters import EDGE_MODES
-from ..core.compensation.methods import METHODS
+from ..core.options import OPTIONS
 
 GROUP = "User parameter:BaseApp/Preferences/Mod/SurfComp"
 
@@ -26,16 +25,16 @@ DISPLAY_UNIT = "DisplayUnit"
 FILE_UNITS = "MeasurementUnits"
 
 #: choice lists in the order of the .ui combo boxes
-METHOD_CHOICES = tuple(METHODS)
-EDGE_CHOICES = tuple(EDGE_MODES)
+METHOD_CHOICES = OPTIONS["method"].choices
+EDGE_CHOICES = OPTIONS["edge"].choices
 SCHEME_CHOICES = tuple(SCHEMES)
 DISPLAY_UNIT_CHOICES = ("mm", "um")
 FILE_UNIT_CHOICES = ("mm", "um", "in")
 
 DEFAULTS = {
-    MASK_SIZE: 5,
-    METHOD: "filtered",
-    EDGE: "renormalize",
+    MASK_SIZE: OPTIONS["mask_size"].default,
+    METHOD: OPTIONS["method"].default,
+    EDGE: OPTIONS["edge"].default,
     SCHEME: "rainbow",
     TOLERANCE_BAND: False,
     TOLERANCE_LOWER: -0.01,

@@ -31,14 +31,14 @@ RENAMED = {"ToleranceBand": "TolBand", "ToleranceLower": "TolLow", "ToleranceUpp
            "LegendUnit": "Unit", "ShowLegend": "Legend", "ShowPoints": "Points",
            "ShowLabels": "Labels"}
 
-QUANTITIES = ("deviation", "determined", "random", "correction", "increment", "residual")
+QUANTITIES = reports.QUANTITIES  # the quantities a map shows (the reports')
 TITLES = {"deviation": "Deviation", "determined": "Determined component",
           "random": "Random component", "correction": "Correction",
           "increment": "Correction of this round", "residual": "Predicted residual"}
 #: the sign convention under the title of the maps whose sign is not a deviation's
 NOTES = {"correction": "+ = material removed (the face moves in by it)",
          "increment": "+ = material removed (the face moves in by it)",
-         "deviation": "+ = material left", "residual": "left of the repeatable error"}
+         "deviation": "+ = material left", "residual": "left of the systematic error"}
 #: view properties whose change only recolours the map
 STYLE_PROPERTIES = ("Scheme", "AutoRange", "RangeMin", "RangeMax", "TolBand",
                     "TolLow", "TolHigh", "Unit", "Points",

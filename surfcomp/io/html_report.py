@@ -22,7 +22,7 @@ no external resources. Sections carry stable ids for tools and tests:
                 (``id="simulated-maps"``, :func:`simulation_maps`)
 ``warnings``    messages of the run
 
-The predicted residual is what the correction leaves of the repeatable (determined)
+The predicted residual is what the correction leaves of the systematic (determined)
 error when the next part is cut: ``d_f - s - delta`` (``s`` the stock for the mirror
 method, else 0); the next part's new random scatter comes on top. It is defined for every
 method: zero for filtered, ``-(d - d_f)`` for raw and mirror (they copy this part's random
@@ -306,7 +306,7 @@ def _section_maps(arrays, style=None):
     return ('<section id="maps"><h2>Maps</h2><p>Values along the outward normal in µm; '
             'positive = material left; correction positive = material removed (the face moves '
             'inwards by it). Predicted residual = d_f - stock - delta: what the correction '
-            'leaves of the repeatable error; the next part\'s random scatter comes on top. '
+            'leaves of the systematic error; the next part\'s random scatter comes on top. '
             'Colour scheme %s%s.</p><div class="figs">%s</div></section>'
             % (_e((style or DEFAULT_STYLE)["scheme"]), _range_note(style), "".join(figs)))
 

@@ -18,6 +18,7 @@ import math
 import os
 import stat
 
+from ..core.options import OPTIONS
 from ..errors import InputError
 
 #: largest job file, bytes (a job file names files and options: a few hundred bytes)
@@ -51,20 +52,31 @@ _NUMBER = ("a finite number", _number)
 _OPT_NUMBER = ("a finite number or null", lambda v: v is None or _number(v))
 _INTEGER = ("a whole number", _integer)
 
-#: known keys: (what is expected, test); paths, choices and numbers
+
+
+def _option_type(o):
+    """What a job file's value of the registry's option ``o`` must be (the choices are
+    checked by :meth:`surfcomp.core.compensation.pipeline.Options.validate`)."""
+    if o.type is bool:
+        return _BOOL
+    if o.type is int:
+        return _INTEGER
+    if o.type is float:
+        return _OPT_NUMBER if o.optional else _NUMBER
+    return _NAME
+
+
+#: known keys: (what is expected, test); paths, choices and numbers; the compensation's
+#: options (:data:`surfcomp.core.options.OPTIONS`) by their type
 KEY_TYPES = {
     "command": _NAME,
     "nominal": _PATH, "measurements": _PATH,
     "output": _PATH, "report": _PATH, "points": _PATH, "curves": _PATH, "html": _PATH,
     "face": _NAME, "object": _NAME, "units": _NAME, "deviation_units": _NAME, "fmt": _NAME,
-    "sample": _NAME, "face_only": _BOOL, "flip_normals": _BOOL, "lean": _BOOL,
-    "accept_stock": _BOOL,
-    "method": _NAME, "mask_kind": _NAME, "edge": _NAME, "layout": _NAME,
-    "mask_size": _INTEGER, "refine": _INTEGER,
+    "sample": _NAME, "face_only": _BOOL,
+    **{name: _option_type(o) for name, o in OPTIONS.items()},
     "weights": ("a weights text such as \"1 2 1; 2 4 2; 1 2 1\" or a square list of lists "
                 "of numbers, or null", lambda v: v is None or _weights(v)),
-    "sigma": _OPT_NUMBER, "stock": _OPT_NUMBER, "smoothing": _OPT_NUMBER,
-    "max_offset": _NUMBER, "tip_radius": _NUMBER,
     "plan": _PATH, "touches": _INTEGER,
     "align": ("one of \"none\", \"bestfit\", \"rps\"",
               lambda v: v in ("none", "bestfit", "rps")),
@@ -72,8 +84,8 @@ KEY_TYPES = {
 }
 #: keys that may be null (meaning: not given)
 NULLABLE = {"output", "report", "points", "curves", "html", "face", "object", "units",
-            "deviation_units", "sample", "weights", "sigma", "stock", "smoothing", "plan",
-            "align_faces", "align_dof", "rps", "transform"}
+            "deviation_units", "sample", "plan", "align_faces", "align_dof", "rps",
+            "transform"} | {name for name, o in OPTIONS.items() if o.optional}
 
 
 def _describe(value):

@@ -70,6 +70,8 @@ def test_update_a_shop_document(shop, tmp_path):
         assert documents.restore_failures(doc, out) == []
         comp = doc.getObject(res.compensation)
         assert features.is_compensation(comp) and comp.Output == "solid"
+        # every option of the run is on the object (options_of reads them all back)
+        assert features.options_of(comp) == Options(refine=1, stock=0.0, context="document")
         assert comp.Measurement.SourceName == "meas.csv" and comp.Measurement.PointCount == 225
         clone = doc.getObject("Clone")
         assert clone.Objects == [comp] and doc.getObject("Block").Visibility is False

@@ -23,6 +23,19 @@ Gui.updateGui()
 RESULTS["filter_dialog_open"] = bool(Gui.Control.activeDialog())
 panel = panels.FilterPanel.instance
 RESULTS["figures_initial"] = panel.figures.text()
+# what the user sees of the options: the panel's widgets and the property view's tooltips
+RESULTS["panel_options"] = {
+    "mask_range": [panel.mask.minimum(), panel.mask.maximum()],
+    "kind_items": [panel.kind.itemText(i) for i in range(panel.kind.count())],
+    "edge_items": [panel.edge.itemText(i) for i in range(panel.edge.count())],
+    "tooltips": {"mask_size": panel.mask.toolTip(), "weights": panel.weights.toolTip(),
+                 "mask_kind": panel.kind.toolTip(), "edge": panel.edge.toolTip()}}
+RESULTS["property_options"] = {
+    name: [comp.getDocumentationOfProperty(name),
+           comp.getEnumerationsOfProperty(name) if name in ("Method", "MaskKind", "Edge",
+                                                            "Layout") else None]
+    for name in ("Method", "MaskSize", "Weights", "MaskKind", "Sigma", "Edge", "Refine",
+                 "Layout", "Smoothing", "TipRadius", "MaxOffset", "StockOk")}
 
 # the stale map: mask 5 -> 11 changed the numbers but not the picture
 shot_5 = shot(view, "filter_mask5")
@@ -111,7 +124,8 @@ dlg.resize(520, 420)
 dlg.show()
 Gui.updateGui()
 RESULTS["stock_dialog"] = {"tooltip": dlg.spin.toolTip(), "suffix": dlg.spin.suffix(),
-                           "value": dlg.value(), "png": os.path.join(TMP, "stock.png")}
+                           "value": dlg.value(), "png": os.path.join(TMP, "stock.png"),
+                           "range": [dlg.spin.minimum(), dlg.spin.maximum()]}
 dlg.grab().save(RESULTS["stock_dialog"]["png"])
 dlg.close()
 Gui.runCommand("SurfComp_Mirror")

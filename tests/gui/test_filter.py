@@ -106,3 +106,26 @@ def test_mirror_stock_explained_and_residual_defined(session):
     assert largest > 1e-4                      # not all 0.00 (the issue)
     assert vs_random < 1e-9                    # = -random for the mirror method
     assert session["after_mirror_undo"] == ["filtered", 0.0]
+
+
+def test_panel_and_property_view_show_the_option_registry(session):
+    """The filter panel's ranges, items and tooltips and the compensation's property
+    tooltips and enumerations, as the user meets them, are the option registry's."""
+    from surfcomp.core.options import OPTIONS, tooltip
+
+    seen = session["panel_options"]
+    size = OPTIONS["mask_size"]
+    assert seen["mask_range"] == [size.low, size.high] == [1, 201]
+    assert seen["kind_items"] == list(OPTIONS["mask_kind"].choices) == ["box", "gaussian"]
+    assert seen["edge_items"] == list(OPTIONS["edge"].choices)
+    for name, tip in seen["tooltips"].items():
+        assert tip == tooltip(name), name
+    assert "Weights" in seen["tooltips"]["mask_size"]       # the property's name, not a flag
+    props = {o.prop: o for o in OPTIONS.values()}
+    for prop, (doc, items) in session["property_options"].items():
+        assert doc == tooltip(props[prop].name), prop
+        if items is not None:
+            assert items == list(props[prop].choices), prop
+    assert "0: MaskSize / 4" in session["property_options"]["Sigma"][0]
+    stock = OPTIONS["stock"]                # the stock dialog's spin box: the stock's domain
+    assert session["stock_dialog"]["range"] == [stock.low, stock.high] == [0.0, 10.0]

@@ -20,18 +20,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..limits import ACCEPT_TOL, MATCH_ITERATIONS, MATCH_TOL, OVERSHOOT_TOL
+from ..options import OPTIONS
 from ..progress import report, sub
 from ..surface import bspline
 from .corrected_check import NodeFrame, check_figures, realised_correction
 from .field import GridField
 
-DEFAULT_REFINE = 4
-#: target of the residual iteration at the measured points (mm)
-MATCH_TOL = 2e-5
-MATCH_ITERATIONS = 8
-#: a lean or capped surface is kept when it meets the points this well (the pipeline's
-#: requirement, 0.1 um) even if the iteration has not reached MATCH_TOL (see meets_limits)
-ACCEPT_TOL = 1e-4
+#: knot spans per measurement grid step at most (the option registry's default)
+DEFAULT_REFINE = OPTIONS["refine"].default
 #: poles of the finer space a dense grid across the parameter lines falls back to (two
 #: spans per grid step, fewer (at least 1.25) where that would exceed this)
 POLE_BUDGET = 4.5e6
@@ -393,10 +390,10 @@ def _checked(smp, surf, field, k, real, nominal, U, V, delta, outward, shape):
     return Construction(surf, zero, field, k, checks)
 
 
-#: the limits a corrected surface is held to (mm): realised - intended correction at the
-#: points and the zero field's deviation from the nominal at most ACCEPT_TOL, the largest
-#: realised correction on the dense check grid at most the largest intended + OVERSHOOT_TOL
-OVERSHOOT_TOL = 1e-3
+# the limits a corrected surface is held to (mm, :mod:`surfcomp.core.limits`): realised -
+# intended correction at the points and the zero field's deviation from the nominal at most
+# ACCEPT_TOL, the largest realised correction on the dense check grid at most the largest
+# intended + OVERSHOOT_TOL
 
 
 def _excess(checks):

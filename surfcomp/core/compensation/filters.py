@@ -19,12 +19,12 @@ import numpy as np
 from scipy import ndimage
 
 from ...errors import InputError
-from ..choices import EDGE_MODES
+from ..choices import EDGE_MODES, MASK_KINDS
+from ..limits import MAX_MASK_SIZE
+from ..options import OPTIONS
 
-#: Werner 2022's mask: 5 x 5 box (the default everywhere)
-WERNER_MASK_SIZE = 5
-#: the largest mask accepted (a window of 201 x 201 grid steps)
-MAX_MASK_SIZE = 201
+#: Werner 2022's mask: 5 x 5 box (the default everywhere, from the option registry)
+WERNER_MASK_SIZE = OPTIONS["mask_size"].default
 
 
 def box_mask(size):
@@ -115,7 +115,7 @@ def make_mask(size=WERNER_MASK_SIZE, weights=None, kind="box", sigma=None):
         return box_mask(size)
     if kind == "gaussian":
         return gaussian_mask(size, sigma)
-    raise InputError("unknown mask kind %r (expected box or gaussian)" % (kind,))
+    raise InputError("unknown mask kind %r (expected %s)" % (kind, " or ".join(MASK_KINDS)))
 
 
 def mask_filter(d, mask, edge="renormalize"):

@@ -69,7 +69,7 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
         raise InputError("unknown method %r (expected one of %s)" % (method, ", ".join(METHODS)))
     d = np.asarray(d, dtype=float)
     if determined is None:
-        mask = make_mask(5) if mask is None else np.asarray(mask, dtype=float)
+        mask = make_mask() if mask is None else np.asarray(mask, dtype=float)
         determined = mask_filter(d, mask, edge)
     else:
         determined, mask = np.asarray(determined, dtype=float), None

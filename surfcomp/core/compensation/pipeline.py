@@ -13,34 +13,26 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...errors import ComputationError, GridError, InputError, MeasurementFileError
+from ..choices import LAYOUTS  # noqa: F401  (re-exported: Options.layout's choices)
+from ..limits import ACCEPT_TOL, NORMAL_WARNING_DEG, OVERSHOOT_TOL, SMOOTH_MATCH
 from ..memory import return_free_memory
+from ..options import DOMAINS as _DOMAINS
+from ..options import OPTIONS
 from ..progress import report, sub
 from ..surface import bspline
 from ..surface.grid import Scattered, grid_from_indices, grid_from_uv
 from ..surface.projection import project, tangent_lengths
 from . import plausibility
-from .corrected import DEFAULT_REFINE, construct, construct_smooth, meets_limits
+from .corrected import construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
-from .filters import EDGE_MODES, MAX_MASK_SIZE, WERNER_MASK_SIZE, make_mask
+from .filters import make_mask
 from .grid_check import as_scattered, unlocatable
-from .methods import METHODS, compute_correction
+from .methods import compute_correction
 from .spline_field import ConstantField
 
-#: a given normal more than this many degrees off the face normal is reported
-NORMAL_WARNING_DEG = 5.0
-#: a corrected face that misses the intended correction at a point by more is reported
-MISS_WARNING = 1e-4
-#: ... and one that moves more than the largest intended correction plus this anywhere
-OVERSHOOT_WARNING = 1e-3
-#: a scattered layout's corrected face is built from its smoothing fit's spline when the
-#: intended corrections are the fit's values at the points within this (mm)
-SMOOTH_MATCH = 1e-9
 #: the median nearest-neighbour distance of a scattered layout and the median tangent
 #: lengths are taken over about this many points at most (sampling error well under 1 %)
 SPACING_SAMPLE = 50000
-#: how the points are arranged: found automatically (a complete grid, else scattered),
-#: or forced
-LAYOUTS = ("auto", "grid", "scattered")
 
 
 @dataclass
@@ -64,21 +56,21 @@ class Options:
     mean (else it is refused).
     """
 
-    method: str = "filtered"
-    mask_size: int = WERNER_MASK_SIZE
-    weights: object = None
-    mask_kind: str = "box"
-    sigma: float = None
-    edge: str = "renormalize"
-    stock: float = None
-    max_offset: float = 1.0
-    flip_normals: bool = False
-    refine: int = DEFAULT_REFINE
-    tip_radius: float = 0.0
-    layout: str = "auto"
-    smoothing: float = None
-    lean: bool = True
-    accept_stock: bool = False
+    method: str = OPTIONS["method"].default
+    mask_size: int = OPTIONS["mask_size"].default
+    weights: object = OPTIONS["weights"].default
+    mask_kind: str = OPTIONS["mask_kind"].default
+    sigma: float = OPTIONS["sigma"].default
+    edge: str = OPTIONS["edge"].default
+    stock: float = OPTIONS["stock"].default
+    max_offset: float = OPTIONS["max_offset"].default
+    flip_normals: bool = OPTIONS["flip_normals"].default
+    refine: int = OPTIONS["refine"].default
+    tip_radius: float = OPTIONS["tip_radius"].default
+    layout: str = OPTIONS["layout"].default
+    smoothing: float = OPTIONS["smoothing"].default
+    lean: bool = OPTIONS["lean"].default
+    accept_stock: bool = OPTIONS["accept_stock"].default
     #: who reads the messages: ``'cli'`` (options named as ``--max-offset``) or
     #: ``'document'`` (as the compensation's properties, ``MaxOffset``, for the GUI)
     context: str = "cli"
@@ -105,18 +97,15 @@ class Options:
                 ok = lo <= float(value) <= hi           # False for NaN
             except (TypeError, ValueError):
                 ok = False
-            if ok and name in ("mask_size", "refine"):
+            if ok and OPTIONS[name].type is int:
                 ok = float(value).is_integer()
             if not ok:
                 raise InputError("%s %r: expected %s from %g to %g (%s in the document)"
                                  % (option, value, what, lo, hi, prop))
-        for name, choices, option in (("method", METHODS, "--method"),
-                                      ("mask_kind", ("box", "gaussian"), "--mask-kind"),
-                                      ("edge", EDGE_MODES, "--edge"),
-                                      ("layout", LAYOUTS, "--layout")):
-            if getattr(self, name) not in choices:
+        for o in OPTIONS.values():
+            if o.choices is not None and getattr(self, o.name) not in o.choices:
                 raise InputError("%s %r: expected one of %s"
-                                 % (option, getattr(self, name), ", ".join(choices)))
+                                 % (o.flag, getattr(self, o.name), ", ".join(o.choices)))
         for name, flag, prop in (("lean", "lean", "Lean"),
                                  ("accept_stock", "--accept-stock", "StockOk")):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
@@ -132,23 +121,10 @@ class Options:
 def option_name(options, name):
     """How a message names option ``name`` (a field of :class:`Options`) for its reader:
     the command line's ``--max-offset``, or the compensation's property ``MaxOffset``."""
-    option, prop = (_DOMAINS[name][:2] if name in _DOMAINS else
-                    {"flip_normals": ("--flip-normals", "Flip")}[name])
+    option, prop = OPTIONS[name].flag, OPTIONS[name].prop
     if getattr(options, "context", "cli") == "document":
         return "the compensation's %s" % prop
     return option
-
-
-#: option domains: field -> (option, document property, low, high, may be None, what)
-_DOMAINS = {
-    "mask_size": ("--mask", "MaskSize", 1, MAX_MASK_SIZE, False, "an odd whole number"),
-    "sigma": ("--sigma", "Sigma", 1e-3, MAX_MASK_SIZE, True, "grid steps"),
-    "stock": ("--stock", "Stock", 0.0, 10.0, True, "a length in mm"),
-    "max_offset": ("--max-offset", "MaxOffset", 1e-4, 100.0, False, "a length in mm"),
-    "refine": ("--refine", "Refine", 1, 16, False, "a whole number of spans per grid step"),
-    "tip_radius": ("--tip-radius", "TipRadius", 0.0, 50.0, False, "a length in mm"),
-    "smoothing": ("--smoothing", "Smoothing", 1e-3, 1e4, True, "a length in mm"),
-}
 
 
 @dataclass
@@ -519,20 +495,20 @@ def build_surface(result, surface, outward, delta, progress=None):
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
-    if built.checks.max_error_at_points > MISS_WARNING:
+    if built.checks.max_error_at_points > ACCEPT_TOL:
         prepared.warnings.append(
             "%s: the corrected face misses the intended correction by up to %.3f um at the "
             "measured points (more than %.1f um): neighbouring points closer than the knot "
             "spacing with different corrections (raw data?); the filtered method or a larger "
             "--refine helps" % (prepared.source, built.checks.max_error_at_points * 1e3,
-                                MISS_WARNING * 1e3))
+                                ACCEPT_TOL * 1e3))
     over = built.checks.max_realised - built.checks.max_intended
-    if over > OVERSHOOT_WARNING:
+    if over > OVERSHOOT_TOL:
         prepared.warnings.append(
             "%s: somewhere on the face the corrected face moves %.2f um more than the largest "
             "intended correction (more than %.1f um; usually beyond the measured region, "
             "where noisy raw data are continued): the filtered method or a larger --refine "
-            "helps" % (prepared.source, over * 1e3, OVERSHOOT_WARNING * 1e3))
+            "helps" % (prepared.source, over * 1e3, OVERSHOOT_TOL * 1e3))
     return result
 
 

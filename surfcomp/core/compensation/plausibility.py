@@ -36,13 +36,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..options import OPTIONS
+
 #: ISO 2768-1 class f: (largest dimension up to, mm) -> permissible deviation (+- mm)
 ISO2768_FINE = ((6.0, 0.05), (30.0, 0.1), (120.0, 0.15), (400.0, 0.2), (1000.0, 0.3),
                 (np.inf, 0.5))
 #: deviations all larger than this many size tolerances: flagged as a units mistake
 UNITS_FACTOR = 100.0
-#: default largest accepted deviation (mm), as ``--max-offset``
-DEFAULT_MAX_OFFSET = 1.0
+#: default largest accepted deviation (mm): the option registry's ``max_offset``
+DEFAULT_MAX_OFFSET = OPTIONS["max_offset"].default
 #: lines named one by one before "and N more"
 MAX_LISTED = 20
 #: a stock is consistent while the mean deviation is within this many spreads of it

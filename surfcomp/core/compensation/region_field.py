@@ -30,6 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...errors import InputError, MeasurementFileError
+from .filters import WERNER_MASK_SIZE
 
 #: the wider kernels the field falls back on where no point lies within R: (factor, weight)
 FALLBACK = ((4.0, 1e-3), (16.0, 1e-6))
@@ -76,7 +77,7 @@ def assign(distances, max_offset):
     return np.where(best <= max_offset, face, -1)
 
 
-def mask_filter_3d(points, d, mask_size=5, kind="box", sigma=None, step=None):
+def mask_filter_3d(points, d, mask_size=WERNER_MASK_SIZE, kind="box", sigma=None, step=None):
     """Werner's mask filter over scattered points in space (see the module docstring).
 
     Parameters

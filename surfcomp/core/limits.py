@@ -1,0 +1,47 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The limits and tolerances of the compensation, each under one name (lengths in mm).
+
+Importable without numpy. The modules that apply a limit import it from here (and may
+re-export it: ``surfcomp.core.compensation.corrected.ACCEPT_TOL`` is this module's); the option
+registry (:mod:`surfcomp.core.options`) takes its domains from here. Words as in the glossary of
+``docs/architecture.md``.
+"""
+
+# ------------------------------------------------------------------ the corrected face
+#: the corrected face must realise the intended correction at the measured points within
+#: this, and its zero correction reproduce the nominal within this (0.1 um): a lean or
+#: capped knot space is kept when it does, and a face that does not is reported
+ACCEPT_TOL = 1e-4
+#: ... and move nowhere (on the dense check grid) more than the largest intended
+#: correction plus this (1 um); a face that does is reported
+OVERSHOOT_TOL = 1e-3
+#: target of the residual iteration at the measured points (0.02 um)
+MATCH_TOL = 2e-5
+#: iterations of the residual iteration at most
+MATCH_ITERATIONS = 8
+#: a scattered layout's corrected face is built from its smoothing fit's spline when the
+#: intended corrections are the fit's values at the points within this
+SMOOTH_MATCH = 1e-9
+
+# ------------------------------------------------------------------ the measured points
+#: a given normal more than this many degrees off the face normal is reported
+NORMAL_WARNING_DEG = 5.0
+
+# ------------------------------------------------------------------ option domains
+#: the largest mask accepted (a window of 201 x 201 grid steps); also the largest
+#: Gaussian sigma (grid steps)
+MAX_MASK_SIZE = 201
+#: the smallest Gaussian sigma (grid steps)
+MIN_SIGMA = 1e-3
+#: knot spans of the corrected surface per measurement grid step, at most
+MAX_REFINE = 16
+#: the largest semi-finishing allowance of the mirror method
+MAX_STOCK = 10.0
+#: the accepted distance of a point from the face: at least, at most
+MIN_MAX_OFFSET = 1e-4
+MAX_MAX_OFFSET = 100.0
+#: the largest stylus ball radius
+MAX_TIP_RADIUS = 50.0
+#: the smoothing length of a scattered layout's fit: at least, at most
+MIN_SMOOTHING = 1e-3
+MAX_SMOOTHING = 1e4
