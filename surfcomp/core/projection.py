@@ -73,6 +73,8 @@ class Projection:
         than 1e-10 mm, or no further decrease was possible at the rounding
         level. False also for NaN input points and points farther than
         ``max_distance``; their other fields are NaN (``outside`` False).
+    derivatives : ndarray, shape (6, 3, N), or None
+        ``S, Su, Sv, Suu, Suv, Svv`` at the feet, when asked for (NaN where ``u`` is).
     """
 
     u: np.ndarray
@@ -82,6 +84,7 @@ class Projection:
     distance: np.ndarray
     outside: np.ndarray
     converged: np.ndarray
+    derivatives: np.ndarray = None
 
     def __len__(self):
         return self.u.shape[0]
@@ -218,8 +221,9 @@ class Projector:
         return np.unique(us), np.unique(vs)
 
     # ------------------------------------------------------------------ public
-    def project(self, points, max_distance=None, progress=None):
-        """Project points; see :func:`project`."""
+    def project(self, points, max_distance=None, progress=None, derivatives=False):
+        """Project points; see :func:`project` (``derivatives``: fill
+        :attr:`Projection.derivatives`)."""
         P = np.asarray(points, dtype=float)
         if P.ndim != 2 or P.shape[1] != 3:
             raise InputError("points must have shape (N, 3), got %r" % (P.shape,))
@@ -227,6 +231,8 @@ class Projector:
         res = dict(u=np.full(N, np.nan), v=np.full(N, np.nan), foot=np.full((N, 3), np.nan),
                    normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
                    outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
+        if derivatives:
+            res["derivatives"] = np.full((6, 3, N), np.nan)
         good = np.flatnonzero(np.all(np.isfinite(P), axis=1))
         # blocks are independent (disjoint result rows): one thread each; two per thread
         # at most (each ends with a tail of iterations on its few slow points)
@@ -522,6 +528,9 @@ class Projector:
         res["distance"][idx] = d[keep]
         res["outside"][idx] = out[keep]
         res["converged"][idx] = conv[keep]
+        if "derivatives" in res:
+            for k, d_ in enumerate(D):
+                res["derivatives"][k][:, idx] = d_[:, keep]
 
 
 def tangent_lengths(surf, u, v, chunk=CHUNK):
