@@ -498,7 +498,8 @@ class Projector:
 
     def _finish(self, P, idx, u, v, D, conv, res, max_distance):
         S, Su, Sv = D[0], D[1], D[2]                       # SoA (3, n)
-        n = np.cross(Su, Sv, axis=0)
+        n = np.array([Su[1] * Sv[2] - Su[2] * Sv[1], Su[2] * Sv[0] - Su[0] * Sv[2],
+                      Su[0] * Sv[1] - Su[1] * Sv[0]])
         nn = np.sqrt(dot(n, n))
         # degenerate normals (collapsed edges, poles) as bspline.normals has them
         bad = ((nn <= 1e-10 * self._scale_u * self._scale_v)
@@ -512,14 +513,17 @@ class Projector:
         d = dot(r, n)
         # outside: at a bound with a tangential residual (> 1e-8 mm) pointing out of
         # the work area, i.e. the unconstrained foot lies beyond that bound
-        rt = r - d * n
-        big = dot(rt, rt) > 1e-16
-        tu, tv = dot(rt, Su), dot(rt, Sv)
         (u0, u1), (v0, v1) = self.surf.u_range, self.surf.v_range
-        out = big & (((u <= u0) & (tu < 0)) | ((u >= u1) & (tu > 0)) |
-                     ((v <= v0) & (tv < 0)) | ((v >= v1) & (tv > 0)))
-        d = np.where(out, np.copysign(np.sqrt(dot(r, r)), d), d)
-        keep = np.ones(u.size, dtype=bool)
+        out = np.zeros(u.size, dtype=bool)
+        at = np.flatnonzero((u <= u0) | (u >= u1) | (v <= v0) | (v >= v1))
+        if at.size:
+            ra, ua, va = r[:, at], u[at], v[at]
+            rt = ra - d[at] * n[:, at]
+            tu, tv = dot(rt, Su[:, at]), dot(rt, Sv[:, at])
+            out[at] = (dot(rt, rt) > 1e-16) & (((ua <= u0) & (tu < 0)) | ((ua >= u1) & (tu > 0))
+                                               | ((va <= v0) & (tv < 0)) | ((va >= v1) & (tv > 0)))
+            d[out] = np.copysign(np.sqrt(dot(r[:, out], r[:, out])), d[out])
+        keep = slice(None)
         if max_distance is not None:
             keep = np.abs(d) <= float(max_distance)
         idx = idx[keep]
