@@ -6,9 +6,10 @@ has it (no FreeCAD).
 12's scipy 1.10 does not) evaluates a tensor-product spline in compiled code. Which
 evaluator runs is decided by what the installed scipy has (:data:`NDBSPLINE`), never by a
 version number. ``bench/bench_basis.py`` measured it beside the hand-written evaluation
-(:func:`surfcomp.core.bspline.evaluate` without it) on scipy 1.15: faster for points
-(about 1.4 times), slower for derivatives (0.8 times for the first, 0.6 times for the
-second), so :func:`surfcomp.core.bspline.evaluate` uses it for points only. Rational faces
+(:func:`surfcomp.core.bspline.evaluate` without it): faster for points on scipy 1.15 and
+1.17 (1.3 and 3.5 times), slower for derivatives on 1.15 (0.56 times for the first, 0.33
+for the second, 1.4 times faster on 1.17), so :func:`surfcomp.core.bspline.evaluate` uses
+it for points only. Rational faces
 are evaluated in homogeneous coordinates and divided, as the hand-written path does;
 outside the knot domain both extrapolate the end polynomial pieces.
 """
