@@ -30,6 +30,7 @@ from ...errors import InputError
 from ..progress import report
 from ..surface import bspline
 from ..surface.projection import Projector
+from ..surface.projection_warm import Tracker
 
 #: the six degrees of freedom, in the order of the parameter vector
 DOF_NAMES = ("x", "y", "z", "rx", "ry", "rz")
@@ -162,36 +163,48 @@ class Distances:
     goes to the face given for it (``assign``), else to its nearest face.
     """
 
-    def __init__(self, references, points=0, workers=None):
+    def __init__(self, references, points=0, workers=None, warm=True):
         if not references:
             raise InputError("the alignment needs at least one reference face")
         self.refs = list(references)
         self.proj = [Projector(r.surface, workers=workers, min_samples=min(points, 10 ** 6) // 16)
                      for r in self.refs]
+        self.warm = warm
 
-    def __call__(self, Q, assign=None):
+    def tracking(self):
+        """Per reference a :class:`~surfcomp.core.surface.projection_warm.Tracker` for one point set
+        moved call after call (``None`` when not ``warm``: every call projects afresh)."""
+        return [Tracker(p) for p in self.proj] if self.warm else None
+
+    def __call__(self, Q, assign=None, track=None):
         """``(r, g, face)``: outward distances (N,), their gradients (N, 3) (unit vectors;
         the face normal inside the face, towards the boundary foot beyond it) and the
-        reference of every point (N,); NaN where a point could not be projected."""
+        reference of every point (N,); NaN where a point could not be projected.
+        ``track``: :meth:`tracking` of these points (the same ``assign`` at every call)."""
         N = Q.shape[0]
         r, g = np.full(N, np.nan), np.full((N, 3), np.nan)
         face = np.zeros(N, dtype=int) if assign is None else np.asarray(assign)
         for k, ref in enumerate(self.refs):
-            idx = np.arange(N) if assign is None else np.flatnonzero(face == k)
-            if not idx.size:
+            idx = None if assign is None else np.flatnonzero(face == k)
+            if idx is not None and not idx.size:
                 continue
-            p = self.proj[k].project(Q[idx])
+            Qk = Q if idx is None else Q[idx]
+            p = (track[k] if track else self.proj[k]).project(Qk)
             d = p.distance * ref.outward
-            diff = Q[idx] - p.foot
-            ln = np.linalg.norm(diff, axis=1)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                gk = np.where((ln > 1e-9)[:, None], diff / ln[:, None] * np.sign(d)[:, None],
-                              p.normal * ref.outward)
-            if assign is None:
-                better = ~(np.abs(d) >= np.abs(r[idx]))      # NaN old values lose
-                idx, d, gk = idx[better], d[better], gk[better]
-                face[idx] = k
-            r[idx], g[idx] = d, gk
+            gk = p.normal * ref.outward
+            # beyond the face the foot is on its boundary: the gradient points from it
+            edge = np.flatnonzero(p.outside)
+            diff = Qk[edge] - p.foot[edge]
+            ln = np.sqrt(np.einsum("ij,ij->i", diff, diff))
+            far = ln > 1e-9
+            gk[edge[far]] = diff[far] / ln[far, None] * np.sign(d[edge[far]])[:, None]
+            if idx is not None:
+                r[idx], g[idx] = d, gk
+            elif k == 0:
+                r, g = d, gk
+            else:
+                better = ~(np.abs(d) >= np.abs(r))      # NaN old values lose
+                r[better], g[better], face[better] = d[better], gk[better], k
         return r, g, face
 
 
@@ -268,9 +281,9 @@ class Solver:
         self.tol = tol
         self.names = names
 
-    def residuals(self, P, M, assign=None):
+    def residuals(self, P, M, assign=None, track=None):
         Q = apply(M, P)
-        r, g, face = self.dist(Q, assign)
+        r, g, face = self.dist(Q, assign, track)
         if self.passive:        # points nearest to a passive face take no part (NaN)
             r = np.where(np.isin(face, self.passive), np.nan, r)
         return Q, r - self.offset, g, face
@@ -287,8 +300,9 @@ class Solver:
                              % (P.shape[0], len(self.cols), " ".join(DOF_NAMES[c]
                                                                       for c in self.cols)))
         M, moved, scale = M.copy(), np.inf, None
+        track = self.dist.tracking()
         for it in range(1, max_iter + 1):
-            Q, r, g, face = self.residuals(P, M, assign)
+            Q, r, g, face = self.residuals(P, M, assign, track)
             if weights is None:
                 settled = moved <= FREEZE_STEP
                 if not settled:
@@ -298,16 +312,19 @@ class Solver:
             else:
                 w = h = weights
             c = Q.mean(axis=0) if self.pivot is None else self.pivot
-            J = np.hstack([g, np.cross(Q - c, g)])
+            J, arm = jacobian(Q, c, g)
             ok = w > 0
-            step, moved = self._step(J[ok], r[ok], w[ok], h[ok], Q[ok] - c)
+            rk, wk, hk = r, w, h
+            if not ok.all():
+                J, rk, wk, hk, arm = J[ok], r[ok], w[ok], h[ok], arm[ok]
+            step, moved = self._step(J, rk, wk, hk, arm)
             M = step_matrix(step, c) @ M
             if moved <= self.tol:
                 if check:
-                    self._check(J[ok], w[ok], Q[ok] - c)
-                Q, r, g, face = self.residuals(P, M, assign)
+                    self._check(J, wk, arm)
+                Q, r, g, face = self.residuals(P, M, assign, track)
                 return Fit(M, it, True, r, w, face, g)
-        Q, r, g, face = self.residuals(P, M, assign)
+        Q, r, g, face = self.residuals(P, M, assign, track)
         return Fit(M, max_iter, False, r, w, face, g)
 
     def _check(self, J, w, arm):
@@ -320,7 +337,7 @@ class Solver:
         """Newton step of the robust loss (Hessian ``J^T diag(h) J``, gradient
         ``J^T diag(w) r``), the reweighted least-squares step where that Hessian is not
         positive definite."""
-        A = J[:, self.cols]
+        A = J if len(self.cols) == 6 else J[:, self.cols]
         grad = A.T @ (w * r)
         x = None
         for hw in (h, w):
@@ -339,8 +356,21 @@ class Solver:
         rot = np.linalg.norm(step[3:])
         if rot > MAX_STEP_ROT:
             step *= MAX_STEP_ROT / rot
-        reach = float(np.sqrt((arm ** 2).sum(axis=1).max())) if arm.size else 0.0
+        reach = float(np.sqrt(np.einsum("ij,ij->i", arm, arm).max())) if arm.size else 0.0
         return step, float(np.linalg.norm(step[:3]) + np.linalg.norm(step[3:]) * reach)
+
+
+def jacobian(Q, c, g):
+    """``(J, arm)``: the residuals' derivatives (N, 6) along a translation and a rotation
+    vector about ``c``, ``[g, (Q - c) x g]``, and the lever arms ``Q - c`` (N, 3)."""
+    arm = Q - c
+    J = np.empty((Q.shape[0], 6))
+    J[:, :3] = g
+    a, b = arm.T, g.T
+    J[:, 3] = a[1] * b[2] - a[2] * b[1]
+    J[:, 4] = a[2] * b[0] - a[0] * b[2]
+    J[:, 5] = a[0] * b[1] - a[1] * b[0]
+    return J, arm
 
 
 def step_matrix(step, centre):
@@ -447,7 +477,7 @@ def pre_align(P, solver, M0, progress=None):
 
 def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=True,
              robust=True, offset=0.0, max_iter=MAX_ITER, tol=STEP_TOL, workers=None,
-             progress=None, passive=(), distances=None):
+             progress=None, passive=(), distances=None, warm=True):
     """Robust rigid least-squares fit of measured points to reference faces.
 
     Parameters
@@ -475,6 +505,10 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
         fit (the compensated face beside datum faces); their residuals are NaN.
     distances : Distances, optional
         The references' projection engines when the caller has them.
+    warm : bool
+        Iterations after the first answer each point from its last foot
+        (:class:`~surfcomp.core.surface.projection_warm.Tracker`, the same distances to ~1e-12
+        mm); False projects afresh at every iteration.
 
     Returns
     -------
@@ -491,6 +525,7 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
     P = np.asarray(points, dtype=float)
     M0 = np.eye(4) if start is None else np.asarray(start, dtype=float)
     dist = distances or Distances(references, P.shape[0], workers)
+    dist.warm = warm
     pivot = None if {"x", "y", "z"} <= set(dof) else np.zeros(3)
     names = [r.name for k, r in enumerate(references) if k not in passive]
     solver = Solver(dist, dof, robust, offset, pivot, tol, names, passive)

@@ -17,6 +17,7 @@ from ...errors import GeometryError
 from ..chunks import for_chunks
 from .bspline_basis import basis_functions, basis_matrix, find_spans, greville
 from .bspline_fit import fit_grid_lsq, interpolate_grid, refine_knots
+from .bspline_nd import point_evaluator
 
 __all__ = ["Surface", "CHUNK_VALUES", "evaluate", "derivatives", "normals", "evaluate_grid",
            "insert_knots", "find_spans", "basis_functions", "basis_matrix", "greville",
@@ -190,7 +191,11 @@ def _all_ders(surf, u, v, order):
     keys = _ORDER_KEYS[order]
     out = [np.empty((uf.size, 3)) for _ in keys]
     Pw = _homogeneous(surf) if surf.weights is not None else surf.poles
+    compiled = point_evaluator(surf, Pw) if order == 0 and uf.size else None
     def job(sl):
+        if compiled is not None:     # scipy's NdBSpline where it has one (bspline_nd.py)
+            out[0][sl] = compiled(np.stack([uf[sl], vf[sl]], axis=1))
+            return
         res = _ders_chunk(surf, Pw, uf[sl], vf[sl], order)
         for arr, key in zip(out, keys):
             arr[sl] = res[key]

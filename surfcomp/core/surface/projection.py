@@ -73,6 +73,8 @@ class Projection:
         than 1e-10 mm, or no further decrease was possible at the rounding
         level. False also for NaN input points and points farther than
         ``max_distance``; their other fields are NaN (``outside`` False).
+    derivatives : ndarray, shape (6, 3, N), or None
+        ``S, Su, Sv, Suu, Suv, Svv`` at the feet, when asked for (NaN where ``u`` is).
     """
 
     u: np.ndarray
@@ -82,6 +84,7 @@ class Projection:
     distance: np.ndarray
     outside: np.ndarray
     converged: np.ndarray
+    derivatives: np.ndarray = None
 
     def __len__(self):
         return self.u.shape[0]
@@ -218,8 +221,9 @@ class Projector:
         return np.unique(us), np.unique(vs)
 
     # ------------------------------------------------------------------ public
-    def project(self, points, max_distance=None, progress=None):
-        """Project points; see :func:`project`."""
+    def project(self, points, max_distance=None, progress=None, derivatives=False):
+        """Project points; see :func:`project` (``derivatives``: fill
+        :attr:`Projection.derivatives`)."""
         P = np.asarray(points, dtype=float)
         if P.ndim != 2 or P.shape[1] != 3:
             raise InputError("points must have shape (N, 3), got %r" % (P.shape,))
@@ -227,6 +231,8 @@ class Projector:
         res = dict(u=np.full(N, np.nan), v=np.full(N, np.nan), foot=np.full((N, 3), np.nan),
                    normal=np.full((N, 3), np.nan), distance=np.full(N, np.nan),
                    outside=np.zeros(N, dtype=bool), converged=np.zeros(N, dtype=bool))
+        if derivatives:
+            res["derivatives"] = np.full((6, 3, N), np.nan)
         good = np.flatnonzero(np.all(np.isfinite(P), axis=1))
         # blocks are independent (disjoint result rows): one thread each; two per thread
         # at most (each ends with a tail of iterations on its few slow points)
@@ -492,7 +498,8 @@ class Projector:
 
     def _finish(self, P, idx, u, v, D, conv, res, max_distance):
         S, Su, Sv = D[0], D[1], D[2]                       # SoA (3, n)
-        n = np.cross(Su, Sv, axis=0)
+        n = np.array([Su[1] * Sv[2] - Su[2] * Sv[1], Su[2] * Sv[0] - Su[0] * Sv[2],
+                      Su[0] * Sv[1] - Su[1] * Sv[0]])
         nn = np.sqrt(dot(n, n))
         # degenerate normals (collapsed edges, poles) as bspline.normals has them
         bad = ((nn <= 1e-10 * self._scale_u * self._scale_v)
@@ -506,14 +513,17 @@ class Projector:
         d = dot(r, n)
         # outside: at a bound with a tangential residual (> 1e-8 mm) pointing out of
         # the work area, i.e. the unconstrained foot lies beyond that bound
-        rt = r - d * n
-        big = dot(rt, rt) > 1e-16
-        tu, tv = dot(rt, Su), dot(rt, Sv)
         (u0, u1), (v0, v1) = self.surf.u_range, self.surf.v_range
-        out = big & (((u <= u0) & (tu < 0)) | ((u >= u1) & (tu > 0)) |
-                     ((v <= v0) & (tv < 0)) | ((v >= v1) & (tv > 0)))
-        d = np.where(out, np.copysign(np.sqrt(dot(r, r)), d), d)
-        keep = np.ones(u.size, dtype=bool)
+        out = np.zeros(u.size, dtype=bool)
+        at = np.flatnonzero((u <= u0) | (u >= u1) | (v <= v0) | (v >= v1))
+        if at.size:
+            ra, ua, va = r[:, at], u[at], v[at]
+            rt = ra - d[at] * n[:, at]
+            tu, tv = dot(rt, Su[:, at]), dot(rt, Sv[:, at])
+            out[at] = (dot(rt, rt) > 1e-16) & (((ua <= u0) & (tu < 0)) | ((ua >= u1) & (tu > 0))
+                                               | ((va <= v0) & (tv < 0)) | ((va >= v1) & (tv > 0)))
+            d[out] = np.copysign(np.sqrt(dot(r[:, out], r[:, out])), d[out])
+        keep = slice(None)
         if max_distance is not None:
             keep = np.abs(d) <= float(max_distance)
         idx = idx[keep]
@@ -522,6 +532,9 @@ class Projector:
         res["distance"][idx] = d[keep]
         res["outside"][idx] = out[keep]
         res["converged"][idx] = conv[keep]
+        if "derivatives" in res:
+            for k, d_ in enumerate(D):
+                res["derivatives"][k][:, idx] = d_[:, keep]
 
 
 def tangent_lengths(surf, u, v, chunk=CHUNK):

@@ -20,6 +20,10 @@ from . import bspline
 STEP_TOL = 1e-6
 #: the same for other steps and near curvature centres (linear convergence)
 STEP_TOL_SLOW = 1e-10
+#: points evaluated at once by :meth:`SpanTable.evaluate`: the Horner temporaries then
+#: stay in the processor's cache (about 3 times faster per point than 65536 at once,
+#: bench/bench_align.py)
+EVAL_BLOCK = 8192
 
 
 # --------------------------------------------------------------------------- power-basis table
@@ -81,6 +85,19 @@ class SpanTable:
 
     def evaluate(self, u, v, order):
         """SoA derivatives: list of (3, n) arrays in bspline._ORDER_KEYS[order] order."""
+        n = u.size
+        if n <= EVAL_BLOCK:
+            return self._evaluate(u, v, order)
+        out = None
+        for a in range(0, n, EVAL_BLOCK):
+            part = self._evaluate(u[a:a + EVAL_BLOCK], v[a:a + EVAL_BLOCK], order)
+            if out is None:
+                out = [np.empty((p.shape[0], n)) for p in part]
+            for o, p in zip(out, part):
+                o[:, a:a + EVAL_BLOCK] = p
+        return out
+
+    def _evaluate(self, u, v, order):
         key, s, t, hu, hv = self.locate(u, v)
         n = u.size
         pu, pv, dim = self.pu, self.pv, self.dim
