@@ -19,6 +19,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..core import region_build, region_edges, region_field
 from ..core.bspline import derivatives, evaluate, normals
@@ -130,11 +131,9 @@ def project_all(faces, base, max_offset):
     (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face."""
     dist = np.full((len(faces), len(base)), np.inf)
     res = []
+    may = _sample_distances(faces, base, max_offset)
     for i, f in enumerate(faces):
-        bb = f.face.BoundBox
-        near = np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset) &
-                      (base <= np.array([bb.XMax, bb.YMax, bb.ZMax]) + max_offset), axis=1)
-        idx = np.flatnonzero(near)
+        idx = np.flatnonzero(may[i])
         p = f.project(base[idx], max_distance=max_offset) if len(idx) else None
         res.append((idx, p))
         if p is None:
@@ -143,6 +142,32 @@ def project_all(faces, base, max_offset):
         ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
         dist[i, idx[ok]] = np.abs(p.distance[ok])
     return dist, res
+
+
+def _sample_distances(faces, base, max_offset, n=200):
+    """Per face, which points may have it as their nearest face, from an n x n grid of
+    samples on each: a face's distance from a point is at least its nearest sample's less
+    the grid's covering radius, and at most the nearest sample's on any face. (A blade
+    side's box holds the other side's points too; projecting them would double the work.)"""
+    from ..core.bspline import evaluate_grid
+
+    low = np.full((len(faces), len(base)), np.inf)
+    high = np.full(len(base), np.inf)
+    for i, f in enumerate(faces):
+        bb = f.face.BoundBox
+        idx = np.flatnonzero(np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset)
+                                    & (base <= np.array([bb.XMax, bb.YMax, bb.ZMax])
+                                       + max_offset), axis=1))
+        if not len(idx):
+            continue
+        u0, u1, v0, v1 = f.bface.ParameterRange
+        g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
+        r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
+                            np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
+        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1)
+        low[i, idx] = d - r
+        high[idx] = np.minimum(high[idx], d)
+    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)
 
 
 def face_samples(f, n=60):
@@ -220,7 +245,7 @@ def shared_edges(shape, faces, all_faces=False):
                         continue
                     pts = _edge_points(ea)
                     b = region[k] if not all_faces else -1 - k
-                    ang = _nominal_angle(f, g, pts)
+                    ang = _nominal_angle(f, faces[region[k]] if k in region else g, pts)
                     out.append(SharedEdge(i, b, ja, jb, pts, ang))
     return out
 

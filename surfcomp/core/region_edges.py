@@ -109,6 +109,10 @@ class SharpEdges:
         self.band = float(band)
         self._edges = [np.flatnonzero(self.edge == k) for k in np.unique(self.edge)]
         self._trees = [cKDTree(self.points[idx]) for idx in self._edges]
+        self._tree = cKDTree(self.points)
+        # a point within the band of a segment is within this much more of a sample
+        self._reach = float(np.max(np.linalg.norm(np.diff(self.points, axis=0), axis=1)[
+            np.diff(self.edge) == 0], initial=0.0))
 
     def _one(self, x, idx, tree):
         """Distance to one edge polyline, the miter and exactness there."""
@@ -140,17 +144,31 @@ class SharpEdges:
         m = np.zeros((len(x), 3))
         e = np.zeros(len(x))
         eps2 = (1e-9 * self.band) ** 2
+        # beyond the band of every edge nothing turns (their distance is not needed)
+        near = np.flatnonzero(np.isfinite(self._tree.query(
+            x, k=1, distance_upper_bound=self.band + self._reach)[0]))
+        if not len(near):
+            return dmin, m, np.ones(len(x))
+        full = (dmin, wsum, m, e)
+        x = x[near]
+        dmin, wsum, m, e = (a[near] for a in full)
         for idx, tree in zip(self._edges, self._trees):
-            d, mk, ek = self._one(x, idx, tree)
+            # only the points in the edge's box widened by the band weigh it
+            lo, hi = self.points[idx].min(axis=0), self.points[idx].max(axis=0)
+            k = np.flatnonzero(np.all((x >= lo - self.band) & (x <= hi + self.band), axis=1))
+            d, mk, ek = self._one(x[k], idx, tree)
             w = (1.0 - smoothstep(d / self.band)) / (d * d + eps2)
-            dmin = np.minimum(dmin, d)
-            wsum += w
-            m += w[:, None] * mk
-            e += w * ek
+            dmin[k] = np.minimum(dmin[k], d)
+            wsum[k] += w
+            m[k] += w[:, None] * mk
+            e[k] += w * ek
         far = wsum <= 0
         wsum[far] = 1.0
         e[far] = 1.0
-        return dmin, m / wsum[:, None], e / wsum
+        out_d, _, out_m, out_e = full
+        out_e[:] = 1.0
+        out_d[near], out_m[near], out_e[near] = dmin, m / wsum[:, None], e / wsum
+        return out_d, out_m, out_e
 
 
 def knife_limit(angle):
