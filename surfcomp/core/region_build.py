@@ -18,7 +18,10 @@ alike and the corrected edges coincide up to the fit (:func:`corrected_surface`)
   moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
   :data:`MITER_ANGLE` (a blade's knife edges) get a shortened miter along their bisector:
   there the edge stays closed and the realised correction falls short of ``delta`` within
-  half the band (reported per point).
+  half the band (reported per point). Between 90 degrees and that angle the share of the
+  band that keeps the normal component falls smoothly; vertices where several sharp edges
+  end get one vector, and every edge within the band counts
+  (:mod:`surfcomp.core.region_edges`).
 """
 
 import math
