@@ -19,10 +19,11 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.spatial import cKDTree
 
-from ..core.compensation import region_build, region_field
+from ..core.compensation import region_build, region_edges, region_field
 from ..core.surface.bspline import derivatives, evaluate, normals
-from ..core.surface.projection import project
+from ..core.surface.projection import Projector
 from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError
 from .convert import surface_from_part
@@ -51,6 +52,15 @@ class RegionFace:
     coverage: float = 0.0
     built: object = None
     part_surface: object = None
+    projector: object = None
+
+    def project(self, points, max_distance=None):
+        """Closest points on the face's nominal; one projection engine per face (its seed
+        grid and tables cost about a second on a blade side, and a run projects onto each
+        face a dozen times)."""
+        if self.projector is None:      # seeds as dense as project() takes for a cloud
+            self.projector = Projector(self.surface, min_samples=len(points) // 16)
+        return self.projector.project(np.asarray(points, dtype=float), max_distance)
 
 
 @dataclass
@@ -97,23 +107,11 @@ def region_face(shape, k):
                       boundary_polylines(bface, 200))
 
 
-def locate(faces, base, max_offset):
-    """Project ``base`` (N, 3) on every face: (face index or -1, u, v, normal, distance)."""
+def locate(faces, base, max_offset, found=None):
+    """Project ``base`` (N, 3) on every face: (face index or -1, u, v, normal, distance).
+    ``found``: the :func:`project_all` of these faces, when already done."""
+    dist, res = found if found is not None else project_all(faces, base, max_offset)
     n = len(base)
-    dist = np.full((len(faces), n), np.inf)
-    res = []
-    for i, f in enumerate(faces):
-        bb = f.face.BoundBox
-        near = np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset) &
-                      (base <= np.array([bb.XMax, bb.YMax, bb.ZMax]) + max_offset), axis=1)
-        idx = np.flatnonzero(near)
-        p = project(f.surface, base[idx], max_distance=max_offset) if len(idx) else None
-        res.append((idx, p))
-        if p is None:
-            continue
-        ok = p.converged.copy()
-        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
-        dist[i, idx[ok]] = np.abs(p.distance[ok])
     owner = region_field.assign(dist, max_offset)
     u, v, normal, signed = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, 3), np.nan),
                             np.full(n, np.nan))
@@ -126,6 +124,50 @@ def locate(faces, base, max_offset):
         normal[k] = p.normal[mine] * faces[i].outward
         signed[k] = p.distance[mine] * faces[i].outward
     return owner, u, v, normal, signed
+
+
+def project_all(faces, base, max_offset):
+    """Each face's distance from every point in its widened bounding box, inside its trim
+    (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face."""
+    dist = np.full((len(faces), len(base)), np.inf)
+    res = []
+    may = _sample_distances(faces, base, max_offset)
+    for i, f in enumerate(faces):
+        idx = np.flatnonzero(may[i])
+        p = f.project(base[idx], max_distance=max_offset) if len(idx) else None
+        res.append((idx, p))
+        if p is None:
+            continue
+        ok = p.converged.copy()
+        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
+        dist[i, idx[ok]] = np.abs(p.distance[ok])
+    return dist, res
+
+
+def _sample_distances(faces, base, max_offset, n=200):
+    """Per face, which points may have it as their nearest face, from an n x n grid of
+    samples on each: a face's distance from a point is at least its nearest sample's less
+    the grid's covering radius, and at most the nearest sample's on any face. (A blade
+    side's box holds the other side's points too; projecting them would double the work.)"""
+    from ..core.surface.bspline import evaluate_grid
+
+    low = np.full((len(faces), len(base)), np.inf)
+    high = np.full(len(base), np.inf)
+    for i, f in enumerate(faces):
+        bb = f.face.BoundBox
+        idx = np.flatnonzero(np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset)
+                                    & (base <= np.array([bb.XMax, bb.YMax, bb.ZMax])
+                                       + max_offset), axis=1))
+        if not len(idx):
+            continue
+        u0, u1, v0, v1 = f.bface.ParameterRange
+        g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
+        r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
+                            np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
+        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1)
+        low[i, idx] = d - r
+        high[idx] = np.minimum(high[idx], d)
+    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)
 
 
 def face_samples(f, n=60):
@@ -148,7 +190,7 @@ def _edge_points(edge, n=EDGE_SAMPLES):
 def normals_at(f, pts):
     """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
     and their parameters."""
-    p = project(f.surface, np.asarray(pts, dtype=float))
+    p = f.project(pts)
     return normals(f.surface, p.u, p.v) * f.outward, p.u, p.v
 
 
@@ -203,7 +245,7 @@ def shared_edges(shape, faces, all_faces=False):
                         continue
                     pts = _edge_points(ea)
                     b = region[k] if not all_faces else -1 - k
-                    ang = _nominal_angle(f, g, pts)
+                    ang = _nominal_angle(f, faces[region[k]] if k in region else g, pts)
                     out.append(SharedEdge(i, b, ja, jb, pts, ang))
     return out
 
@@ -227,9 +269,11 @@ def _angle(a, b):
 
 
 def sharp_edges(faces, edges, band):
-    """The :class:`~surfcomp.core.compensation.region_build.SharpEdges` of the region's edges that
-    are not G1, with the normals and in-face directions at their samples."""
-    pts, mit, cl, eid = [], [], [], []
+    """The :class:`~surfcomp.core.compensation.region_edges.SharpEdges` of the region's edges that
+    are not G1, with the normals and in-face directions at their samples, each edge's vector
+    turned to its vertices' near them
+    (:func:`~surfcomp.core.compensation.region_edges.at_vertices`)."""
+    pts, mit, cl, eid, nrm = [], [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:
             continue
@@ -242,17 +286,21 @@ def sharp_edges(faces, edges, band):
         mit.append(m)
         cl.append(c)
         eid.append(np.full(len(m), k))
+        nrm.append(np.stack([na, nb], axis=1))
     if not pts:
         return None
-    return region_build.SharpEdges(np.concatenate(pts), np.concatenate(mit), np.concatenate(cl),
-                                   np.concatenate(eid), band)
+    pts, eid = np.concatenate(pts), np.concatenate(eid)
+    mit, exact = region_edges.at_vertices(
+        pts, np.concatenate(mit), np.concatenate(cl), eid, np.concatenate(nrm), 0.5 * band,
+        region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL)
+    return region_edges.SharpEdges(pts, mit, exact, eid, band)
 
 
 def _inward(f, p, n, t):
     """Unit directions in face ``f`` at edge points ``p``, normal to the edge, into the face."""
     d = np.cross(n, t)
     d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
-    probe = project(f.surface, p + 1e-3 * d)
+    probe = f.project(p + 1e-3 * d)
     ok = inside(f.polylines, probe.u, probe.v)
     return np.where(ok[:, None], d, -d)
 
@@ -275,6 +323,10 @@ def continuity(faces, edges):
                      "nominal_angle_deg": e.nominal_angle,
                      "max_gap_um": float(np.max(np.linalg.norm(pa - pb, axis=1))) * 1e3,
                      "nominal_gap_um": float(np.max(np.linalg.norm(qa - qb, axis=1))) * 1e3,
+                     # where the nominal faces are apart (a tip cap 41 um off its side), the
+                     # gap the correction adds, sample by sample
+                     "max_gap_beyond_nominal_um": float(np.max(
+                         np.linalg.norm(pa - pb, axis=1) - np.linalg.norm(qa - qb, axis=1))) * 1e3,
                      "max_angle_deg": float(np.max(angles)),
                      "max_angle_change_deg": float(np.max(np.abs(angles - nominal)))}
     return [e.figures for e in edges]

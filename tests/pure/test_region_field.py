@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The region's filter and field in space (issue 30): invariants and reference values."""
 
+import math
+
 import numpy as np
 import pytest
 
@@ -91,14 +93,19 @@ def test_straddle_refused_with_lines_and_faces():
 def test_miter_has_unit_normal_components():
     na = np.array([[0.0, 0.0, 1.0]])
     nb = np.array([[1.0, 0.0, 0.0]])
-    m, clamped = region_build.miters(na, nb, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]))
-    assert not clamped[0]
+    m, exact = region_build.miters(na, nb, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]))
+    assert exact[0] == 1.0
     np.testing.assert_allclose(m @ na[0], 1.0, atol=1e-15)
     np.testing.assert_allclose(m @ nb[0], 1.0, atol=1e-15)
     # a knife edge (opposite normals) gets a shortened miter along its bisector
-    m, clamped = region_build.miters(na, -na, np.array([[1.0, 0, 0]]), np.array([[1.0, 0, 0]]))
-    assert clamped[0]
+    m, exact = region_build.miters(na, -na, np.array([[1.0, 0, 0]]), np.array([[1.0, 0, 0]]))
+    assert exact[0] == 0.0
     np.testing.assert_allclose(m[0], [-2.0, 0.0, 0.0], atol=1e-12)
+    # between 90 and 120 deg the miter is still exact, its exactness falls smoothly
+    nc = np.array([[math.sin(math.radians(105.0)), 0.0, math.cos(math.radians(105.0))]])
+    m, exact = region_build.miters(na, nc, np.array([[1.0, 0, 0]]), np.array([[0, 0, 1.0]]))
+    np.testing.assert_allclose([m[0] @ na[0], m[0] @ nc[0]], 1.0, atol=1e-12)
+    assert exact[0] == pytest.approx(0.5, abs=1e-12)
 
 
 def test_displacement_same_on_both_faces_at_a_sharp_edge():
@@ -118,3 +125,56 @@ def test_displacement_same_on_both_faces_at_a_sharp_edge():
     dy = region_build.displacement(y, np.tile(na, (2, 1)), np.full(2, 0.02), sharp)
     np.testing.assert_allclose(dy @ na, -0.02, atol=1e-15)
     np.testing.assert_allclose(dy[1], [0.0, 0.0, -0.02], atol=1e-15)
+
+
+def _cube_corner(band=2.0):
+    """The corner of the cube [0, 10]^3 at the origin: three sharp edges (along x, y, z)
+    ending at one vertex, each between two of the faces x = 0, y = 0, z = 0."""
+    from surfcomp.core.compensation import region_edges
+
+    t = np.linspace(0.0, 10.0, 101)
+    z = np.zeros_like(t)
+    n = {"x": np.array([-1.0, 0, 0]), "y": np.array([0, -1.0, 0]), "z": np.array([0, 0, -1.0])}
+    specs = [(np.stack([t, z, z], 1), "y", "z"), (np.stack([z, t, z], 1), "x", "z"),
+             (np.stack([z, z, t], 1), "x", "y")]
+    pts, mit, ex, eid, nrm = [], [], [], [], []
+    for k, (p, a, b) in enumerate(specs):
+        na, nb = np.tile(n[a], (len(p), 1)), np.tile(n[b], (len(p), 1))
+        m, e = region_build.miters(na, nb, -nb, -na)
+        pts.append(p), mit.append(m), ex.append(e), eid.append(np.full(len(p), k))
+        nrm.append(np.stack([na, nb], 1))
+    pts, eid = np.concatenate(pts), np.concatenate(eid)
+    mit, ex = region_edges.at_vertices(pts, np.concatenate(mit), np.concatenate(ex), eid,
+                                       np.concatenate(nrm), 0.5 * band,
+                                       region_edges.knife_limit(region_build.MITER_ANGLE), 1e-6)
+    return region_edges.SharpEdges(pts, mit, ex, eid, band), n
+
+
+def test_a_vertex_moves_alike_from_every_face():
+    sharp, n = _cube_corner()
+    delta = np.array([0.02])
+    o = np.zeros((1, 3))
+    d = [region_build.displacement(o, n[k][None], delta, sharp)[0] for k in "xyz"]
+    np.testing.assert_allclose(d[0], d[1], atol=1e-15)
+    np.testing.assert_allclose(d[0], d[2], atol=1e-15)
+    # the vertex's vector is the least-squares miter of the three faces (moved inwards)
+    assert np.all(d[0] > 0.0) and np.allclose(d[0], d[0][0], atol=1e-15)
+    # two zones (2 mm) from the vertex, each edge's own miter again: both corrections met
+    x = np.array([[5.0, 0.0, 0.0]])
+    dy = region_build.displacement(x, n["y"][None], delta, sharp)[0]
+    dz = region_build.displacement(x, n["z"][None], delta, sharp)[0]
+    np.testing.assert_allclose(dy, dz, atol=1e-15)
+    np.testing.assert_allclose([dy @ n["y"], dy @ n["z"]], -0.02, atol=1e-15)
+
+
+def test_displacement_continuous_where_the_nearest_edge_changes():
+    sharp, n = _cube_corner()
+    # across the diagonal of the face z = 0, where the edges along x and y are equally near
+    s = np.linspace(0.3, 0.7, 4001)
+    x = np.stack([s, 1.0 - s, np.zeros_like(s)], axis=1)
+    d = region_build.displacement(x, np.tile(n["z"], (len(s), 1)), np.full(len(s), 0.02),
+                                  sharp)
+    # steps of 1e-4 mm: the displacement changes by 5e-6 mm per step, no jump (the two
+    # edges' vectors differ by 0.028 mm, which the nearest edge alone would jump by)
+    step = np.linalg.norm(np.diff(d, axis=0), axis=1)
+    assert np.max(step) < 1e-5 and np.max(step) < 1.1 * np.median(step)

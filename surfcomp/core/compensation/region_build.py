@@ -18,21 +18,33 @@ alike and the corrected edges coincide up to the fit (:func:`corrected_surface`)
   moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
   :data:`MITER_ANGLE` (a blade's knife edges) get a shortened miter along their bisector:
   there the edge stays closed and the realised correction falls short of ``delta`` within
-  half the band (reported per point).
+  half the band (reported per point). Between 90 degrees and that angle the share of the
+  band that keeps the normal component falls smoothly; vertices where several sharp edges
+  end get one vector, and every edge within the band counts
+  (:mod:`surfcomp.core.compensation.region_edges`).
 """
 
 import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ..surface.bspline import Surface, evaluate_grid, fit_grid_lsq, insert_knots
+from .region_edges import SharpEdges, knife_limit, smoothstep  # noqa: F401 (SharpEdges: API)
 
 #: largest angle (degrees) between the two normals of an edge that gets its full miter
 MITER_ANGLE = 120.0
+#: weight of the in-face directions in a sharp edge's bisector (they take over where the
+#: normals are opposite)
+KNIFE_SHARE = 0.05
+#: below this angle (degrees) between the normals an edge's miter is taken exactly
+EXACT_ANGLE = 90.0
 #: samples of the fit per knot span, each direction
 PER_SPAN = 3
+#: directions with more knot spans than this keep those finer than a quarter step whole
+HALVED_SPANS = 128
+#: the fewest knot spans of a corrected face in each direction
+MIN_SPANS = 8
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
 
@@ -43,90 +55,55 @@ def _unit(a):
 
 
 def miters(n_a, n_b, inward_a, inward_b):
-    """Miter vectors of edge samples and whether they were shortened.
+    """Miter vectors of edge samples and their exactness.
 
     ``n_a``, ``n_b``: outward unit normals of the two faces (K, 3); ``inward_a``, ``inward_b``:
     unit directions in each face, normal to the edge, pointing into the face (for knife
     edges, whose normals are opposite, the bisector is ``-(inward_a + inward_b)``).
+
+    Returns ``(m, exact)``: ``exact`` is 1 up to :data:`EXACT_ANGLE` between the normals
+    and falls smoothly to 0 at :data:`MITER_ANGLE`, beyond which the miter is shortened
+    (an edge's angle varies along it: a step in ``exact`` from one sample to the next is a
+    step in the displacement no fit follows).
     """
     c = np.einsum("ij,ij->i", n_a, n_b)
-    limit = 1.0 / math.cos(math.radians(0.5 * MITER_ANGLE))
+    limit = knife_limit(MITER_ANGLE)
     clamped = 1.0 + c < 2.0 / limit ** 2         # |m|^2 = 2 / (1 + c)
     m = (n_a + n_b) / np.where(clamped, 1.0, 1.0 + c)[:, None]
     s = n_a + n_b
-    knife = np.linalg.norm(s, axis=1) < 0.1
-    b = np.where(knife[:, None], _unit(-(inward_a + inward_b)), _unit(s))
+    # the bisector; at a knife edge (s near 0) the in-face directions give it, with no
+    # switch from one to the other along an edge whose angle varies
+    b = _unit(s - KNIFE_SHARE * (inward_a + inward_b))
     m[clamped] = limit * b[clamped]
-    return m, clamped
-
-
-@dataclass
-class SharpEdges:
-    """Polylines along the edges where corrected faces meet at an angle.
-
-    Attributes
-    ----------
-    points : ndarray, shape (K, 3)
-    miter : ndarray, shape (K, 3)
-    clamped : ndarray of bool, shape (K,)
-    edge : ndarray of int, shape (K,)
-        Which edge each sample belongs to (consecutive samples of one edge are neighbours).
-    band : float
-        Width (mm) of the band in which the displacement turns to the miter.
-    """
-
-    points: np.ndarray
-    miter: np.ndarray
-    clamped: np.ndarray
-    edge: np.ndarray
-    band: float
-
-    def __post_init__(self):
-        self._tree = cKDTree(self.points)
-
-    def nearest(self, x):
-        """Distance to the nearest edge polyline, the miter and the clamp there."""
-        _, j = self._tree.query(x, k=1)
-        best_d = np.full(len(x), np.inf)
-        best_m = np.zeros((len(x), 3))
-        best_c = np.zeros(len(x), bool)
-        for k0, k1 in ((j - 1, j), (j, j + 1)):
-            ok = (k0 >= 0) & (k1 < len(self.points))
-            k0c, k1c = np.clip(k0, 0, len(self.points) - 1), np.clip(k1, 0, len(self.points) - 1)
-            ok &= self.edge[k0c] == self.edge[k1c]
-            a, b = self.points[k0c], self.points[k1c]
-            ab = b - a
-            t = np.einsum("ij,ij->i", x - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
-                                                              1e-300)
-            t = np.clip(t, 0.0, 1.0)
-            p = a + t[:, None] * ab
-            d = np.linalg.norm(x - p, axis=1)
-            d = np.where(ok, d, np.linalg.norm(x - self.points[j], axis=1))
-            m = np.where(ok[:, None], (1 - t)[:, None] * self.miter[k0c]
-                         + t[:, None] * self.miter[k1c], self.miter[j])
-            c = np.where(ok, self.clamped[k0c] | self.clamped[k1c], self.clamped[j])
-            better = d < best_d
-            best_d[better], best_m[better], best_c[better] = d[better], m[better], c[better]
-        return best_d, best_m, best_c
-
-
-def _smoothstep(s):
-    s = np.clip(s, 0.0, 1.0)
-    return s * s * s * (s * (6 * s - 15) + 10)
+    angle = np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
+    exact = 1.0 - smoothstep((angle - EXACT_ANGLE) / (MITER_ANGLE - EXACT_ANGLE))
+    return m, exact
 
 
 def displacement(x, n, delta, sharp=None):
     """``D`` at points ``x`` (M, 3) of one face with outward unit normals ``n`` and
     corrections ``delta`` (M,) in mm (see the module docstring)."""
+    return -delta[:, None] * direction(x, n, sharp)
+
+
+def direction(x, n, sharp=None):
+    """``D / -delta``: the unit normal away from sharp edges, turned towards the edges'
+    vectors within their band (see the module docstring)."""
     if sharp is None or len(sharp.points) == 0:
-        return -delta[:, None] * n
-    d, m, clamped = sharp.nearest(x)
+        return np.array(n, dtype=float)
+    d, m, exact = sharp.nearest(x)
     s = d / sharp.band
-    w = 1.0 - _smoothstep((s - 0.1) / 0.9)
-    lam = np.where(clamped, _smoothstep(s / 0.5), 1.0)
+    w = 1.0 - smoothstep((s - 0.1) / 0.9)
+    lam = exact + (1.0 - exact) * smoothstep(s / 0.5)
     mn = np.einsum("ij,ij->i", m, n)
     turned = m + (lam * (1.0 - mn))[:, None] * n
-    return -delta[:, None] * ((1.0 - w)[:, None] * n + w[:, None] * turned)
+    return (1.0 - w)[:, None] * n + w[:, None] * turned
+
+
+def designed_share(x, n, sharp=None):
+    """The share of the correction the displacement puts along the normal at ``x``: 1
+    except near knife edges and vertices, where the edge is moved by one vector."""
+    return np.einsum("ij,ij->i", direction(x, n, sharp), n)
 
 
 def _refined(knots, degree, lo, hi, step):
@@ -134,9 +111,15 @@ def _refined(knots, degree, lo, hi, step):
     every span is split at least once."""
     br = np.unique(knots[degree:len(knots) - degree])
     new = []
+    # a narrow face (a blade's tip cap, a few mm across) still gets MIN_SPANS spans: the
+    # displacement turns from one edge's vector to the other's across it
+    step = min(step, (br[-1] - br[0]) / MIN_SPANS)
     for a, b in zip(br[:-1], br[1:]):
-        # every span at least halved: the nominal's own spans leave no room for the field
-        k = max(2, int(math.ceil((b - a) / step - 1e-9)))
+        # every span at least halved (the nominal's own spans leave no room for the field)
+        # unless there are many, already finer than a quarter step: a blade side's 523
+        # chordwise spans would take the budget its few spanwise ones need
+        fine = len(br) > HALVED_SPANS and b - a <= 0.25 * step
+        k = max(1 if fine else 2, int(math.ceil((b - a) / step - 1e-9)))
         if k > 1:
             new.extend(a + (b - a) * np.arange(1, k) / k)
     return np.array(new)

@@ -1,0 +1,177 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The sharp edges of a region and the vector each moves by (issue 30; numpy/scipy only).
+
+Where two corrected faces meet at an angle, the edge is moved once, by one vector ``-delta m``
+that both faces take (:mod:`surfcomp.core.compensation.region_build` turns each face's displacement
+towards it within a band around the edge). ``m`` is the edge's miter
+``(n_A + n_B) / (1 + n_A.n_B)``: both faces' normal components are then the correction, and
+the edge moves as the intersection of the two offset faces does. The miter grows as
+``1 / cos(half the angle between the normals)``; past
+:data:`~surfcomp.core.compensation.region_build.MITER_ANGLE` (a knife edge, the normals nearly
+opposite) it is shortened along the bisector and the correction there is not met in full (the offset
+of a knife edge recedes without bound: no edge vector closes both faces and realises both
+corrections).
+
+**Vertices.** Where several sharp edges end at one vertex (a blade's leading edge, its
+side and its root cap), each edge's own miter differs; the vertex gets one vector
+(:func:`vertex_miter`, the least-squares miter of every face meeting there) and each edge's
+miter turns to it within half a band of the vertex; where no vector realises every face's
+correction at the vertex (a knife edge ending on a cap) the correction is shortened there
+as at a knife edge, so the faces meet at the vertex whichever edge is nearest.
+
+**Between edges** the displacement takes every edge within the band, weighted by
+``(1 - smoothstep(d / band)) / d^2`` (``d`` the distance to the edge): on an edge that
+edge's vector alone, and continuous where the nearest edge changes.
+"""
+
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+#: regularisation of a vertex's least-squares miter (share of the normal matrix)
+VERTEX_REG = 1e-9
+
+
+def smoothstep(s):
+    """Quintic smooth step: 0 below 0, 1 above 1, C2."""
+    s = np.clip(s, 0.0, 1.0)
+    return s * s * s * (s * (6 * s - 15) + 10)
+
+
+def vertex_miter(normals, limit):
+    """One vector ``m`` with ``m . n ~ 1`` for every outward normal (K, 3) of the faces at a
+    vertex (regularised least squares, no longer than ``limit``)."""
+    n = np.asarray(normals, dtype=float)
+    a = n.T @ n
+    m = np.linalg.solve(a + VERTEX_REG * np.trace(a) * np.eye(3), n.T @ np.ones(len(n)))
+    size = np.linalg.norm(m)
+    return m * (limit / size) if size > limit else m
+
+
+def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
+    """Turn each edge's miters to its vertex's vector near the vertex (see the module
+    docstring). ``normals``: (K, 2, 3), both faces' normals at each sample; ``zone``: the
+    arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet.
+    Returns new ``miter`` and ``exact`` arrays."""
+    miter, exact = miter.copy(), exact.astype(float).copy()
+    ends = []
+    for k in np.unique(edge):
+        idx = np.flatnonzero(edge == k)
+        ends.extend([(k, idx), (k, idx[::-1])])
+    tips = np.array([points[idx[0]] for _, idx in ends])
+    groups = cKDTree(tips).query_ball_point(tips, tol)
+    done = set()
+    for g in groups:
+        key = tuple(sorted(g))
+        if key in done:
+            continue
+        done.add(key)
+        if len({ends[i][0] for i in g}) < 2:       # one edge's end: nothing to agree on
+            continue
+        nv = np.concatenate([normals[ends[i][1][0]] for i in g])
+        mv = vertex_miter(nv, limit)
+        # a vertex whose faces' normals admit one miter (a box corner) keeps the correction
+        shorten = np.max(np.abs(nv @ mv - 1.0)) > 1e-6
+        for i in g:
+            idx = ends[i][1]
+            arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[idx], axis=0), axis=1))]
+            t = smoothstep(arc / zone)[:, None]
+            miter[idx] = t * miter[idx] + (1.0 - t) * mv
+            if shorten:
+                exact[idx] *= smoothstep(arc / zone - 1.0)
+    return miter, exact
+
+
+class SharpEdges:
+    """Polylines along the edges where corrected faces meet at an angle.
+
+    Parameters
+    ----------
+    points : ndarray, shape (K, 3)
+    miter : ndarray, shape (K, 3)
+    exact : ndarray, shape (K,)
+        1 where the miter realises both faces' corrections (the faces turn to it with their
+        normal component kept), 0 where the edge moves by ``-delta m`` alone (a knife edge,
+        a vertex); booleans ``clamped`` may be given as ``~exact``.
+    edge : ndarray of int, shape (K,)
+        Which edge each sample belongs to (an edge's samples are consecutive).
+    band : float
+        Width (mm) of the band in which the displacement turns to the edge's vector.
+    """
+
+    def __init__(self, points, miter, exact, edge, band):
+        self.points = np.asarray(points, dtype=float)
+        self.miter = np.asarray(miter, dtype=float)
+        exact = np.asarray(exact)
+        self.exact = (~exact).astype(float) if exact.dtype == bool else exact.astype(float)
+        self.edge = np.asarray(edge)
+        self.band = float(band)
+        self._edges = [np.flatnonzero(self.edge == k) for k in np.unique(self.edge)]
+        self._trees = [cKDTree(self.points[idx]) for idx in self._edges]
+        self._tree = cKDTree(self.points)
+        # a point within the band of a segment is within this much more of a sample
+        self._reach = float(np.max(np.linalg.norm(np.diff(self.points, axis=0), axis=1)[
+            np.diff(self.edge) == 0], initial=0.0))
+
+    def _one(self, x, idx, tree):
+        """Distance to one edge polyline, the miter and exactness there."""
+        pts, mit, ex = self.points[idx], self.miter[idx], self.exact[idx]
+        last = len(idx) - 1
+        _, j = tree.query(x, k=1)
+        best_d = np.full(len(x), np.inf)
+        best_m = np.zeros((len(x), 3))
+        best_e = np.zeros(len(x))
+        for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
+            a, b = pts[k0], pts[k1]
+            ab = b - a
+            t = np.einsum("ij,ij->i", x - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
+                                                              1e-300)
+            t = np.clip(t, 0.0, 1.0)
+            d = np.linalg.norm(x - (a + t[:, None] * ab), axis=1)
+            better = d < best_d
+            tt = t[better, None]
+            best_d[better] = d[better]
+            best_m[better] = (1 - tt) * mit[k0[better]] + tt * mit[k1[better]]
+            best_e[better] = (1 - tt[:, 0]) * ex[k0[better]] + tt[:, 0] * ex[k1[better]]
+        return best_d, best_m, best_e
+
+    def nearest(self, x):
+        """Distance to the nearest edge, and the blended miter and exactness at ``x``."""
+        x = np.asarray(x, dtype=float)
+        dmin = np.full(len(x), np.inf)
+        wsum = np.zeros(len(x))
+        m = np.zeros((len(x), 3))
+        e = np.zeros(len(x))
+        eps2 = (1e-9 * self.band) ** 2
+        # beyond the band of every edge nothing turns (their distance is not needed)
+        near = np.flatnonzero(np.isfinite(self._tree.query(
+            x, k=1, distance_upper_bound=self.band + self._reach)[0]))
+        if not len(near):
+            return dmin, m, np.ones(len(x))
+        full = (dmin, wsum, m, e)
+        x = x[near]
+        dmin, wsum, m, e = (a[near] for a in full)
+        for idx, tree in zip(self._edges, self._trees):
+            # only the points in the edge's box widened by the band weigh it
+            lo, hi = self.points[idx].min(axis=0), self.points[idx].max(axis=0)
+            k = np.flatnonzero(np.all((x >= lo - self.band) & (x <= hi + self.band), axis=1))
+            d, mk, ek = self._one(x[k], idx, tree)
+            w = (1.0 - smoothstep(d / self.band)) / (d * d + eps2)
+            dmin[k] = np.minimum(dmin[k], d)
+            wsum[k] += w
+            m[k] += w[:, None] * mk
+            e[k] += w * ek
+        far = wsum <= 0
+        wsum[far] = 1.0
+        e[far] = 1.0
+        out_d, _, out_m, out_e = full
+        out_e[:] = 1.0
+        out_d[near], out_m[near], out_e[near] = dmin, m / wsum[:, None], e / wsum
+        return out_d, out_m, out_e
+
+
+def knife_limit(angle):
+    """The longest miter (share of the correction) of the edges sharper than ``angle``
+    (degrees between the normals)."""
+    return 1.0 / math.cos(math.radians(0.5 * angle))
