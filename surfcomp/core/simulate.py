@@ -31,6 +31,7 @@ import numpy as np
 from ..errors import InputError
 from . import bspline
 from .deviations import statistics
+from .measurement_set import MeasurementSet
 from .methods import METHODS
 from .pipeline import Options, compensate, prepare
 from .process_model import (  # noqa: F401 (the simulation's public names)
@@ -142,31 +143,6 @@ def method_specs(methods=("none", "offset", "raw", "filtered", "mirror"), masks=
 
 
 # ---------------------------------------------------------------------- the loop
-@dataclass
-class GridMeasurements:
-    """A measurement set built in memory, with the attributes of
-    :class:`surfcomp.io.measurements.MeasurementSet` that :func:`pipeline.prepare` reads
-    (core does not import io): nominal points and outward normals (N, 3), deviations
-    (N,), grid indices ``row``/``col`` (N,)."""
-
-    nominal: np.ndarray
-    normal: np.ndarray
-    deviation: np.ndarray
-    row: np.ndarray
-    col: np.ndarray
-    measured: np.ndarray = None
-    source: str = "<simulated measurement>"
-    warnings: list = field(default_factory=list)
-    lines: np.ndarray = None
-
-    def __post_init__(self):
-        if self.lines is None:
-            self.lines = np.arange(1, len(self.nominal) + 1, dtype=np.int64)
-
-    def __len__(self):
-        return len(self.lines)
-
-
 @dataclass
 class Layout:
     """Measurement grid (n, m) and the denser evaluation grid over the same area.
@@ -430,21 +406,26 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     return result
 
 
+#: the source the simulated measurement sets name in messages
+SIMULATED = "<simulated measurement>"
+
+
 def _measurement_set(surface, outward, layout, points=None):
     """The measurement set (deviations zero) of the grid nodes, or of ``points`` (P, 3)."""
     b = layout.between
     if points is not None:
         P = np.asarray(points, dtype=float).reshape(-1, 3)
         proj = Projector(surface).project(P)
-        return GridMeasurements(nominal=P, normal=proj.normal * outward,
-                                deviation=np.zeros(len(P)), row=None, col=None)
+        return MeasurementSet(nominal=P, normal=proj.normal * outward,
+                              deviation=np.zeros(len(P)), source=SIMULATED)
     n, m = layout.grid
     S, Su, Sv = bspline.evaluate_grid(surface, layout.us[::b], layout.vs[::b], order=1)
     nrm = np.cross(Su, Sv)
     nrm *= outward / np.linalg.norm(nrm, axis=-1, keepdims=True)
     rows, cols = np.indices((n, m))
-    return GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                            deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
+    return MeasurementSet(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                          deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel(),
+                          source=SIMULATED)
 
 
 def _file_order(prepared, grid_values):

@@ -10,9 +10,9 @@ from numpy.testing import assert_allclose
 from surfcomp.core import bspline, presets
 from surfcomp.core.field import GridField
 from surfcomp.core.grid import grid_from_uv
+from surfcomp.core.measurement_set import MeasurementSet
 from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.core.projection import Projector
-from surfcomp.core.simulate import GridMeasurements
 from surfcomp.errors import GridError
 
 
@@ -57,8 +57,8 @@ def _measure(u, v):
     P = np.array([bspline.evaluate_grid(surf, [a], [b])[0, 0] for a, b in zip(u, v)])
     normal = Projector(surf).project(P).normal * outward
     d = 0.02 * np.sin(3 * u) + 0.01 * np.cos(2 * v)
-    return surf, outward, GridMeasurements(nominal=P, normal=normal, deviation=d, row=None,
-                                           col=None)
+    return surf, outward, MeasurementSet(nominal=P, normal=normal, deviation=d,
+                                         source="<simulated measurement>")
 
 
 def _corrected(surf, outward, ms, layout):

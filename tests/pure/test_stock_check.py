@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 from surfcomp.core import bspline
 from surfcomp.core import plausibility as pl
-from surfcomp.core import simulate as sm
+from surfcomp.core.measurement_set import MeasurementSet
 from surfcomp.core.pipeline import Options, compensate, prepare
 from surfcomp.errors import InputError
 from tests.pure.surfaces import wavy_patch
@@ -88,8 +88,8 @@ def _prepared(d, n):
     nrm = np.cross(Su, Sv)
     nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
     rows, cols = np.indices((n, n))
-    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                             deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
+    ms = MeasurementSet(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                        deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
     return surf, prepare(surf, 1, ms, Options(method="mirror", stock=0.1))
 
 
