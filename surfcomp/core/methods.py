@@ -79,10 +79,11 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
         delta = determined.copy()
     elif method == "mirror":
         if stock is None:
-            raise InputError("the mirror method needs --stock, the semi-finishing allowance in mm "
-                             "(the mirror surface lies at half of it, DH = stock / 2)")
+            raise InputError("the mirror method needs stock, the semi-finishing allowance in mm "
+                             "(the mirror surface lies at half of it)", options=("stock",))
         if not np.isfinite(stock) or stock < 0:
-            raise InputError("--stock must be a finite allowance >= 0 mm, got %r" % (stock,))
+            raise InputError("stock must be a finite allowance >= 0 mm, got %r" % (stock,),
+                             options=("stock",))
         delta = d - float(stock)
     else:
         delta = np.where(np.isfinite(d), np.nanmean(d), np.nan)

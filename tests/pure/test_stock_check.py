@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from surfcomp.cli.option_flags import flag
 from surfcomp.core import bspline
 from surfcomp.core import plausibility as pl
 from surfcomp.core.measurement_set import MeasurementSet
@@ -100,9 +101,11 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
     with pytest.raises(InputError) as err:
         compensate(surf, 1, prep, Options(method="mirror", stock=0.1), build=False)
     msg = str(err.value)
-    assert "the stock 0.1 mm (option --stock, Stock in the document)" in msg
+    assert "the stock 0.1 mm (Stock in the document)" in msg
     assert "measured mean deviation 15.7 um" in msg
-    assert "--accept-stock (StockOk = true in the document)" in msg
+    assert "use this one anyway with accept_stock (StockOk = true in the document)" in msg
+    # the command line names the option by its flag
+    assert "with --accept-stock (StockOk" in err.value.shown(flag)
     # confirmed: used as given, delta = d - s (mirror paper eq. 1-2)
     comp = compensate(surf, 1, prep, Options(method="mirror", stock=0.1, accept_stock=True),
                       build=False)
@@ -112,6 +115,6 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
 
 
 def test_accept_stock_is_a_boolean():
-    with pytest.raises(InputError, match=r"--accept-stock 'yes': expected true or false "
+    with pytest.raises(InputError, match=r"accept_stock 'yes': expected true or false "
                                          r"\(StockOk in the document\)"):
         Options(method="mirror", stock=0.1, accept_stock="yes").validate()

@@ -1,0 +1,23 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The command line's flag of each option a message names.
+
+Errors below the command line name options as the API and job files do (``max_offset``,
+listed in :attr:`surfcomp.errors.SurfcompError.options`); the command line prints them as
+its flags (``--max-offset``) through :func:`shown`.
+"""
+
+#: options whose flag is not ``--`` and the name with dashes; None: no flag (job files only)
+_FLAGS = {"mask_size": "--mask", "fmt": "--format", "lean": None}
+
+
+def flag(name):
+    """The flag of option ``name`` (``max_offset`` -> ``--max-offset``); the name itself
+    for an option the command line does not have."""
+    if name in _FLAGS:
+        return _FLAGS[name] or name
+    return "--" + name.replace("_", "-")
+
+
+def shown(exc):
+    """The text of the error ``exc`` with its options named as flags."""
+    return exc.shown(flag)
