@@ -12,7 +12,9 @@ _FLAGS = {"mask_size": "--mask", "fmt": "--format", "lean": None}
 
 def flag(name):
     """The flag of option ``name`` (``max_offset`` -> ``--max-offset``); the name itself
-    for an option the command line does not have."""
+    for an option the command line does not have, or a name that is a flag already."""
+    if name.startswith("-"):
+        return name
     if name in _FLAGS:
         return _FLAGS[name] or name
     return "--" + name.replace("_", "-")

@@ -178,8 +178,9 @@ def make_layout(surface, grid=(45, 45), margin=0.02, between=2):
         raise InputError("between must be a whole number >= 1, got %r" % (between,))
     size = (between * (n - 1) + 1, between * (m - 1) + 1)
     if max(size) > MAX_EVAL_GRID:
-        raise InputError("--between %d: the evaluation grid would have %d x %d points (expected "
-                         "at most %d per direction)" % ((between,) + size + (MAX_EVAL_GRID,)))
+        raise InputError("between %d: the evaluation grid would have %d x %d points (expected "
+                         "at most %d per direction)" % ((between,) + size + (MAX_EVAL_GRID,)),
+                         options=("between",))
     if not 0 <= margin < 0.5:
         raise InputError("margin must be in [0, 0.5), got %r" % (margin,))
     (u0, u1), (v0, v1) = surface.u_range, surface.v_range
