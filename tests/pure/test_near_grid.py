@@ -86,9 +86,10 @@ def test_staggered_rows_with_dropped_points_take_the_scattered_route():
     assert comp.checks.max_error_at_points < 1e-4     # mm, the intended correction met
     _, _, scattered = _corrected(surf, outward, ms, "scattered")
     assert_allclose(auto, scattered, rtol=0, atol=1e-12)
-    with pytest.raises(GridError, match=r"too distorted for the grid route.*--layout "
-                                        r"scattered uses the points as they are"):
+    with pytest.raises(GridError, match=r"too distorted for the grid route.*; layout "
+                                        r"'scattered' uses the points as they are") as err:
         _corrected(surf, outward, ms, "grid")
+    assert err.value.options == ("layout",)       # the command line shows --layout
 
 
 def test_staggered_rows_too_sheared_for_prepare_take_the_scattered_route():
