@@ -55,3 +55,32 @@ def test_document_messages_name_the_property():
     assert option_name(Options(), "max_offset") == "max_offset"
     assert option_name(Options(context="document"), "max_offset") == \
         "the compensation's MaxOffset"
+
+
+def test_no_error_below_the_command_line_names_a_flag():
+    """Every ``raise`` in core and io names options, not flags (``--max-offset``): a
+    script and a job file get the names they pass."""
+    import ast
+    import os
+    import re
+
+    root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__)))), "surfcomp")
+    found = []
+    for layer in ("core", "io"):
+        for folder, _dirs, files in os.walk(os.path.join(root, layer)):
+            for name in files:
+                if not name.endswith(".py"):
+                    continue
+                path = os.path.join(folder, name)
+                with open(path, encoding="utf-8") as fh:
+                    tree = ast.parse(fh.read())
+                for node in ast.walk(tree):
+                    if not isinstance(node, ast.Raise) or node.exc is None:
+                        continue
+                    for sub in ast.walk(node.exc):
+                        if isinstance(sub, ast.Constant) and isinstance(sub.value, str) and \
+                                re.search(r"(?<![\w-])--[a-z]", sub.value):
+                            found.append("%s:%d: %s" % (os.path.relpath(path, root),
+                                                        node.lineno, sub.value))
+    assert found == []
