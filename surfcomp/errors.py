@@ -1,5 +1,12 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The one exception hierarchy of surfcomp (pure Python, no FreeCAD)."""
+"""The one exception hierarchy of surfcomp (pure Python, no FreeCAD).
+
+Messages name options as the API and job files do (``max_offset``, ``stock``); an error
+lists the options it names in ``options``, and the command line shows them as its flags
+(:meth:`SurfcompError.shown`, :mod:`surfcomp.cli.option_flags`).
+"""
+
+import re
 
 
 class SurfcompError(Exception):
@@ -15,18 +22,36 @@ class SurfcompError(Exception):
         1-based line number in ``file``.
     column : int or str, optional
         1-based column number or column name.
+    options : tuple of str, optional
+        The options (:class:`surfcomp.core.compensation.pipeline.Options` fields, job keys) the
+        message names, each as its name (``max_offset``).
     """
 
     exit_code = 1
 
-    def __init__(self, message, file=None, line=None, column=None):
+    def __init__(self, message, file=None, line=None, column=None, options=()):
         super().__init__(message)
         self.message = message
         self.file = file
         self.line = line
         self.column = column
+        self.options = tuple(options)
 
     def __str__(self):
+        return self._where() + self.message
+
+    def shown(self, name_of=None):
+        """The text of ``str(self)`` with every option in ``options`` named as
+        ``name_of(option)`` (the command line's ``--max-offset``) in the message; a quoted
+        value such as ``'rps'`` is not an option's name."""
+        message = self.message
+        for name in self.options if name_of else ():
+            # a quoted value ('rps') stays as written
+            message = re.sub(r"(?<![\w'-])%s(?![\w'-])" % re.escape(name),
+                             lambda _m, name=name: name_of(name), message)
+        return self._where() + message
+
+    def _where(self):
         where = ""
         if self.file is not None:
             where = str(self.file)
@@ -35,7 +60,7 @@ class SurfcompError(Exception):
             if self.column is not None:
                 where += ":%s" % (self.column,)
             where += ": "
-        return where + self.message
+        return where
 
 
 class InputError(SurfcompError):
@@ -70,6 +95,13 @@ class Cancelled(SurfcompError):
     """The user interrupted a long step; nothing was written."""
 
     exit_code = 130
+
+
+class FreeCADRequired(SurfcompError, ImportError):
+    """A call needs FreeCAD and this Python cannot import it (the message says what to
+    install or run instead)."""
+
+    exit_code = 2
 
 
 def lookup(table, name, what):

@@ -36,7 +36,23 @@ class Job:
     to it in order with ``touches`` log lines per point (:mod:`surfcomp.io.plan_join`).
 
     ``output`` holds the nominal's whole shape with the face replaced when the face sits in
-    a solid or shell, the corrected face alone when it is a lone face or ``face_only``."""
+    a solid or shell, the corrected face alone when it is a lone face or ``face_only``.
+
+    The whole command-line job in one call (``surfcomp.Job``, ``surfcomp.run_job``; README
+    "Scripting"): the fields are the job file's keys (README "freecadcmd"), ``options`` an
+    :class:`Options` (``surfcomp.options(method="mirror", stock=0.2)``); ``face``,
+    ``object``, ``units``, ``deviation_units``, ``fmt`` and ``sample`` pick the face and
+    read the measurements as ``--face`` ... ``--sample`` do; ``align``, ``align_faces``,
+    ``align_dof``, ``rps`` and ``transform`` align the points first (README "Alignment").
+    :func:`run_job` returns ``(compensation, report)``.
+
+    Example::
+
+        job = Job(nominal="examples/nominal.step",
+                  measurements="examples/measurements.csv",
+                  output="out/corrected.step", report="out/report.json")
+        comp, report = run_job(job)
+    """
 
     nominal: str
     measurements: str

@@ -9,6 +9,7 @@ import hashlib
 import numpy as np
 
 from ..core.compensation.field import GridField
+from ..core.compensation.methods import predicted_residual
 from ..core.compensation.scattered import ScatteredField
 from ..errors import InputError
 
@@ -40,24 +41,16 @@ def _fill_gaps(values):
     return values[tuple(idx)]
 
 
-def stock_of(obj):
-    """The stock (mm) the mirror method's deviations carry (measured after
-    semi-finishing), else 0."""
-    return float(obj.Stock.Value) if obj.Method == "mirror" else 0.0
-
-
 def quantity_values(obj, quantity):
     """Node values (mm) of ``quantity`` on the measurement grid, shape (rows, cols); NaN at
     unmeasured nodes.
 
-    ``residual`` is the predicted residual ``determined - stock - increment``: what this
-    round's correction leaves of the systematic (determined) error when the next part is
-    cut (its new random scatter comes on top). It is defined for every method: zero for
-    ``filtered``, ``-random`` for ``raw`` and ``mirror`` (they copy this part's random
-    scatter into the face), ``determined - mean`` for ``offset``.
+    ``residual`` is the predicted residual of this round's correction
+    (:func:`surfcomp.core.compensation.methods.predicted_residual`).
     """
     if quantity == "residual":
-        return _grid(obj, "Determined") - stock_of(obj) - _grid(obj, "Increment")
+        return predicted_residual(_grid(obj, "Determined"), _grid(obj, "Increment"),
+                                  obj.Method, float(obj.Stock.Value))
     if quantity not in _PROPERTY:
         raise InputError("unknown quantity %r (expected one of %s)"
                          % (quantity, ", ".join(QUANTITIES)))

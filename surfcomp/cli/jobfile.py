@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """A JSON job file run to its exit code: the body of the ``freecadcmd`` job macro
 (``macros/surfcomp_job.py``), with the command line's messages, signals and exit codes
-(:mod:`surfcomp.cli.runner`). The job file is an input like the others: no output may
-replace it."""
+(:mod:`surfcomp.cli.runner`), options named as the job file's keys. The job file is an
+input like the others: no output may replace it."""
 
 import contextlib
 import sys
@@ -24,4 +24,4 @@ def run_job_file(path):
             print_written(job)
         return 0
 
-    return runner.run(body)
+    return runner.run(body, flags=False)    # messages name the job file's keys

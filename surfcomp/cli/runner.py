@@ -18,6 +18,7 @@ import traceback
 
 from ..errors import SurfcompError
 from ..io import atomic
+from .option_flags import shown
 
 SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
 
@@ -105,11 +106,11 @@ def _stdout_closed(exc, rc):
     return rc or 1
 
 
-def _run(body):
+def _run(body, flags):
     try:
         return int(body() or 0)
     except SurfcompError as exc:
-        print("surfcomp: error: %s" % exc, file=sys.stderr)
+        print("surfcomp: error: %s" % (shown(exc) if flags else exc), file=sys.stderr)
         return exc.exit_code
     except KeyboardInterrupt as exc:
         return _interrupted(exc)
@@ -126,11 +127,12 @@ def _is_stdout_error(exc):
         atomic.COMMITTED
 
 
-def run(body, data_to_stdout=False):
+def run(body, data_to_stdout=False, flags=True):
     """``body()`` -> its exit code, with the messages and exit codes of this module.
 
     ``data_to_stdout``: an output goes to standard output, so everything ``body`` prints
-    goes to stderr instead."""
+    goes to stderr instead. ``flags``: errors name options as the command line's flags
+    (``--max-offset``); False keeps their names (``max_offset``, as a job file's keys)."""
     atomic.reset_committed()
     real_stdout = sys.stdout
     try:
@@ -138,7 +140,7 @@ def run(body, data_to_stdout=False):
             try:
                 with atomic.data_stdout(real_stdout), \
                         contextlib.redirect_stdout(sys.stderr if data_to_stdout else sys.stdout):
-                    rc = _run(body)
+                    rc = _run(body, flags)
                 try:
                     real_stdout.flush()
                 except OSError as exc:

@@ -24,7 +24,7 @@ MIN_LIMIT = 64 * 1024 ** 2
 BASE = 300 * 1024 ** 2
 
 
-def parse_size(text, option="--max-memory"):
+def parse_size(text, option="max_memory"):
     """``'4G'``, ``'512M'``, ``'1.5GB'``, ``'4000000000'`` -> bytes (binary units).
 
     Raises
@@ -36,11 +36,11 @@ def parse_size(text, option="--max-memory"):
     unit = m and m.group(2).lower()
     if not m or unit not in _UNITS:
         raise InputError("%s %r: expected a size such as 4G, 512M or a number of bytes"
-                         % (option, text))
+                         % (option, text), options=(option,))
     value = float(m.group(1)) * _UNITS[unit]
     if value < MIN_LIMIT:
         raise InputError("%s %r: expected at least %d M (the program alone needs about that)"
-                         % (option, text, MIN_LIMIT // 1024 ** 2))
+                         % (option, text, MIN_LIMIT // 1024 ** 2), options=(option,))
     return int(value)
 
 
@@ -84,13 +84,14 @@ def check(needed, limit=None, what="this run", hint=""):
     InputError
         With the estimate, the limit and where it comes from, and ``hint``.
     """
-    source = "--max-memory"
+    source = "max_memory"
     if limit is None:
         limit, source = machine_memory(), "the machine's memory"
     if limit is None or needed <= limit:
         return needed
     raise InputError("%s needs about %s of memory, more than %s (%s)%s"
-                     % (what, _gb(needed), source, _gb(limit), hint and "; " + hint))
+                     % (what, _gb(needed), source, _gb(limit), hint and "; " + hint),
+                     options=("max_memory",))
 
 
 # ----------------------------------------------------------------------------- estimates

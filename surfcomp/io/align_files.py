@@ -114,8 +114,9 @@ def read_rps(value):
         return data, value
     parts = [p.strip() for p in str(value).split(";")]
     if len(parts) != 3 or not all(parts):
-        raise InputError("--rps %r: expected a JSON file or three groups of point ids "
-                         "separated by ';' (3, 2 and 1 ids, e.g. P1,P2,P3;P4,P5;P6)" % value)
+        raise InputError("rps %r: expected a JSON file or three groups of point ids "
+                         "separated by ';' (3, 2 and 1 ids, e.g. P1,P2,P3;P4,P5;P6)" % value,
+                         options=("rps",))
     names = ("primary", "secondary", "tertiary")
     return {n: [x.strip() for x in p.split(",")] for n, p in zip(names, parts)}, "--rps"
 

@@ -157,11 +157,12 @@ def _error(text, path, line, col, what, factor, max_error):
     """An error value in mm, refused when larger than ``max_error`` (mm; None: no limit)."""
     v = _number(text, path, line, col, what, factor)
     if max_error is not None and not abs(v) <= max_error:
-        raise MeasurementFileError("%s: error %r = %.6g mm is larger than --max-error %g mm "
-                                   "(expected the error of a machine axis: check the units; "
-                                   "a column in um needs a suffix such as %s[um], or --units "
+        raise MeasurementFileError("%s: error %r = %.6g mm is larger than max_error %g mm "
+                                   "(expected the error of a machine axis: check the unit; "
+                                   "a column in um needs a suffix such as %s[um], or units "
                                    "um)" % (what, text.strip(), v, max_error, what),
-                                   file=path, line=line, column=col)
+                                   file=path, line=line, column=col,
+                                   options=("max_error", "units"))
     return v
 
 

@@ -41,6 +41,7 @@ import numpy as np
 
 from ..core import colormap
 from ..core.compensation.deviations import statistics
+from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
 
 #: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
@@ -132,14 +133,10 @@ def grid_arrays(report):
     out["x"], out["y"] = put(nominal[:, 0]), put(nominal[:, 1])
     for key in ("deviation", "determined", "random", "correction"):
         out[key] = put(pts[key])
-    out["residual"] = out["determined"] - predicted_stock(report) - out["correction"]
-    return out
-
-
-def predicted_stock(report):
-    """The stock (mm) the mirror method's measured deviations include, else 0."""
     meth = report.get("method", {})
-    return float(meth.get("stock_mm") or 0.0) if meth.get("name") == "mirror" else 0.0
+    out["residual"] = predicted_residual(out["determined"], out["correction"], meth.get("name"),
+                                         meth.get("stock_mm"))
+    return out
 
 
 def _cmap(scheme):

@@ -165,8 +165,8 @@ def parse_measurements(text_or_bytes, source="<text>", units="mm", plan=False):
     try:
         default_factor = unit_factor("mm" if units is None else str(units))
     except InputError as exc:
-        raise MeasurementFileError("--units %r is not a known unit (expected mm, um or in)"
-                                   % (units,), file=source) from exc
+        raise MeasurementFileError("units %r is not a known unit (expected mm, um or in)"
+                                   % (units,), file=source, options=("units",)) from exc
     if isinstance(text_or_bytes, str):
         text = text_or_bytes
         raw = text.encode("utf-8", "surrogatepass")

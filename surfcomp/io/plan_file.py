@@ -39,7 +39,8 @@ def plan_text(fmt, ids, points, normals, comments=()):
     P = np.asarray(points, dtype=float)
     n = np.asarray(normals, dtype=float)
     if fmt not in PLAN_FORMATS:
-        raise InputError("--format %r: expected one of %s" % (fmt, ", ".join(PLAN_FORMATS)))
+        raise InputError("fmt %r: expected one of %s" % (fmt, ", ".join(PLAN_FORMATS)),
+                         options=("fmt",))
     if P.shape != n.shape or P.ndim != 2 or P.shape[1] != 3:
         raise InputError("points and normals must both have shape (N, 3), got %r and %r"
                          % (P.shape, n.shape))

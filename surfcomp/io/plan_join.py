@@ -123,7 +123,7 @@ def join_plan(plan, ms, options=None, touches=1):
             % ((b + 1,) + tuple(ms.measured[b]) + (R, off[b], plan.ids[k[b]], plan.source,
                                                   plan.lines[k[b]]) + tuple(plan.points[k[b]])
                + (option_name(options, "max_offset"), options.max_offset, bad.size, touches)),
-            file=ms.source, line=int(ms.lines[b]))
+            file=ms.source, line=int(ms.lines[b]), options=("max_offset",))
     last = slice(touches - 1, None, touches)
     return MeasurementSet(
         nominal=plan.points, measured=ms.measured[last], normal=plan.normals, deviation=None,

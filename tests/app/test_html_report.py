@@ -16,6 +16,7 @@ from PIL import Image
 
 from surfcomp.core import colormap
 from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+from surfcomp.core.measurement_set import MeasurementSet
 from surfcomp.core.simulation import presets
 from surfcomp.core.simulation import simulate as sm
 from surfcomp.core.surface import bspline
@@ -42,8 +43,8 @@ def _report(method="filtered", stock=None, n=11, build=True, seed=1):
          + rng.normal(0, 0.002, (n, n)))
     d = d + (stock or 0.0)
     rows, cols = np.indices((n, n))
-    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                             deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
+    ms = MeasurementSet(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                        deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
     opt = Options(method=method, stock=stock)
     comp = compensate(surf, 1, prepare(surf, 1, ms, opt), opt, build=build)
     inputs = {"nominal": {"path": "/data/nominal.step", "sha256": "ab" * 32, "face": "Face1"},

@@ -84,7 +84,7 @@ def test_map_lifted_past_the_largest_correction_markers_further(holed):
 
 
 def test_option_names_per_reader():
-    assert option_name(Options(), "max_offset") == "--max-offset"
+    assert option_name(Options(), "max_offset") == "max_offset"
     assert option_name(Options(context="document"), "max_offset") == \
         "the compensation's MaxOffset"
     assert option_name(Options(context="document"), "flip_normals") == "the compensation's Flip"

@@ -36,8 +36,8 @@ def test_cli_refuses_the_default_stock_on_a_finished_part(tmp_path):
     assert out.returncode == 2, out.stderr
     assert "Traceback" not in out.stderr and out.stdout == ""
     msg = out.stderr
-    assert msg.startswith("surfcomp: error: the stock 0.1 mm (option --stock, Stock in the "
-                          "document) does not fit the measured deviations")
+    assert msg.startswith("surfcomp: error: the stock 0.1 mm (Stock in the document) does not "
+                          "fit the measured deviations")
     assert "measured mean deviation 15.7 um (spread 19.1 um)" in msg
     assert "a mean of 0.1 mm +- 57.2 um" in msg
     assert "--accept-stock (StockOk = true in the document)" in msg

@@ -66,5 +66,5 @@ def test_bad_alignment_on_simulate_exits_2_and_writes_nothing(tmp_path):
     assert out.returncode == 2 and "do not go with --compare-layouts" in out.stderr
     out = run_cli("simulate", EXAMPLE_STEP, *LOOP, "--align", "rps", "--json",
                   tmp_path / "s.json", "--quiet")
-    assert out.returncode == 2 and "--align rps needs --rps" in out.stderr
+    assert out.returncode == 2 and "--align 'rps' needs --rps" in out.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.txt"]

@@ -148,7 +148,7 @@ OPTIONS = [
          says=("--stock 1e+308",)),
     comp("mirror-without-stock", "--method", "mirror", says=("needs --stock",)),
     comp("mirror-stock-does-not-fit", "--method", "mirror", "--stock", "0.1",
-         says=("the stock 0.1 mm (option --stock, Stock in the document) does not fit",
+         says=("the stock 0.1 mm (Stock in the document) does not fit",
                "--accept-stock")),
     comp("sigma=nan-gaussian", "--mask-kind", "gaussian", "--sigma", "nan", says=("--sigma nan",)),
     comp("sigma=0-gaussian", "--mask-kind", "gaussian", "--sigma", "0", says=("--sigma 0.0",)),

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from surfcomp.cli.option_flags import flag
 from surfcomp.core.compensation.pipeline import Options, prepare
 from surfcomp.core.measurement import align
 from surfcomp.core.measurement.align_report import AlignOptions, absorbed
@@ -146,7 +147,8 @@ def test_plane_reference_refused_naming_free_dof():
     with pytest.raises(InputError) as exc:
         align.best_fit(meas, ref, coarse=False)
     msg = str(exc.value)
-    assert "cannot fix x, y, rz" in msg and "Face3" in msg and "--align-dof z,rx,ry" in msg
+    assert "cannot fix x, y, rz" in msg and "Face3" in msg and "with align_dof z,rx,ry" in msg
+    assert "with --align-dof z,rx,ry" in exc.value.shown(flag)     # as the command line says
     with pytest.raises(InputError, match="cannot fix rz"):
         align.best_fit(meas, ref, dof=align.parse_dof("z,rz"))
     fit, _ = align.best_fit(meas, ref, dof=align.parse_dof("z,rx,ry"))
@@ -158,7 +160,7 @@ def test_parse_dof():
     assert align.parse_dof("rz") == ("rz",)
     assert align.parse_dof("xy,rz") == ("x", "y", "rz")
     assert align.parse_dof("all") == align.DOF_NAMES
-    with pytest.raises(InputError, match="--align-dof 'xq'"):
+    with pytest.raises(InputError, match="^align_dof 'xq'"):
         align.parse_dof("xq")
 
 

@@ -57,11 +57,11 @@ def test_rps_inline_and_json(tmp_path):
 
 
 def test_align_options_and_job_keys():
-    with pytest.raises(InputError, match="--align 'best': expected one of none, bestfit, rps"):
+    with pytest.raises(InputError, match="^align 'best': expected one of none, bestfit, rps"):
         AlignOptions("best").validate()
-    with pytest.raises(InputError, match="--align rps needs --rps"):
+    with pytest.raises(InputError, match="^align 'rps' needs rps"):
         AlignOptions("rps").validate()
-    with pytest.raises(InputError, match="--rps is used by --align rps only"):
+    with pytest.raises(InputError, match="^rps is used by align 'rps' only"):
         AlignOptions("bestfit", rps={"primary": []}).validate()
     with pytest.raises(InputError, match="job key 'align' is \"maybe\""):
         check_values({"align": "maybe"})

@@ -4,6 +4,7 @@ refusal. Real peak figures are measured by bench/bench_memory.py, not here."""
 
 import pytest
 
+from surfcomp.cli.option_flags import flag
 from surfcomp.core import budget
 from surfcomp.core.simulation import simulate as sim
 from surfcomp.errors import InputError
@@ -42,8 +43,10 @@ def test_check_refuses_above_the_limit_and_names_it(monkeypatch):
     assert budget.check(GB, 2 * GB) == GB
     with pytest.raises(InputError) as err:
         budget.check(3 * GB, 2 * GB, "job X", "try less")
-    assert str(err.value) == ("job X needs about 3.0 GB of memory, more than --max-memory "
+    assert str(err.value) == ("job X needs about 3.0 GB of memory, more than max_memory "
                               "(2.0 GB); try less")
+    assert err.value.shown(flag) == ("job X needs about 3.0 GB of memory, more than "
+                                     "--max-memory (2.0 GB); try less")
     monkeypatch.setattr(budget, "machine_memory", lambda: 512 * 1024 ** 2)
     with pytest.raises(InputError, match=r"more than the machine.s memory \(0.5 GB\)"):
         budget.check(GB)

@@ -182,8 +182,8 @@ def test_program_without_moves_but_with_words_is_copied(tmp_path, capsys):
 
 # ------------------------------------------------------------------- axis error files
 @pytest.mark.parametrize("value, what", [
-    ("5000", "ex: error '5000' = 5000 mm is larger than --max-error 1 mm"),
-    ("1e308", "ex: error '1e308' = 1e+308 mm is larger than --max-error 1 mm"),
+    ("5000", "ex: error '5000' = 5000 mm is larger than --max-error 1 mm"),      # as the CLI
+    ("1e308", "ex: error '1e308' = 1e+308 mm is larger than --max-error 1 mm"),  # says it
     ("1e999", "ex: '1e999' is out of range (expected a finite number)"),
 ])
 def test_implausible_axis_errors_are_refused(tmp_path, capsys, value, what):
@@ -192,7 +192,7 @@ def test_implausible_axis_errors_are_refused(tmp_path, capsys, value, what):
     err = _refused(tmp_path, capsys, "G21 G90\nG0 X0 Y0 Z0\nG1 X40 F100\nM2\n", csv=csv)
     assert "err.csv:3:3: " + what in err
     if "larger" in what:
-        assert "check the units" in err and "ex[um]" in err
+        assert "check the unit;" in err and "ex[um], or --units um)" in err
 
 
 def test_max_error_reader(tmp_path):
@@ -201,7 +201,7 @@ def test_max_error_reader(tmp_path):
     with pytest.raises(MeasurementFileError) as exc:
         read_axis_errors(str(path), max_error=1.0)
     assert (exc.value.line, exc.value.column) == (3, 3)
-    assert "EYX: error '12' = 12 mm is larger than --max-error 1 mm" in str(exc.value)
+    assert "EYX: error '12' = 12 mm is larger than max_error 1 mm" in str(exc.value)
     assert "EYX[um]" in str(exc.value)
     # without a limit the reader keeps its old behaviour
     assert read_axis_errors(str(path)).data["x"][1][1, 1] == 12.0

@@ -437,7 +437,8 @@ def test_unit_on_a_normal():
 
 def test_invalid_units_option():
     e = parse_error(nnd_text(), units="ft")
-    assert "--units 'ft' is not a known unit (expected mm, um or in)" in str(e)
+    assert e.message == "units 'ft' is not a known unit (expected mm, um or in)"
+    assert e.options == ("units",)      # the command line shows --units
 
 
 def test_header_without_rows():

@@ -9,8 +9,8 @@ from numpy.testing import assert_allclose
 
 from surfcomp.core.compensation.field import GridField
 from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+from surfcomp.core.measurement_set import MeasurementSet
 from surfcomp.core.simulation import presets
-from surfcomp.core.simulation.simulate import GridMeasurements
 from surfcomp.core.surface import bspline
 from surfcomp.core.surface.grid import grid_from_uv
 from surfcomp.core.surface.projection import Projector
@@ -58,8 +58,8 @@ def _measure(u, v):
     P = np.array([bspline.evaluate_grid(surf, [a], [b])[0, 0] for a, b in zip(u, v)])
     normal = Projector(surf).project(P).normal * outward
     d = 0.02 * np.sin(3 * u) + 0.01 * np.cos(2 * v)
-    return surf, outward, GridMeasurements(nominal=P, normal=normal, deviation=d, row=None,
-                                           col=None)
+    return surf, outward, MeasurementSet(nominal=P, normal=normal, deviation=d,
+                                         source="<simulated measurement>")
 
 
 def _corrected(surf, outward, ms, layout):
@@ -87,9 +87,10 @@ def test_staggered_rows_with_dropped_points_take_the_scattered_route():
     assert comp.checks.max_error_at_points < 1e-4     # mm, the intended correction met
     _, _, scattered = _corrected(surf, outward, ms, "scattered")
     assert_allclose(auto, scattered, rtol=0, atol=1e-12)
-    with pytest.raises(GridError, match=r"too distorted for the grid route.*--layout "
-                                        r"scattered uses the points as they are"):
+    with pytest.raises(GridError, match=r"too distorted for the grid route.*; layout "
+                                        r"'scattered' uses the points as they are") as err:
         _corrected(surf, outward, ms, "grid")
+    assert err.value.options == ("layout",)       # the command line shows --layout
 
 
 def test_staggered_rows_too_sheared_for_prepare_take_the_scattered_route():

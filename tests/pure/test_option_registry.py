@@ -11,6 +11,7 @@ import sys
 import pytest
 
 from surfcomp.cli import build_parser
+from surfcomp.cli.option_flags import shown
 from surfcomp.core import limits
 from surfcomp.core.compensation import corrected, filters, pipeline
 from surfcomp.core.compensation.pipeline import Options
@@ -103,7 +104,10 @@ def test_validation_refuses_just_outside_the_registry_domain(name):
     for bad in (o.low - step, o.high + step, float("nan")) + fraction:
         with pytest.raises(InputError) as exc:
             Options(**{name: bad}).validate()
-        assert exc.value.message.startswith(o.flag) and o.prop in exc.value.message
+        # the core names the option, the command line shows its flag
+        assert exc.value.message.startswith(name + " ") and o.prop in exc.value.message
+        assert exc.value.options == (name,)
+        assert shown(exc.value).startswith(o.flag + " ")
 
 
 @pytest.mark.parametrize("name", sorted(n for n, o in OPTIONS.items() if o.choices))
@@ -113,6 +117,8 @@ def test_validation_refuses_a_value_outside_the_choices(name):
     with pytest.raises(InputError) as exc:
         Options(**{name: "bogus"}).validate()
     assert exc.value.message == "%s 'bogus': expected one of %s" % (
+        name, ", ".join(OPTIONS[name].choices))
+    assert shown(exc.value) == "%s 'bogus': expected one of %s" % (
         OPTIONS[name].flag, ", ".join(OPTIONS[name].choices))
 
 

@@ -76,7 +76,7 @@ def test_logs_that_do_not_fit_are_named_at_their_first_line(tmp_path):
     text = str(err.value)
     assert text.startswith("%s:3: probe line 3 (" % log)
     assert "from its planned point Q2 (%s:5," % (tmp_path / "plan.csv") in text
-    assert "expected at most --max-offset 1 mm (2 line(s) do not fit)" in text
+    assert "expected at most max_offset 1 mm (2 line(s) do not fit)" in text
     # the wrong tip radius puts every line R off
     write_log(log, centres)
     with pytest.raises(MeasurementFileError, match=r"probe.log:1: probe line 1 .* lies 1.0100"):

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from surfcomp.cli.option_flags import flag
 from surfcomp.core.measurement.planning import (
     MAX_POINTS,
     PlanSettings,
@@ -190,7 +191,7 @@ def test_tip_larger_than_concave_radius_refused():
     dom = FaceDomain(_trough(), 1)
     plan = plan_points(dom, "grid", (5, 3), PlanSettings(tip_radius=3.0, max_tilt=80))
     assert plan.min_concave_radius == pytest.approx(40.0, rel=1e-4)
-    with pytest.raises(InputError, match=r"--tip-radius 40.5 mm is larger than the face's "
+    with pytest.raises(InputError, match=r"^tip_radius 40.5 mm is larger than the face's "
                                          r"smallest concave radius 40 mm"):
         plan_points(dom, "grid", (5, 3), PlanSettings(tip_radius=40.5, max_tilt=80))
     # seen from below the trough is convex: any ball fits
@@ -203,22 +204,25 @@ def test_tip_larger_than_concave_radius_refused():
 # ------------------------------------------------------------------ counts
 @pytest.mark.parametrize("text", ["0x5", "5x0", "abc", "3", "1001x1000"])
 def test_bad_grid_counts(text):
-    with pytest.raises(InputError, match=r"--count"):
+    with pytest.raises(InputError, match=r"^count ") as err:
         parse_count(text)
+    assert err.value.shown(flag).startswith("--count %r: " % text)
 
 
 @pytest.mark.parametrize("n", [0, -1, MAX_POINTS + 1, 2.5])
 def test_bad_point_counts(n):
-    with pytest.raises(InputError, match=r"--points"):
+    with pytest.raises(InputError, match=r"^points ") as err:
         check_points(n)
+    assert err.value.shown(flag).startswith("--points %r: expected" % n)
 
 
 def test_bad_settings():
     for kw, text in ((dict(tip_radius=0.0), "--tip-radius"), (dict(max_tilt=91), "--max-tilt"),
                      (dict(edge_margin=-1), "--edge-margin"),
                      (dict(clearance=float("nan")), "--clearance")):
-        with pytest.raises(InputError, match=text):
+        with pytest.raises(InputError, match="^%s " % list(kw)[0]) as err:
             PlanSettings(**kw).check()
+        assert err.value.shown(flag).startswith(text + " ")
 
 
 # ------------------------------------------------------------------ order and travel

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from surfcomp.cli.option_flags import flag
 from surfcomp.core.compensation import plausibility as pl
 from surfcomp.core.compensation.pipeline import Options, compensate, prepare
-from surfcomp.core.simulation import simulate as sm
+from surfcomp.core.measurement_set import MeasurementSet
 from surfcomp.core.surface import bspline
 from surfcomp.errors import InputError
 from tests.pure.surfaces import wavy_patch
@@ -88,8 +89,8 @@ def _prepared(d, n):
     nrm = np.cross(Su, Sv)
     nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
     rows, cols = np.indices((n, n))
-    ms = sm.GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                             deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
+    ms = MeasurementSet(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                        deviation=d.ravel(), row=rows.ravel(), col=cols.ravel())
     return surf, prepare(surf, 1, ms, Options(method="mirror", stock=0.1))
 
 
@@ -100,9 +101,11 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
     with pytest.raises(InputError) as err:
         compensate(surf, 1, prep, Options(method="mirror", stock=0.1), build=False)
     msg = str(err.value)
-    assert "the stock 0.1 mm (option --stock, Stock in the document)" in msg
+    assert "the stock 0.1 mm (Stock in the document)" in msg
     assert "measured mean deviation 15.7 um" in msg
-    assert "--accept-stock (StockOk = true in the document)" in msg
+    assert "use this one anyway with accept_stock (StockOk = true in the document)" in msg
+    # the command line names the option by its flag
+    assert "with --accept-stock (StockOk" in err.value.shown(flag)
     # confirmed: used as given, delta = d - s (mirror paper eq. 1-2)
     comp = compensate(surf, 1, prep, Options(method="mirror", stock=0.1, accept_stock=True),
                       build=False)
@@ -112,6 +115,6 @@ def test_compensate_refuses_naming_the_option_and_the_mean():
 
 
 def test_accept_stock_is_a_boolean():
-    with pytest.raises(InputError, match=r"--accept-stock 'yes': expected true or false "
+    with pytest.raises(InputError, match=r"accept_stock 'yes': expected true or false "
                                          r"\(StockOk in the document\)"):
         Options(method="mirror", stock=0.1, accept_stock="yes").validate()

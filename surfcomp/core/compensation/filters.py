@@ -78,8 +78,8 @@ def _whole(x):
 
 def _check_size(size):
     if not _whole(size) or not 1 <= size <= MAX_MASK_SIZE or size % 2 == 0:
-        raise InputError("mask size must be an odd whole number from 1 to %d (3, 5, 7, ...), "
-                         "got %r" % (MAX_MASK_SIZE, size))
+        raise InputError("mask_size %r: expected an odd whole number from 1 to %d (3, 5, 7, "
+                         "...)" % (size, MAX_MASK_SIZE), options=("mask_size",))
 
 
 def check_mask(mask):

@@ -52,8 +52,9 @@ def as_scattered(prepared, options, exc):
     why = ("the %d x %d grid found in the points (%s) is too distorted for the grid route: %s"
            % (prepared.grid.shape + (prepared.grid.rows_from, exc)))
     if options.layout == "grid":
-        raise GridError("%s (expected a grid whose map to the face can be inverted; --layout "
-                        "scattered uses the points as they are)" % why, file=prepared.source)
+        raise GridError("%s (expected a grid whose map to the face can be inverted; layout "
+                        "'scattered' uses the points as they are)" % why, file=prepared.source,
+                        options=("layout",))
     # the warning goes into the caller's list too (the reports read it from there)
     where = "%s: " % prepared.source if prepared.source else ""
     prepared.warnings.append("%s%s; the points are used as a scattered layout" % (where, why))

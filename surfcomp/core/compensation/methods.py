@@ -79,13 +79,40 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
         delta = determined.copy()
     elif method == "mirror":
         if stock is None:
-            raise InputError("the mirror method needs --stock, the semi-finishing allowance in mm "
-                             "(the mirror surface lies at half of it, DH = stock / 2)")
+            raise InputError("the mirror method needs stock, the semi-finishing allowance in mm "
+                             "(the mirror surface lies at half of it)", options=("stock",))
         if not np.isfinite(stock) or stock < 0:
-            raise InputError("--stock must be a finite allowance >= 0 mm, got %r" % (stock,))
+            raise InputError("stock must be a finite allowance >= 0 mm, got %r" % (stock,),
+                             options=("stock",))
         delta = d - float(stock)
     else:
         delta = np.where(np.isfinite(d), np.nanmean(d), np.nan)
     return CorrectionResult(method=method, deviation=d, determined=determined,
                             random=d - determined, delta=delta, mask=mask, edge=edge,
                             stock=None if stock is None else float(stock))
+
+
+def predicted_residual(determined, increment, method, stock=None):
+    """The predicted residual (mm): what a round's correction leaves of the repeatable
+    (determined) error when the next part is cut, ``determined - s - increment``, where
+    ``s`` is the stock the mirror method's deviations carry (0 for the other methods); the
+    next part's own random scatter comes on top.
+
+    Parameters
+    ----------
+    determined, increment : array_like, same shape
+        The determined component ``d_f`` and this round's intended correction (``delta``
+        of a single round; the increment of an iteration), mm; NaN where not measured.
+    method : str
+        One of :data:`~surfcomp.core.choices.METHODS`.
+    stock : float, optional
+        The mirror method's semi-finishing allowance (mm).
+
+    Returns
+    -------
+    ndarray
+        Zero for ``filtered``, ``-random`` for ``raw`` and ``mirror`` (they copy this
+        part's random scatter into the face), ``determined - mean`` for ``offset``.
+    """
+    s = float(stock or 0.0) if method == "mirror" else 0.0
+    return np.asarray(determined, dtype=float) - s - np.asarray(increment, dtype=float)

@@ -71,9 +71,10 @@ class Options:
     smoothing: float = OPTIONS["smoothing"].default
     lean: bool = OPTIONS["lean"].default
     accept_stock: bool = OPTIONS["accept_stock"].default
-    #: who reads the messages: ``'cli'`` (options named as ``--max-offset``) or
-    #: ``'document'`` (as the compensation's properties, ``MaxOffset``, for the GUI)
-    context: str = "cli"
+    #: who reads the messages: ``'api'`` (options named as ``max_offset``; the command line
+    #: shows its flags, :mod:`surfcomp.cli.option_flags`) or ``'document'`` (as the
+    #: compensation's properties, ``MaxOffset``, for the GUI)
+    context: str = "api"
 
     def mask(self):
         return make_mask(self.mask_size, self.weights, self.mask_kind, self.sigma)
@@ -87,9 +88,9 @@ class Options:
         Raises
         ------
         InputError
-            ``--option value: expected ...`` (the document property in parentheses).
+            ``option value: expected ...`` (the document property in parentheses).
         """
-        for name, (option, prop, lo, hi, optional, what) in _DOMAINS.items():
+        for name, (_flag, prop, lo, hi, optional, what) in _DOMAINS.items():
             value = getattr(self, name)
             if value is None and optional:
                 continue
@@ -101,30 +102,30 @@ class Options:
                 ok = float(value).is_integer()
             if not ok:
                 raise InputError("%s %r: expected %s from %g to %g (%s in the document)"
-                                 % (option, value, what, lo, hi, prop))
+                                 % (name, value, what, lo, hi, prop), options=(name,))
         for o in OPTIONS.values():
             if o.choices is not None and getattr(self, o.name) not in o.choices:
-                raise InputError("%s %r: expected one of %s"
-                                 % (o.flag, getattr(self, o.name), ", ".join(o.choices)))
-        for name, flag, prop in (("lean", "lean", "Lean"),
-                                 ("accept_stock", "--accept-stock", "StockOk")):
+                raise InputError("%s %r: expected one of %s" % (
+                    o.name, getattr(self, o.name), ", ".join(o.choices)), options=(o.name,))
+        for name, prop in (("lean", "Lean"), ("accept_stock", "StockOk")):
             if not isinstance(getattr(self, name), (bool, np.bool_)):
                 raise InputError("%s %r: expected true or false (%s in the document)"
-                                 % (flag, getattr(self, name), prop))
+                                 % (name, getattr(self, name), prop), options=(name,))
         if self.method == "mirror" and self.stock is None:
-            raise InputError("--method mirror needs --stock (the semi-finishing allowance in "
-                             "mm; DH = stock / 2)")
+            raise InputError("method 'mirror' needs stock (the semi-finishing allowance in "
+                             "mm; the mirror surface lies at half of it)",
+                             options=("method", "stock"))
         self.mask()                                      # odd size, custom weights
         return self
 
 
 def option_name(options, name):
     """How a message names option ``name`` (a field of :class:`Options`) for its reader:
-    the command line's ``--max-offset``, or the compensation's property ``MaxOffset``."""
-    option, prop = OPTIONS[name].flag, OPTIONS[name].prop
-    if getattr(options, "context", "cli") == "document":
-        return "the compensation's %s" % prop
-    return option
+    as itself, ``max_offset`` (the command line shows its flag), or as the compensation's
+    property (``the compensation's MaxOffset``) when ``options.context`` is ``document``."""
+    if getattr(options, "context", "api") == "document":
+        return "the compensation's %s" % OPTIONS[name].prop
+    return name
 
 
 @dataclass
@@ -164,8 +165,8 @@ class Prepared:
         return row, col
 
 
-def _err(ms, k, message):
-    return MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]))
+def _err(ms, k, message, options=()):
+    return MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]), options=options)
 
 
 def prepare(surface, outward, ms, options=None, progress=None):
@@ -225,12 +226,12 @@ def prepare(surface, outward, ms, options=None, progress=None):
 def _tip_radius(ms, options, warnings):
     tip = float(options.tip_radius or 0.0)
     if tip and ms.deviation is not None:
-        raise InputError("--tip-radius applies to measured points (tip centres); this file "
+        raise InputError("tip_radius applies to measured points (tip centres); this file "
                          "gives deviations, which the CMM has already compensated",
-                         file=ms.source)
+                         file=ms.source, options=("tip_radius",))
     if tip and ms.measured is None:
-        raise InputError("--tip-radius needs measured points (tip centres) in the file",
-                         file=ms.source)
+        raise InputError("tip_radius needs measured points (tip centres) in the file",
+                         file=ms.source, options=("tip_radius",))
     if getattr(ms, "tip_centres", False) and not tip:
         warnings.append("%s: the points are stylus tip centres (probe log); without "
                         "--tip-radius every deviation is off by the tip radius" % ms.source)
@@ -257,7 +258,8 @@ def _check_on_face(ms, base, proj, dist, options):
                    "%s %g mm; %d point(s) are farther: wrong face, units or alignment?)"
                    % ((what,) + tuple(base[k]) + (abs(dist[k]),
                                                   option_name(options, "max_offset"),
-                                                  options.max_offset, far.size)))
+                                                  options.max_offset, far.size)),
+                   ("max_offset",))
     if outside.size:
         k = outside[0]
         raise _err(ms, k, "point (%.4f, %.4f, %.4f) lies beyond the border of the face "
@@ -279,7 +281,7 @@ def _normals(ms, n_face, options, warnings):
         raise _err(ms, opposite[0], "the given normal points to the other side of the face "
                    "than the face's outward normal (%d point(s)); use %s if the "
                    "file's normals point into the material"
-                   % (opposite.size, option_name(options, "flip_normals")))
+                   % (opposite.size, option_name(options, "flip_normals")), ("flip_normals",))
     ang = np.degrees(np.arccos(np.clip(cosang, -1.0, 1.0)))
     off = np.nonzero(ang > NORMAL_WARNING_DEG)[0]
     for k in off[:10]:
@@ -301,7 +303,7 @@ def _check_deviations(ms, d, options):
         return
     size = np.where(np.isfinite(d[bad]), np.abs(d[bad]), np.inf)
     k = bad[np.argmax(size)]
-    hint = ("are the deviations in um? Give the unit (--units um, or a column name like "
+    hint = ("are the deviations in um? Give the unit (units um, or a column name like "
             "'dev [um]')" if np.isfinite(d[k]) and np.abs(d[k]) < 1e5 * allowed
             else "is this the right file?")
     # 4 decimals as the other messages, but no 300-digit number for 1e308
@@ -309,7 +311,7 @@ def _check_deviations(ms, d, options):
     raise _err(ms, k, "deviation %s mm (expected at most %s %g mm%s; %d point(s) "
                "exceed it): %s" % (shown, option_name(options, "max_offset"), options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
-                                    bad.size, hint))
+                                    bad.size, hint), ("max_offset", "units"))
 
 
 def _check_units(surface, d, warnings, source):
@@ -336,8 +338,8 @@ def _arrange(ms, proj, options, warnings, surface=None):
     if why is not None:
         if options.layout == "grid":
             raise GridError("%s (expected a grid whose map to the face can be inverted; "
-                            "--layout scattered uses the points as they are)" % why,
-                            file=ms.source)
+                            "layout 'scattered' uses the points as they are)" % why,
+                            file=ms.source, options=("layout",))
         warnings.append("%s%s; the points are used as a scattered layout"
                         % ("%s: " % ms.source if ms.source else "", why))
         grid = Scattered(np.arange(proj.u.size), "scattered (grid too distorted)")
@@ -474,11 +476,10 @@ def check_stock(deviation, options):
     check = plausibility.stock_check(deviation, options.stock)
     if not check.consistent and not options.accept_stock:
         raise InputError(
-            "the stock %g mm (option --stock, Stock in the document) does not fit the "
-            "measured deviations: %s. Was the part measured after finishing, or with another "
-            "stock? Give the stock the measured part carries, or use this one anyway with "
-            "--accept-stock (StockOk = true in the document)"
-            % (check.stock, check.describe()))
+            "the stock %g mm (Stock in the document) does not fit the measured deviations: "
+            "%s. Was the part measured after finishing, or with another stock? Give the stock "
+            "the measured part carries, or use this one anyway with accept_stock (StockOk = "
+            "true in the document)" % (check.stock, check.describe()), options=("accept_stock",))
     return check
 
 

@@ -49,7 +49,7 @@ MAX_DEPTH = 24
 SPLIT_SHARE = 0.9
 
 
-def parse_tool(text, option="--tool"):
+def parse_tool(text, option="tool"):
     """``(kind, radius)`` of a tool given as ``ball:R`` (mm).
 
     Raises
@@ -65,14 +65,16 @@ def parse_tool(text, option="--tool"):
                          "cutter touches the face on its %s, not at the centre's closest "
                          "point); regenerate its program on the corrected face instead"
                          % (option, text, "flat" if kind == "flat" else "bull-nose",
-                            "flat bottom" if kind == "flat" else "corner torus"))
+                            "flat bottom" if kind == "flat" else "corner torus"),
+                         options=(option,))
     try:
         radius = float(parts[1]) if kind == "ball" and len(parts) == 2 else math.nan
     except ValueError:
         radius = math.nan
     if not (math.isfinite(radius) and 0 < radius <= 500):
         raise InputError("%s %s: expected ball:R, the ball radius R in mm (0 < R <= 500), "
-                         "e.g. ball:3 for a 6 mm ball end mill" % (option, text))
+                         "e.g. ball:3 for a 6 mm ball end mill" % (option, text),
+                         options=(option,))
     return "ball", radius
 
 
@@ -123,7 +125,8 @@ class BallOffset:
 
     def __init__(self, surface, outward, radius, correction, blend):
         if not (math.isfinite(blend) and blend > 0):
-            raise InputError("--blend %r: expected a positive length in mm" % blend)
+            raise InputError("blend %r: expected a positive length in mm" % blend,
+                             options=("blend",))
         self.surface = surface
         self.outward = int(outward)
         self.radius = float(radius)
@@ -349,10 +352,10 @@ def _refine(prog, arcs, offset, owner, fa, fb, da, db, tolerance):
         if idx.size == 0:
             break
         if depth == MAX_DEPTH:
-            raise GCodeError("a move cannot be followed within --tolerance %g mm after %d "
+            raise GCodeError("a move cannot be followed within tolerance %g mm after %d "
                              "halvings: the correction changes too abruptly along it"
                              % (tolerance, MAX_DEPTH), file=prog.source,
-                             line=int(prog.line[owner[idx[0]]]) + 1)
+                             line=int(prog.line[owner[idx[0]]]) + 1, options=("tolerance",))
         fm = 0.5 * (fa[idx] + fb[idx])
         pm = _points(prog, arcs, owner[idx], fm)
         dm = offset.displace(pm).move

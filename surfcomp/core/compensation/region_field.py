@@ -220,7 +220,7 @@ def check_straddle(points, d, face, edges, radius, max_offset, lines, source, na
         if worst[0] > max_offset:
             raise MeasurementFileError(
                 "the readings straddling the edge between %s and %s differ by %.4f mm "
-                "(line %d on %s against line %d on %s), more than --max-offset %.4g mm "
+                "(line %d on %s against line %d on %s), more than max_offset %.4g mm "
                 "(expected one surface across the edge)"
                 % (names[a], names[b], worst[0], lines[worst[1]], names[a], lines[worst[2]],
-                   names[b], max_offset), file=source)
+                   names[b], max_offset), file=source, options=("max_offset",))

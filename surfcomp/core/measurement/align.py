@@ -63,7 +63,7 @@ AMBIGUOUS = 0.15
 RIGID_TOL = 1e-9
 
 
-def parse_dof(text, option="--align-dof"):
+def parse_dof(text, option="align_dof"):
     """The degrees of freedom of ``text``: ``all``, or names of :data:`DOF_NAMES` written
     together or separated by commas or blanks (``xyz``, ``z``, ``rz``, ``xy,rz``).
 
@@ -86,7 +86,8 @@ def parse_dof(text, option="--align-dof"):
             k += 2
         else:
             raise InputError("%s %r: expected 'all' or degrees of freedom among %s (e.g. xyz, "
-                             "z, rz, xy,rz)" % (option, text, " ".join(DOF_NAMES)))
+                             "z, rz, xy,rz)" % (option, text, " ".join(DOF_NAMES)),
+                             options=(option,))
     return tuple(n for n in DOF_NAMES if n in got)
 
 
@@ -247,9 +248,10 @@ def refuse_free(free, cols, faces):
     fixed = [DOF_NAMES[c] for c in cols if DOF_NAMES[c] not in free]
     raise InputError("the alignment cannot fix %s: the reference (%s) leaves %s free (a plane "
                      "alone fixes only its normal translation and two rotations); exclude "
-                     "them with --align-dof%s, or add reference faces with --align-faces"
+                     "them with align_dof%s, or add reference faces with align_faces"
                      % (", ".join(free), ", ".join(faces), "it" if len(free) == 1 else "them",
-                        " " + ",".join(fixed) if fixed else ""))
+                        " " + ",".join(fixed) if fixed else ""),
+                     options=("align_dof", "align_faces"))
 
 
 @dataclass
@@ -553,5 +555,5 @@ def best_fit(points, references, assign=None, dof=DOF_NAMES, start=None, coarse=
 def _not_converged(max_iter):
     raise InputError("the alignment did not converge in %d iterations (expected the measured "
                      "points to match the reference faces; are they the right faces, or is "
-                     "the start too far off? a --transform may bring the points closer)"
-                     % max_iter)
+                     "the start too far off? a transform may bring the points closer)"
+                     % max_iter, options=("transform",))

@@ -60,14 +60,18 @@ class AlignOptions:
 
     def validate(self):
         if self.method not in METHODS:
-            raise InputError("--align %r: expected one of %s" % (self.method, ", ".join(METHODS)))
+            raise InputError("align %r: expected one of %s" % (self.method, ", ".join(METHODS)),
+                             options=("align",))
         if self.method == "rps" and self.rps is None:
-            raise InputError("--align rps needs --rps (the 3-2-1 point ids)")
+            raise InputError("align 'rps' needs rps (the 3-2-1 point ids)",
+                             options=("align", "rps"))
         if self.rps is not None and self.method != "rps":
-            raise InputError("--rps is used by --align rps only (got --align %s)" % self.method)
+            raise InputError("rps is used by align 'rps' only (got align %r)" % self.method,
+                             options=("align", "rps"))
         dof = _parse_dof(self.dof)
         if self.method == "rps" and dof != DOF_NAMES:
-            raise InputError("--align-dof applies to --align bestfit (3-2-1 fixes all six)")
+            raise InputError("align_dof applies to align 'bestfit' (3-2-1 fixes all six)",
+                             options=("align", "align_dof"))
         if self.transform is not None:
             check_rigid(self.transform, self.transform_source)
         return self

@@ -128,7 +128,7 @@ def _faces(spec, references, source):
             return None
         if name not in names:
             raise InputError("3-2-1 %s: face %r is not a reference face (expected one of %s, "
-                             "given by --align-faces)" % (group, name, ", ".join(names)),
-                             file=source)
+                             "given by align_faces)" % (group, name, ", ".join(names)),
+                             file=source, options=("align_faces",))
         faces += [names.index(name)] * size
     return np.array(faces)

@@ -99,12 +99,12 @@ class PlanSettings:
                           ("clearance", 0.0)):
             val = getattr(self, name)
             if not (np.isfinite(val) and val >= low) or (name == "tip_radius" and val <= 0):
-                raise InputError("--%s %r: expected a finite length %s 0 mm"
-                                 % (name.replace("_", "-"), val,
-                                    "above" if name == "tip_radius" else ">="))
+                raise InputError("%s %r: expected a finite length %s 0 mm"
+                                 % (name, val, "above" if name == "tip_radius" else ">="),
+                                 options=(name,))
         if not (np.isfinite(self.max_tilt) and 0 <= self.max_tilt <= 90):
-            raise InputError("--max-tilt %r: expected an angle from 0 to 90 degrees"
-                             % (self.max_tilt,))
+            raise InputError("max_tilt %r: expected an angle from 0 to 90 degrees"
+                             % (self.max_tilt,), options=("max_tilt",))
         return self
 
 
@@ -181,26 +181,28 @@ class Plan:
         return {k: out[k] for k in keys if k in out}
 
 
-def parse_count(text, option="--count"):
+def parse_count(text, option="count"):
     """``'12x8'`` -> (12, 8): whole numbers >= 1 whose product is at most ``MAX_POINTS``."""
     parts = str(text).lower().replace("*", "x").split("x")
     try:
         n, m = (int(t) for t in parts)
     except ValueError:
-        raise InputError("%s %r: expected UxV, e.g. 12x8" % (option, text)) from None
+        raise InputError("%s %r: expected UxV, e.g. 12x8" % (option, text),
+                         options=(option,)) from None
     if n < 1 or m < 1:
-        raise InputError("%s %r: expected at least 1 point in each direction" % (option, text))
+        raise InputError("%s %r: expected at least 1 point in each direction" % (option, text),
+                         options=(option,))
     if n * m > MAX_POINTS:
-        raise InputError("%s %r: %d points, expected at most %d" % (option, text, n * m,
-                                                                     MAX_POINTS))
+        raise InputError("%s %r: %d points, expected at most %d"
+                         % (option, text, n * m, MAX_POINTS), options=(option,))
     return n, m
 
 
-def check_points(count, option="--points"):
+def check_points(count, option="points"):
     """A point count: a whole number from 1 to ``MAX_POINTS``."""
     if int(count) != count or not 1 <= count <= MAX_POINTS:
-        raise InputError("%s %r: expected a whole number from 1 to %d" % (option, count,
-                                                                           MAX_POINTS))
+        raise InputError("%s %r: expected a whole number from 1 to %d"
+                         % (option, count, MAX_POINTS), options=(option,))
     return int(count)
 
 
@@ -410,17 +412,20 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
     """
     settings = (settings or PlanSettings()).check()
     if layout not in LAYOUTS:
-        raise InputError("--layout %r: expected one of %s" % (layout, ", ".join(LAYOUTS)))
+        raise InputError("layout %r: expected one of %s" % (layout, ", ".join(LAYOUTS)),
+                         options=("layout",))
     if order not in ORDERS:
-        raise InputError("--order %r: expected one of %s" % (order, ", ".join(ORDERS)))
+        raise InputError("order %r: expected one of %s" % (order, ", ".join(ORDERS)),
+                         options=("order",))
     report(progress, 0.0, "sampling the face")
     cloud = _face_cloud(domain)
     radius, where = min_concave_radius(domain, cloud[2], cloud[3])
     if settings.tip_radius > radius:
-        raise InputError("--tip-radius %g mm is larger than the face's smallest concave radius "
+        raise InputError("tip_radius %g mm is larger than the face's smallest concave radius "
                          "%.4g mm (at %.3f, %.3f, %.3f): the stylus ball cannot touch the face "
                          "there (expected a tip radius of at most %.4g mm)"
-                         % ((settings.tip_radius, radius) + where + (radius,)))
+                         % ((settings.tip_radius, radius) + where + (radius,)),
+                         options=("tip_radius",))
     if top_z is None:
         top_z = float(cloud[2][0][cloud[3], 2].max()) if cloud[3].any() else 0.0
     safe_z = float(top_z) + settings.tip_radius + settings.clearance
@@ -453,7 +458,8 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
     dropped = [Drop(int(i), str(reason[i]), float(lay["u"][i]), float(lay["v"][i]),
                     tuple(float(x) for x in S[i])) for i in np.flatnonzero(~keep)]
     if not keep.any():
-        raise InputError(_nothing_left(layout, requested, dropped, info))
+        raise InputError(_nothing_left(layout, requested, dropped, info),
+                         options=("max_tilt", "edge_margin", "tip_radius"))
     report(progress, 0.8, "ordering %d points" % int(keep.sum()))
     idx = np.flatnonzero(keep)
     tour, name, travel = visiting_order(standoff[idx], lay["row"][idx], lay["along"][idx],
@@ -477,5 +483,5 @@ def _nothing_left(layout, requested, dropped, info):
         why = ("%d nodes have no face under them; " % clipped) + why
     return ("no reachable point on the face: the %s layout placed %d point(s) and every one "
             "was dropped (%s); expected at least one point that a 3-axis probe reaches "
-            "(a larger --max-tilt, a smaller --edge-margin or --tip-radius, or another face)"
+            "(a larger max_tilt, a smaller edge_margin or tip_radius, or another face)"
             % (layout, requested, why or "none placed"))

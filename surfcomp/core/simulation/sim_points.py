@@ -3,37 +3,14 @@
 the in-memory measurement set :func:`surfcomp.core.compensation.pipeline.prepare` reads (no
 FreeCAD)."""
 
-from dataclasses import dataclass, field
-
 import numpy as np
 
+from ..measurement_set import MeasurementSet
 from ..surface import bspline
 from ..surface.projection import Projector
 
-
-@dataclass
-class GridMeasurements:
-    """A measurement set built in memory, with the attributes of
-    :class:`surfcomp.io.measurements.MeasurementSet` that :func:`pipeline.prepare` reads
-    (core does not import io): nominal points and outward normals (N, 3), deviations
-    (N,), grid indices ``row``/``col`` (N,)."""
-
-    nominal: np.ndarray
-    normal: np.ndarray
-    deviation: np.ndarray
-    row: np.ndarray
-    col: np.ndarray
-    measured: np.ndarray = None
-    source: str = "<simulated measurement>"
-    warnings: list = field(default_factory=list)
-    lines: np.ndarray = None
-
-    def __post_init__(self):
-        if self.lines is None:
-            self.lines = np.arange(1, len(self.nominal) + 1, dtype=np.int64)
-
-    def __len__(self):
-        return len(self.lines)
+#: the source the simulated measurement sets name in messages
+SIMULATED = "<simulated measurement>"
 
 
 def measurement_set(surface, outward, layout, points=None):
@@ -42,15 +19,16 @@ def measurement_set(surface, outward, layout, points=None):
     if points is not None:
         P = np.asarray(points, dtype=float).reshape(-1, 3)
         proj = Projector(surface).project(P)
-        return GridMeasurements(nominal=P, normal=proj.normal * outward,
-                                deviation=np.zeros(len(P)), row=None, col=None)
+        return MeasurementSet(nominal=P, normal=proj.normal * outward,
+                              deviation=np.zeros(len(P)), source=SIMULATED)
     n, m = layout.grid
     S, Su, Sv = bspline.evaluate_grid(surface, layout.us[::b], layout.vs[::b], order=1)
     nrm = np.cross(Su, Sv)
     nrm *= outward / np.linalg.norm(nrm, axis=-1, keepdims=True)
     rows, cols = np.indices((n, m))
-    return GridMeasurements(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
-                            deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel())
+    return MeasurementSet(nominal=S.reshape(-1, 3), normal=nrm.reshape(-1, 3),
+                          deviation=np.zeros(n * m), row=rows.ravel(), col=cols.ravel(),
+                          source=SIMULATED)
 
 
 def file_order(prepared, grid_values):

@@ -10,7 +10,7 @@ for every compensation method and replica, with the machining-process model of
    pass (the nominal offset outward by the stock), as the mirror paper does on the
    machine;
 2. compensate with :func:`surfcomp.core.compensation.pipeline.compensate` (a
-   :class:`~surfcomp.io.measurements.MeasurementSet` built in memory);
+   :class:`~surfcomp.core.measurement_set.MeasurementSet` built in memory);
 3. machine a part from the corrected surface with the same model (new random
    realisations; the mirror method finishes the part it measured, whose semi-finished
    error sets the finishing pass's engagement);
@@ -47,7 +47,7 @@ from .process_model import (  # noqa: F401 (the simulation's public names)
     machine_pass,
 )
 from .process_model import SUMMARY as MODEL_SUMMARY
-from .sim_points import GridMeasurements, file_order, measurement_set  # noqa: F401
+from .sim_points import file_order, measurement_set
 from .sim_tables import (  # noqa: F401
     STAT_KEYS,
     TABLE_ROWS,
@@ -178,8 +178,9 @@ def make_layout(surface, grid=(45, 45), margin=0.02, between=2):
         raise InputError("between must be a whole number >= 1, got %r" % (between,))
     size = (between * (n - 1) + 1, between * (m - 1) + 1)
     if max(size) > MAX_EVAL_GRID:
-        raise InputError("--between %d: the evaluation grid would have %d x %d points (expected "
-                         "at most %d per direction)" % ((between,) + size + (MAX_EVAL_GRID,)))
+        raise InputError("between %d: the evaluation grid would have %d x %d points (expected "
+                         "at most %d per direction)" % ((between,) + size + (MAX_EVAL_GRID,)),
+                         options=("between",))
     if not 0 <= margin < 0.5:
         raise InputError("margin must be in [0, 0.5), got %r" % (margin,))
     (u0, u1), (v0, v1) = surface.u_range, surface.v_range

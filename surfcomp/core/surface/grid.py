@@ -210,9 +210,9 @@ def grid_from_uv(u, v, lines=None, source=None):
         except GridError:
             pass  # not a proper grid after all: report why the other ways failed
     raise GridError("the %d measured points do not form a complete n x m grid on the face: %s "
-                    "(expected rows of equal length; add row/col columns, or --layout "
-                    "scattered)" % (u.size, _describe_incomplete(v, u, "v", "u", sorted_v)),
-                    file=source)
+                    "(expected rows of equal length; add row/col columns, or layout "
+                    "'scattered')" % (u.size, _describe_incomplete(v, u, "v", "u", sorted_v)),
+                    file=source, options=("layout",))
 
 
 #: cosine of the direction change (45 degrees) that ends a scan line in file order

@@ -170,26 +170,26 @@ def check_contact(off, closest, contact, source=None):
                  "every cutting point is farther than %.3f mm from it (this line has "
                  "the first)" % off.reach)
         raise GCodeError("no cutting move of the program comes near the face (the ball of "
-                         "radius %g mm within --blend %g mm of it): %s; expected the "
+                         "radius %g mm within blend %g mm of it): %s; expected the "
                          "finishing program of this face" % (r, off.blend, where),
-                         file=source, line=closest[1] or None)
+                         file=source, line=closest[1] or None, options=("blend",))
     gap, tilt, interior, lines = (np.concatenate(a) for a in zip(*contact))
     fit = fit_contact(gap, tilt, interior, lines, r)
     if fit.deepest < -CONTACT_TOL:
-        raise GCodeError("the ball of radius %g mm (--tool) at this cutter-location point "
+        raise GCodeError("the ball of radius %g mm (tool) at this cutter-location point "
                          "cuts %.4f mm into the nominal face (more than %g mm): the program "
                          "was made for a smaller ball or another face; expected the ball "
                          "radius the program was made with" % (r, -fit.deepest, CONTACT_TOL),
-                         file=source, line=fit.deepest_line)
+                         file=source, line=fit.deepest_line, options=("tool",))
     if fit.radius_error is not None:
         effect = abs(fit.radius_error) * (1.0 - np.cos(np.radians(fit.max_tilt)))
         if effect > CONTACT_TOL:
             raise GCodeError("the program's cutter-location points fit a ball of radius "
-                             "%.3f mm, not %g mm (--tool; %d contact points on slopes up to "
+                             "%.3f mm, not %g mm (tool; %d contact points on slopes up to "
                              "%.1f degrees, %.4f mm off): expected the ball radius the "
                              "program was made with"
                              % (r + fit.radius_error, r, fit.points, fit.max_tilt, effect),
-                             file=source, line=fit.deepest_line or None)
+                             file=source, line=fit.deepest_line or None, options=("tool",))
     if abs(fit.stock) > CONTACT_TOL:
         raise GCodeError("the program's contact points lie %.4f mm %s the nominal face's "
                          "ball offset on average (%d points; more than %g mm): a program "

@@ -131,12 +131,12 @@ class BoundsCheck:
         if self.error_over:
             error, nominal, line = self.error_first
             raise GCodeError("the error model predicts an error of %.6g mm at the programmed "
-                             "point (%.6g, %.6g, %.6g) mm, more than --max-error %g mm (%d "
+                             "point (%.6g, %.6g, %.6g) mm, more than max_error %g mm (%d "
                              "point(s)): check the units of the error file, or whether the "
                              "program leaves the measured travel (the error functions are "
                              "extrapolated there)"
                              % ((error,) + tuple(nominal) + (self.max_error, self.error_over)),
-                             file=source, line=line)
+                             file=source, line=line, options=("max_error",))
         self._prune(resolution)
         if self.kept:
             corr, emitted, nominal, line = self.kept[0]
