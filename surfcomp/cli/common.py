@@ -186,10 +186,11 @@ def print_summary(comp, rep, out=None):
         print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
     else:
         print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
-    from ..core.align_report import summary_lines
+    if rep.get("alignment"):        # (its module only then: the alignment's numerics)
+        from ..core.align_report import summary_lines
 
-    for line in summary_lines(rep.get("alignment")):
-        print(line, file=out)
+        for line in summary_lines(rep["alignment"]):
+            print(line, file=out)
     for w in p.warnings:
         print("warning: " + w, file=sys.stderr)
     o = comp.options
