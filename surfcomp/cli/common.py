@@ -6,7 +6,7 @@ import time
 
 from ..core.choices import EDGE_MODES, METHODS
 from ..core.choices import MEASUREMENT_FORMATS as FORMATS
-from . import registry
+from . import registry, runner
 
 
 def add_job_parser(subparsers, name, summary, description):
@@ -103,10 +103,12 @@ def run_job_command(args, command):
     """Run a job command line: progress on stderr, the summary, the files written."""
     from ..app import cadread
 
-    # the nominal's reader child starts first and runs beside the imports of the numerics
-    cadread.prefetch(args.nominal)
     try:
-        from ..app.file_route import run_job
+        with runner.collector_paused():
+            # the nominal's reader child starts first and runs beside the imports of the
+            # numerics
+            cadread.prefetch(args.nominal)
+            from ..app.file_route import run_job
 
         job = job_from_args(args, command)
         comp, rep = run_job(job, progress=ProgressLine(args.quiet),
