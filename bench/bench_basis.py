@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The B-spline collocation matrix: scipy's ``BSpline.design_matrix`` (what
-``surfcomp.core.surface.bspline_basis.basis_matrix`` uses where the installed scipy has it with
-extrapolation, 1.10 and later) beside the hand-written basis (NURBS book A2.2), in the
-same run.
+``surfcomp.core.surface.bspline_basis.basis_matrix`` uses from ``SCIPY_FROM`` parameters on where
+the installed scipy has it with extrapolation, 1.10 and later) beside the hand-written
+basis (NURBS book A2.2), in the same run.
 
     /usr/bin/python3 bench/bench_basis.py [--points 1000,100000,1000000] [--degree 3]
         [--spans 200] [--repeat 3]
@@ -87,9 +87,9 @@ def main(argv=None):
     knots = np.r_[[0.0] * p, np.linspace(0.0, 1.0, args.spans + 1), [1.0] * p]
     n_poles = knots.size - p - 1
     print("scipy %s: BSpline.design_matrix with extrapolate %s" % (
-        scipy.__version__, "used" if bb.SCIPY_DESIGN_MATRIX is not None else "missing"))
-    surface_rows(args)
-    if bb.SCIPY_DESIGN_MATRIX is None:
+        scipy.__version__, "used from %d points on" % bb.SCIPY_FROM
+        if bb.scipy_design_matrix() is not None else "missing"))
+    if bb.scipy_design_matrix() is None:
         return 1
     print("%10s %14s %14s %7s %10s" % ("points", "hand-written s", "scipy s", "ratio",
                                          "max diff"))
@@ -97,7 +97,7 @@ def main(argv=None):
     for m in (int(x) for x in args.points.split(",")):
         t = rng.uniform(0.0, 1.0, m)
         ours, a = best(lambda t=t: bb._basis_matrix(knots, p, n_poles, t), args.repeat)
-        theirs, b = best(lambda t=t: bb.basis_matrix(knots, p, n_poles, t), args.repeat)
+        theirs, b = best(lambda t=t: bb._scipy_basis_matrix(knots, p, t), args.repeat)
         diff = abs(a - b).max() if m else 0.0
         print("%10d %14.4f %14.4f %7.2f %10.1e" % (m, ours, theirs, ours / theirs, diff))
     return 0

@@ -4,23 +4,26 @@
 OpenCASCADE's STEP reader segfaults on some damaged files (a STEP with one entity line
 removed is enough). Read in this process, that ends the command (or the user's FreeCAD
 session, with its unsaved work) without a message. :func:`read_cad` runs the reader in a
-child ``python3`` that writes the shape as BREP (OCCT's own format, which it reads back
+child process that writes the shape as BREP (OCCT's own format, which it reads back
 robustly); a crash of the child becomes a clear :class:`~surfcomp.errors.GeometryError`.
 
-The child is this module run as a script::
+The child is, where that is safe, a fork of this process once FreeCAD and Part are imported
+(:mod:`surfcomp.app.cadfork`): it has only the file to read, not a second start of Python
+and FreeCAD. Elsewhere (inside the FreeCAD GUI, in a process with threads, without
+``os.fork``) it is a fresh ``python3`` running this module as a script::
 
     python3 -m surfcomp.app.cadread IN.step OUT.brep
 """
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
 import time
 
 from ..errors import GeometryError, InputError
+from . import cadfork
 
 #: seconds the reader may take (a large assembly takes minutes; a hang must end);
 #: ``SURFCOMP_CAD_TIMEOUT`` replaces it
@@ -79,6 +82,9 @@ class _Reader:
         src = os.path.join(self.tmp, "input" + os.path.splitext(path)[1].lower())
         try:
             os.symlink(os.path.abspath(path), src)
+            if cadfork.usable():
+                self.proc = cadfork.Forked(lambda: _read_to_brep(src, self.out), self.tmp)
+                return
             env = dict(os.environ, PYTHONPATH=os.pathsep.join(
                 [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
             self.proc = subprocess.Popen([_python(), "-m", "surfcomp.app.cadread", src, self.out],
@@ -168,10 +174,7 @@ def read_cad(path, label="NOMINAL"):
 def _fatal_signals_kill():
     """Let a crash kill the child with its signal. FreeCAD installs a SIGSEGV handler that
     exits with code 1 and no message, which the parent could not tell from a reader error."""
-    for name in ("SIGSEGV", "SIGBUS", "SIGFPE", "SIGILL", "SIGABRT"):
-        sig = getattr(signal, name, None)
-        if sig is not None:
-            signal.signal(sig, signal.SIG_DFL)
+    cadfork.default_signals(cadfork.FATAL_SIGNALS)
 
 
 def _main(argv):
@@ -179,9 +182,14 @@ def _main(argv):
     from . import fcenv
 
     fcenv.import_freecad()
-    import Part
-
     _fatal_signals_kill()
+    return _read_to_brep(src, dst)
+
+
+def _read_to_brep(src, dst):
+    """The child's work: read ``src`` with OCCT, write it to ``dst`` as BREP; the exit code
+    (0, or :data:`_REFUSED` with the reason on stderr)."""
+    import Part
 
     try:
         shape = Part.read(src)

@@ -122,13 +122,14 @@ _MODULES_1X = {"Job": "Path.Main.Job", "Surface": "Path.Op.Surface",
                "Profile": "Path.Op.Profile", "ToolController": "Path.Tool.Controller",
                "Preferences": "Path.Preferences", "Geom": "Path.Geom",
                "Dressup": "Path.Dressup.Utils", "PathUtils": "PathScripts.PathUtils",
-               "ToolBit": "Path.Tool.Bit", "toolbit": "Path.Tool.toolbit"}
+               "ToolBit": "Path.Tool.Bit", "toolbit": "Path.Tool.toolbit",
+               "Custom": "Path.Op.Custom"}
 _MODULES_020 = {"Job": "PathScripts.PathJob", "Surface": "PathScripts.PathSurface",
                 "Profile": "PathScripts.PathProfile",
                 "ToolController": "PathScripts.PathToolController",
                 "Preferences": "PathScripts.PathPreferences", "Geom": "PathScripts.PathGeom",
                 "Dressup": "PathScripts.PathDressup", "PathUtils": "PathScripts.PathUtils",
-                "ToolBit": "PathScripts.PathToolBit"}
+                "ToolBit": "PathScripts.PathToolBit", "Custom": "PathScripts.PathCustom"}
 
 
 def api():
@@ -157,7 +158,7 @@ def api():
 def module(role):
     """The CAM module that plays ``role`` (``'Job'``, ``'Surface'``, ``'Profile'``,
     ``'ToolController'``, ``'Preferences'``, ``'Geom'``, ``'Dressup'``, ``'PathUtils'``,
-    ``'ToolBit'``, ``'toolbit'``) on this FreeCAD, imported on first use."""
+    ``'ToolBit'``, ``'toolbit'``, ``'Custom'``) on this FreeCAD, imported on first use."""
     return importlib.import_module(api().names[role])
 
 

@@ -15,7 +15,6 @@ from ..errors import GeometryError
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
 from .convert import surface_from_part
-from .documents import open_document
 
 
 @dataclass
@@ -75,6 +74,8 @@ def read_shape(path, object_name=None):
 
 def _shape_from_document(path, object_name):
     import FreeCAD
+
+    from .documents import open_document  # (documents only: it loads the CAM adapters)
 
     before = set(FreeCAD.listDocuments())
     doc = open_document(path)[0]

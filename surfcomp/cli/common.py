@@ -5,7 +5,7 @@ import sys
 import time
 
 from ..core.choices import MEASUREMENT_FORMATS as FORMATS
-from . import registry
+from . import registry, runner
 from .options import add_arguments
 
 
@@ -65,10 +65,12 @@ def run_job_command(args, command):
     """Run a job command line: progress on stderr, the summary, the files written."""
     from ..app import cadread
 
-    # the nominal's reader child starts first and runs beside the imports of the numerics
-    cadread.prefetch(args.nominal)
     try:
-        from ..app.file_route import run_job
+        with runner.collector_paused():
+            # the nominal's reader child starts first and runs beside the imports of the
+            # numerics
+            cadread.prefetch(args.nominal)
+            from ..app.file_route import run_job
 
         job = job_from_args(args, command)
         comp, rep = run_job(job, progress=ProgressLine(args.quiet),
@@ -145,10 +147,11 @@ def print_summary(comp, rep, out=None):
         print("Layout:       %d scattered points (%s)" % (p.u.size, p.grid.rows_from), file=out)
     else:
         print("Grid:         %d x %d (%s)" % (p.grid.shape + (p.grid.rows_from,)), file=out)
-    from ..core.measurement.align_report import summary_lines
+    if rep.get("alignment"):        # (its module only then: the alignment's numerics)
+        from ..core.measurement.align_report import summary_lines
 
-    for line in summary_lines(rep.get("alignment")):
-        print(line, file=out)
+        for line in summary_lines(rep["alignment"]):
+            print(line, file=out)
     for w in p.warnings:
         print("warning: " + w, file=sys.stderr)
     o = comp.options

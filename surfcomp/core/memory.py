@@ -10,7 +10,6 @@ other C libraries) :func:`return_free_memory` does nothing.
 """
 
 import ctypes
-import ctypes.util
 import sys
 
 _TRIM = []      # [malloc_trim] or [None], looked up once
@@ -20,9 +19,8 @@ def _trim():
     if not _TRIM:
         fn = None
         if sys.platform.startswith("linux"):
-            try:
-                fn = getattr(ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6"),
-                             "malloc_trim", None)
+            try:    # the process's own symbols (the C library is loaded): no ldconfig run
+                fn = getattr(ctypes.CDLL(None), "malloc_trim", None)
             except OSError:
                 fn = None
         _TRIM.append(fn)

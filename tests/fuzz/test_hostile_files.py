@@ -37,9 +37,11 @@ def _child(tmp_path, body):
 ], ids=["killed-by-SIGSEGV", "killed-by-SIGABRT", "refused", "hangs"])
 def test_cad_reader_child_that_crashes_or_hangs(tmp_path, monkeypatch, body, says):
     """The parent's handling of its reader child: a crash (killed by a signal), a refusal
-    and a hang each give exit 2 naming the nominal, nothing written."""
-    from surfcomp.app import cadread
+    and a hang each give exit 2 naming the nominal, nothing written. The child here is the
+    fresh ``python3`` (the forked one's cases are in tests/app/test_cadfork.py)."""
+    from surfcomp.app import cadfork, cadread
 
+    monkeypatch.setattr(cadfork, "usable", lambda: False)
     child = _child(tmp_path, body)
     monkeypatch.setattr(cadread, "_python", lambda: child)
     monkeypatch.setattr(cadread, "TIMEOUT", 1.0)

@@ -14,7 +14,8 @@ import pytest
 from tests.conftest import ROOT
 from tests.gui.harness import run_session
 
-COMMAND_IDS = ["SurfComp_AddProbeOperation", "SurfComp_AlignMeasurements",
+COMMAND_IDS = ["SurfComp_AddProbeOperation", "SurfComp_AddSurfaceCorrection",
+               "SurfComp_AlignMeasurements",
                "SurfComp_BuildFace", "SurfComp_DeviationMap", "SurfComp_Filter",
                "SurfComp_ImportMeasurements", "SurfComp_LoadNominal", "SurfComp_Mirror",
                "SurfComp_PlanMeasurement", "SurfComp_ReplaceInDocument", "SurfComp_Report",

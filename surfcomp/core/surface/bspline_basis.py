@@ -13,25 +13,33 @@ import inspect
 
 import numpy as np
 import scipy.sparse as _sp
-from scipy.interpolate import BSpline as _BSpline
+
+#: from this many parameters on, :func:`basis_matrix` takes scipy's compiled collocation
+#: matrix (:func:`scipy_design_matrix`); below, the hand-written one. Importing
+#: ``scipy.interpolate`` (it brings ``scipy.optimize``) costs about 0.06 s of CPU, about
+#: what the compiled matrix saves on 100 000 parameters (``bench/bench_basis.py``); a
+#: measurement grid of a few thousand points would pay it to save a millisecond.
+SCIPY_FROM = 100_000
+
+_DESIGN = []
 
 
-def _scipy_design_matrix():
+def scipy_design_matrix():
     """scipy's compiled collocation matrix where the installed scipy has it with
     extrapolation (``BSpline.design_matrix(x, t, k, extrapolate)``, scipy 1.10 and later),
     else None. It gives the values of :func:`basis_functions` (to rounding: equal in
     ``tests/pure/test_basis_scipy.py``) in less time; ``bench/bench_basis.py`` prints the
-    ratio."""
-    design = getattr(_BSpline, "design_matrix", None)
-    try:
-        takes_extrapolate = "extrapolate" in inspect.signature(design).parameters
-    except (TypeError, ValueError):
-        takes_extrapolate = False
-    return design if takes_extrapolate else None
+    ratio. ``scipy.interpolate`` is imported on the first call."""
+    if not _DESIGN:
+        from scipy.interpolate import BSpline
 
-
-#: ``BSpline.design_matrix`` of the installed scipy, or None (see :func:`_scipy_design_matrix`)
-SCIPY_DESIGN_MATRIX = _scipy_design_matrix()
+        design = getattr(BSpline, "design_matrix", None)
+        try:
+            takes_extrapolate = "extrapolate" in inspect.signature(design).parameters
+        except (TypeError, ValueError):
+            takes_extrapolate = False
+        _DESIGN.append(design if takes_extrapolate else None)
+    return _DESIGN[0]
 
 
 def find_spans(knots, degree, n_poles, t):
@@ -160,9 +168,15 @@ def basis_matrix(knots, degree, n_poles, t, deriv=0):
     if knots.size != n_poles + degree + 1:
         raise ValueError("knot vector length %d does not match n_poles + degree + 1 = %d"
                          % (knots.size, n_poles + degree + 1))
-    if deriv == 0 and SCIPY_DESIGN_MATRIX is not None and np.isfinite(t).all():
-        return _sp.csr_matrix(SCIPY_DESIGN_MATRIX(t, knots, int(degree), extrapolate=True))
+    if deriv == 0 and t.size >= SCIPY_FROM and scipy_design_matrix() is not None \
+            and np.isfinite(t).all():
+        return _scipy_basis_matrix(knots, degree, t)
     return _basis_matrix(knots, degree, n_poles, t, deriv)
+
+
+def _scipy_basis_matrix(knots, degree, t):
+    """:func:`basis_matrix` (``deriv=0``, finite parameters) from scipy's compiled matrix."""
+    return _sp.csr_matrix(scipy_design_matrix()(t, knots, int(degree), extrapolate=True))
 
 
 def _basis_matrix(knots, degree, n_poles, t, deriv=0):

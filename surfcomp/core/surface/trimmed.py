@@ -142,7 +142,9 @@ def knots_of(*surfaces):
 
 def correction_integral(nominal, corrected, outward, polylines):
     """Integral of the correction over the trimmed face (mm^3; positive = material removed):
-    the volume of the layer between the nominal and the corrected face.
+    the volume of the layer between the nominal and the corrected face (over a face bounded
+    by its surface's whole domain, :func:`whole_domain`, by :func:`tensor_integral`, else by
+    :func:`domain_integral`).
 
     The correction at ``(u, v)`` is ``delta = n . (S - S_c)`` with the outward unit normal
     ``n`` (``S_c = S - delta n``, docs/method.md). The layer swept along the normals
@@ -170,14 +172,51 @@ def correction_integral(nominal, corrected, outward, polylines):
                       bspline.evaluate_grid(corrected, us, vs), outward)
 
     # panels at both surfaces' knots (each holds one polynomial piece of the correction) and
-    # 16 more: on the example's face 6e-8 of the integral from a 1000-panel rule, 0.03 s on
-    # the grid; a correction with very many knots gets the nominal's knots and 64 panels
+    # 16 more; a correction with very many knots gets the nominal's knots and 64 panels. A
+    # face bounded by its whole domain (the example's) takes the tensor rule: 1e-11 of the
+    # integral from 1000 panels, 0.01 s (Green's rule along 400 boundary points: 6e-8, 0.04 s)
     knots = knots_of(nominal, corrected)
     if max(len(k) for k in knots) > MAX_KNOTS:
         knots, panels = knots_of(nominal), 64
     else:
         panels = _PANELS
+    if whole_domain(polylines, nominal.u_range, nominal.v_range):
+        return tensor_integral(grid, nominal.u_range, nominal.v_range, knots, panels)
     return domain_integral(func, polylines, knots=knots, panels=panels, grid=grid)
+
+
+def whole_domain(pieces, u_range, v_range, tol=1e-9):
+    """True when the boundary ``pieces`` enclose the whole rectangle ``u_range x v_range``
+    (a face bounded by its surface's whole parameter domain): every point lies on the
+    rectangle's border (within ``tol`` of its sides) and the loop's area (shoelace) is the
+    rectangle's, so it runs once around it (no holes, nothing cut off)."""
+    (u0, u1), (v0, v1) = u_range, v_range
+    du, dv = tol * (u1 - u0), tol * (v1 - v0)
+    pts = np.concatenate([np.asarray(p, dtype=float) for p in pieces])
+    u, v = pts[:, 0], pts[:, 1]
+    border = (np.abs(u - u0) <= du) | (np.abs(u - u1) <= du) | \
+        (np.abs(v - v0) <= dv) | (np.abs(v - v1) <= dv)
+    within = (u >= u0 - du) & (u <= u1 + du) & (v >= v0 - dv) & (v <= v1 + dv)
+    if not (border.all() and within.all()):
+        return False
+    area = sum(0.5 * float(np.sum(p[:-1, 0] * p[1:, 1] - p[1:, 0] * p[:-1, 1]))
+               for p in (np.asarray(q, dtype=float) for q in pieces))
+    return abs(abs(area) - (u1 - u0) * (v1 - v0)) <= 1e-6 * (u1 - u0) * (v1 - v0)
+
+
+def tensor_integral(grid, u_range, v_range, knots, panels=_PANELS):
+    """Integral of a function over the whole rectangle ``u_range x v_range``: the composite
+    Gauss-Legendre rule of :func:`domain_integral` (panels broken at the ``knots``, plus
+    ``panels`` equal ones) in u and in v, on the tensor grid of its nodes (``grid(us, vs)``,
+    evaluated in blocks of u). Exact where :func:`domain_integral` is in u, and so in v
+    (it takes the midpoint rule along the boundary there): for a rectangle it is the same
+    rule in u, more exact in v, on fewer points."""
+    x, w = np.polynomial.legendre.leggauss(_GAUSS)
+    su, wu = _composite(_breaks(*u_range, panels, knots[0]), x, w)
+    sv, wv = _composite(_breaks(*v_range, panels, knots[1]), x, w)
+    step = max(1, _GRID_BLOCK // sv.size)
+    return float(sum(wu[k:k + step] @ grid(su[k:k + step], sv) @ wv
+                     for k in range(0, su.size, step)))
 
 
 def _dot(a, b):
