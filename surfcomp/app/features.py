@@ -43,7 +43,6 @@ from ..core.compensation.deviations import statistics
 from ..core.compensation.filters import EDGE_MODES, WERNER_MASK_SIZE
 from ..core.compensation.methods import METHODS
 from ..core.compensation.pipeline import (
-    Options,
     build_surface,
     compensate,
     parameter_scale,
@@ -66,6 +65,7 @@ from .properties import (
     OUTPUTS,
     RENAMED,
     VERSION,
+    options_of,
 )
 from .proxies import Proxy
 from .proxies import migrate as _migrate
@@ -283,20 +283,6 @@ class CompensationFeature(_Proxy):
         # the feature sits where its nominal sits
         obj.Placement = result.shape.Placement
         obj.Shape = result.shape
-
-
-def options_of(obj):
-    """The core :class:`~surfcomp.core.compensation.pipeline.Options` of a compensation object."""
-    weights = obj.Weights.strip() or None
-    return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
-                   mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
-                   edge=obj.Edge, stock=float(obj.Stock.Value),
-                   accept_stock=bool(getattr(obj, "StockOk", False)),
-                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
-                   refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
-                   layout=obj.Layout,
-                   smoothing=(float(obj.Smoothing.Value) or None),
-                   tip_radius=float(obj.TipRadius.Value), context="document")
 
 
 #: compensation property -> core option of the filter (the task panel's fields)

@@ -139,9 +139,26 @@ _IN, _RES = "Compensation", "Result"
 _UNSET = {float: 0.0, str: "", int: 0}
 
 
+def options_of(obj):
+    """The core :class:`~surfcomp.core.compensation.pipeline.Options` of a compensation object
+    (this table module imports no numerics until then)."""
+    from ..core.compensation.pipeline import Options
+
+    weights = obj.Weights.strip() or None
+    return Options(method=obj.Method, mask_size=int(obj.MaskSize), weights=weights,
+                   mask_kind=obj.MaskKind, sigma=(float(obj.Sigma) or None),
+                   edge=obj.Edge, stock=float(obj.Stock.Value),
+                   accept_stock=bool(getattr(obj, "StockOk", False)),
+                   max_offset=float(obj.MaxOffset.Value), flip_normals=bool(obj.Flip),
+                   refine=int(obj.Refine), lean=bool(getattr(obj, "Lean", True)),
+                   layout=obj.Layout,
+                   smoothing=(float(obj.Smoothing.Value) or None),
+                   tip_radius=float(obj.TipRadius.Value), context="document")
+
+
 def store_options(obj, options):
     """Set every option property of compensation ``obj`` from core ``options`` (the inverse
-    of :func:`surfcomp.app.features.options_of`): an unset option becomes 0 or empty, and
+    of :func:`options_of`): an unset option becomes 0 or empty, and
     weights given as rows of numbers the property's text."""
     for name, o in OPTIONS.items():
         value = getattr(options, name)
