@@ -42,11 +42,11 @@ def surface_rows(args):
     """Points and derivatives of the example face by scipy's NdBSpline and by hand."""
     from surfcomp.core.simulation.presets import werner_surface
     from surfcomp.core.surface import bspline, bspline_nd
-    if bspline_nd.NDBSPLINE is None:
+    if bspline_nd.ndbspline() is None:
         print("scipy.interpolate.NdBSpline: missing (points evaluated by hand)")
         return
     s = werner_surface()
-    nd = bspline_nd.NDBSPLINE((s.knots_u, s.knots_v), s.poles, (s.degree_u, s.degree_v))
+    nd = bspline_nd.ndbspline()((s.knots_u, s.knots_v), s.poles, (s.degree_u, s.degree_v))
     print("%10s %6s %17s %17s %7s %10s" % ("points", "order", "hand wall (CPU) s",
                                            "NdBSpline wall s", "ratio", "max diff"))
     rng = np.random.default_rng(0)

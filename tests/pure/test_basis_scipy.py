@@ -76,7 +76,7 @@ def test_the_grid_route_does_not_import_scipy_interpolate():
 
     from tests.conftest import ROOT
 
-    code = ("import sys, numpy as np; from surfcomp.core import bspline_basis as bb; "
+    code = ("import sys, numpy as np; from surfcomp.core.surface import bspline_basis as bb; "
             "bb.basis_matrix(np.r_[0., 0, 0, 0, 1, 1, 1, 1], 3, 4, np.linspace(0, 1, 2025)); "
             "print(sorted(m for m in ('scipy.interpolate', 'scipy.optimize') "
             "if m in sys.modules))")

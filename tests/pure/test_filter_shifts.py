@@ -46,7 +46,7 @@ def test_the_grid_route_does_not_import_ndimage():
 
     from tests.conftest import ROOT
 
-    code = ("import sys, numpy as np; from surfcomp.core import filters; "
+    code = ("import sys, numpy as np; from surfcomp.core.compensation import filters; "
             "print(filters.mask_filter(np.arange(49.).reshape(7, 7), np.ones((5, 5)))[3, 3], "
             "'scipy.ndimage' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -191,7 +191,7 @@ def _all_ders(surf, u, v, order):
     keys = _ORDER_KEYS[order]
     out = [np.empty((uf.size, 3)) for _ in keys]
     Pw = _homogeneous(surf) if surf.weights is not None else surf.poles
-    compiled = point_evaluator(surf, Pw) if order == 0 and uf.size else None
+    compiled = point_evaluator(surf, Pw, uf.size) if order == 0 and uf.size else None
     def job(sl):
         if compiled is not None:     # scipy's NdBSpline where it has one (bspline_nd.py)
             out[0][sl] = compiled(np.stack([uf[sl], vf[sl]], axis=1))

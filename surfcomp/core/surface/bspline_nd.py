@@ -4,7 +4,7 @@ has it (no FreeCAD).
 
 ``scipy.interpolate.NdBSpline`` (scipy 1.12 and later: Debian 13 and sid have it, Debian
 12's scipy 1.10 does not) evaluates a tensor-product spline in compiled code. Which
-evaluator runs is decided by what the installed scipy has (:data:`NDBSPLINE`), never by a
+evaluator runs is decided by what the installed scipy has (:func:`ndbspline`), never by a
 version number. ``bench/bench_basis.py`` measured it beside the hand-written evaluation
 (:func:`surfcomp.core.surface.bspline.evaluate` without it): faster for points on scipy 1.15 and
 1.17 (1.3 and 3.5 times), slower for derivatives on 1.15 (0.56 times for the first, 0.33
@@ -14,24 +14,31 @@ are evaluated in homogeneous coordinates and divided, as the hand-written path d
 outside the knot domain both extrapolate the end polynomial pieces.
 """
 
-import scipy.interpolate
+import functools
+
+from .bspline_basis import SCIPY_FROM
 
 
-def _ndbspline():
-    """``scipy.interpolate.NdBSpline`` when the installed scipy has it, else None."""
+@functools.cache
+def ndbspline():
+    """``scipy.interpolate.NdBSpline`` when the installed scipy has it, else None (imported
+    on the first call: ``scipy.interpolate`` costs about 0.06 s of CPU)."""
+    import scipy.interpolate
+
     return getattr(scipy.interpolate, "NdBSpline", None)
 
 
-#: ``scipy.interpolate.NdBSpline`` of the installed scipy, or None
-NDBSPLINE = _ndbspline()
-
-
-def point_evaluator(surf, Pw):
+def point_evaluator(surf, Pw, count=None):
     """A function ``(xi (n, 2)) -> (n, 3)`` giving points of ``surf`` (homogeneous poles
-    ``Pw`` for rational faces, else its poles) by :data:`NDBSPLINE`, or None without it."""
-    if NDBSPLINE is None:
+    ``Pw`` for rational faces, else its poles) by :func:`ndbspline`, or None without it, or
+    for ``count`` points fewer than :data:`~surfcomp.core.surface.bspline_basis.SCIPY_FROM`
+    (where the import would cost more than the compiled evaluation saves)."""
+    if count is not None and count < SCIPY_FROM:
         return None
-    spline = NDBSPLINE((surf.knots_u, surf.knots_v), Pw, (surf.degree_u, surf.degree_v),
+    nd = ndbspline()
+    if nd is None:
+        return None
+    spline = nd((surf.knots_u, surf.knots_v), Pw, (surf.degree_u, surf.degree_v),
                        extrapolate=True)
     if surf.weights is None:
         return spline
