@@ -1,27 +1,10 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Conversion between ``Part.BSplineSurface`` and :class:`surfcomp.core.surface.bspline.Surface`."""
 
-import gc
-from contextlib import contextmanager
-
 import numpy as np
 
+from ..core.memory import collector_paused
 from ..core.surface.bspline import Surface, compress_knots
-
-
-@contextmanager
-def gc_paused():
-    """No cyclic garbage collection inside (restored after): a pole net of a million
-    poles as nested lists or Vectors is a million new containers, and the collections
-    they trigger would each walk every object of the process (several times the
-    ``tolist`` itself for a pole net of a million poles)."""
-    was = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was:
-            gc.enable()
 
 
 def _flat_knots(knots, mults):
@@ -46,7 +29,7 @@ def surface_from_part(bs, u_range=None, v_range=None):
             bs.setUNotPeriodic()
         if bs.isVPeriodic():
             bs.setVNotPeriodic()
-    with gc_paused():
+    with collector_paused():
         poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float)
     weights = (np.array(bs.getWeights(), dtype=float) if bs.isURational() or bs.isVRational()
                else None)
@@ -62,7 +45,7 @@ def surface_to_part(surf):
     ku, mu = compress_knots(surf.knots_u)
     kv, mv = compress_knots(surf.knots_v)
     out = Part.BSplineSurface()
-    with gc_paused():
+    with collector_paused():
         # nested [x, y, z] lists: much faster than Vectors for millions of poles
         kwargs = dict(poles=surf.poles.tolist(), umults=mu, vmults=mv, uknots=ku, vknots=kv,
                       uperiodic=False, vperiodic=False, udegree=surf.degree_u,

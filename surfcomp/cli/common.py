@@ -5,7 +5,8 @@ import sys
 import time
 
 from ..core.choices import MEASUREMENT_FORMATS as FORMATS
-from . import registry, runner
+from ..core.memory import collector_paused
+from . import registry
 from .options import add_arguments
 
 
@@ -66,7 +67,7 @@ def run_job_command(args, command):
     from ..app import cadread
 
     try:
-        with runner.collector_paused():
+        with collector_paused():
             # the nominal's reader child starts first and runs beside the imports of the
             # numerics
             cadread.prefetch(args.nominal)

@@ -75,23 +75,6 @@ def signals_handled():
             signal.signal(sig, old if old is not None else signal.SIG_DFL)
 
 
-@contextlib.contextmanager
-def collector_paused():
-    """The cycle collector off for the block (and on again after it, if it was on): for
-    importing numpy, scipy, FreeCAD and the numerics at a command's start, whose hundreds of
-    thousands of new objects would otherwise have every older one searched for cycles again
-    and again as the heap grows (0.025 s of CPU; modules make no garbage to collect)."""
-    import gc
-
-    was = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was:
-            gc.enable()
-
-
 def _written():
     return ", ".join("standard output" if p == "-" else p for p in atomic.COMMITTED)
 

@@ -9,7 +9,9 @@ memory that ``malloc_trim`` returns (peak 2.15 GB -> 1.86 GB). Elsewhere (Window
 other C libraries) :func:`return_free_memory` does nothing.
 """
 
+import contextlib
 import ctypes
+import gc
 import sys
 
 _TRIM = []      # [malloc_trim] or [None], looked up once
@@ -35,3 +37,19 @@ def return_free_memory():
         return False
     fn(0)
     return True
+
+
+@contextlib.contextmanager
+def collector_paused():
+    """The cycle collector off for the block (and on again after it, if it was on), where
+    hundreds of thousands of new containers are made and none of them is garbage: importing
+    numpy, scipy, FreeCAD and the numerics at a command's start, or a pole net of a million
+    poles as nested lists or Vectors. Each collection they would trigger walks every older
+    object of the process again."""
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was:
+            gc.enable()

@@ -26,6 +26,7 @@ from ..core.measurement.align_report import METHODS
 from ..errors import SurfcompError
 from . import dialogs
 from .commands import Command, selected
+from .task_panel import UndoTaskPanel
 
 translate = FreeCAD.Qt.translate
 ID = "SurfComp_AlignMeasurements"
@@ -61,11 +62,9 @@ class AlignMeasurements(Command):
         FreeCADGui.Control.showDialog(AlignPanel(comp))
 
 
-class AlignPanel:
-    """Task panel (module docstring)."""
-
-    #: the open panel (None when closed), for scripts and tests
-    instance = None
+class AlignPanel(UndoTaskPanel):
+    """Task panel (module docstring). ``instance``: the open panel (None when closed), for
+    scripts and tests."""
 
     def __init__(self, comp):
         AlignPanel.instance = self
@@ -235,26 +234,6 @@ class AlignPanel:
         self.result.setPlainText("\n".join(lines))
         self.result.setStyleSheet("")
         return True
-
-    def accept(self):
-        if not self.apply():
-            return False        # keep the panel open with the message
-        self.step.commit()
-        self._close()
-        return True
-
-    def reject(self):
-        self.step.abort()
-        self._close()
-        return True
-
-    def _close(self):
-        AlignPanel.instance = None
-        FreeCADGui.Control.closeDialog()
-
-    def getStandardButtons(self):
-        buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
-        return buttons.value if hasattr(buttons, "value") else int(buttons)
 
 
 def _row(*widgets):

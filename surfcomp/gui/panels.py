@@ -21,6 +21,7 @@ from ..core.compensation.deviations import Statistics, format_table
 from ..core.options import OPTIONS, tooltip
 from ..errors import SurfcompError
 from . import dialogs, prefs
+from .task_panel import ok_cancel_buttons
 
 translate = FreeCAD.Qt.translate
 
@@ -324,9 +325,7 @@ class FilterPanel:
             FreeCADGui.ActiveDocument.resetEdit()
 
     def getStandardButtons(self):
-        buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
-        # Qt5 flags convert with int(); Qt6 (PySide6) flags are Python enums with .value
-        return buttons.value if hasattr(buttons, "value") else int(buttons)
+        return ok_cancel_buttons()
 
 
 STOCK_TIP = QT_TRANSLATE_NOOP(

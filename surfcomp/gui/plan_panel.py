@@ -16,6 +16,7 @@ from PySide import QtGui
 from ..app import features
 from ..app.undo import UndoStep
 from ..core.measurement.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
+from .task_panel import UndoTaskPanel
 
 translate = FreeCAD.Qt.translate
 
@@ -47,11 +48,9 @@ def _spin(value, low, high, step=1.0, decimals=None):
     return box
 
 
-class PlanPanel:
-    """Task panel (module docstring)."""
-
-    #: the open panel (None when closed), for scripts and tests
-    instance = None
+class PlanPanel(UndoTaskPanel):
+    """Task panel (module docstring). ``instance``: the open panel (None when closed), for
+    scripts and tests."""
 
     def __init__(self, nominal, face):
         PlanPanel.instance = self
@@ -139,26 +138,6 @@ class PlanPanel:
         self.result.setText(text)
         self.result.setStyleSheet("")
         return True
-
-    def accept(self):
-        if not self.apply():
-            return False        # keep the panel open with the message
-        self.step.commit()
-        self._close()
-        return True
-
-    def reject(self):
-        self.step.abort()
-        self._close()
-        return True
-
-    def _close(self):
-        PlanPanel.instance = None
-        FreeCADGui.Control.closeDialog()
-
-    def getStandardButtons(self):
-        buttons = QtGui.QDialogButtonBox.Ok | QtGui.QDialogButtonBox.Cancel
-        return buttons.value if hasattr(buttons, "value") else int(buttons)
 
 
 if show_points not in features.NEW_OBJECT_HOOKS:

@@ -7,69 +7,29 @@ activated (dressups made by a script or headless, opened later in the GUI). The 
 operation shows under the dressup in the tree, as under CAM's own dressups.
 """
 
-import FreeCAD
-
-from .. import paths
 from ..app.dressup_surface import DressupSurfaceCorrection
-from ..app.proxies import Stateless
-
-MODE = "Waypoints"
+from . import path_view
 
 
 def is_surface_dressup(obj):
     return isinstance(getattr(obj, "Proxy", None), DressupSurfaceCorrection)
 
 
-class ViewProviderSurfaceCorrection(Stateless):
-    """No state: ``dumps``/``loads`` return None."""
+class ViewProviderSurfaceCorrection(path_view.PathViewProvider):
+    """No state: ``dumps``/``loads`` return None. The base operation shows under the
+    dressup in the tree."""
 
-    def __init__(self, vobj):
-        vobj.Proxy = self
-
-    def attach(self, vobj):
-        self.obj = vobj.Object
-
-    def getDisplayModes(self, vobj):
-        return [MODE]
-
-    def getDefaultDisplayMode(self):
-        return MODE
-
-    def setDisplayMode(self, mode):
-        return mode
+    ICON = "SurfComp_AddSurfaceCorrection.svg"
 
     def claimChildren(self):
         base = getattr(getattr(self, "obj", None), "Base", None)
         return [base] if base is not None else []
 
-    def getIcon(self):
-        return paths.icon("SurfComp_AddSurfaceCorrection.svg")
-
 
 def attach(obj):
     """Give a surface correction dressup its view provider and display mode (idempotent);
     True when it got one."""
-    vobj = getattr(obj, "ViewObject", None)
-    if (not is_surface_dressup(obj) or vobj is None
-            or isinstance(vobj.Proxy, ViewProviderSurfaceCorrection)):
-        return False
-    proxy = ViewProviderSurfaceCorrection(vobj)
-    if not hasattr(proxy, "obj"):       # an existing view object: FreeCAD does not attach
-        proxy.attach(vobj)
-    modes = list(vobj.getEnumerationsOfProperty("DisplayMode") or [])
-    if MODE not in modes:               # the enumeration was made before the proxy existed
-        vobj.DisplayMode = modes + [MODE]
-    vobj.DisplayMode = MODE
-    return True
+    return path_view.attach(obj, is_surface_dressup, ViewProviderSurfaceCorrection)
 
 
-class _Observer:
-    def slotActivateDocument(self, doc):
-        for obj in doc.Objects:
-            attach(obj)
-
-
-_OBSERVER = []
-if not _OBSERVER:
-    _OBSERVER.append(_Observer())
-    FreeCAD.addDocumentObserver(_OBSERVER[0])
+path_view.watch(attach)

@@ -171,7 +171,7 @@ def test_conversion_pauses_the_garbage_collector_and_restores_it():
     process) and leave the collector as it was, also after an error inside."""
     import gc
 
-    from surfcomp.app.convert import gc_paused
+    from surfcomp.core.memory import collector_paused as gc_paused
 
     rng = np.random.default_rng(3)
     knots = np.r_[0, 0, 0, np.linspace(0, 1, 298), 1, 1, 1]
