@@ -99,8 +99,14 @@ class _TextWriter:
         """The next block: its lines (from line index ``base`` on) and the plan of their
         moves."""
         self.prog = prog
+        self.plan = plan
         self.base = base
-        # plain lists: indexing them is much faster than indexing arrays
+        self.listed = False
+
+    def _lists(self):
+        """The block's arrays as plain lists: indexing them is much faster than indexing
+        arrays (made when the first move is written line by line)."""
+        prog, plan = self.prog, self.plan
         self.known_l = prog.known.tolist()
         self.kind_l = prog.kind.tolist()
         self.end_l = prog.end.tolist()
@@ -109,6 +115,7 @@ class _TextWriter:
         self.off_l = plan.offsets.tolist()
         self.keep_l = plan.keep.tolist()
         self.split_l = plan.split.tolist()
+        self.listed = True
 
     def line(self, idx, content, eol):
         """The output text of line ``idx`` (its ending included)."""
@@ -133,6 +140,8 @@ class _TextWriter:
         return self._move_line(idx, content, eol, info)
 
     def _move_line(self, idx, content, eol, info):
+        if not self.listed:
+            self._lists()
         j = info.move
         sep, asep = _word_sep(content, info.words, self.file_sep)
         if self.keep_l[j]:

@@ -36,6 +36,8 @@ from ...errors import GCodeError
 from .emitter import DEFAULT_DECIMALS, _TextWriter, default_eol, file_sep
 from .interpreter import _Interpreter, parse_gcode
 from .lexer import BOM, decode, tokenize
+from .plain import read_block
+from .plain_write import write_block
 from .result import GCodeResult
 from .totals import BoundsCheck, PointTotals
 
@@ -153,13 +155,14 @@ class Compensator:
         """Read, interpret and compensate the next block of ``(content, ending)`` lines;
         its output text."""
         base = self.n_lines
-        toks = [tokenize(c, self.source, base + k + 1) for k, (c, _e) in enumerate(lines)]
-        infos = self.interp.lines(toks, base)
-        return self.program(self.interp.take_moves(infos, self.interp.warnings), lines, base)
+        infos, runs = read_block(self.interp, lines, base, self.source)
+        return self.program(self.interp.take_moves(infos, self.interp.warnings), lines, base,
+                            runs)
 
-    def program(self, prog, lines, base):
+    def program(self, prog, lines, base, runs=()):
         """Compensate the interpreted block ``prog`` of ``lines`` (from line index ``base``
-        on); its output text. Past the segment limit the rest is only counted."""
+        on; ``runs`` of plain lines read as arrays, :func:`.plain.read_block`); its output
+        text. Past the segment limit the rest is only counted."""
         self.n_lines = base + len(lines)
         self.words = self.words or not prog.is_empty()
         self.n_moves += prog.n_moves
@@ -178,7 +181,7 @@ class Compensator:
                           max_segments=self.max_segments)
         w = self.writer
         w.block(prog, plan, base)
-        out = "".join([w.line(base + k, c, e) for k, (c, e) in enumerate(lines)])
+        out = write_block(w, lines, base, runs)
         nominal, emitted, known, line = w.state.take_points()
         self.n_points += line.size
         self.totals.add(nominal, emitted, known)
