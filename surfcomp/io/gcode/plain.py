@@ -19,6 +19,7 @@ directly before its number, nothing or one blank between words, blanks at the en
 """
 
 import re
+from itertools import repeat
 
 import numpy as np
 
@@ -53,17 +54,19 @@ class PlainRun:
 
     ``matches``: their :data:`PLAIN` matches; ``first_move``: the block's index of the
     first line's move (line ``k`` of the run has move ``first_move + k``); ``motion``
-    (n,): 0 or 1 per line; ``present`` (n, 3) bool, ``value`` (n, 3) (mm): the axis words.
+    (n,): 0 or 1 per line; ``present`` (n, 3) bool, ``value`` (n, 3) (mm), ``decimals``
+    (n, 3) int: the axis words; ``groups``: the matches' groups.
     """
 
     __slots__ = ("start", "stop", "matches", "first_move", "motion", "present", "value",
-                 "groups")
+                 "decimals", "groups")
 
-    def __init__(self, start, stop, matches, first_move, motion, present, value, groups):
+    def __init__(self, start, stop, matches, first_move, motion, present, value, decimals,
+                 groups):
         self.start, self.stop, self.matches = start, stop, matches
         self.first_move, self.motion, self.present, self.value = (first_move, motion,
                                                                    present, value)
-        self.groups = groups
+        self.decimals, self.groups = decimals, groups
 
 
 def _candidates(lines):
@@ -146,10 +149,14 @@ def _read_run(interp, ms, first, base, start, stop):
     n = len(ms)
     value = np.empty((n, 3))
     present = np.empty((n, 3), dtype=bool)
+    decimals = np.zeros((n, 3), dtype=np.int64)
     for a, g in enumerate(AXIS_GROUPS):
-        col = cols[g - 1]
-        value[:, a] = [float("nan") if t is None else float(t) for t in col]
-        present[:, a] = [t is not None for t in col]
+        text = ["nan" if t is None else t for t in cols[g - 1]]
+        value[:, a] = list(map(float, text))
+        present[:, a] = [t is not None for t in cols[g - 1]]
+        size = np.fromiter(map(len, text), dtype=np.int64, count=n)
+        dot = np.fromiter(map(str.find, text, repeat(".")), dtype=np.int64, count=n)
+        decimals[:, a] = np.where(present[:, a] & (dot >= 0), size - dot - 1, 0)
     feeds = [float(t) for t in cols[8] if t is not None]
     if not (np.abs(value[present]) <= MAX_POSITION).all() or \
             not np.isfinite(np.array(feeds, dtype=float)).all():
@@ -167,7 +174,7 @@ def _read_run(interp, ms, first, base, start, stop):
         "factor": np.ones(n), "absolute": ones})
     interp.pos = end[-1].tolist()
     interp.motion = int(motion[-1])
-    return PlainRun(start, stop, ms, first, motion, present, value, groups)
+    return PlainRun(start, stop, ms, first, motion, present, value, decimals, groups)
 
 
 def _ffill(value, present, initial):

@@ -14,7 +14,7 @@ through the line-by-line writer (their ``LineInfo`` built by
 import numpy as np
 
 from .emitter import _fmt
-from .plain import AXIS_GROUPS, line_info
+from .plain import line_info
 
 
 def _round_units(x, d):
@@ -37,6 +37,7 @@ def write_block(w, lines, base, runs):
     (:class:`surfcomp.io.gcode.plain.PlainRun`) as arrays."""
     out = []
     pos = 0
+    w.few = 10 * (len(lines) - sum(r.stop - r.start for r in runs)) < len(lines)
     for run in runs:
         out.extend([w.line(base + k, c, e) for k, (c, e) in enumerate(lines[pos:run.start],
                                                                         pos)])
@@ -87,10 +88,7 @@ def _write_plain(w, run, k0, k1, lines, base, out):
     present = run.present[k0:k1]
     pv = run.value[k0:k1]
     groups = run.groups[k0:k1]
-    dec = np.zeros((n, 3), dtype=np.int64)
-    for a, g in enumerate(AXIS_GROUPS):
-        dec[:, a] = [0 if t[g - 1] is None else (len(t[g - 1]) - t[g - 1].find(".") - 1
-                                                  if "." in t[g - 1] else 0) for t in groups]
+    dec = run.decimals[k0:k1]
     dmin = w.dmin_mm
     # decimals of the last word of each axis, after each line (the writer's last_dec)
     idx = np.where(present, np.arange(1, n + 1)[:, None], 0)
