@@ -47,25 +47,35 @@ BLOCK_LINES = 10_000
 _BOM_BYTES = BOM.encode("latin-1")
 
 
-def iter_lines(fh):
+def iter_lines(fh, chunk=1 << 14):
     """``(content, ending)`` of every line of the binary file ``fh`` as Latin-1 text
     (as :func:`surfcomp.io.gcode.split_lines` of the whole text), without a UTF-8
-    byte-order mark at the start."""
+    byte-order mark at the start; read ``chunk`` bytes at a time."""
+    rest = ""
     first = True
-    for raw in fh:
-        s = raw.decode("latin-1")
+    pending = []            # pieces of a line longer than a chunk (joined once)
+    while True:
+        data = fh.read(chunk)
+        if not data:
+            break
+        if not first and b"\n" not in data:
+            pending.append(data.decode("latin-1"))
+            continue
+        text = "".join([rest] + pending + [data.decode("latin-1")])
+        pending = []
         if first:
+            if len(text) < len(BOM) and BOM.startswith(text):
+                rest = text         # too short to tell yet
+                continue
             first = False
-            if s.startswith(BOM):
-                s = s[len(BOM):]
-                if not s:
-                    continue
-        if s.endswith("\r\n"):
-            yield s[:-2], "\r\n"
-        elif s.endswith("\n"):
-            yield s[:-1], "\n"
-        else:
-            yield s, ""
+            if text.startswith(BOM):
+                text = text[len(BOM):]
+        parts = text.split("\n")
+        rest = parts.pop()
+        yield from [(p[:-1], "\r\n") if p.endswith("\r") else (p, "\n") for p in parts]
+    rest = "".join([rest] + pending)
+    if rest:
+        yield rest, ""
 
 
 class ProgramFile:
