@@ -7,6 +7,7 @@ of every spelling with comments, feeds, tool changes, arcs, modal lines and ters
 (``tests/pure/test_gcode_stream.py`` compares the block path, which reads runs as arrays,
 with the whole-program path, which reads every line on its own, on the test programs.)"""
 
+import io
 import os
 
 import numpy as np
@@ -18,6 +19,7 @@ from surfcomp.core.program_offset import BallOffset
 from surfcomp.errors import GCodeError, InputError
 from surfcomp.io.gcode import ProgramFile, compensate_gcode, plain
 from surfcomp.io.gcode.offset_stream import offset_stream
+from surfcomp.io.gcode.stream import iter_lines
 from tests.conftest import ROOT
 from tests.toolpath_checks import drop_cutter
 
@@ -214,3 +216,35 @@ def test_refusals_inside_a_run_name_the_same_line(bad, says, monkeypatch, tmp_pa
     exc = _same_axis(data, SQUARE, monkeypatch)
     if bad in ("G41 D1", "G1 X1e5"):
         assert isinstance(exc, GCodeError) and says in str(exc), exc
+
+
+def _lines_one_by_one(data):
+    """The lines of ``data`` as a binary file iterates them (the reading before chunks)."""
+    out = []
+    for k, raw in enumerate(io.BytesIO(data)):
+        s = raw.decode("latin-1")
+        if k == 0 and s.startswith("\xef\xbb\xbf"):
+            s = s[3:]
+            if not s:
+                continue
+        if s.endswith("\r\n"):
+            out.append((s[:-2], "\r\n"))
+        elif s.endswith("\n"):
+            out.append((s[:-1], "\n"))
+        else:
+            out.append((s, ""))
+    return out
+
+
+def test_lines_read_in_chunks_are_the_lines_of_the_file():
+    """Chunks split anywhere: inside a CRLF, inside the byte-order mark, inside a line."""
+    rng = np.random.default_rng(7)
+    bom = b"\xef\xbb\xbf"
+    cases = [b"", bom, bom + b"\n", b"\xef", b"\xef\xbb", b"\r", b"a\r", b"a\rb\n",
+             bom + b"x\r\ny", b"\n\n", b"\xef\xbbx\n"]
+    cases += [(bom if rng.random() < 0.2 else b"")
+              + bytes(rng.choice(list(b"ab\r\n\xef\xbb\xbf "), size=rng.integers(0, 30)))
+              for _ in range(2000)]
+    for data in cases:
+        for chunk in (1, 2, 3, 5, 1 << 14):
+            assert list(iter_lines(io.BytesIO(data), chunk)) == _lines_one_by_one(data)
