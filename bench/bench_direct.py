@@ -5,7 +5,7 @@
                                            [--skip finish,large]
 
 Rows (each run a fresh process, timed from its start to its exit; CPU = user + system of
-the process):
+the process and of the children it waited for, such as the STEP reader):
 
 * ``finish``: ``compensate examples/nominal.step examples/measurements.csv --program
   FINISH.ngc --tool ball:3 -o OUT.ngc`` on the example's finishing program made by
@@ -20,7 +20,8 @@ the process):
   1M moves within 10 s, t(1M) / t(250k) at most 4.5.
 
 Absolute seconds depend on the machine and on what else runs on it; ratios measured side
-by side much less.
+by side much less. The figures measured, before and after plain G0/G1 runs were read and
+written as arrays: docs/benchmarks.md (bench_direct.py) and docs/direct_program.md (Speed).
 """
 
 import argparse

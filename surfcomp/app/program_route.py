@@ -47,10 +47,12 @@ class ProgramJob:
 def correction_at(nominal, comp):
     """``correction(u, v)``: the correction (mm, positive inwards) the corrected face of
     ``comp`` realises along the nominal's normal at ``(u, v)``
-    (:func:`surfcomp.core.compensation.corrected.realised_correction`, from the intended field)."""
+    (:func:`surfcomp.core.compensation.corrected.realised_correction`). Newton starts on the nominal
+    point itself: the corrected face lies micrometres from it, and the intended field as
+    a start (locating every point in the measured grid first) cost more than the
+    iteration it saves; both converge to 1e-12 mm."""
     def correction(u, v):
-        return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward,
-                                   guess=comp.field(u, v))
+        return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward)
     return correction
 
 

@@ -3,10 +3,12 @@
 
 Modules: :mod:`.lexer` (lines and words), :mod:`.interpreter` (modal state, moves),
 :mod:`.emitter` (rewriting the text), :mod:`.stream` (a program compensated a block of
-lines at a time, or whole), :mod:`.totals` (whole-program figures added up over blocks),
-:mod:`.commands` (FreeCAD Path command lists),
-:mod:`.result` (what a compensation returns); the arc geometry and the move planning
-are compensation maths in :mod:`surfcomp.core.axis.arcs` and :mod:`surfcomp.core.axis.moves`.
+lines at a time, or whole), :mod:`.plain` and :mod:`.plain_write` (runs of plain G0/G1
+lines read and written as arrays inside the block path, with the same output),
+:mod:`.totals` (whole-program figures added up over blocks), :mod:`.commands` (FreeCAD
+Path command lists), :mod:`.result` (what a compensation returns); the arc geometry and
+the move planning are compensation maths in :mod:`surfcomp.core.axis.arcs` and
+:mod:`surfcomp.core.axis.moves`.
 
 Every line the compensation does not change is written back byte for byte (the file is
 handled as Latin-1 text, which maps every byte to one character and back); a zero error

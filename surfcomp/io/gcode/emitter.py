@@ -6,6 +6,8 @@ keep their words, spacing, case and comments, with only the axis numbers replace
 motion words where an arc became G1 pieces). See :mod:`surfcomp.io.gcode`.
 """
 
+import numpy as np
+
 from ...errors import GCodeError
 from .lexer import AXIS_LETTERS
 from .result import OutputState
@@ -99,16 +101,26 @@ class _TextWriter:
         """The next block: its lines (from line index ``base`` on) and the plan of their
         moves."""
         self.prog = prog
+        self.plan = plan
         self.base = base
-        # plain lists: indexing them is much faster than indexing arrays
-        self.known_l = prog.known.tolist()
-        self.kind_l = prog.kind.tolist()
-        self.end_l = prog.end.tolist()
-        self.comp_l = plan.compensated.tolist()
-        self.nom_l = plan.nominal.tolist()
-        self.off_l = plan.offsets.tolist()
-        self.keep_l = plan.keep.tolist()
-        self.split_l = plan.split.tolist()
+        self.listed = False
+        self.few = False            # few lines are written one by one (:meth:`_lists`)
+
+    def _lists(self):
+        """The block's arrays as plain lists: indexing them is much faster than indexing
+        arrays (made when the first move is written line by line; with ``few`` set, for a
+        block written mostly as arrays, rows are taken from the arrays when asked for)."""
+        prog, plan = self.prog, self.plan
+        conv = _Rows if self.few else np.ndarray.tolist
+        self.known_l = conv(prog.known)
+        self.kind_l = conv(prog.kind)
+        self.end_l = conv(prog.end)
+        self.comp_l = conv(plan.compensated)
+        self.nom_l = conv(plan.nominal)
+        self.off_l = conv(plan.offsets)
+        self.keep_l = conv(plan.keep)
+        self.split_l = conv(plan.split)
+        self.listed = True
 
     def line(self, idx, content, eol):
         """The output text of line ``idx`` (its ending included)."""
@@ -133,6 +145,8 @@ class _TextWriter:
         return self._move_line(idx, content, eol, info)
 
     def _move_line(self, idx, content, eol, info):
+        if not self.listed:
+            self._lists()
         j = info.move
         sep, asep = _word_sep(content, info.words, self.file_sep)
         if self.keep_l[j]:
@@ -264,6 +278,19 @@ class _TextWriter:
             held[a] += float(inc)
             return AXIS_LETTERS[a] + inc
         return None
+
+
+class _Rows:
+    """``rows[i]``: row ``i`` of an array as a list (or a number), as ``tolist()`` of the
+    whole array would give it, without converting the rest."""
+
+    __slots__ = ("a",)
+
+    def __init__(self, a):
+        self.a = a
+
+    def __getitem__(self, i):
+        return self.a[i].tolist()
 
 
 def _apply(content, edits):

@@ -93,6 +93,8 @@ class Program:
         Axis positions known (programmed) after each move.
     factor : ndarray (m,)
         mm per program unit at each move.
+    absolute : ndarray (m,) bool
+        The move was programmed in absolute mode (G90).
     """
 
     lines: list
@@ -109,6 +111,7 @@ class Program:
     source: str = None
     start_known: bool = False
     start_pos: np.ndarray = None
+    absolute: np.ndarray = None
 
     @property
     def n_moves(self):
@@ -214,8 +217,9 @@ class _Interpreter:
         self.known = [start is not None] * 3
         self.pos = ([0.0, 0.0, 0.0] if start is None
                     else [float(v) for v in np.reshape(start, 3)])
-        self.moves = {k: [] for k in ("kind", "start", "end", "centre", "plane", "turns",
-                                      "line", "known", "factor")}
+        self.moves = {k: [] for k in _MOVE_FIELDS}
+        self.chunks = []                # the moves before those in self.moves, as arrays
+        self.chunk_moves = 0
         self.warnings = []
         self.unknown_use = {}
 
@@ -324,7 +328,7 @@ class _Interpreter:
                     first, count = self.unknown_use.get(a, (ln, 0))
                     self.unknown_use[a] = (first, count + 1)
         mv = self.moves
-        info.move = len(mv["kind"])
+        info.move = self.chunk_moves + len(mv["kind"])
         mv["kind"].append(self.motion)
         mv["start"].append(self.pos)
         mv["end"].append(target)
@@ -334,6 +338,7 @@ class _Interpreter:
         mv["line"].append(idx)
         mv["known"].append(tuple(self.known))
         mv["factor"].append(self.factor)
+        mv["absolute"].append(self.absolute)
         self.pos = target
 
     def _first_move(self, ln):
@@ -450,33 +455,58 @@ class _Interpreter:
                 % (count, first, AXIS_LETTERS[a], AXIS_LETTERS[a], start[a], AXIS_LETTERS[a])
                 for a, (first, count) in sorted(self.unknown_use.items())]
 
+    def _flush(self):
+        """Turn the moves collected one by one into a chunk of arrays."""
+        mv = self.moves
+        m = len(mv["kind"])
+        if m:
+            self.chunks.append(_move_arrays(mv, m))
+            self.chunk_moves += m
+            for v in mv.values():
+                v.clear()
+
+    def add_moves(self, arrays):
+        """Append moves given as arrays (the fields of :data:`_MOVE_FIELDS`, in order
+        after those collected so far)."""
+        self._flush()
+        self.chunks.append(arrays)
+        self.chunk_moves += int(arrays["kind"].size)
+
     def take_moves(self, infos, warnings):
         """The :class:`Program` of the moves collected since the last call (then
         forgotten: a program read block by block holds one block's moves at a time)."""
         start = self.start
-        mv = self.moves
-        m = len(mv["kind"])
-        prog = Program(
-            infos,
-            np.array(mv["kind"], dtype=int),
-            np.array(mv["start"], dtype=float).reshape(m, 3),
-            np.array(mv["end"], dtype=float).reshape(m, 3),
-            np.array(mv["centre"], dtype=float).reshape(m, 3),
-            np.array(mv["plane"], dtype=int),
-            np.array(mv["turns"], dtype=int),
-            np.array(mv["line"], dtype=int),
-            np.array(mv["known"], dtype=bool).reshape(m, 3),
-            np.array(mv["factor"], dtype=float),
+        self._flush()
+        if len(self.chunks) == 1:
+            arr = self.chunks[0]
+        else:
+            arr = _move_arrays(self.moves, 0) if not self.chunks else {
+                k: np.concatenate([c[k] for c in self.chunks]) for k in _MOVE_FIELDS}
+        self.chunks = []
+        self.chunk_moves = 0
+        return Program(
+            infos, arr["kind"], arr["start"], arr["end"], arr["centre"], arr["plane"],
+            arr["turns"], arr["line"], arr["known"], arr["factor"],
             warnings, self.source, start is not None,
-            np.zeros(3) if start is None else np.array(start, dtype=float).reshape(3))
-        for v in mv.values():
-            v.clear()
-        return prog
+            np.zeros(3) if start is None else np.array(start, dtype=float).reshape(3),
+            arr["absolute"])
 
     def program(self, infos):
         """The :class:`Program` of the lines interpreted."""
         self.warnings.extend(self.unknown_warnings())
         return self.take_moves(infos, self.warnings)
+
+
+#: the arrays of a program's moves (:class:`Program`), and their element types
+_MOVE_FIELDS = {"kind": int, "start": float, "end": float, "centre": float, "plane": int,
+                "turns": int, "line": int, "known": bool, "factor": float, "absolute": bool}
+_MOVE_WIDE = ("start", "end", "centre", "known")
+
+
+def _move_arrays(mv, m):
+    """The lists of ``m`` moves ``mv`` as arrays."""
+    return {k: (np.array(mv[k], dtype=t).reshape(m, 3) if k in _MOVE_WIDE
+                else np.array(mv[k], dtype=t)) for k, t in _MOVE_FIELDS.items()}
 
 
 def interpret(line_words, source=None, start=None, line_numbers=None, path=False):

@@ -21,7 +21,8 @@ from ...errors import GCodeError
 from .commands import _CommandWriter, command_words
 from .emitter import DEFAULT_DECIMALS, _TextWriter
 from .interpreter import _Interpreter, interpret
-from .lexer import tokenize
+from .plain import read_block
+from .plain_write import write_block
 from .result import CommandsResult
 from .stream import stream_program
 
@@ -63,8 +64,7 @@ class ProgramOffset:
         """Read, interpret, move and write the next block of ``(content, ending)`` lines;
         its output text."""
         base = self.n_lines
-        toks = [tokenize(c, self.source, base + k + 1) for k, (c, _e) in enumerate(lines)]
-        infos = self.interp.lines(toks, base)
+        infos, runs = read_block(self.interp, lines, base, self.source)
         prog = self.interp.take_moves(infos, self.interp.warnings)
         self.n_lines = base + len(lines)
         self.words = self.words or not prog.is_empty()
@@ -80,7 +80,7 @@ class ProgramOffset:
         self._collect(prog, op)
         w = self.writer
         w.block(prog, plan, base)
-        out = "".join([w.line(base + k, c, e) for k, (c, e) in enumerate(lines)])
+        out = write_block(w, lines, base, runs)
         nominal, emitted, _known, _line = w.state.take_points()
         if nominal.shape[0]:
             self.largest = max(self.largest,
@@ -89,16 +89,17 @@ class ProgramOffset:
 
     def _check_modes(self, prog, base):
         """Refuse a move in inch or incremental mode (naming its line)."""
-        for j in range(prog.n_moves):
-            info = prog.lines[int(prog.line[j]) - base]
-            if info.factor != 1.0:
-                raise GCodeError("move in inch mode (G20): the correction is in mm and the "
-                                 "program is moved in mm; expected a program in mm (G21)",
-                                 file=self.source, line=int(prog.line[j]) + 1)
-            if not info.absolute:
-                raise GCodeError("move in incremental mode (G91): expected absolute "
-                                 "positions (G90), as CAM writes finishing programs",
-                                 file=self.source, line=int(prog.line[j]) + 1)
+        bad = np.flatnonzero((prog.factor != 1.0) | ~prog.absolute)
+        if not bad.size:
+            return
+        j = int(bad[0])
+        if prog.factor[j] != 1.0:
+            raise GCodeError("move in inch mode (G20): the correction is in mm and the "
+                             "program is moved in mm; expected a program in mm (G21)",
+                             file=self.source, line=int(prog.line[j]) + 1)
+        raise GCodeError("move in incremental mode (G91): expected absolute "
+                         "positions (G90), as CAM writes finishing programs",
+                         file=self.source, line=int(prog.line[j]) + 1)
 
     def _collect(self, prog, op):
         """The cutting moves' end points for the contact check."""

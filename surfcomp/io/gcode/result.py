@@ -133,6 +133,7 @@ class OutputState:
         #: value of each axis the machine holds (program units), None when not known
         self.held = [None, None, None] if start is None else [float(v) for v in start]
         self.nominal, self.emitted, self.known, self.line = [], [], [], []
+        self.chunks = []                # points recorded before those in the lists, as arrays
         self.changed = self.added = self.split = self.converted = 0
 
     def forget(self, axes):
@@ -169,13 +170,27 @@ class OutputState:
         self.emitted.append(point)
         self.known.append(known[0] and known[1] and known[2])
 
-    def take_points(self):
-        """The points recorded since the last call as arrays ``(nominal, emitted, known,
-        line)``, then forgotten (a program written block by block)."""
+    def _lists(self):
         pts = (np.array(self.nominal, dtype=float).reshape(-1, 3),
                np.array(self.emitted, dtype=float).reshape(-1, 3),
                np.array(self.known, dtype=bool), np.array(self.line, dtype=int))
         self.nominal, self.emitted, self.known, self.line = [], [], [], []
+        return pts
+
+    def record_many(self, line, nominal, emitted):
+        """Output move end points as arrays: input lines ``line`` (1-based), programmed
+        points and the commands the machine holds (mm, every axis known)."""
+        if self.line:
+            self.chunks.append(self._lists())
+        self.chunks.append((nominal, emitted, np.ones(line.size, dtype=bool), line))
+
+    def take_points(self):
+        """The points recorded since the last call as arrays ``(nominal, emitted, known,
+        line)``, then forgotten (a program written block by block)."""
+        pts = self._lists()
+        if self.chunks:
+            pts = tuple(np.concatenate(p) for p in zip(*self.chunks, pts))
+            self.chunks = []
         return pts
 
     def stats(self, lines_in, lines_out, moves, points):
@@ -185,6 +200,7 @@ class OutputState:
 
     def result(self, cls, output, lines_in, lines_out, prog):
         """The :class:`CompensationResult` subclass ``cls`` of what was recorded."""
-        stats = self.stats(lines_in, lines_out, prog.n_moves, len(self.nominal))
+        stats = self.stats(lines_in, lines_out, prog.n_moves,
+                           len(self.nominal) + sum(c[3].size for c in self.chunks))
         nominal, emitted, known, line = self.take_points()
         return cls(output, stats, nominal, emitted, known, list(prog.warnings), prog, line)

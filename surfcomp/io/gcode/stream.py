@@ -36,6 +36,8 @@ from ...errors import GCodeError
 from .emitter import DEFAULT_DECIMALS, _TextWriter, default_eol, file_sep
 from .interpreter import _Interpreter, parse_gcode
 from .lexer import BOM, decode, tokenize
+from .plain import read_block
+from .plain_write import write_block
 from .result import GCodeResult
 from .totals import BoundsCheck, PointTotals
 
@@ -45,25 +47,35 @@ BLOCK_LINES = 10_000
 _BOM_BYTES = BOM.encode("latin-1")
 
 
-def iter_lines(fh):
+def iter_lines(fh, chunk=1 << 14):
     """``(content, ending)`` of every line of the binary file ``fh`` as Latin-1 text
     (as :func:`surfcomp.io.gcode.split_lines` of the whole text), without a UTF-8
-    byte-order mark at the start."""
+    byte-order mark at the start; read ``chunk`` bytes at a time."""
+    rest = ""
     first = True
-    for raw in fh:
-        s = raw.decode("latin-1")
+    pending = []            # pieces of a line longer than a chunk (joined once)
+    while True:
+        data = fh.read(chunk)
+        if not data:
+            break
+        if not first and b"\n" not in data:
+            pending.append(data.decode("latin-1"))
+            continue
+        text = "".join([rest] + pending + [data.decode("latin-1")])
+        pending = []
         if first:
+            if len(text) < len(BOM) and BOM.startswith(text):
+                rest = text         # too short to tell yet
+                continue
             first = False
-            if s.startswith(BOM):
-                s = s[len(BOM):]
-                if not s:
-                    continue
-        if s.endswith("\r\n"):
-            yield s[:-2], "\r\n"
-        elif s.endswith("\n"):
-            yield s[:-1], "\n"
-        else:
-            yield s, ""
+            if text.startswith(BOM):
+                text = text[len(BOM):]
+        parts = text.split("\n")
+        rest = parts.pop()
+        yield from [(p[:-1], "\r\n") if p.endswith("\r") else (p, "\n") for p in parts]
+    rest = "".join([rest] + pending)
+    if rest:
+        yield rest, ""
 
 
 class ProgramFile:
@@ -153,13 +165,14 @@ class Compensator:
         """Read, interpret and compensate the next block of ``(content, ending)`` lines;
         its output text."""
         base = self.n_lines
-        toks = [tokenize(c, self.source, base + k + 1) for k, (c, _e) in enumerate(lines)]
-        infos = self.interp.lines(toks, base)
-        return self.program(self.interp.take_moves(infos, self.interp.warnings), lines, base)
+        infos, runs = read_block(self.interp, lines, base, self.source)
+        return self.program(self.interp.take_moves(infos, self.interp.warnings), lines, base,
+                            runs)
 
-    def program(self, prog, lines, base):
+    def program(self, prog, lines, base, runs=()):
         """Compensate the interpreted block ``prog`` of ``lines`` (from line index ``base``
-        on); its output text. Past the segment limit the rest is only counted."""
+        on; ``runs`` of plain lines read as arrays, :func:`.plain.read_block`); its output
+        text. Past the segment limit the rest is only counted."""
         self.n_lines = base + len(lines)
         self.words = self.words or not prog.is_empty()
         self.n_moves += prog.n_moves
@@ -178,7 +191,7 @@ class Compensator:
                           max_segments=self.max_segments)
         w = self.writer
         w.block(prog, plan, base)
-        out = "".join([w.line(base + k, c, e) for k, (c, e) in enumerate(lines)])
+        out = write_block(w, lines, base, runs)
         nominal, emitted, known, line = w.state.take_points()
         self.n_points += line.size
         self.totals.add(nominal, emitted, known)
