@@ -4,6 +4,7 @@ program by the correction (:mod:`surfcomp.app.program_route`) instead of writing
 
 import math
 
+from ..core.memory import collector_paused
 from ..errors import InputError
 from . import registry
 from .common import ProgressLine, job_from_args, wrote
@@ -63,18 +64,27 @@ def run_program(args):
     _positive(args.segment_length, "--segment-length", 1e-3)
     if args.decimals is not None and not 3 <= args.decimals <= 9:
         raise InputError("--decimals %d: expected 3 to 9" % args.decimals)
-    from ..core.compensation.program_offset import parse_tool
+    from ..app import cadread
 
-    parse_tool(args.tool)
-    from ..app.program_route import ProgramJob, run_program_job, summary_lines
+    try:
+        with collector_paused():
+            # the nominal's reader child starts first (a fork while this process has one
+            # thread, before the numerics' imports start theirs) and runs beside them
+            cadread.prefetch(args.nominal)
+            from ..app.program_route import ProgramJob, run_program_job, summary_lines
+            from ..core.compensation.program_offset import parse_tool
 
-    job = job_from_args(args, "compensate")
-    job.output = None
-    pj = ProgramJob(job, args.program, args.output, args.tool, blend=args.blend,
-                    tolerance=args.tolerance, segment_length=args.segment_length,
-                    decimals=args.decimals)
-    comp, po = run_program_job(pj, *registry.declared(args, "compensate"),
-                               progress=ProgressLine(args.quiet), max_memory=args.max_memory)
+        parse_tool(args.tool)
+        job = job_from_args(args, "compensate")
+        job.output = None
+        pj = ProgramJob(job, args.program, args.output, args.tool, blend=args.blend,
+                        tolerance=args.tolerance, segment_length=args.segment_length,
+                        decimals=args.decimals)
+        comp, po = run_program_job(pj, *registry.declared(args, "compensate"),
+                                   progress=ProgressLine(args.quiet),
+                                   max_memory=args.max_memory)
+    finally:
+        cadread.discard()
     for line in summary_lines(comp, po, pj):
         print(line)
     print(wrote(args.output))
