@@ -47,8 +47,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     inputs = [("nominal", nominal), ("measurements", measurements)]
     check_outputs(outputs, inputs)
     cad_format(output)
-    if method not in ("raw", "filtered"):
-        raise InputError("--faces works with --method raw or filtered (got %s)" % method)
+    check_method(method)
     fcenv.import_freecad()
     import Part
 
@@ -56,6 +55,31 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
 
     shape, _ = read_shape(nominal)
     ms = read_any(measurements, units, fmt, sample, deviation_units=deviation_units)
+    out_shape, rep = compute_region(
+        shape, ms, faces_text, (nominal, measurements), method=method, mask_size=mask_size,
+        mask_kind=mask_kind, sigma=sigma, max_offset=max_offset, min_coverage=min_coverage,
+        smoothing=smoothing, max_factor=max_factor, log=log)
+    with Transaction(outputs, inputs) as tx:
+        tx.write(output, lambda tmp: _write(out_shape, tmp, Part))
+        if report:
+            tx.stage_text(report, json.dumps(rep, indent=1) + "\n")
+        tx.commit()
+    return rep
+
+
+def check_method(method):
+    if method not in ("raw", "filtered"):
+        raise InputError("--faces works with --method raw or filtered (got %s)" % method)
+
+
+def compute_region(shape, ms, faces_text, sources, method="filtered",
+                   mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
+                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print):
+    """The region of ``shape`` (faces ``faces_text``: ``'Face1,Face2'`` or ``'auto'``)
+    corrected by the measurement set ``ms``; ``sources``: the nominal's and the
+    measurements' names for the report and the errors. Returns ``(shape, report dict)``;
+    nothing is written."""
+    nominal, measurements = sources
     base = _base(ms)
     chosen = region.parse_faces(faces_text, shape)
     candidates = chosen if chosen is not None else [
@@ -78,7 +102,8 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     log("points per face: " + ", ".join("%s %d" % kv for kv in counts.items())
         + "; on no face: %d" % int(np.sum(~on)))
     d = _deviation(ms, normal, signed)
-    pts, dev, lines = base[on], d[on], np.asarray(ms.lines)[on]
+    lines = np.asarray(ms.lines) if ms.lines is not None else np.arange(2, len(base) + 2)
+    pts, dev, lines = base[on], d[on], lines[on]
     step = region_field.spacing(pts)
     # coverage of every face
     for i, f in enumerate(faces):
@@ -119,12 +144,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     out_shape, kind, volume = _assemble(shape, faces, fld)
     rep["output"] = {"kind": kind, "faces": len(out_shape.Faces), **volume}
     log(output_line(rep["output"]))
-    with Transaction(outputs, inputs) as tx:
-        tx.write(output, lambda tmp: _write(out_shape, tmp, Part))
-        if report:
-            tx.stage_text(report, json.dumps(rep, indent=1) + "\n")
-        tx.commit()
-    return rep
+    return out_shape, rep
 
 
 def _near(face, base, max_offset):
