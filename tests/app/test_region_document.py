@@ -43,6 +43,11 @@ out = {"module": type(region.Proxy).__module__, "type": region.Proxy.Type,
        "region_faces": list(region.RegionFaces), "method": region.Method,
        "min_coverage": region.MinCoverage, "edges": report["edges"],
        "points_stored": doc.getObject("Measurement").PointCount}
+from surfcomp.app import replace
+replace.restore(doc, region)
+doc.recompute()
+out["restored"] = [mirror.Source.Name, block.Visibility, region.ReplacedLinks,
+                   mirror.Shape.Volume]
 print("RESULT " + json.dumps(out))
 '''
 
@@ -137,6 +142,10 @@ def test_reopened_in_a_fresh_freecadcmd_recomputes_the_same(replaced, tmp_path):
     # the mirror now mirrors the corrected block
     assert r["mirror_source"] == "RegionCompensation" and not r["block_visible"]
     assert r["mirror_volume"] == pytest.approx(r["volume"], abs=1e-6)
+    # and Restore puts the block back under it
+    source, visible, record, volume = r["restored"]
+    assert source == "Block" and visible and record == ""
+    assert volume == pytest.approx(r["nominal_volume"], abs=1e-6)
     # continuity along the shared G1 edge
     (edge,) = r["edges"]
     assert edge["g1"] and r["max_gap"] == edge["max_gap_um"] <= 0.1
