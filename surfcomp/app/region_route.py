@@ -69,7 +69,8 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
 
 def check_method(method):
     if method not in ("raw", "filtered"):
-        raise InputError("--faces works with --method raw or filtered (got %s)" % method)
+        raise InputError("faces works with method raw or filtered (got %s)" % method,
+                         options=("faces", "method"))
 
 
 def compute_region(shape, ms, faces_text, sources, method="filtered",
@@ -90,9 +91,9 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     if chosen is None:
         keep = [i for i in range(len(faces)) if np.sum(owner == i) >= AUTO_MIN_POINTS]
         if not keep:
-            raise MeasurementFileError("--faces auto: no face of the shape has %d points within "
-                                       "--max-offset %g mm" % (AUTO_MIN_POINTS, max_offset),
-                                       file=measurements)
+            raise MeasurementFileError("faces auto: no face of the shape has %d points within "
+                                       "max_offset %g mm" % (AUTO_MIN_POINTS, max_offset),
+                                       file=measurements, options=("faces", "max_offset"))
         faces = [faces[i] for i in keep]      # the points go to their nearest kept face
         owner, u, v, normal, signed = region.locate(faces, base, max_offset,
                                                     (dist[keep], [res[i] for i in keep]))
@@ -112,9 +113,10 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
         f.coverage = region_field.coverage(samples, base[owner == i], 3.0 * step)
         if f.coverage < min_coverage:
             raise MeasurementFileError(
-                "%s: the points cover %.0f %% of the face, less than --min-coverage %.0f %% "
-                "(expected measurements over the whole face, or leave it out of --faces)"
-                % (f.name, 100 * f.coverage, 100 * min_coverage), file=measurements)
+                "%s: the points cover %.0f %% of the face, less than min_coverage %.0f %% "
+                "(expected measurements over the whole face, or leave it out of faces)"
+                % (f.name, 100 * f.coverage, 100 * min_coverage), file=measurements,
+                options=("min_coverage", "faces"))
     edges = region.shared_edges(shape, faces)
     _check_connected(faces, edges, log)
     radius = 0.5 * mask_size * step
@@ -177,9 +179,9 @@ def _check_neighbours(shape, faces, fld, sharp):
         if move > PRECISION:
             raise GeometryError(
                 "%s meets Face%d, which is not in the region, where the correction moves their "
-                "edge by %.2f um (more than %.2g um): re-trimming a neighbour of a region of "
-                "several faces is not done; add Face%d to --faces"
-                % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b))
+                "edge by %.2f um (more than %.2g um): re-trimming a neighbour of a region is "
+                "not done; add Face%d to faces"
+                % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
 def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
