@@ -100,6 +100,7 @@ def run_region_document(document, measurements, object_name, faces, save, replac
         region_doc.write_results(comp, rep)
         comp.Placement = shape.Placement
         comp.Shape = shape
+        comp.purgeTouched()      # computed: the document's recompute need not do it again
         result = RegionDocumentResult(document=os.path.abspath(document),
                                       compensation=comp.Name, measurement=meas.Name,
                                       options=region_doc.options_record(comp))
