@@ -81,12 +81,12 @@ def parse_faces(text, shape):
     out = []
     for name in (t.strip() for t in text.split(",")):
         if not name.startswith("Face") or not name[4:].isdigit():
-            raise InputError("--faces: %r is not a face name (expected FaceN, N from 1 to %d, "
-                             "or auto)" % (name, len(shape.Faces)))
+            raise InputError("faces: %r is not a face name (expected FaceN, N from 1 to %d, "
+                             "or auto)" % (name, len(shape.Faces)), options=("faces",))
         k = int(name[4:])
         if not 1 <= k <= len(shape.Faces):
-            raise InputError("--faces: the shape has no %s (it has Face1 to Face%d)"
-                             % (name, len(shape.Faces)))
+            raise InputError("faces: the shape has no %s (it has Face1 to Face%d)"
+                             % (name, len(shape.Faces)), options=("faces",))
         if k - 1 not in out:
             out.append(k - 1)
     return out

@@ -47,8 +47,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     inputs = [("nominal", nominal), ("measurements", measurements)]
     check_outputs(outputs, inputs)
     cad_format(output)
-    if method not in ("raw", "filtered"):
-        raise InputError("--faces works with --method raw or filtered (got %s)" % method)
+    check_method(method)
     fcenv.import_freecad()
     import Part
 
@@ -56,6 +55,32 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
 
     shape, _ = read_shape(nominal)
     ms = read_any(measurements, units, fmt, sample, deviation_units=deviation_units)
+    out_shape, rep = compute_region(
+        shape, ms, faces_text, (nominal, measurements), method=method, mask_size=mask_size,
+        mask_kind=mask_kind, sigma=sigma, max_offset=max_offset, min_coverage=min_coverage,
+        smoothing=smoothing, max_factor=max_factor, log=log)
+    with Transaction(outputs, inputs) as tx:
+        tx.write(output, lambda tmp: _write(out_shape, tmp, Part))
+        if report:
+            tx.stage_text(report, json.dumps(rep, indent=1) + "\n")
+        tx.commit()
+    return rep
+
+
+def check_method(method):
+    if method not in ("raw", "filtered"):
+        raise InputError("faces works with method raw or filtered (got %s)" % method,
+                         options=("faces", "method"))
+
+
+def compute_region(shape, ms, faces_text, sources, method="filtered",
+                   mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
+                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print):
+    """The region of ``shape`` (faces ``faces_text``: ``'Face1,Face2'`` or ``'auto'``)
+    corrected by the measurement set ``ms``; ``sources``: the nominal's and the
+    measurements' names for the report and the errors. Returns ``(shape, report dict)``;
+    nothing is written."""
+    nominal, measurements = sources
     base = _base(ms)
     chosen = region.parse_faces(faces_text, shape)
     candidates = chosen if chosen is not None else [
@@ -66,9 +91,9 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     if chosen is None:
         keep = [i for i in range(len(faces)) if np.sum(owner == i) >= AUTO_MIN_POINTS]
         if not keep:
-            raise MeasurementFileError("--faces auto: no face of the shape has %d points within "
-                                       "--max-offset %g mm" % (AUTO_MIN_POINTS, max_offset),
-                                       file=measurements)
+            raise MeasurementFileError("faces auto: no face of the shape has %d points within "
+                                       "max_offset %g mm" % (AUTO_MIN_POINTS, max_offset),
+                                       file=measurements, options=("faces", "max_offset"))
         faces = [faces[i] for i in keep]      # the points go to their nearest kept face
         owner, u, v, normal, signed = region.locate(faces, base, max_offset,
                                                     (dist[keep], [res[i] for i in keep]))
@@ -78,7 +103,8 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     log("points per face: " + ", ".join("%s %d" % kv for kv in counts.items())
         + "; on no face: %d" % int(np.sum(~on)))
     d = _deviation(ms, normal, signed)
-    pts, dev, lines = base[on], d[on], np.asarray(ms.lines)[on]
+    lines = np.asarray(ms.lines) if ms.lines is not None else np.arange(2, len(base) + 2)
+    pts, dev, lines = base[on], d[on], lines[on]
     step = region_field.spacing(pts)
     # coverage of every face
     for i, f in enumerate(faces):
@@ -87,9 +113,10 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
         f.coverage = region_field.coverage(samples, base[owner == i], 3.0 * step)
         if f.coverage < min_coverage:
             raise MeasurementFileError(
-                "%s: the points cover %.0f %% of the face, less than --min-coverage %.0f %% "
-                "(expected measurements over the whole face, or leave it out of --faces)"
-                % (f.name, 100 * f.coverage, 100 * min_coverage), file=measurements)
+                "%s: the points cover %.0f %% of the face, less than min_coverage %.0f %% "
+                "(expected measurements over the whole face, or leave it out of faces)"
+                % (f.name, 100 * f.coverage, 100 * min_coverage), file=measurements,
+                options=("min_coverage", "faces"))
     edges = region.shared_edges(shape, faces)
     _check_connected(faces, edges, log)
     radius = 0.5 * mask_size * step
@@ -119,12 +146,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     out_shape, kind, volume = _assemble(shape, faces, fld)
     rep["output"] = {"kind": kind, "faces": len(out_shape.Faces), **volume}
     log(output_line(rep["output"]))
-    with Transaction(outputs, inputs) as tx:
-        tx.write(output, lambda tmp: _write(out_shape, tmp, Part))
-        if report:
-            tx.stage_text(report, json.dumps(rep, indent=1) + "\n")
-        tx.commit()
-    return rep
+    return out_shape, rep
 
 
 def _near(face, base, max_offset):
@@ -157,9 +179,9 @@ def _check_neighbours(shape, faces, fld, sharp):
         if move > PRECISION:
             raise GeometryError(
                 "%s meets Face%d, which is not in the region, where the correction moves their "
-                "edge by %.2f um (more than %.2g um): re-trimming a neighbour of a region of "
-                "several faces is not done; add Face%d to --faces"
-                % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b))
+                "edge by %.2f um (more than %.2g um): re-trimming a neighbour of a region is "
+                "not done; add Face%d to faces"
+                % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
 def _fidelity(faces, owner, u, v, fld, base, normal, sharp):

@@ -82,6 +82,13 @@ def _map_subs(subs, mapping, where, label):
     return out
 
 
+def _replaces(obj):
+    """A compensation, or a region compensation (:mod:`surfcomp.app.region_doc`)."""
+    from .region_doc import is_region
+
+    return features.is_compensation(obj) or is_region(obj)
+
+
 def _targets(comp):
     """Objects whose users move to ``comp``: its nominal and the earlier rounds."""
     return [comp.Nominal] + features.chain(comp)[1:]
@@ -132,7 +139,7 @@ def plan(doc, comp):
     clones = set()
     changes = []
     for o in doc.Objects:
-        if o is comp or features.is_compensation(o) or features.is_measurement(o):
+        if o is comp or _replaces(o) or features.is_measurement(o):
             continue
         for prop in o.PropertiesList:
             kind = None if prop in SKIP_PROPERTIES else _kind(o.getTypeIdOfProperty(prop))
@@ -286,7 +293,7 @@ def replace(doc, comp):
     GeometryError
         A user links a face the compensation's output does not have.
     """
-    if not features.is_compensation(comp):
+    if not _replaces(comp):
         raise InputError("%s is not a surfcomp compensation" % comp.Label)
     if comp.ReplacedLinks:
         raise InputError("%s already replaces its nominal (restore it first)" % comp.Label)
@@ -334,7 +341,7 @@ def restore(doc, comp):
     list of (object name, property name)
         The links that were put back.
     """
-    if not features.is_compensation(comp):
+    if not _replaces(comp):
         raise InputError("%s is not a surfcomp compensation" % comp.Label)
     if not comp.ReplacedLinks:
         raise InputError("%s does not replace its nominal (nothing to restore)" % comp.Label)

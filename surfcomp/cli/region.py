@@ -5,6 +5,10 @@ from ..errors import InputError
 
 
 def run_region_command(args):
+    if args.replace or args.save:
+        from .region_document import run_region_document_command
+
+        return run_region_document_command(args)
     if not args.output:
         raise InputError("--faces needs -o OUT (the corrected shape)")
     for flag, value in (("--face", args.face), ("--replace", args.replace),

@@ -555,16 +555,19 @@ class PlanMeasurement(Command):
 
 
 from .probe_op_cmd import AddProbeOperation  # noqa: E402 (its base class is above)
+from .region_cmd import CompensateRegion  # noqa: E402 (its base class is above)
 from .surface_dressup_cmd import AddSurfaceCorrection  # noqa: E402 (its base class is above)
 
 COMMANDS = (LoadNominal, ImportMeasurements, DeviationMap, ShowDeviation, ShowDetermined,
             ShowRandom, ShowCorrection, Filter, Mirror, BuildFace, ReplaceInDocument,
-            RestoreNominal, Report, PlanMeasurement, AddProbeOperation, AddSurfaceCorrection)
+            RestoreNominal, Report, PlanMeasurement, AddProbeOperation, AddSurfaceCorrection,
+            CompensateRegion)
 #: command groups (toolbar drop-downs)
 GROUPS = (ShowMaps,)
 #: toolbar/menu order (None: separator)
 TOOLBAR = ("SurfComp_LoadNominal", "SurfComp_ImportMeasurements", None, "SurfComp_DeviationMap",
-           "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace", None,
+           "SurfComp_ShowMaps", "SurfComp_Filter", "SurfComp_Mirror", "SurfComp_BuildFace",
+           "SurfComp_CompensateRegion", None,
            "SurfComp_ReplaceInDocument", "SurfComp_RestoreNominal", None, "SurfComp_Report",
            None, "SurfComp_PlanMeasurement", "SurfComp_AddProbeOperation",
            "SurfComp_AddSurfaceCorrection", None, "SurfComp_AlignMeasurements")

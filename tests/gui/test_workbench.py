@@ -16,7 +16,8 @@ from tests.gui.harness import run_session
 
 COMMAND_IDS = ["SurfComp_AddProbeOperation", "SurfComp_AddSurfaceCorrection",
                "SurfComp_AlignMeasurements",
-               "SurfComp_BuildFace", "SurfComp_DeviationMap", "SurfComp_Filter",
+               "SurfComp_BuildFace", "SurfComp_CompensateRegion", "SurfComp_DeviationMap",
+               "SurfComp_Filter",
                "SurfComp_ImportMeasurements", "SurfComp_LoadNominal", "SurfComp_Mirror",
                "SurfComp_PlanMeasurement", "SurfComp_ReplaceInDocument", "SurfComp_Report",
                "SurfComp_RestoreNominal",

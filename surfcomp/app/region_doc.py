@@ -1,0 +1,186 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The region compensation as a document object (issue 30): ``SurfComp_RegionCompensation``.
+
+A ``Part::FeaturePython`` that links the nominal object (``Nominal``), the region's faces
+(``Faces``: ``Face1,Face2`` or ``auto``) and a measurement object (``Measurement``, a
+``SurfComp_Measurement``: the points are kept in the document). Its ``execute`` runs
+:func:`surfcomp.app.region_route.compute_region` on the nominal's shape and the stored
+points; its ``Shape`` is the nominal's solid with the region's faces corrected (same faces,
+same order, so ``FaceN`` links of Path operations stay valid). The figures of the run (points
+per face, the continuity along every shared edge, the volume check) are written to
+read-only properties and the whole report to ``Report`` (JSON).
+
+It carries what :func:`surfcomp.app.replace.replace` needs of a compensation (``Output`` is
+always ``solid``, ``Base`` always empty, ``ReplacedLinks``), so the nominal's users (Path
+Job models, operations) can be moved to it and back.
+
+The proxy module path ``surfcomp.app.region_doc`` is permanent once documents exist.
+"""
+
+import json
+
+from ..core.choices import MASK_KINDS
+from ..core.compensation.filters import WERNER_MASK_SIZE
+from ..errors import InputError
+from . import features
+from .properties import QT_TRANSLATE_NOOP
+from .proxies import Proxy
+
+REGION_TYPE = "SurfComp_RegionCompensation"
+VERSION = 1
+
+_IN = "Region"
+_OUT = "Region result"
+_RO, _HIDDEN = 1, 2
+_T = "App::Property"
+
+REGION_PROPERTIES = (
+    ("App::PropertyLink", "Nominal", _IN,
+     QT_TRANSLATE_NOOP(_T, "The object whose faces are compensated"), None, 0),
+    ("App::PropertyString", "Faces", _IN,
+     QT_TRANSLATE_NOOP(_T, "The region: FaceN names separated by commas, or auto (the faces "
+                           "the measurements cover)"), "auto", 0),
+    ("App::PropertyLink", "Measurement", _IN,
+     QT_TRANSLATE_NOOP(_T, "The measurement object (points stored in the document)"), None, 0),
+    ("App::PropertyEnumeration", "Method", _IN,
+     QT_TRANSLATE_NOOP(_T, "filtered: Werner's mask filter over the region; raw: the "
+                           "deviations as measured"), ["filtered", "raw"], 0),
+    ("App::PropertyInteger", "MaskSize", _IN,
+     QT_TRANSLATE_NOOP(_T, "Side of the filter mask in point spacings"), WERNER_MASK_SIZE, 0),
+    ("App::PropertyEnumeration", "MaskKind", _IN,
+     QT_TRANSLATE_NOOP(_T, "Weights of the filter mask"), list(MASK_KINDS), 0),
+    ("App::PropertyFloat", "Sigma", _IN,
+     QT_TRANSLATE_NOOP(_T, "Gaussian mask's sigma in point spacings (0: the default)"), 0.0, 0),
+    ("App::PropertyLength", "MaxOffset", _IN,
+     QT_TRANSLATE_NOOP(_T, "Largest distance of a point from its face, and largest step "
+                           "between the readings of two faces across an edge"), 1.0, 0),
+    ("App::PropertyFloat", "MinCoverage", _IN,
+     QT_TRANSLATE_NOOP(_T, "Least share of every face's area with measured points near"),
+     0.5, 0),
+    ("App::PropertyLength", "Smoothing", _IN,
+     QT_TRANSLATE_NOOP(_T, "Radius of the correction field (0: 5 % of the shape's diagonal, "
+                           "at least 4 point spacings)"), 0.0, 0),
+    ("App::PropertyString", "Output", _IN,
+     QT_TRANSLATE_NOOP(_T, "Always solid: the nominal's shape with the region corrected"),
+     "solid", _RO | _HIDDEN),
+    ("App::PropertyLink", "Base", _IN,
+     QT_TRANSLATE_NOOP(_T, "Not used by a region (no iterations)"), None, _RO | _HIDDEN),
+    ("App::PropertyString", "ReplacedLinks", _IN,
+     QT_TRANSLATE_NOOP(_T, "Links moved from the nominal to this object by Replace (JSON)"),
+     "", _RO | _HIDDEN),
+    ("App::PropertyStringList", "RegionFaces", _OUT,
+     QT_TRANSLATE_NOOP(_T, "The faces corrected"), None, _RO),
+    ("App::PropertyStringList", "PointsPerFace", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Measured points given to every face (each to its nearest)"),
+     None, _RO),
+    ("App::PropertyInteger", "PointsOnNoFace", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Points farther than MaxOffset from every face of the region"),
+     0, _RO),
+    ("App::PropertyStringList", "Continuity", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Per face and per shared edge: points, poles, largest gap and "
+                           "normal angle"), None, _RO),
+    ("App::PropertyFloat", "MaxGap", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Largest gap along the region's shared edges (um)"), 0.0, _RO),
+    ("App::PropertyFloat", "MaxAngleChange", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Largest change of the normal angle along the shared edges (deg)"),
+     0.0, _RO),
+    ("App::PropertyFloat", "VolChange", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Volume of the result minus the nominal's (mm^3)"), 0.0, _RO),
+    ("App::PropertyFloat", "CorrIntegral", _OUT,
+     QT_TRANSLATE_NOOP(_T, "-integral of the correction over the region (mm^3): the expected "
+                           "volume change"), 0.0, _RO),
+    ("App::PropertyString", "Report", _OUT,
+     QT_TRANSLATE_NOOP(_T, "The run's report (JSON)"), "", _RO | _HIDDEN),
+    ("App::PropertyInteger", "Version", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Version of the property set"), VERSION, _RO | _HIDDEN),
+)
+
+
+def is_region(obj):
+    return features.is_type(obj, REGION_TYPE)
+
+
+class RegionCompensationFeature(Proxy):
+    """Proxy of ``SurfComp_RegionCompensation`` (see the module docstring)."""
+
+    Type = REGION_TYPE
+    PROPERTIES = REGION_PROPERTIES
+    VERSION = VERSION
+
+    def onDocumentRestored(self, obj):
+        super().onDocumentRestored(obj)
+        features._restored(obj)
+
+    def execute(self, obj):
+        shape, rep = compute(obj)
+        write_results(obj, rep)
+        # the result is in the document's coordinates (the nominal's shape is placed)
+        obj.Placement = shape.Placement
+        obj.Shape = shape
+
+
+def compute(obj, log=None):
+    """``(shape, report)`` of a region object from its properties."""
+    from .region_route import check_method, compute_region
+
+    nominal, meas = obj.Nominal, obj.Measurement
+    if nominal is None or not hasattr(nominal, "Shape") or nominal.Shape.isNull():
+        raise InputError("%s: Nominal is not set or has no shape" % obj.Label)
+    if meas is None or not features.is_measurement(meas):
+        raise InputError("%s: Measurement is not a surfcomp measurement object" % obj.Label)
+    check_method(obj.Method)
+    ms = features.measurement_set(meas)
+    lines = []
+    shape, rep = compute_region(
+        nominal.Shape, ms, obj.Faces, (nominal.Label, ms.source), method=obj.Method,
+        mask_size=int(obj.MaskSize), mask_kind=obj.MaskKind, sigma=float(obj.Sigma) or None,
+        max_offset=float(obj.MaxOffset.Value), min_coverage=float(obj.MinCoverage),
+        smoothing=float(obj.Smoothing.Value) or None, log=log or lines.append)
+    if rep["output"]["kind"] != "solid":
+        raise InputError("%s: %s is not one closed solid; a region in a document needs a "
+                         "solid (compensate the faces to a file instead)"
+                         % (obj.Label, nominal.Label))
+    rep["inputs"]["measurement_object"] = meas.Name
+    return shape, rep
+
+
+def write_results(obj, rep):
+    from .region_route import output_line, summary
+
+    obj.RegionFaces = [f["face"] for f in rep["faces"]]
+    obj.PointsPerFace = ["%s %d" % (f["face"], f["points"]) for f in rep["faces"]]
+    obj.PointsOnNoFace = int(rep["points_on_no_face"])
+    obj.Continuity = summary(rep) + [output_line(rep["output"])]
+    obj.MaxGap = max((e["max_gap_um"] for e in rep["edges"]), default=0.0)
+    obj.MaxAngleChange = max((e["max_angle_change_deg"] for e in rep["edges"]), default=0.0)
+    obj.VolChange = float(rep["output"]["change_mm3"])
+    obj.CorrIntegral = float(rep["output"]["integral_mm3"])
+    obj.Report = json.dumps(rep, sort_keys=True)
+
+
+def make_region(doc, nominal, faces, measurement, name="RegionCompensation", **options):
+    """Add a region compensation of ``nominal``'s ``faces`` (``'Face1,Face2'``, a list of
+    names, or ``'auto'``) with the measurement object ``measurement``; ``options``:
+    property values (``Method``, ``MaskSize``, ``MaxOffset``, ``MinCoverage`` ...)."""
+    obj = doc.addObject("Part::FeaturePython", name)
+    RegionCompensationFeature(obj)
+    obj.Nominal = nominal
+    obj.Measurement = measurement
+    obj.Faces = faces if isinstance(faces, str) else ",".join(faces)
+    for key, value in options.items():
+        if value is not None:
+            setattr(obj, key, value)
+    obj.Label = "%s_region" % nominal.Label
+    return features._created(obj)
+
+
+def options_record(obj):
+    """The object's inputs as a dict (what the summary and the tests show)."""
+    return {"Faces": obj.Faces, "Method": obj.Method, "MaskSize": int(obj.MaskSize),
+            "MaskKind": obj.MaskKind, "Sigma": float(obj.Sigma),
+            "MaxOffset": float(obj.MaxOffset.Value), "MinCoverage": float(obj.MinCoverage),
+            "Smoothing": float(obj.Smoothing.Value)}
+
+
+__all__ = ["RegionCompensationFeature", "make_region", "is_region", "REGION_TYPE"]
+__all__ += ["compute", "write_results", "options_record"]

@@ -1,0 +1,148 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""The region compensation on a shop document (issue 30):
+
+    python3 -m surfcomp compensate DOC.FCStd MEAS.csv --object O --faces F1,F2|auto \\
+        [--replace] --save OUT.FCStd
+
+adds a measurement object and a ``SurfComp_RegionCompensation``
+(:mod:`surfcomp.app.region_doc`) to the document, optionally moves the nominal's users (Path
+Jobs) to it, recomputes and saves a copy. The safety rules of the single-face route
+(:mod:`surfcomp.app.document_route`) hold: the document is opened safely, the outputs are
+checked against the inputs before it is opened, the input document is never overwritten
+unless ``overwrite_input``, and nothing is written after any failure.
+"""
+
+import json
+import os
+from dataclasses import dataclass, field
+
+from ..core import budget
+from ..core.progress import report
+from ..errors import InputError
+from ..io.readers import read_any
+from . import cam, features, toolpaths
+from .document_route import (
+    _check_paths,
+    _declared,
+    _find_object,
+    _jobs_using,
+    _recompute,
+    _write,
+)
+from .documents import open_document, restore_failures
+
+
+@dataclass
+class RegionDocumentResult:
+    document: str
+    compensation: str
+    measurement: str
+    options: dict = field(default_factory=dict)
+    report: dict = field(default_factory=dict)
+    replaced: list = field(default_factory=list)
+    jobs: list = field(default_factory=list)
+    toolpaths: list = field(default_factory=list)
+    saved: str = None
+    gcode: str = None
+    gcode_lines: int = 0
+
+
+def run_region_document(document, measurements, object_name, faces, save, replace=False,
+                        overwrite_input=False, units="mm", deviation_units=None, fmt="auto",
+                        sample=None, max_memory=None, progress=None, **options):
+    """Compensate the region ``faces`` (``'Face1,Face2'`` or ``'auto'``) of ``object_name``
+    in ``document``; save the result to ``save``. ``options``: the region object's
+    properties (``Method``, ``MaskSize``, ``MaskKind``, ``Sigma``, ``MaxOffset``,
+    ``MinCoverage``, ``Smoothing``). Returns a :class:`RegionDocumentResult`.
+
+    Raises
+    ------
+    InputError, MeasurementFileError, GeometryError
+        Bad paths or input, a region that cannot be corrected (named), a nominal that is not
+        one closed solid; nothing is written.
+    """
+    if not save:
+        raise InputError("--faces on a document needs --save OUT.FCStd (the input document is "
+                         "not overwritten)")
+    _check_paths(document, measurements, save, None, replace, overwrite_input)
+    report(progress, 0.0, "setting up Path")
+    cam.setup_workbench()
+    import FreeCAD
+
+    from . import region_doc
+    from . import replace as replace_mod
+
+    before = set(FreeCAD.listDocuments())
+    report(progress, 0.05, "opening %s" % os.path.basename(document))
+    doc, refused, info = open_document(document)
+    try:
+        problems = restore_failures(doc, info=info)
+        if problems:
+            why = "".join("; module %s %s" % item for item in sorted(refused.items()))
+            raise InputError("%d object(s) did not restore, so the document cannot be updated "
+                             "safely (saving would lose them): %s%s"
+                             % (len(problems), "; ".join(problems), why), file=document)
+        nominal = _find_object(doc, object_name, document)
+        if len(nominal.Shape.Solids) != 1:
+            raise InputError("%s has %d solids: a region in a document is corrected on one "
+                             "closed solid (expected an object with one solid)"
+                             % (nominal.Label, len(nominal.Shape.Solids)), file=document)
+        paths_before = toolpaths.snapshot(doc)
+        report(progress, 0.1, "reading the measurements")
+        ms = read_any(os.fspath(measurements), units=units, fmt=fmt or "auto", sample=sample,
+                      deviation_units=deviation_units)
+        budget.check_job(len(ms), True, max_memory)
+        meas = features.make_measurement_from_set(doc, ms)
+        comp = region_doc.make_region(doc, nominal, faces, meas, **options)
+        report(progress, 0.2, "compensating the region %s of %s" % (faces, nominal.Label))
+        # computed once outside the recompute so bad input raises with its message
+        shape, rep = region_doc.compute(comp)
+        region_doc.write_results(comp, rep)
+        comp.Placement = shape.Placement
+        comp.Shape = shape
+        comp.purgeTouched()      # computed: the document's recompute need not do it again
+        result = RegionDocumentResult(document=os.path.abspath(document),
+                                      compensation=comp.Name, measurement=meas.Name,
+                                      options=region_doc.options_record(comp))
+        if replace:
+            report(progress, 0.6, "replacing the nominal")
+            result.replaced = replace_mod.replace(doc, comp)
+        report(progress, 0.65, "recomputing the document")
+        _recompute(doc)
+        result.report = json.loads(comp.Report)
+        result.jobs = [j.Name for j in _jobs_using(doc, comp)]
+        result.toolpaths = toolpaths.compare(doc, paths_before, result.jobs)
+        report(progress, 0.95, "saving")
+        _write(doc, result, save, None, None,
+               _declared(document, measurements, save, None, overwrite_input))
+        report(progress, 1.0, "done")
+        return result
+    finally:
+        if doc.Name not in before and doc.Name in FreeCAD.listDocuments():
+            FreeCAD.closeDocument(doc.Name)
+
+
+def summary_lines(result):
+    """The printed lines of a :class:`RegionDocumentResult`."""
+    from .region_route import output_line, summary
+
+    rep = result.report
+    lines = ["region compensation %s (measurement %s) added to the document: faces %s"
+             % (result.compensation, result.measurement,
+                ", ".join(f["face"] for f in rep["faces"]))]
+    lines.append("options: " + ", ".join("%s %s" % kv for kv in result.options.items()))
+    lines.append("points per face: " + ", ".join("%s %d" % (f["face"], f["points"])
+                                                 for f in rep["faces"])
+                 + "; on no face: %d" % rep["points_on_no_face"])
+    lines += summary(rep)
+    lines.append(output_line(rep["output"]))
+    if result.replaced:
+        lines.append("replaced the nominal in: %s"
+                     % ", ".join("%s.%s" % pair for pair in result.replaced))
+    lines += toolpaths.describe(result.toolpaths)
+    if result.saved:
+        lines.append("wrote %s" % result.saved)
+    return lines
+
+
+__all__ = ["run_region_document", "RegionDocumentResult", "summary_lines"]
