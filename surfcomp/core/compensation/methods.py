@@ -93,7 +93,7 @@ def compute_correction(d, method="filtered", mask=None, edge="renormalize", stoc
 
 
 def predicted_residual(determined, increment, method, stock=None):
-    """The predicted residual (mm): what a round's correction leaves of the repeatable
+    """The predicted residual (mm): what a round's correction leaves of the systematic
     (determined) error when the next part is cut, ``determined - s - increment``, where
     ``s`` is the stock the mirror method's deviations carry (0 for the other methods); the
     next part's own random scatter comes on top.
