@@ -145,7 +145,7 @@ def test_cloned_workbench_appears_and_works(installed):
     r = installed["first"]
     assert r["surfcomp_file"].startswith(os.path.join(installed["home"], "Mod", "surfcomp"))
     assert "SurfCompWorkbench" in r["workbenches"]
-    assert len(r["commands"]) == 18         # 17 commands and the map drop-down
+    assert len(r["commands"]) == 19         # 18 commands and the map drop-down
     assert r["dialog_errors"] == []
     assert "Up-to-date" in r["state"]
     assert r["vertices"] == 90 * 90
