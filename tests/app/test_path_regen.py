@@ -68,17 +68,20 @@ def regenerated():
     nom.Shape = Part.read(EXAMPLE_STEP)
     doc.recompute()
     job = cam_job.create_job(doc, [nom])
+    # Path's stock follows the model clones' bounding boxes, which become tight once the
+    # clone is meshed (OCCT then bounds the triangulation): mesh it as the operation will
+    # and settle the stock before the operation exists, so that only the compensation
+    # changes the program (and the operation is computed once, not again for the stock)
+    clone = cam_job.model_clone(job, nom)
+    clone.Shape.tessellate(0.001)
+    clone.touch()
+    doc.recompute()
     tc = cam_job.ball_end_tool_controller(job, 2 * R)
     op = cam_job.surface_operation(job, nom, ["Face1"], tc, step_over=50.0, sample_interval=1.0,
                                    linear_deflection=0.001)
     m = features.make_measurement(doc, EXAMPLE_CSV)
     comp = features.make_compensation(doc, nom, "Face1", m)
     comp.Refine = 1          # fewer knots: OCCT meshes the corrected face 7x faster
-    doc.recompute()
-    # Path's stock follows the model clones' bounding boxes, which become tight once the
-    # operation has meshed the clone (OCCT then bounds the triangulation): settle it now,
-    # so that only the compensation changes the program
-    cam_job.model_clone(job, nom).touch()
     doc.recompute()
     before = {"cl": cam_job.cutter_locations(op),
               "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
