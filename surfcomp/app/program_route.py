@@ -13,9 +13,9 @@ never over an input; nothing is written when it is refused.
 from dataclasses import dataclass
 
 from ..core import budget
-from ..core.compensation.corrected import realised_correction
 from ..core.compensation.pipeline import compensate, prepare
 from ..core.compensation.program_offset import BallOffset, parse_tool
+from ..core.compensation.realised_feet import RealisedAt
 from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
@@ -50,10 +50,11 @@ def correction_at(nominal, comp):
     (:func:`surfcomp.core.compensation.corrected.realised_correction`). Newton starts on the nominal
     point itself: the corrected face lies micrometres from it, and the intended field as
     a start (locating every point in the measured grid first) cost more than the
-    iteration it saves; both converge to 1e-12 mm."""
-    def correction(u, v):
-        return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward)
-    return correction
+    iteration it saves; both converge to 1e-12 mm. At the contact points of the program
+    the nominal point and normal come from the projection, and path points start from
+    their neighbours' intersections
+    (:class:`surfcomp.core.compensation.realised_feet.RealisedAt`)."""
+    return RealisedAt(nominal.surface, comp.corrected, nominal.outward)
 
 
 def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):

@@ -35,6 +35,7 @@ from ...errors import GCodeError, InputError
 from ..axis.arcs import PLANES, arc_params, arc_steps
 from ..axis.moves import MovePlan
 from ..surface.projection import Projector
+from ..surface.projection_chain import project_chain
 
 #: tool shapes :func:`parse_tool` knows
 TOOL_KINDS = ("ball", "flat", "bull")
@@ -121,9 +122,15 @@ class BallOffset:
         positive inwards (the corrected face is ``S - t n``).
     blend : float
         Clearance (mm) over which the correction fades out beyond the face (> 0).
+    warm : bool
+        Project the points of a call, which follow the path, from nearby feet
+        (:func:`surfcomp.core.surface.projection_chain.project_chain`; the full engine's
+        results to ~1e-10 mm); False: every point through the full engine. A ``correction``
+        with an ``at(u, v, foot, normal)`` method
+        (:class:`surfcomp.core.compensation.realised_feet.RealisedAt`) is given the feet too.
     """
 
-    def __init__(self, surface, outward, radius, correction, blend):
+    def __init__(self, surface, outward, radius, correction, blend, warm=True):
         if not (math.isfinite(blend) and blend > 0):
             raise InputError("blend %r: expected a positive length in mm" % blend,
                              options=("blend",))
@@ -135,6 +142,9 @@ class BallOffset:
         #: centres farther than this from the face are not projected (moved by nothing)
         self.reach = self.radius + self.blend + 1.0
         self.projector = Projector(surface)
+        self.warm = bool(warm)
+        #: points projected from a nearby foot (``'warm'``) and by the full engine
+        self.counts = {"warm": 0, "full": 0}
 
     def displace(self, tips):
         """The :class:`Displacement` of tool tips ``tips`` (N, 3) (mm)."""
@@ -149,7 +159,11 @@ class BallOffset:
             return Displacement(move, gap, weight, tilt, interior)
         centre = tips.copy()
         centre[:, 2] += self.radius
-        pr = self.projector.project(centre, max_distance=self.reach)
+        if self.warm:
+            pr = project_chain(self.projector, centre, self.reach, counts=self.counts)
+        else:
+            pr = self.projector.project(centre, max_distance=self.reach)
+            self.counts["full"] += n
         ok = pr.converged & np.isfinite(pr.u)
         normal = pr.normal[ok] * self.outward
         side = np.sign(pr.distance[ok] * self.outward)
@@ -162,7 +176,10 @@ class BallOffset:
         act = np.flatnonzero(ok)[weight[ok] > 0]
         if act.size:
             sel = weight[ok] > 0
-            t = np.asarray(self.correction(pr.u[act], pr.v[act]), dtype=float)
+            at = getattr(self.correction, "at", None)
+            t = np.asarray(self.correction(pr.u[act], pr.v[act]) if at is None
+                           else at(pr.u[act], pr.v[act], pr.foot[act], pr.normal[act]),
+                           dtype=float)
             move[act] = -(weight[act] * t)[:, None] * normal[sel]
         return Displacement(move, gap, weight, tilt, interior)
 
