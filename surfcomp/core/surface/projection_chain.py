@@ -79,30 +79,38 @@ def project_chain(projector, points, max_distance=None, levels=LEVELS, counts=No
                outside=np.zeros(n, dtype=bool), converged=np.zeros(n, dtype=bool),
                derivatives=np.full((6, 3, n), np.nan))
     order = np.arange(n)
-    full = warm = 0
+    solved = np.zeros(n, dtype=bool)
     for k in range(len(levels) + 1):
         idx = np.flatnonzero(level == k)
-        if k:
-            base = np.maximum.accumulate(np.where(level < k, order, 0))[idx]
-            go = res["converged"][base]
-            ok = np.zeros(idx.size, dtype=bool)
-            if go.any():
-                ok[go] = _warm(projector, P, idx[go], base[go], res, max_distance)
-            warm += int(ok.sum())
-            idx = idx[~ok]
-        if idx.size:
-            p = projector.project(P[idx], max_distance, derivatives=True)
-            for key in res:
-                if key == "derivatives":
-                    res[key][:, :, idx] = p.derivatives
-                else:
-                    res[key][idx] = getattr(p, key)
-            full += idx.size
+        if k == 0:
+            _engine(projector, P, idx, res, max_distance)
+            solved[idx] = True
+            continue
+        base = np.maximum.accumulate(np.where(level < k, order, 0))[idx]
+        # from solved feet only (the others go through the engine at the end, together)
+        go = res["converged"][base] & solved[base]
+        if go.any():
+            solved[idx[go]] = _warm(projector, P, idx[go], base[go], res, max_distance)
+    rest = np.flatnonzero(~solved)
+    _engine(projector, P, rest, res, max_distance)
+    full = int(np.count_nonzero(level == 0) + rest.size)
+    warm = n - full
     if counts is not None:
         counts["full"] = counts.get("full", 0) + full
         counts["warm"] = counts.get("warm", 0) + warm
     del res["derivatives"]
     return Projection(**res)
+
+
+def _engine(projector, P, idx, res, max_distance):
+    """The full engine's projection of ``P[idx]`` into ``res`` (with derivatives)."""
+    if idx.size:
+        p = projector.project(P[idx], max_distance, derivatives=True)
+        for key in res:
+            if key == "derivatives":
+                res[key][:, :, idx] = p.derivatives
+            else:
+                res[key][idx] = getattr(p, key)
 
 
 def _step(r, Su, Sv, Suu, Suv, Svv):
