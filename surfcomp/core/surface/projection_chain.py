@@ -39,8 +39,8 @@ FINAL_STEP = 3e-5
 SECOND_STEP = 1e-2
 #: path lengths (mm) between the points of each level: the first level's go through the
 #: full engine, the next level's start from them, the remaining points from the level
-#: before theirs (within a quarter millimetre: one exact evaluation finishes most)
-LEVELS = (1.0, 0.25)
+#: before theirs (within an eighth of a millimetre: one exact evaluation finishes most)
+LEVELS = (0.5, 0.125)
 
 
 def path_anchors(points, spacing):
