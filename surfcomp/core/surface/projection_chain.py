@@ -6,23 +6,27 @@ so do their feet on the face. :func:`project_chain` projects *anchors* with the 
 (:meth:`surfcomp.core.surface.projection.Projector.project`: seeds, Newton, the global
 checks) and every other point from its anchor's foot:
 
-- an anchor is the first point, a point after a non-finite one, a point more than
-  ``spacing`` from the one before (a rapid, a retract, the next pass), and the first point
-  past each further ``spacing`` of path length; every other point lies within ``spacing``
-  (along the path, so in space too) of its anchor;
-- from the anchor's foot and the face's derivatives there (``S, Su, Sv, Suu, Suv, Svv``)
-  two Newton steps on the anchor's second-order Taylor model of the face (as
+- the points of the first of :data:`LEVELS` (the first point, a point after a non-finite
+  one, a point more than the level's spacing from the one before: a rapid, a retract, the
+  next pass; and the first point past each further spacing of path length,
+  :func:`path_anchors`) go through the engine; the points of each further level start
+  from the last point of a coarser level before them (within that level's spacing along
+  the path, so in space too), the remaining points from the last point of any level;
+- from that foot and the face's derivatives there (``S, Su, Sv, Suu, Suv, Svv``) two
+  Newton steps on its second-order Taylor model of the face (as
   :class:`surfcomp.core.surface.projection_warm.Tracker` takes them) bring the foot within
-  the model's third-order error; one exact evaluation and a full Newton step finish it.
-  A point is answered so when that step is a fast (positive definite) Newton step of at
-  most :data:`FINAL_STEP` (what is left after it is of the order ``step^2 / radius``:
-  ~1e-12 mm), and its foot is certified global as the engine certifies it: closer to the
-  face than the projector's ``safe_distance``, or covered by the region certificate, and
-  not at the end of a closed direction;
-- everything else (anchors that did not converge, points whose step was too long or whose
-  foot is not certified) goes through the full engine.
+  the model's third-order error; one exact evaluation and a full Newton step finish it (a
+  second evaluation where that step is longer than :data:`FINAL_STEP`). A point is
+  answered so when its last step is a fast (positive definite) Newton step of at most
+  :data:`FINAL_STEP` (what is left after it is of the order ``step^2 x curvature``:
+  ~1e-10 mm), its foot lies inside the work area (not on its border, so not at the end of
+  a closed direction either), and the foot is certified global as the engine certifies
+  it: closer to the face than the projector's ``safe_distance``, or covered by the region
+  certificate;
+- everything else (points whose start did not converge, whose step was too long, whose
+  foot is on the border or not certified) goes through the full engine, in one call.
 
-The results are those of the full engine to ~1e-12 mm (tested to 1e-9 mm against it).
+The results are those of the full engine to ~1e-10 mm (tested to 1e-9 mm against it).
 """
 
 import numpy as np
