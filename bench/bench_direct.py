@@ -21,7 +21,9 @@ the process and of the children it waited for, such as the STEP reader):
 
 Absolute seconds depend on the machine and on what else runs on it; ratios measured side
 by side much less. The figures measured, before and after plain G0/G1 runs were read and
-written as arrays: docs/benchmarks.md (bench_direct.py) and docs/direct_program.md (Speed).
+written as arrays and before and after the geometry followed the path (projection from the
+neighbours' feet, the realised correction at the projection's feet): docs/benchmarks.md
+(bench_direct.py) and docs/direct_program.md (Speed).
 """
 
 import argparse

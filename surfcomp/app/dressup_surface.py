@@ -17,12 +17,11 @@ dressup is created. No FreeCADGui, no PySide: it recomputes in ``freecadcmd``.
 import FreeCAD
 import Path
 
-from ..core.compensation.corrected import realised_correction
-from ..core.compensation.program_offset import BallOffset
 from ..errors import InputError
 from ..io.gcode.offset_stream import offset_commands
 from . import cam
 from .dressups import DressupProxy, check_base, place
+from .program_geometry import offset_of
 
 QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
@@ -92,11 +91,7 @@ def ball_offset(obj):
         raise InputError("%s: BallRadius must be positive (the ball end mill's radius)"
                          % obj.Label)
 
-    def correction(u, v):
-        return realised_correction(nominal.surface, corrected, u, v, nominal.outward)
-
-    return BallOffset(nominal.surface, nominal.outward, radius, correction,
-                      float(obj.Blend.Value))
+    return offset_of(nominal, corrected, radius, float(obj.Blend.Value))
 
 
 def move_path(obj):

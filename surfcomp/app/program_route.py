@@ -13,15 +13,15 @@ never over an input; nothing is written when it is refused.
 from dataclasses import dataclass
 
 from ..core import budget
-from ..core.compensation.corrected import realised_correction
 from ..core.compensation.pipeline import compensate, prepare
-from ..core.compensation.program_offset import BallOffset, parse_tool
+from ..core.compensation.program_offset import parse_tool
 from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import offset_stream
 from ..io.readers import read_any
 from . import fcenv
+from .program_geometry import offset_of
 
 
 @dataclass
@@ -42,18 +42,6 @@ class ProgramJob:
     tolerance: float = 5e-4
     segment_length: float = 2.0
     decimals: int = None
-
-
-def correction_at(nominal, comp):
-    """``correction(u, v)``: the correction (mm, positive inwards) the corrected face of
-    ``comp`` realises along the nominal's normal at ``(u, v)``
-    (:func:`surfcomp.core.compensation.corrected.realised_correction`). Newton starts on the nominal
-    point itself: the corrected face lies micrometres from it, and the intended field as
-    a start (locating every point in the measured grid first) cost more than the
-    iteration it saves; both converge to 1e-12 mm."""
-    def correction(u, v):
-        return realised_correction(nominal.surface, comp.corrected, u, v, nominal.outward)
-    return correction
 
 
 def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
@@ -79,8 +67,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
                        progress=sub(progress, 0, 0.3))
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options,
                       progress=sub(progress, 0.3, 0.7))
-    offset = BallOffset(nominal.surface, nominal.outward, radius, correction_at(nominal, comp),
-                        pj.blend)
+    offset = offset_of(nominal, comp.corrected, radius, pj.blend)
     report(progress, 0.7, "moving the program")
     done = []
     with Transaction(outputs, inputs) as tr:

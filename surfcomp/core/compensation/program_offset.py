@@ -34,7 +34,9 @@ import numpy as np
 from ...errors import GCodeError, InputError
 from ..axis.arcs import PLANES, arc_params, arc_steps
 from ..axis.moves import MovePlan
+from ..surface import bspline
 from ..surface.projection import Projector
+from ..surface.projection_chain import project_chain
 
 #: tool shapes :func:`parse_tool` knows
 TOOL_KINDS = ("ball", "flat", "bull")
@@ -121,9 +123,20 @@ class BallOffset:
         positive inwards (the corrected face is ``S - t n``).
     blend : float
         Clearance (mm) over which the correction fades out beyond the face (> 0).
+    warm : bool
+        Project the points of a call, which follow the path, from nearby feet
+        (:func:`surfcomp.core.surface.projection_chain.project_chain`; the full engine's
+        results to ~1e-10 mm); False: every point through the full engine. A ``correction``
+        with an ``at(u, v, foot, normal)`` method
+        (:class:`surfcomp.core.compensation.realised_feet.RealisedAt`) is given the feet too.
+    trim : surfcomp.core.compensation.program_trim.Trim, optional
+        The trimmed face's boundary: a centre whose foot lies outside the trimmed face
+        (beyond its outer boundary or in a hole) is measured from the boundary's closest
+        point, and the correction there fades out over the blend as beyond the surface's
+        edge. None: the face is its whole surface.
     """
 
-    def __init__(self, surface, outward, radius, correction, blend):
+    def __init__(self, surface, outward, radius, correction, blend, warm=True, trim=None):
         if not (math.isfinite(blend) and blend > 0):
             raise InputError("blend %r: expected a positive length in mm" % blend,
                              options=("blend",))
@@ -135,6 +148,10 @@ class BallOffset:
         #: centres farther than this from the face are not projected (moved by nothing)
         self.reach = self.radius + self.blend + 1.0
         self.projector = Projector(surface)
+        self.warm = bool(warm)
+        self.trim = trim
+        #: points projected from a nearby foot (``'warm'``) and by the full engine
+        self.counts = {"warm": 0, "full": 0}
 
     def displace(self, tips):
         """The :class:`Displacement` of tool tips ``tips`` (N, 3) (mm)."""
@@ -149,21 +166,37 @@ class BallOffset:
             return Displacement(move, gap, weight, tilt, interior)
         centre = tips.copy()
         centre[:, 2] += self.radius
-        pr = self.projector.project(centre, max_distance=self.reach)
+        if self.warm:
+            pr = project_chain(self.projector, centre, self.reach, counts=self.counts)
+        else:
+            pr = self.projector.project(centre, max_distance=self.reach)
+            self.counts["full"] += n
         ok = pr.converged & np.isfinite(pr.u)
-        normal = pr.normal[ok] * self.outward
-        side = np.sign(pr.distance[ok] * self.outward)
-        dist = np.linalg.norm(centre[ok] - pr.foot[ok], axis=1)
-        # a centre on the material side is inside the nominal by its distance plus R
-        gap[ok] = np.where(side >= 0, dist, -dist) - self.radius
-        weight[ok] = blend_weight(gap[ok], self.blend)
-        tilt[ok] = 1.0 - normal[:, 2]
+        u, v, foot, normal = pr.u.copy(), pr.v.copy(), pr.foot.copy(), pr.normal.copy()
+        side = np.sign(pr.distance * self.outward)
+        dist = np.linalg.norm(centre - foot, axis=1)
         interior[ok] = ~pr.outside[ok]
-        act = np.flatnonzero(ok)[weight[ok] > 0]
+        if self.trim is not None and ok.any():
+            # feet outside the trimmed face: the ball touches it, if at all, on its boundary
+            k = np.flatnonzero(ok)
+            k = k[self.trim.outside(u[k], v[k])]
+            if k.size:
+                _x, u[k], v[k], dist[k] = self.trim.closest(centre[k])
+                foot[k], Su, Sv = bspline.derivatives(self.surface, u[k], v[k], order=1)
+                normal[k] = bspline.unit_normals(self.surface, u[k], v[k], Su, Sv)
+                side[k], interior[k] = 1.0, False
+        normal = normal * self.outward
+        # a centre on the material side is inside the nominal by its distance plus R
+        gap[ok] = np.where(side[ok] >= 0, dist[ok], -dist[ok]) - self.radius
+        weight[ok] = blend_weight(gap[ok], self.blend)
+        tilt[ok] = 1.0 - normal[ok, 2]
+        act = np.flatnonzero(ok & (weight > 0))
         if act.size:
-            sel = weight[ok] > 0
-            t = np.asarray(self.correction(pr.u[act], pr.v[act]), dtype=float)
-            move[act] = -(weight[act] * t)[:, None] * normal[sel]
+            at = getattr(self.correction, "at", None)
+            t = np.asarray(self.correction(u[act], v[act]) if at is None
+                           else at(u[act], v[act], foot[act], normal[act] * self.outward),
+                           dtype=float)
+            move[act] = -(weight[act] * t)[:, None] * normal[act]
         return Displacement(move, gap, weight, tilt, interior)
 
 
