@@ -59,6 +59,17 @@ class DocumentJobResult:
     alignment_warnings: list = field(default_factory=list)
 
 
+
+def check_restored(doc, refused, info, document):
+    """Refuse a document some objects of which did not restore (``refused``, ``info`` as
+    :func:`surfcomp.app.documents.open_document` returns them): saving it would lose them."""
+    problems = restore_failures(doc, info=info)
+    if problems:
+        why = "".join("; module %s %s" % item for item in sorted(refused.items()))
+        raise InputError("%d object(s) did not restore, so the document cannot be updated "
+                         "safely (saving would lose them): %s%s"
+                         % (len(problems), "; ".join(problems), why), file=document)
+
 def _find_object(doc, name, source):
     obj = doc.getObject(name) or next((o for o in doc.Objects if o.Label == name), None)
     if obj is None:
@@ -154,12 +165,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
     before = set(FreeCAD.listDocuments())
     doc, refused, info = open_document(document)
     try:
-        problems = restore_failures(doc, info=info)
-        if problems:
-            why = "".join("; module %s %s" % item for item in sorted(refused.items()))
-            raise InputError("%d object(s) did not restore, so the document cannot be updated "
-                             "safely (saving would lose them): %s%s"
-                             % (len(problems), "; ".join(problems), why), file=document)
+        check_restored(doc, refused, info, document)
         nominal = _find_object(doc, object_name, document)
         paths_before = toolpaths.snapshot(doc)
         report(progress, 0.1, "reading the measurements")

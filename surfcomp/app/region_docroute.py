@@ -28,8 +28,9 @@ from .document_route import (
     _jobs_using,
     _recompute,
     _write,
+    check_restored,
 )
-from .documents import open_document, restore_failures
+from .documents import open_document
 
 
 @dataclass
@@ -76,12 +77,7 @@ def run_region_document(document, measurements, object_name, faces, save, replac
     report(progress, 0.05, "opening %s" % os.path.basename(document))
     doc, refused, info = open_document(document)
     try:
-        problems = restore_failures(doc, info=info)
-        if problems:
-            why = "".join("; module %s %s" % item for item in sorted(refused.items()))
-            raise InputError("%d object(s) did not restore, so the document cannot be updated "
-                             "safely (saving would lose them): %s%s"
-                             % (len(problems), "; ".join(problems), why), file=document)
+        check_restored(doc, refused, info, document)
         nominal = _find_object(doc, object_name, document)
         if len(nominal.Shape.Solids) != 1:
             raise InputError("%s has %d solids: a region in a document is corrected on one "
