@@ -284,6 +284,20 @@ def _write(doc, result, save, gcode, text, declared):
         tx.commit()
 
 
+def outcome_lines(result):
+    """What a document route did to the document: the links moved to the compensation,
+    per Job which operations regenerated (commands changed) and which did not and why, and
+    the file saved."""
+    lines = []
+    if result.replaced:
+        lines.append("replaced the nominal in: %s"
+                     % ", ".join("%s.%s" % pair for pair in result.replaced))
+    lines += toolpaths.describe(result.toolpaths)
+    if result.saved:
+        lines.append("wrote %s" % result.saved)
+    return lines
+
+
 def summary_lines(result):
     """Short human-readable lines about a :class:`DocumentJobResult` (for the CLI)."""
     lines = ["compensation %s (measurement %s) added to the document"
@@ -293,13 +307,7 @@ def summary_lines(result):
                      "mm^3, the correction integrates to %.4f mm^3"
                      % (result.volume_change, -result.correction_volume))
     lines += [a for a in result.alignment if a not in result.alignment_warnings]
-    if result.replaced:
-        lines.append("replaced the nominal in: %s"
-                     % ", ".join("%s.%s" % pair for pair in result.replaced))
-    # per Job: which operations regenerated (commands changed), which did not and why
-    lines += toolpaths.describe(result.toolpaths)
-    if result.saved:
-        lines.append("wrote %s" % result.saved)
+    lines += outcome_lines(result)
     if result.gcode:
         lines.append("wrote %s (%d lines)" % (result.gcode, result.gcode_lines))
     return lines

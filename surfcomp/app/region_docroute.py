@@ -29,6 +29,7 @@ from .document_route import (
     _recompute,
     _write,
     check_restored,
+    outcome_lines,
 )
 from .documents import open_document
 
@@ -44,8 +45,6 @@ class RegionDocumentResult:
     jobs: list = field(default_factory=list)
     toolpaths: list = field(default_factory=list)
     saved: str = None
-    gcode: str = None
-    gcode_lines: int = 0
 
 
 def run_region_document(document, measurements, object_name, faces, save, replace=False,
@@ -132,13 +131,7 @@ def summary_lines(result):
                  + "; on no face: %d" % rep["points_on_no_face"])
     lines += summary(rep)
     lines.append(output_line(rep["output"]))
-    if result.replaced:
-        lines.append("replaced the nominal in: %s"
-                     % ", ".join("%s.%s" % pair for pair in result.replaced))
-    lines += toolpaths.describe(result.toolpaths)
-    if result.saved:
-        lines.append("wrote %s" % result.saved)
-    return lines
+    return lines + outcome_lines(result)
 
 
 __all__ = ["run_region_document", "RegionDocumentResult", "summary_lines"]
