@@ -214,6 +214,11 @@ def compute(obj, log=None):
         raise InputError("%s: Measurement is not a surfcomp measurement object" % obj.Label)
     check_method(obj.Method)
     earlier = chain(obj)[1:]
+    if earlier and obj.Faces.strip().lower() != "auto":
+        from .region import parse_faces
+
+        _same_faces(obj, earlier[0], ["Face%d" % (k + 1)
+                                      for k in parse_faces(obj.Faces, nominal.Shape)])
     fields = [base_field(b) for b in earlier]
     ms = features.measurement_set(meas)
     ms, alignment = aligned(meas, nominal.Shape, obj.Faces, ms)
@@ -233,18 +238,22 @@ def compute(obj, log=None):
         raise InputError("%s: %s is not one closed solid; a region in a document needs a "
                          "solid (compensate the faces to a file instead)"
                          % (obj.Label, nominal.Label))
-    names = [f["face"] for f in rep["faces"]]
-    if earlier and names != list(earlier[0].RegionFaces):
-        raise InputError("%s: the region is %s, but Base %s corrected %s (iterations must "
-                         "correct the same faces: set Faces to %s)"
-                         % (obj.Label, ",".join(names), earlier[0].Label,
-                            ",".join(earlier[0].RegionFaces), ",".join(earlier[0].RegionFaces)),
-                         options=("faces",))
+    if earlier:
+        _same_faces(obj, earlier[0], [f["face"] for f in rep["faces"]])
     rep["inputs"]["measurement_object"] = meas.Name
     rep["round"] = len(earlier) + 1
     rep["base"] = [b.Name for b in earlier]
     rep["alignment"] = None if alignment is None else alignment.as_dict()
     return RegionRun(shape, rep, own[0], alignment)
+
+
+def _same_faces(obj, base, names):
+    """Refuse a round whose faces are not its Base's."""
+    if sorted(names) != sorted(base.RegionFaces):
+        raise InputError("%s: the region is %s, but Base %s corrected %s (a next round "
+                         "corrects what the earlier ones corrected: set faces to %s)"
+                         % (obj.Label, ",".join(names), base.Label, ",".join(base.RegionFaces),
+                            ",".join(base.RegionFaces)), options=("faces",))
 
 
 def write_results(obj, run):
@@ -278,9 +287,16 @@ def make_region(doc, nominal, faces, measurement, name="RegionCompensation", bas
     names, or ``'auto'``) with the measurement object ``measurement``; ``base``: the
     previous round (a region object of the same nominal); ``options``: property values
     (``Method``, ``MaskSize``, ``MaxOffset``, ``MinCoverage`` ...)."""
-    if base is not None and not is_region(base):
-        raise InputError("%s is not a surfcomp region compensation (expected the previous "
-                         "round)" % base.Label)
+    rounds = 1
+    if base is not None:
+        if not is_region(base):
+            raise InputError("%s is not a surfcomp region compensation (expected the previous "
+                             "round)" % base.Label)
+        if base.Nominal != nominal:
+            raise InputError("%s compensates %s, not %s (iterations must compensate the same "
+                             "nominal)" % (base.Label, getattr(base.Nominal, "Label", None),
+                                           nominal.Label))
+        rounds = len(chain(base)) + 1
     obj = doc.addObject("Part::FeaturePython", name)
     RegionCompensationFeature(obj)
     obj.Nominal = nominal
@@ -290,7 +306,6 @@ def make_region(doc, nominal, faces, measurement, name="RegionCompensation", bas
     for key, value in options.items():
         if value is not None:
             setattr(obj, key, value)
-    rounds = len(chain(obj))
     obj.Label = "%s_region" % nominal.Label + ("" if rounds == 1 else " round %d" % rounds)
     return features._created(obj)
 
