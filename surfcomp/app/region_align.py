@@ -54,9 +54,9 @@ def aligned(meas, shape, faces_text, ms):
                          % (meas.Label, ms.kind()), file=ms.source)
     region = parse_faces(faces_text, shape)
     if region is None and opts.method != "none":
-        raise InputError("%s: AlignMethod %s with faces auto: name the region's faces "
-                         "(Face1,Face2,...); the region is chosen from where the aligned "
-                         "points lie, so it cannot be fitted first"
+        raise InputError("%s: align %s with faces auto: give the region's FaceN names "
+                         "instead of auto (the region is chosen from where the aligned points "
+                         "lie, so it cannot be fitted first)"
                          % (meas.Label, opts.method), options=("faces", "align"))
     if opts.method == "none":
         points, record = align(ms.measured, opts, [])
