@@ -146,6 +146,7 @@ class RegionCompensationFeature(Proxy):
 
     def onDocumentRestored(self, obj):
         super().onDocumentRestored(obj)
+        obj.setEditorMode("Base", 0)     # hidden and read-only in version 1 (no iterations)
         features._restored(obj)
 
     def execute(self, obj):

@@ -215,3 +215,35 @@ def test_a_field_kept_as_arrays_gives_the_same_values():
     arrays["weights"] = arrays["weights"][:-1]
     with pytest.raises(InputError, match="Round1 holds no usable correction field"):
         field_from_arrays(**arrays, source="Round1")
+
+
+def test_a_region_object_of_version_1_opens_and_is_refused_as_base_until_recomputed(rounds):
+    import FreeCAD
+
+    old = str(rounds["tmp"] / "version1.FCStd")
+    doc = FreeCAD.openDocument(rounds["out1"])
+    try:
+        r1 = doc.getObject("RegionCompensation")
+        for name in ("Round", "AlignMatrix", "Alignment", "FieldCentres", "FieldValues",
+                     "FieldWeights", "FieldMean", "FieldRadius"):
+            r1.removeProperty(name)
+        r1.Version = 1
+        r1.setEditorMode("Base", 3)
+        doc.saveAs(old)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    doc = FreeCAD.openDocument(old)
+    try:
+        r1 = doc.getObject("RegionCompensation")
+        assert r1.Version == 2 and r1.Round == 1 and list(r1.FieldCentres) == []
+        assert r1.getEditorMode("Base") == []
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    sha = _sha(old)
+    bad = str(rounds["tmp"] / "on_version1.FCStd")
+    r = _cli(old, rounds["second"], "--object", "RegionCompensation", "--faces", "Face1,Face2",
+             "--save", bad)
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert "Block_region holds no correction field to stack on (not computed, or saved by an " \
+           "earlier surfcomp): recompute it first" in r.stderr
+    assert not os.path.exists(bad) and _sha(old) == sha
