@@ -189,11 +189,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         result.jobs = [j.Name for j in jobs]
         result.toolpaths = toolpaths.compare(doc, paths_before, result.jobs)
         result.operations = [op.name for j in result.toolpaths for op in j.regenerated()]
-        text = None
-        if gcode:
-            job = _one_job(jobs, job_name)
-            report(progress, 0.9, "post-processing %s with %s" % (job.Label, post))
-            text = cam_job.post_process(job, post, post_args)
+        text = post_program(jobs, gcode, post, post_args, job_name, progress)
         result.statistics = json.loads(comp.Statistics)
         result.checks = json.loads(comp.Checks)
         result.warnings = list(comp.Warnings)
@@ -268,6 +264,16 @@ def _one_job(jobs, job_name):
     return jobs[0]
 
 
+def post_program(jobs, gcode, post, post_args, job_name, progress=None):
+    """The program of the one Job of ``jobs`` (``job_name`` picks it among several) posted
+    with ``post``, or None without ``gcode``."""
+    if not gcode:
+        return None
+    job = _one_job(jobs, job_name)
+    report(progress, 0.9, "post-processing %s with %s" % (job.Label, post))
+    return cam_job.post_process(job, post, post_args)
+
+
 def _write(doc, result, save, gcode, text, declared):
     with Transaction(*declared) as tx:
         if save:
@@ -286,8 +292,8 @@ def _write(doc, result, save, gcode, text, declared):
 
 def outcome_lines(result):
     """What a document route did to the document: the links moved to the compensation,
-    per Job which operations regenerated (commands changed) and which did not and why, and
-    the file saved."""
+    per Job which operations regenerated (commands changed) and which did not and why, the
+    file saved and the program posted."""
     lines = []
     if result.replaced:
         lines.append("replaced the nominal in: %s"
@@ -295,6 +301,8 @@ def outcome_lines(result):
     lines += toolpaths.describe(result.toolpaths)
     if result.saved:
         lines.append("wrote %s" % result.saved)
+    if getattr(result, "gcode", None):
+        lines.append("wrote %s (%d lines)" % (result.gcode, result.gcode_lines))
     return lines
 
 
@@ -307,10 +315,7 @@ def summary_lines(result):
                      "mm^3, the correction integrates to %.4f mm^3"
                      % (result.volume_change, -result.correction_volume))
     lines += [a for a in result.alignment if a not in result.alignment_warnings]
-    lines += outcome_lines(result)
-    if result.gcode:
-        lines.append("wrote %s (%d lines)" % (result.gcode, result.gcode_lines))
-    return lines
+    return lines + outcome_lines(result)
 
 
 __all__ = ["run_document_job", "DocumentJobResult", "summary_lines"]

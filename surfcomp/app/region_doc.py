@@ -11,13 +11,26 @@ per face, the continuity along every shared edge, the volume check) are written 
 read-only properties and the whole report to ``Report`` (JSON).
 
 It carries what :func:`surfcomp.app.replace.replace` needs of a compensation (``Output`` is
-always ``solid``, ``Base`` always empty, ``ReplacedLinks``), so the nominal's users (Path
-Job models, operations) can be moved to it and back.
+always ``solid``, ``ReplacedLinks``), so the nominal's users (Path Job models, operations)
+can be moved to it and back.
+
+Iterations: a region object whose ``Base`` is an earlier region object of the same nominal
+and faces takes a measurement of the part machined from the earlier result. Its deviations
+are against the nominal, its own field (the increment) comes from them, and the faces are
+rebuilt from the sum of the fields of every round
+(:mod:`surfcomp.core.compensation.region_rounds`). Each round keeps its own field in hidden
+properties (``Field*``), so the next round does not recompute the earlier ones.
+
+Alignment: the measurement object's Align* properties (as for one face,
+:mod:`surfcomp.app.align_doc`) align the points to the region's faces, or to datum faces
+(``AlignFaces``), before the deviations (:mod:`surfcomp.app.region_align`); the result goes
+to ``AlignMatrix`` and ``Alignment``.
 
 The proxy module path ``surfcomp.app.region_doc`` is permanent once documents exist.
 """
 
 import json
+from dataclasses import dataclass
 
 from ..core.choices import MASK_KINDS
 from ..core.compensation.filters import WERNER_MASK_SIZE
@@ -27,7 +40,7 @@ from .properties import QT_TRANSLATE_NOOP
 from .proxies import Proxy
 
 REGION_TYPE = "SurfComp_RegionCompensation"
-VERSION = 1
+VERSION = 2
 
 _IN = "Region"
 _OUT = "Region result"
@@ -64,7 +77,8 @@ REGION_PROPERTIES = (
      QT_TRANSLATE_NOOP(_T, "Always solid: the nominal's shape with the region corrected"),
      "solid", _RO | _HIDDEN),
     ("App::PropertyLink", "Base", _IN,
-     QT_TRANSLATE_NOOP(_T, "Not used by a region (no iterations)"), None, _RO | _HIDDEN),
+     QT_TRANSLATE_NOOP(_T, "The previous round (iterations): this measurement is of the part "
+                           "machined from Base's result"), None, 0),
     ("App::PropertyString", "ReplacedLinks", _IN,
      QT_TRANSLATE_NOOP(_T, "Links moved from the nominal to this object by Replace (JSON)"),
      "", _RO | _HIDDEN),
@@ -89,6 +103,29 @@ REGION_PROPERTIES = (
     ("App::PropertyFloat", "CorrIntegral", _OUT,
      QT_TRANSLATE_NOOP(_T, "-integral of the correction over the region (mm^3): the expected "
                            "volume change"), 0.0, _RO),
+    ("App::PropertyInteger", "Round", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Iteration round (1 without a Base)"), 1, _RO),
+    ("App::PropertyFloatList", "AlignMatrix", _OUT,
+     QT_TRANSLATE_NOOP(_T, "Alignment applied to the measured points (4x4 row-major, "
+                           "measured -> nominal; empty: none)"), None, _RO | _HIDDEN),
+    ("App::PropertyStringList", "Alignment", _OUT,
+     QT_TRANSLATE_NOOP(_T, "What the alignment did: method, transform, RMS per face"), None,
+     _RO),
+    ("App::PropertyFloatList", "FieldCentres", _OUT,
+     QT_TRANSLATE_NOOP(_T, "This round's correction field: kernel centres (x, y, z, mm)"),
+     None, _RO | _HIDDEN),
+    ("App::PropertyFloatList", "FieldValues", _OUT,
+     QT_TRANSLATE_NOOP(_T, "This round's correction field: values at the centres (mm)"),
+     None, _RO | _HIDDEN),
+    ("App::PropertyFloatList", "FieldWeights", _OUT,
+     QT_TRANSLATE_NOOP(_T, "This round's correction field: weights of the centres"),
+     None, _RO | _HIDDEN),
+    ("App::PropertyFloat", "FieldMean", _OUT,
+     QT_TRANSLATE_NOOP(_T, "This round's correction field: mean value (mm)"), 0.0,
+     _RO | _HIDDEN),
+    ("App::PropertyFloat", "FieldRadius", _OUT,
+     QT_TRANSLATE_NOOP(_T, "This round's correction field: kernel radius (mm)"), 0.0,
+     _RO | _HIDDEN),
     ("App::PropertyString", "Report", _OUT,
      QT_TRANSLATE_NOOP(_T, "The run's report (JSON)"), "", _RO | _HIDDEN),
     ("App::PropertyInteger", "Version", _OUT,
@@ -109,18 +146,66 @@ class RegionCompensationFeature(Proxy):
 
     def onDocumentRestored(self, obj):
         super().onDocumentRestored(obj)
+        obj.setEditorMode("Base", 0)     # hidden and read-only in version 1 (no iterations)
         features._restored(obj)
 
     def execute(self, obj):
-        shape, rep = compute(obj)
-        write_results(obj, rep)
+        run = compute(obj)
+        write_results(obj, run)
         # the result is in the document's coordinates (the nominal's shape is placed)
-        obj.Placement = shape.Placement
-        obj.Shape = shape
+        obj.Placement = run.shape.Placement
+        obj.Shape = run.shape
+
+
+@dataclass
+class RegionRun:
+    """What :func:`compute` gives: the shape, the report, this round's own field and the
+    alignment (None without one)."""
+
+    shape: object
+    report: dict
+    field: object
+    alignment: object = None
+
+
+def chain(obj):
+    """The region object and its ``Base`` chain, newest first.
+
+    Raises
+    ------
+    InputError
+        A ``Base`` that is not a region object, of another nominal, or a cycle.
+    """
+    out, seen, base = [obj], {obj.Name}, obj.Base
+    while base is not None:
+        if not is_region(base):
+            raise InputError("%s: Base %s is not a surfcomp region compensation (iterations "
+                             "stack region objects)" % (obj.Label, base.Label))
+        if base.Name in seen:
+            raise InputError("%s: the Base chain has a cycle at %s" % (obj.Label, base.Label))
+        if base.Nominal != obj.Nominal:
+            raise InputError("%s: Base %s compensates %s, not %s (iterations must compensate "
+                             "the same nominal)" % (obj.Label, base.Label,
+                                                    getattr(base.Nominal, "Label", None),
+                                                    getattr(obj.Nominal, "Label", None)))
+        seen.add(base.Name)
+        out.append(base)
+        base = base.Base
+    return out
+
+
+def base_field(base):
+    """The field of an earlier round, from its ``Field*`` properties."""
+    from ..core.compensation.region_rounds import field_from_arrays
+
+    return field_from_arrays(base.FieldCentres, base.FieldValues, base.FieldWeights,
+                             base.FieldMean, base.FieldRadius, source=base.Label)
 
 
 def compute(obj, log=None):
-    """``(shape, report)`` of a region object from its properties."""
+    """The :class:`RegionRun` of a region object from its properties."""
+    from ..core.compensation.region_rounds import StackedField
+    from .region_align import aligned
     from .region_route import check_method, compute_region
 
     nominal, meas = obj.Nominal, obj.Measurement
@@ -129,24 +214,55 @@ def compute(obj, log=None):
     if meas is None or not features.is_measurement(meas):
         raise InputError("%s: Measurement is not a surfcomp measurement object" % obj.Label)
     check_method(obj.Method)
+    earlier = chain(obj)[1:]
+    if earlier and obj.Faces.strip().lower() != "auto":
+        from .region import parse_faces
+
+        _same_faces(obj, earlier[0], ["Face%d" % (k + 1)
+                                      for k in parse_faces(obj.Faces, nominal.Shape)])
+    fields = [base_field(b) for b in earlier]
     ms = features.measurement_set(meas)
+    ms, alignment = aligned(meas, nominal.Shape, obj.Faces, ms)
+    own = []
+
+    def stack(field):
+        own.append(field)
+        return StackedField(fields, field) if fields else field
+
     lines = []
     shape, rep = compute_region(
         nominal.Shape, ms, obj.Faces, (nominal.Label, ms.source), method=obj.Method,
         mask_size=int(obj.MaskSize), mask_kind=obj.MaskKind, sigma=float(obj.Sigma) or None,
         max_offset=float(obj.MaxOffset.Value), min_coverage=float(obj.MinCoverage),
-        smoothing=float(obj.Smoothing.Value) or None, log=log or lines.append)
+        smoothing=float(obj.Smoothing.Value) or None, log=log or lines.append, stack=stack)
     if rep["output"]["kind"] != "solid":
         raise InputError("%s: %s is not one closed solid; a region in a document needs a "
                          "solid (compensate the faces to a file instead)"
                          % (obj.Label, nominal.Label))
+    if earlier:
+        _same_faces(obj, earlier[0], [f["face"] for f in rep["faces"]])
     rep["inputs"]["measurement_object"] = meas.Name
-    return shape, rep
+    rep["round"] = len(earlier) + 1
+    rep["base"] = [b.Name for b in earlier]
+    rep["alignment"] = None if alignment is None else alignment.as_dict()
+    return RegionRun(shape, rep, own[0], alignment)
 
 
-def write_results(obj, rep):
+def _same_faces(obj, base, names):
+    """Refuse a round whose faces are not its Base's."""
+    if sorted(names) != sorted(base.RegionFaces):
+        raise InputError("%s: the region is %s, but Base %s corrected %s (a next round "
+                         "corrects what the earlier ones corrected: set faces to %s)"
+                         % (obj.Label, ",".join(names), base.Label, ",".join(base.RegionFaces),
+                            ",".join(base.RegionFaces)), options=("faces",))
+
+
+def write_results(obj, run):
+    from ..core.compensation.region_rounds import field_arrays
+    from .align_doc import store
     from .region_route import output_line, summary
 
+    rep = run.report
     obj.RegionFaces = [f["face"] for f in rep["faces"]]
     obj.PointsPerFace = ["%s %d" % (f["face"], f["points"]) for f in rep["faces"]]
     obj.PointsOnNoFace = int(rep["points_on_no_face"])
@@ -155,22 +271,43 @@ def write_results(obj, rep):
     obj.MaxAngleChange = max((e["max_angle_change_deg"] for e in rep["edges"]), default=0.0)
     obj.VolChange = float(rep["output"]["change_mm3"])
     obj.CorrIntegral = float(rep["output"]["integral_mm3"])
+    obj.Round = int(rep["round"])
+    store(obj, run.alignment)
+    arrays = field_arrays(run.field)
+    obj.FieldCentres = arrays["centres"].ravel().tolist()
+    obj.FieldValues = arrays["values"].tolist()
+    obj.FieldWeights = arrays["weights"].tolist()
+    obj.FieldMean = arrays["mean"]
+    obj.FieldRadius = arrays["radius"]
     obj.Report = json.dumps(rep, sort_keys=True)
 
 
-def make_region(doc, nominal, faces, measurement, name="RegionCompensation", **options):
+def make_region(doc, nominal, faces, measurement, name="RegionCompensation", base=None,
+                **options):
     """Add a region compensation of ``nominal``'s ``faces`` (``'Face1,Face2'``, a list of
-    names, or ``'auto'``) with the measurement object ``measurement``; ``options``:
-    property values (``Method``, ``MaskSize``, ``MaxOffset``, ``MinCoverage`` ...)."""
+    names, or ``'auto'``) with the measurement object ``measurement``; ``base``: the
+    previous round (a region object of the same nominal); ``options``: property values
+    (``Method``, ``MaskSize``, ``MaxOffset``, ``MinCoverage`` ...)."""
+    rounds = 1
+    if base is not None:
+        if not is_region(base):
+            raise InputError("%s is not a surfcomp region compensation (expected the previous "
+                             "round)" % base.Label)
+        if base.Nominal != nominal:
+            raise InputError("%s compensates %s, not %s (iterations must compensate the same "
+                             "nominal)" % (base.Label, getattr(base.Nominal, "Label", None),
+                                           nominal.Label))
+        rounds = len(chain(base)) + 1
     obj = doc.addObject("Part::FeaturePython", name)
     RegionCompensationFeature(obj)
     obj.Nominal = nominal
+    obj.Base = base
     obj.Measurement = measurement
     obj.Faces = faces if isinstance(faces, str) else ",".join(faces)
     for key, value in options.items():
         if value is not None:
             setattr(obj, key, value)
-    obj.Label = "%s_region" % nominal.Label
+    obj.Label = "%s_region" % nominal.Label + ("" if rounds == 1 else " round %d" % rounds)
     return features._created(obj)
 
 
@@ -183,4 +320,4 @@ def options_record(obj):
 
 
 __all__ = ["RegionCompensationFeature", "make_region", "is_region", "REGION_TYPE"]
-__all__ += ["compute", "write_results", "options_record"]
+__all__ += ["compute", "write_results", "options_record", "chain", "RegionRun"]

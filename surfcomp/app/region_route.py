@@ -75,11 +75,12 @@ def check_method(method):
 
 def compute_region(shape, ms, faces_text, sources, method="filtered",
                    mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
-                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print):
+                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print, stack=None):
     """The region of ``shape`` (faces ``faces_text``: ``'Face1,Face2'`` or ``'auto'``)
     corrected by the measurement set ``ms``; ``sources``: the nominal's and the
-    measurements' names for the report and the errors. Returns ``(shape, report dict)``;
-    nothing is written."""
+    measurements' names for the report and the errors; ``stack``: a function given this
+    measurement's field that returns the field to correct by (an iteration adds the earlier
+    rounds'). Returns ``(shape, report dict)``; nothing is written."""
     nominal, measurements = sources
     base = _base(ms)
     chosen = region.parse_faces(faces_text, shape)
@@ -128,6 +129,8 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     bb = shape.BoundBox
     field_radius = smoothing or max(4.0 * step, region.FIELD_SHARE * bb.DiagonalLength)
     fld = region_field.RegionField(pts, filtered, field_radius)
+    if stack is not None:
+        fld = stack(fld)
     sharp = region.sharp_edges(faces, edges, band=field_radius)
     _check_neighbours(shape, faces, fld, sharp)
     for f in faces:

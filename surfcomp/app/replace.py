@@ -89,9 +89,16 @@ def _replaces(obj):
     return features.is_compensation(obj) or is_region(obj)
 
 
+def _chain(comp):
+    """``comp`` and its earlier rounds, newest first."""
+    from .region_doc import chain, is_region
+
+    return chain(comp) if is_region(comp) else features.chain(comp)
+
+
 def _targets(comp):
     """Objects whose users move to ``comp``: its nominal and the earlier rounds."""
-    return [comp.Nominal] + features.chain(comp)[1:]
+    return [comp.Nominal] + _chain(comp)[1:]
 
 
 def _sub_mapping(comp):
@@ -323,7 +330,7 @@ def replace(doc, comp):
             if "Visibility" in o.PropertiesList:
                 record["visibility"][o.Name] = bool(o.Visibility)
                 undo.set(o, "Visibility", vis)
-        for earlier in features.chain(comp)[1:]:
+        for earlier in _chain(comp)[1:]:
             if "Visibility" in earlier.PropertiesList and earlier.Visibility:
                 record["visibility"][earlier.Name] = True
                 undo.set(earlier, "Visibility", False)

@@ -71,6 +71,17 @@ def run(args):
     return run_job_command(args, "compensate")
 
 
+def align_of(args):
+    """The :class:`AlignOptions` of the --align options, or None without them: the files
+    are read and the transform checked before a document is opened."""
+    from ..app.alignment import align_options
+
+    if args.align != "none" or args.transform or args.rps or args.align_faces \
+            or args.align_dof:
+        return align_options(args)
+    return None
+
+
 def run_document(args):
     """The shop-document route: compensate, replace, save, post (see the option group)."""
     if not args.nominal.lower().endswith(".fcstd"):
@@ -88,12 +99,9 @@ def run_document(args):
     from ..app import fcenv
 
     fcenv.import_freecad()
-    from ..app.alignment import align_options
     from ..app.document_route import run_document_job, summary_lines
 
-    # the files are read and the transform checked before the document is opened
-    align = align_options(args) if (args.align != "none" or args.transform or args.rps
-                                    or args.align_faces or args.align_dof) else None
+    align = align_of(args)
 
     res = run_document_job(args.nominal, args.measurements, args.object, face=args.face,
                            save=args.save, replace=args.replace, gcode=args.gcode,

@@ -5,7 +5,7 @@ from ..errors import InputError
 
 
 def run_region_command(args):
-    if args.replace or args.save:
+    if args.replace or args.save or args.gcode:
         from .region_document import run_region_document_command
 
         return run_region_document_command(args)
@@ -16,9 +16,15 @@ def run_region_command(args):
                         ("--points", args.points), ("--curves", args.curves),
                         ("--html", args.html), ("--weights", args.weights),
                         ("--face-only", args.face_only), ("--flip-normals", args.flip_normals),
-                        ("--tip-radius", args.tip_radius), ("--stock", args.stock)):
+                        ("--tip-radius", args.tip_radius), ("--stock", args.stock),
+                        ("--align", args.align != "none"), ("--transform", args.transform),
+                        ("--rps", args.rps), ("--align-faces", args.align_faces),
+                        ("--align-dof", args.align_dof)):
         if value:
-            raise InputError("%s cannot be combined with --faces" % flag)
+            raise InputError("%s cannot be combined with --faces -o (it works with --faces on "
+                             "a document: --save OUT.FCStd)" % flag
+                             if flag.startswith(("--align", "--transform", "--rps")) else
+                             "%s cannot be combined with --faces" % flag)
     if not 0.0 <= args.min_coverage <= 1.0:
         raise InputError("--min-coverage must be between 0 and 1 (got %g)" % args.min_coverage)
     from ..app import fcenv

@@ -1,6 +1,9 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""``compensate DOC.FCStd MEAS --object O --faces F1,F2|auto [--replace] --save OUT.FCStd``:
-a region of faces compensated in a shop document (issue 30)."""
+"""``compensate DOC.FCStd MEAS --object O --faces F1,F2|auto [--replace] --save OUT.FCStd
+[--gcode OUT.ngc] [--align ...]``: a region of faces compensated in a shop document (issue
+30); ``--object`` naming a region object adds its next round."""
+
+import sys
 
 from ..errors import InputError
 from .common import ProgressLine
@@ -8,13 +11,13 @@ from .common import ProgressLine
 
 def run_region_document_command(args):
     if not args.nominal.lower().endswith(".fcstd"):
-        raise InputError("--replace/--save with --faces work on a FreeCAD document: NOMINAL "
-                         "must be an .FCStd file", file=args.nominal)
+        raise InputError("--replace/--save/--gcode with --faces work on a FreeCAD document: "
+                         "NOMINAL must be an .FCStd file", file=args.nominal)
     if not args.object:
         raise InputError("--object NAME is required with --faces and --replace/--save (the "
                          "object holding the region's faces)", file=args.nominal)
     for flag, value in (("--face", args.face), ("-o", args.output), ("--report", args.report),
-                        ("--gcode", args.gcode), ("--points", args.points),
+                        ("--points", args.points),
                         ("--curves", args.curves), ("--html", args.html),
                         ("--weights", args.weights), ("--face-only", args.face_only),
                         ("--flip-normals", args.flip_normals),
@@ -27,10 +30,13 @@ def run_region_document_command(args):
 
     fcenv.import_freecad()
     from ..app.region_docroute import run_region_document, summary_lines
+    from .compensate import align_of
 
     res = run_region_document(
         args.nominal, args.measurements, args.object, args.faces, args.save,
         replace=args.replace, overwrite_input=args.overwrite_input, units=args.units or "mm",
+        gcode=args.gcode, post=args.post, post_args=args.post_args, job_name=args.job,
+        align=align_of(args),
         deviation_units=args.deviation_units, fmt=args.fmt, sample=args.sample,
         max_memory=args.max_memory, progress=ProgressLine(args.quiet), Method=args.method,
         MaskSize=args.mask, MaskKind=args.mask_kind, Sigma=args.sigma or 0.0,
@@ -38,4 +44,6 @@ def run_region_document_command(args):
         Smoothing=args.smoothing or 0.0)
     for line in summary_lines(res):
         print(line)
+    for w in res.alignment_warnings:
+        print("warning: " + w, file=sys.stderr)
     return 0

@@ -471,17 +471,21 @@ class _ReplaceCommand(Command):
 
     def active(self):
         from ..app import replace
+        from .region_cmd import selected_replacing
 
-        comp = selected_compensation()
-        return comp is not None and replace.is_replacing(comp) == self.WHILE_REPLACING
+        # a wrong selection keeps the command active: run() says what to select
+        comp = selected_replacing()
+        return bool(FreeCADGui.Selection.getSelection()) and (
+            comp is None or replace.is_replacing(comp) == self.WHILE_REPLACING)
 
     def run(self):
         from ..app import recompute, replace, toolpaths
         from ..errors import Cancelled
         from . import busy
+        from .region_cmd import replacing_or_refuse
 
         # surfcomp.app.replace opens and commits its own transaction
-        comp = selected_compensation()
+        comp = replacing_or_refuse(self.WHILE_REPLACING)
         doc = comp.Document
         before = replace.summary(doc, comp) if self.WHILE_REPLACING else None
         paths_before = toolpaths.snapshot(doc)

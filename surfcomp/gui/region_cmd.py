@@ -5,6 +5,10 @@ view and a measurement object (selected, or the document's only one) give a
 together, continuity kept. One undo step; a region that cannot be corrected (a face covered
 too little, a step across an edge, a neighbour the correction would move) leaves the document
 as it was and says why. No numerics.
+
+Replace in document and Restore nominal (:mod:`surfcomp.gui.commands`) take a region object
+as they take a compensation: :func:`selected_replacing` finds it, and a wrong selection is
+told what to select (:func:`replacing_or_refuse`).
 """
 
 import FreeCAD
@@ -57,6 +61,36 @@ def plain_view(obj):
 for _hooks in (features.NEW_OBJECT_HOOKS, features.RESTORED_HOOKS):
     if plain_view not in _hooks:
         _hooks.append(plain_view)
+
+
+def selected_replacing():
+    """The one selected compensation or region compensation (nothing else selected), or
+    None."""
+    from ..app.region_doc import is_region
+
+    sel = FreeCADGui.Selection.getSelection()
+    if len(sel) != 1 or not (features.is_compensation(sel[0]) or is_region(sel[0])):
+        return None
+    return sel[0]
+
+
+def replacing_or_refuse(while_replacing):
+    """The selected compensation or region compensation; raises with what to select when
+    the selection holds something else."""
+    comp = selected_replacing()
+    if comp is not None:
+        return comp
+    labels = [o.Label for o in FreeCADGui.Selection.getSelection()]
+    if while_replacing:
+        what = translate("SurfComp", "Select the one compensation or region compensation "
+                                     "that replaces its nominal (in the tree or the 3D view), "
+                                     "then run Restore nominal")
+    else:
+        what = translate("SurfComp", "Select one compensation or region compensation (in the "
+                                     "tree or the 3D view): its result takes the nominal's "
+                                     "place, then run Replace in document")
+    raise InputError(what + translate("SurfComp", "; the selection holds %s") % (
+        ", ".join(labels) or translate("SurfComp", "nothing")))
 
 
 class CompensateRegion(Command):
