@@ -98,7 +98,7 @@ def _absorbed(record, refs, own, before_points, after, assign):
     on = np.isin(face, own) & np.all(np.isfinite(normal), axis=1)
     if not on.any():
         return
-    record.absorbed = absorbed(before[on], after[on], normal[on])
+    record.absorbed = dict(absorbed(before[on], after[on], normal[on]), where="region")
     record.warnings.append(
         "the best fit used the region's faces themselves: it absorbed a mean offset of %.3f "
         "um and a tilt of %.3f um of the machining error, which the corrected faces will "

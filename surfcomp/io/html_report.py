@@ -286,9 +286,10 @@ def _section_alignment(report):
                 "%.3f before, %.3f after (%d points)"
                 % (a["rms_before_um"].get(name, float("nan")), after, a["points"][name]))))
     if a.get("absorbed"):
-        rows.append(("Absorbed on the compensated face", _e(
-            "mean offset %.3f um, tilt %.3f um across the face"
-            % (a["absorbed"]["mean_offset_um"], a["absorbed"]["tilt_um"]))))
+        where = a["absorbed"].get("where", "face")
+        rows.append(("Absorbed on the compensated " + where, _e(
+            "mean offset %.3f um, tilt %.3f um across the %s"
+            % (a["absorbed"]["mean_offset_um"], a["absorbed"]["tilt_um"], where))))
     return '<section id="alignment"><h2>Alignment</h2>%s</section>' % _kv_table(rows)
 
 

@@ -148,6 +148,10 @@ def test_bestfit_on_the_region_itself_says_what_it_absorbed(shop):
     assert "absorbed a mean offset of %.3f um and a tilt of %.3f um" \
         % (absorbed["mean_offset_um"], absorbed["tilt_um"]) in r.stderr
     assert a["faces"] == ["Face1", "Face2"] and a["dof"] == ["z", "rx", "ry"]
+    # the summary speaks of the region, not of one face
+    assert absorbed["where"] == "region"
+    assert "absorbed on the compensated region: mean offset %.3f um" \
+        % absorbed["mean_offset_um"] in r.stdout
     # the robust fit weighs most of the ridge out, so it takes little of it: the deviations
     # change by the absorbed shift, and the volume removed by that shift over the 200 mm^2
     assert a["outliers"] > 500

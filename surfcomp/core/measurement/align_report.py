@@ -131,9 +131,10 @@ def summary_lines(d):
         if d["outliers"]:
             out.append("  %d point(s) weighted out as outliers" % d["outliers"])
     if d["absorbed"]:
-        out.append("  absorbed on the compensated face: mean offset %.3f um, tilt %.3f um "
-                   "across the face" % (d["absorbed"]["mean_offset_um"],
-                                        d["absorbed"]["tilt_um"]))
+        where = d["absorbed"].get("where", "face")
+        out.append("  absorbed on the compensated %s: mean offset %.3f um, tilt %.3f um "
+                   "across the %s" % (where, d["absorbed"]["mean_offset_um"],
+                                      d["absorbed"]["tilt_um"], where))
     return out
 
 
