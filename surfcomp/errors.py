@@ -9,6 +9,43 @@ lists the options it names in ``options``, and the command line shows them as it
 import re
 
 
+def renamed(text, options, name_of):
+    """``text`` with every option of ``options`` named as ``name_of(option)``; a word that
+    only contains an option's name, and a quoted value such as ``'rps'``, stay."""
+    for name in options:
+        text = re.sub(r"(?<![\w'-])%s(?![\w'-])" % re.escape(name),
+                      lambda _m, name=name: name_of(name), text)
+    return text
+
+
+class Note(str):
+    """A warning's text that names options as the API does (``refine``), with the options
+    it names in ``options``: the command line shows them as flags (``--refine``,
+    :func:`surfcomp.cli.option_flags.shown`), the GUI as field labels. Everything else
+    takes it as the plain string it is (reports, document properties).
+
+    Example: ``Note("a larger refine helps", ("refine",))``.
+    """
+
+    def __new__(cls, text, options=()):
+        note = super().__new__(cls, text)
+        note.options = tuple(options)
+        return note
+
+    def __reduce__(self):
+        return (Note, (str(self), self.options))
+
+    def __add__(self, other):      # "FILE:LINE: " + note stays a note
+        return Note(str(self) + other, self.options + getattr(other, "options", ()))
+
+    def __radd__(self, other):
+        return Note(other + str(self), getattr(other, "options", ()) + self.options)
+
+    def shown(self, name_of=None):
+        """The text with every option in ``options`` named as ``name_of(option)``."""
+        return renamed(str(self), self.options if name_of else (), name_of)
+
+
 class SurfcompError(Exception):
     """Base class of every error surfcomp raises on purpose.
 
@@ -44,12 +81,7 @@ class SurfcompError(Exception):
         """The text of ``str(self)`` with every option in ``options`` named as
         ``name_of(option)`` (the command line's ``--max-offset``) in the message; a quoted
         value such as ``'rps'`` is not an option's name."""
-        message = self.message
-        for name in self.options if name_of else ():
-            # a quoted value ('rps') stays as written
-            message = re.sub(r"(?<![\w'-])%s(?![\w'-])" % re.escape(name),
-                             lambda _m, name=name: name_of(name), message)
-        return self._where() + message
+        return self._where() + renamed(self.message, self.options if name_of else (), name_of)
 
     def _where(self):
         where = ""
