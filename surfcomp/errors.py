@@ -19,31 +19,60 @@ def renamed(text, options, name_of):
 
 
 class Note(str):
-    """A warning's text that names options as the API does (``refine``), with the options
-    it names in ``options``: the command line shows them as flags (``--refine``,
-    :func:`surfcomp.cli.option_flags.shown`), the GUI as field labels. Everything else
-    takes it as the plain string it is (reports, document properties).
+    """A warning's text that names options as the API does (``refine``): the command line
+    shows them as flags (``--refine``, :func:`surfcomp.cli.option_flags.shown`), the GUI as
+    field labels, a document as properties. Everything else takes it as the plain string it
+    is (reports, comparisons, JSON).
 
-    Example: ``Note("a larger refine helps", ("refine",))``.
+    ``refs``: ``(start, end, name)`` of each place the text names option ``name`` (only
+    those places are renamed: the same word in the prose stays); made by :func:`note`.
     """
 
-    def __new__(cls, text, options=()):
-        note = super().__new__(cls, text)
-        note.options = tuple(options)
-        return note
+    def __new__(cls, text, refs=()):
+        made = super().__new__(cls, text)
+        made.refs = tuple(refs)
+        return made
+
+    @property
+    def options(self):
+        """The options the text names, in order."""
+        return tuple(dict.fromkeys(name for _s, _e, name in self.refs))
 
     def __reduce__(self):
-        return (Note, (str(self), self.options))
+        return (Note, (str(self), self.refs))
 
-    def __add__(self, other):      # "FILE:LINE: " + note stays a note
-        return Note(str(self) + other, self.options + getattr(other, "options", ()))
+    def __add__(self, other):      # a note and more text stays a note
+        more = [(s + len(self), e + len(self), n) for s, e, n in getattr(other, "refs", ())]
+        return Note(str(self) + other, self.refs + tuple(more))
 
-    def __radd__(self, other):
-        return Note(other + str(self), getattr(other, "options", ()) + self.options)
+    def __radd__(self, other):     # "FILE:LINE: " + note
+        shift = len(other)
+        return Note(other + str(self), tuple(getattr(other, "refs", ())) + tuple(
+            (s + shift, e + shift, n) for s, e, n in self.refs))
 
     def shown(self, name_of=None):
-        """The text with every option in ``options`` named as ``name_of(option)``."""
-        return renamed(str(self), self.options if name_of else (), name_of)
+        """The text with every place that names an option as itself (``refine``) naming it
+        as ``name_of(option)``; a place already in a reader's words (``the compensation's
+        Refine``) stays."""
+        text = str(self)
+        for start, end, name in sorted(self.refs, reverse=True) if name_of else ():
+            if text[start:end] == name:
+                text = text[:start] + name_of(name) + text[end:]
+        return text
+
+
+def note(*parts):
+    """A :class:`Note` of ``parts``: strings, and ``(name,)`` or ``(name, text)`` where the
+    text names option ``name`` (as itself, or as ``text``: ``option_name(options,
+    "refine")``). Example: ``note("a larger ", ("refine",), " helps")``."""
+    text, refs = "", []
+    for part in parts:
+        if isinstance(part, tuple):
+            name, shown = part[0], part[-1]
+            refs.append((len(text), len(text) + len(shown), name))
+            part = shown
+        text += part
+    return Note(text, refs)
 
 
 class SurfcompError(Exception):

@@ -49,10 +49,12 @@ INPUTS = _table(
            unset="the only B-spline face", help="the nominal face (FaceN)", stored="Face1"),
     Option("object", str, None, None, flag="--object", metavar="NAME",
            help="object holding the face (FCStd only)"),
-    Option("units", str, None, None, flag="--units", choices=UNITS, unset="mm",
+    Option("units", str, None, None, label="Coordinates (x, y, z) in", flag="--units",
+           choices=UNITS, unset="mm",
            help="units of values that carry no unit of their own (column suffix, XYZIJK "
                 "METRIC, QIF FileUnits)"),
-    Option("deviation_units", str, None, None, flag="--deviation-units", choices=UNITS,
+    Option("deviation_units", str, None, None, label="Deviation column in",
+           flag="--deviation-units", choices=UNITS,
            unset="the same as {units}",
            help="unit of a deviation column without a unit of its own, when it is not the "
                 "coordinates' ({units}): a CMM report in mm with deviations in um"),

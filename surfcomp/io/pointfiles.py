@@ -39,7 +39,7 @@ import re
 
 import numpy as np
 
-from ..errors import InputError, MeasurementFileError, Note
+from ..errors import InputError, MeasurementFileError, note
 from .files import read_bytes
 from .measurement_set import (
     NORMAL_LENGTH_TOL,
@@ -115,9 +115,9 @@ def _resolve_units(units, file_units, warnings=None, line=0):
     """
     if (warnings is not None and units is not None and file_units is not None
             and unit_factor(units) != unit_factor(file_units)):
-        warnings.append((line, Note("the file states the unit of its lengths (%s); units %s "
-                                    "applies only to values that carry no unit of their own, so "
-                                    "the file's unit is used" % (file_units, units), ("units",))))
+        warnings.append((line, note("the file states its units (%s); " % file_units,
+                                    ("units",), " %s applies only to values without units of "
+                                    "their own, so the file's units are used" % units)))
     name = file_units if file_units is not None else ("mm" if units is None else units)
     factor = unit_factor(name)
     return _UNIT_NAMES.get(factor, name.strip().lower()), factor

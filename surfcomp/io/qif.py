@@ -62,7 +62,7 @@ from xml.parsers import expat
 
 import numpy as np
 
-from ..errors import InputError, MeasurementFileError, Note
+from ..errors import InputError, MeasurementFileError, note
 from .files import clip, read_bytes
 from .measurement_set import (
     DEV_CHECK_TOL,
@@ -265,8 +265,8 @@ def _choose(doc, blocks, samples, sample):
     listing = "; ".join(s.describe() for s in samples)
     if sample is None:
         if len(samples) > 1:
-            doc.warn(Note("the file holds %d measured parts (MeasurementResults): %s; the first "
-                          "is read, choose another with sample" % (len(samples), listing),
+            doc.warn(note("the file holds %d measured parts (MeasurementResults): %s; the first "
+                          "is read, choose another with " % (len(samples), listing),
                           ("sample",)))
         return 0
     if isinstance(sample, (bool, np.bool_)) or not isinstance(sample, (int, np.integer, str)):

@@ -227,7 +227,7 @@ def test_point_only_files_through_the_pipeline(tmp_path, kind):
     np.testing.assert_allclose(np.sort(got), np.sort(d.ravel()), atol=tol)
     assert rep["grid"]["shape"] == [15, 12] or rep["grid"]["shape"] == [12, 15]
     if kind == "xyz_inch_header":
-        assert "the file states the unit of its lengths (in); --units mm applies only" in out.stderr
+        assert "the file states its units (in); --units mm applies only" in out.stderr
 
 
 def test_html_report_written_with_the_other_outputs(example_run):

@@ -112,10 +112,10 @@ def test_the_other_objects_properties_are_the_registry_rows(fresh_doc):
 def test_document_warnings_name_the_properties():
     """A warning that names options (a Note) is kept in a document with the options named
     as its properties (the command line shows flags, the panels labels)."""
-    from surfcomp.errors import Note
+    from surfcomp.errors import note
 
-    note = Note("bring them near with transform, or name datum faces with align_faces",
-                ("transform", "align_faces"))
-    assert properties.property_text(note) == \
-        "bring them near with AlignTransform, or name datum faces with AlignFaces"
+    text = note("bring them near with ", ("transform",), ", or name datum faces with ",
+                ("align_faces",), " (a transform)")
+    assert properties.property_text(text) == \
+        "bring them near with AlignTransform, or name datum faces with AlignFaces (a transform)"
     assert properties.property_text("plain") == "plain"

@@ -60,7 +60,7 @@ def test_document_messages_name_the_property():
 def _messages_below_the_command_line():
     """``(where, AST of a message)`` of core and io: every raised exception, and every
     warning: an argument of ``*warn*.append/extend/insert(...)``, ``*.warn(...)`` and
-    ``Note(...)``, and what a function named ``*warning*`` returns."""
+    ``note(...)``, and what a function named ``*warning*`` returns."""
     import ast
     import os
 
@@ -91,10 +91,10 @@ def _is_warning(func):
     import ast
 
     if isinstance(func, ast.Name):
-        return func.id == "Note"
+        return func.id in ("Note", "note")
     if not isinstance(func, ast.Attribute):
         return False
-    if func.attr in ("warn", "Note"):
+    if func.attr in ("warn", "Note", "note"):
         return True
     return func.attr in ("append", "extend", "insert") and "warn" in ast.unparse(func.value)
 
@@ -124,8 +124,8 @@ def test_the_scan_finds_the_warnings():
     texts = [ast.unparse(node) for kind, _where, node in _messages_below_the_command_line()
              if kind == "warning"]
     joined = " ".join(texts)
-    for words in ("a larger %s helps", "the file states the unit of its lengths",
-                  "choose another with sample", "name datum faces with align_faces",
-                  "without %s every deviation"):
+    for words in ("the filtered method or a larger", "the file states its units",
+                  "choose another with", "name datum faces with", "stylus tip centres",
+                  "used as a scattered layout"):
         assert words in joined, words
     assert len(texts) > 20

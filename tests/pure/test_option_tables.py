@@ -16,7 +16,7 @@ from surfcomp.cli import build_parser
 from surfcomp.cli.option_flags import flag, shown
 from surfcomp.core.option_tables import ALIGN, INPUTS, MODEL, PLAN, PROGRAM, TABLES, find
 from surfcomp.core.options import OPTIONS, cli_help
-from surfcomp.errors import Note
+from surfcomp.errors import note
 from tests.conftest import ROOT
 
 
@@ -185,13 +185,19 @@ def test_a_note_is_the_plain_string_everywhere_else():
     import json
     import pickle
 
-    note = Note("a larger refine helps", ("refine",))
-    assert note == "a larger refine helps" and json.dumps([note]) == '["a larger refine helps"]'
-    assert pickle.loads(pickle.dumps(note)).options == ("refine",)
-    prefixed = "part.csv:3: " + note
-    assert prefixed.options == ("refine",)
-    assert shown(prefixed) == "part.csv:3: a larger --refine helps"
+    text = note("a larger ", ("refine",), " helps (refine: the knot spans)")
+    assert text == "a larger refine helps (refine: the knot spans)"
+    assert json.dumps([text]) == '["a larger refine helps (refine: the knot spans)"]'
+    assert pickle.loads(pickle.dumps(text)).refs == text.refs == ((9, 15, "refine"),)
+    prefixed = "part.csv:3: " + text + note("; see ", ("layout",))
+    assert prefixed.options == ("refine", "layout")
+    # only the places that name the option: the same word in the prose stays
+    assert shown(prefixed) == \
+        "part.csv:3: a larger --refine helps (refine: the knot spans); see --layout"
     assert shown("a plain refine") == "a plain refine"
+    # a place already in a reader's words stays (a document's warning)
+    doc = note("a larger ", ("refine", "the compensation's Refine"), " helps")
+    assert shown(doc) == "a larger the compensation's Refine helps"
 
 
 def test_reader_warnings_name_options_and_the_command_line_shows_flags(tmp_path):
@@ -200,10 +206,11 @@ def test_reader_warnings_name_options_and_the_command_line_shows_flags(tmp_path)
     path = tmp_path / "inch.xyz"
     path.write_text("x[in] y[in] z[in]\n0 0 0\n1 0 0\n0 1 0\n")
     ms = read_any(str(path), units="mm", fmt="xyz")
-    (warning,) = [w for w in ms.warnings if "unit of its lengths" in w]
+    (warning,) = [w for w in ms.warnings if "the file states its units" in w]
     assert warning.options == ("units",) and "--" not in warning
-    assert "; units mm applies only" in warning
-    assert "; --units mm applies only" in shown(warning)
+    assert "(in); units mm applies only to values without units of their own" in warning
+    assert "(in); --units mm applies only to values without units of their own" in \
+        shown(warning)
 
 
 def test_the_qif_sample_warning_shows_the_flag():
@@ -228,3 +235,32 @@ def test_the_alignment_warnings_name_options():
     assert "near with transform, or name datum faces with align_faces" in far
     assert "near with --transform, or name datum faces with --align-faces" in shown(far)
     assert shown(near).endswith("(name datum faces with --align-faces to keep them)")
+
+
+def test_the_readme_model_table_is_the_registry():
+    """README's table of the machining-process model lists each model option of the
+    registry with its flag, metavar and default."""
+    import os
+    import re
+
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as fh:
+        text = fh.read()
+    table = text[text.index("| term | option | default |"):]
+    table = table[:table.index("\n\n")]
+    listed = {}
+    for row in table.splitlines()[2:]:
+        _term, options, defaults = (c.strip() for c in row.strip("|").split("|"))
+        flags = re.findall(r"`(--[a-z-]+) ([^`]+)`", options)
+        values = re.split(r"[;]\s*|,\s(?=\d)", defaults) if len(flags) > 1 else [defaults]
+        for (flag_, metavar), value in zip(flags, values):
+            listed[flag_] = (metavar, value.split(" ")[0])
+
+    def shown_default(o):
+        if o.default is None:
+            return "the"                                   # "the stock"
+        if o.type is tuple:
+            return ",".join("%g" % x for x in o.default)
+        return "%g" % o.default
+
+    for name, o in MODEL.items():
+        assert listed[o.flag] == (o.metavar, shown_default(o)), name
