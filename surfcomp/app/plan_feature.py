@@ -22,7 +22,7 @@ from ..core.measurement.planning import (
 from ..core.option_tables import PLAN
 from ..errors import GeometryError
 from .features import _created, _Proxy
-from .properties import option_row
+from .properties import option_row, property_text
 
 PLAN_TYPE = "SurfComp_MeasurementPlan"
 PLAN_VERSION = 1
@@ -103,7 +103,7 @@ def compute_plan(obj):
     obj.PointIds = list(plan.ids)
     obj.Placed = int(plan.requested)
     obj.Kept = len(plan)
-    obj.Dropped = ["%d %s" % (n, REASONS.get(k) or PART_REASONS.get(k, k))
+    obj.Dropped = [property_text("%d " % n + (REASONS.get(k) or PART_REASONS.get(k, k)))
                    for k, n in plan.drop_counts().items()]
     obj.Travel = float(plan.travel)
     obj.SafeZ = float(plan.safe_z)

@@ -34,6 +34,7 @@ from ..io.atomic import Transaction
 from ..io.plan_file import dropped_text, plan_text
 from . import SUMMARIES, plan_program, registry
 from .common import ProgressLine, wrote
+from .option_flags import shown
 from .options import add_arguments
 
 #: the probe's options (the plan's reach checks and its probing program use them)
@@ -123,7 +124,7 @@ def _comments(args, plan, nominal):
 def _reason_text(key):
     from ..app.plan_reach import REASONS as PART
 
-    return REASONS.get(key) or PART.get(key, key)
+    return shown(REASONS.get(key) or PART.get(key, key))       # options named as flags
 
 
 def _write(args, plan, nominal):

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import InputError
+from ...errors import InputError, note
 from ..choices import PLAN_LAYOUTS as LAYOUTS
 from ..choices import PLAN_ORDERS as ORDERS
 from ..choices import POINT_LAYOUTS  # noqa: F401
@@ -66,7 +66,7 @@ FACE_SAMPLES = 40000
 REASONS = {
     "outside": "not on the trimmed face",
     "margin": "closer than the margin to the boundary or a hole",
-    "tilt": "normal leans more than --max-tilt from +Z",
+    "tilt": note("normal leans more than ", ("max_tilt",), " from +Z"),
     "approach": "the stylus meets the face on the approach along the normal",
     "descent": "the stylus meets the face on the descent from the safe height",
 }
