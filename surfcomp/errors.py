@@ -9,6 +9,72 @@ lists the options it names in ``options``, and the command line shows them as it
 import re
 
 
+def renamed(text, options, name_of):
+    """``text`` with every option of ``options`` named as ``name_of(option)``; a word that
+    only contains an option's name, and a quoted value such as ``'rps'``, stay."""
+    for name in options:
+        text = re.sub(r"(?<![\w'-])%s(?![\w'-])" % re.escape(name),
+                      lambda _m, name=name: name_of(name), text)
+    return text
+
+
+class Note(str):
+    """A warning's text that names options as the API does (``refine``): the command line
+    shows them as flags (``--refine``, :func:`surfcomp.cli.option_flags.shown`), the GUI as
+    field labels, a document as properties. Everything else takes it as the plain string it
+    is (reports, comparisons, JSON).
+
+    ``refs``: ``(start, end, name)`` of each place the text names option ``name`` (only
+    those places are renamed: the same word in the prose stays); made by :func:`note`.
+    """
+
+    def __new__(cls, text, refs=()):
+        made = super().__new__(cls, text)
+        made.refs = tuple(refs)
+        return made
+
+    @property
+    def options(self):
+        """The options the text names, in order."""
+        return tuple(dict.fromkeys(name for _s, _e, name in self.refs))
+
+    def __reduce__(self):
+        return (Note, (str(self), self.refs))
+
+    def __add__(self, other):      # a note and more text stays a note
+        more = [(s + len(self), e + len(self), n) for s, e, n in getattr(other, "refs", ())]
+        return Note(str(self) + other, self.refs + tuple(more))
+
+    def __radd__(self, other):     # "FILE:LINE: " + note
+        shift = len(other)
+        return Note(other + str(self), tuple(getattr(other, "refs", ())) + tuple(
+            (s + shift, e + shift, n) for s, e, n in self.refs))
+
+    def shown(self, name_of=None):
+        """The text with every place that names an option as itself (``refine``) naming it
+        as ``name_of(option)``; a place already in a reader's words (``the compensation's
+        Refine``) stays."""
+        text = str(self)
+        for start, end, name in sorted(self.refs, reverse=True) if name_of else ():
+            if text[start:end] == name:
+                text = text[:start] + name_of(name) + text[end:]
+        return text
+
+
+def note(*parts):
+    """A :class:`Note` of ``parts``: strings, and ``(name,)`` or ``(name, text)`` where the
+    text names option ``name`` (as itself, or as ``text``: ``option_name(options,
+    "refine")``). Example: ``note("a larger ", ("refine",), " helps")``."""
+    text, refs = "", []
+    for part in parts:
+        if isinstance(part, tuple):
+            name, shown = part[0], part[-1]
+            refs.append((len(text), len(text) + len(shown), name))
+            part = shown
+        text += part
+    return Note(text, refs)
+
+
 class SurfcompError(Exception):
     """Base class of every error surfcomp raises on purpose.
 
@@ -44,12 +110,7 @@ class SurfcompError(Exception):
         """The text of ``str(self)`` with every option in ``options`` named as
         ``name_of(option)`` (the command line's ``--max-offset``) in the message; a quoted
         value such as ``'rps'`` is not an option's name."""
-        message = self.message
-        for name in self.options if name_of else ():
-            # a quoted value ('rps') stays as written
-            message = re.sub(r"(?<![\w'-])%s(?![\w'-])" % re.escape(name),
-                             lambda _m, name=name: name_of(name), message)
-        return self._where() + message
+        return self._where() + renamed(self.message, self.options if name_of else (), name_of)
 
     def _where(self):
         where = ""

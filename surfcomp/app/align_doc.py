@@ -15,6 +15,7 @@ from ..core.measurement.align import check_rigid, describe, parse_dof
 from ..core.measurement.align_report import AlignOptions, summary_lines
 from ..errors import InputError
 from ..io.align_files import read_rps, read_transform
+from .properties import property_text
 
 
 def options_of(meas):
@@ -141,4 +142,5 @@ def store(obj, alignment):
         return
     d = None if alignment is None else alignment.as_dict()
     obj.AlignMatrix = [] if d is None else [float(x) for row in d["matrix"] for x in row]
-    obj.Alignment = [] if d is None else summary_lines(d) + list(alignment.warnings)
+    obj.Alignment = [] if d is None else summary_lines(d) + [property_text(w) for w in
+                                                            alignment.warnings]

@@ -66,6 +66,7 @@ from .properties import (
     RENAMED,
     VERSION,
     options_of,
+    property_text,
 )
 from .proxies import Proxy
 from .proxies import migrate as _migrate
@@ -141,7 +142,7 @@ def set_measurement_data(obj, ms):
     except InputError:
         obj.Kind = ""
     obj.Columns = json.dumps(dict(ms.columns or {}), sort_keys=True)
-    obj.ReadWarnings = [str(w) for w in (ms.warnings or [])]
+    obj.ReadWarnings = [property_text(w) for w in (ms.warnings or [])]
     obj.PointCount = n
 
 
@@ -508,7 +509,7 @@ def _write_results(obj, r):
     if comp.checks is not None or not obj.Preview:  # a preview keeps the face's checks
         values["Checks"] = json.dumps(comp.checks.as_dict() if comp.checks else {},
                                       sort_keys=True)
-    values["Warnings"] = [str(w) for w in p.warnings]
+    values["Warnings"] = [property_text(w) for w in p.warnings]
     values["Round"] = r.round
     if r.output is not None:                  # a preview keeps the shape's figures
         values["EdgeTol"] = float(r.output.edge_tolerance)

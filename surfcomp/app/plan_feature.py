@@ -13,41 +13,31 @@ permanent once documents exist.
 import FreeCAD
 
 from ..core.measurement.planning import (
-    LAYOUTS,
     POINT_LAYOUTS,
     REASONS,
     PlanSettings,
     check_points,
     parse_count,
 )
+from ..core.option_tables import PLAN
 from ..errors import GeometryError
 from .features import _created, _Proxy
+from .properties import option_row, property_text
 
 PLAN_TYPE = "SurfComp_MeasurementPlan"
 PLAN_VERSION = 1
-_DEF = PlanSettings()
 _RO = 1        # editor mode: read-only
 #: (type, name, group, tooltip, default, editor mode)
 PLAN_PROPERTIES = (
     ("App::PropertyInteger", "Version", "Base", "surfcomp object version", PLAN_VERSION, 1),
     ("App::PropertyLink", "Nominal", "Plan", "object holding the nominal face", None, 0),
     ("App::PropertyString", "Face", "Plan", "the nominal face (FaceN)", "Face1", 0),
-    ("App::PropertyEnumeration", "Layout", "Plan",
-     "grid: U x V along the parameter lines; xy: U x V in the machine's XY plane; adaptive: "
-     "denser where the slope changes fast; uniform: evenly spread", list(LAYOUTS), 0),
-    ("App::PropertyString", "Count", "Plan", "grid and xy: U x V points", "10x10", 0),
-    ("App::PropertyInteger", "Points", "Plan", "adaptive and uniform: number of points", 100,
-     0),
-    ("App::PropertyFloat", "TipRadius", "Probe", "stylus ball radius (mm)", _DEF.tip_radius, 0),
-    ("App::PropertyFloat", "EdgeMargin", "Probe",
-     "distance kept from the boundary and holes beyond the tip radius (mm)", _DEF.edge_margin,
-     0),
-    ("App::PropertyFloat", "MaxTilt", "Probe",
-     "largest angle between the outward normal and +Z (degrees)", _DEF.max_tilt, 0),
-    ("App::PropertyFloat", "StandOff", "Probe", "start of the touch along the normal (mm)",
-     _DEF.stand_off, 0),
-    ("App::PropertyFloat", "Clearance", "Probe", "safe height above the part's top (mm)",
-     _DEF.clearance, 0),
+    # the plan's settings: the option registry's PLAN table
+    option_row("App::PropertyEnumeration", "layout", "Plan", PLAN),
+    option_row("App::PropertyString", "count", "Plan", PLAN),
+    option_row("App::PropertyInteger", "points", "Plan", PLAN),
+    *(option_row("App::PropertyFloat", name, "Probe", PLAN)
+      for name in ("tip_radius", "edge_margin", "max_tilt", "stand_off", "clearance")),
     ("App::PropertyVectorList", "PlanPoints", "Result",
      "nominal surface points in visiting order (mm)", None, _RO),
     ("App::PropertyVectorList", "PlanNormals", "Result", "outward unit normals", None, _RO),
@@ -113,7 +103,7 @@ def compute_plan(obj):
     obj.PointIds = list(plan.ids)
     obj.Placed = int(plan.requested)
     obj.Kept = len(plan)
-    obj.Dropped = ["%d %s" % (n, REASONS.get(k) or PART_REASONS.get(k, k))
+    obj.Dropped = [property_text("%d " % n + (REASONS.get(k) or PART_REASONS.get(k, k)))
                    for k, n in plan.drop_counts().items()]
     obj.Travel = float(plan.travel)
     obj.SafeZ = float(plan.safe_z)

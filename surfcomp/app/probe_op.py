@@ -27,10 +27,12 @@ and leaves an empty ``Path`` (never the moves of an older plan). No FreeCADGui.
 
 import Path
 
+from ..core.option_tables import PROGRAM
 from ..errors import GCodeError, InputError
 from ..io.probe_path import WORK_OFFSETS, ProbeSettings, probe_path, travel_summary
 from . import cam, cam_job, progress
 from .features import _created, _restored
+from .properties import option_row
 from .proxies import Proxy
 
 PROBE_OP_TYPE = "SurfComp_ProbeOperation"
@@ -46,16 +48,11 @@ PROBE_OP_PROPERTIES = (
     ("App::PropertyBool", "Active", "Path", "post this operation", True, 0),
     ("App::PropertyLink", "ToolController", "Path", "the probe's tool controller", None, 0),
     ("App::PropertyLink", "Plan", "Probe", "the measurement plan to probe", None, 0),
-    ("App::PropertyEnumeration", "WorkOffset", "Probe",
-     "work offset the part was machined in", list(WORK_OFFSETS), 0),
-    ("App::PropertyFloat", "Overtravel", "Probe",
-     "how far past the nominal contact a probe move ends (mm)", _DEF.overtravel, 0),
-    ("App::PropertyFloat", "Feed", "Probe", "fast approach and retract feed (mm/min)",
-     _DEF.feed, 0),
-    ("App::PropertyFloat", "TouchFeed", "Probe", "probe move feed (mm/min)", _DEF.touch_feed,
-     0),
-    ("App::PropertyString", "LogFile", "Probe",
-     "file LinuxCNC writes the probe log to (PROBEOPEN)", _DEF.log_file, 0),
+    # the program's settings: the option registry's PROGRAM table
+    option_row("App::PropertyEnumeration", "work_offset", "Probe", PROGRAM),
+    *(option_row("App::PropertyFloat", name, "Probe", PROGRAM)
+      for name in ("overtravel", "feed", "touch_feed")),
+    option_row("App::PropertyString", "log_file", "Probe", PROGRAM),
     ("App::PropertyInteger", "Probes", "Result", "G38.2 probe moves in the Path", 0, _RO),
     ("App::PropertyFloat", "SafeHeight", "Result", "tip-centre Z of the traverses (mm)", 0.0,
      _RO),

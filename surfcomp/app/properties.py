@@ -11,6 +11,7 @@ Import this module where FreeCAD is importable.
 
 import FreeCAD
 
+from ..core.option_tables import ALIGN, INPUTS
 from ..core.options import OPTIONS, tooltip
 
 #: marks property tooltips for translation (FreeCAD translates them in the "App::Property"
@@ -31,6 +32,37 @@ OUTPUTS = ("face", "solid")
 
 _RO = 1      # editor mode: read-only
 _HIDDEN = 2  # editor mode: hidden
+#: the property value of an unset option (:mod:`surfcomp.core.options`)
+_UNSET = {float: 0.0, str: "", int: 0}
+
+
+def property_text(message):
+    """The text of a warning for a document property: the options a
+    :class:`surfcomp.errors.Note` names shown as their document properties (``align_faces``
+    -> ``AlignFaces``; :mod:`surfcomp.core.option_tables`); a plain string as it is."""
+    from ..core.option_tables import find
+
+    if not hasattr(message, "shown"):
+        return str(message)
+    return message.shown(lambda name: getattr(find(name), "prop", None) or name)
+
+
+def option_row(typ, name, group, table=OPTIONS, mode=0):
+    """The property row of option ``name`` of the option registry's ``table``
+    (:mod:`surfcomp.core.options`, :mod:`surfcomp.core.option_tables`): its property,
+    tooltip and default (an enumeration: the choices, the first one set; an unset option:
+    its ``stored`` value, else 0 or empty; a list: empty)."""
+    o = table[name]
+    if o.choices is not None:
+        default = list(o.choices)
+    elif o.default is not None:
+        default = o.default
+    elif o.stored is not None:
+        default = o.stored
+    else:
+        default = None if typ.endswith("List") else _UNSET[o.type]
+    return (typ, o.prop, group, QT_TRANSLATE_NOOP("App::Property", tooltip(name, table)),
+            default, mode)
 
 # (type, name, group, tooltip, default, editor mode)
 _MEAS = "Measurement"
@@ -106,37 +138,18 @@ MEASUREMENT_PROPERTIES = (
     ("App::PropertyStringList", "ReadWarnings", _MEAS,
      QT_TRANSLATE_NOOP("App::Property", "Warnings of the file reader"),
      None, _RO),
-    ("App::PropertyEnumeration", "AlignMethod", "Alignment",
-     QT_TRANSLATE_NOOP("App::Property", "Align the measured points to the nominal before the "
-                                        "deviations: none (they are in its frame), bestfit, "
-                                        "rps (3-2-1 on AlignRps); README 'Alignment'"),
-     ["none", "bestfit", "rps"], 0),
-    ("App::PropertyString", "AlignFaces", "Alignment",
-     QT_TRANSLATE_NOOP("App::Property", "Reference faces of the nominal, e.g. Face1,Face3 "
-                                        "(empty: the compensated face, which absorbs the "
-                                        "error's mean and tilt)"),
-     "", 0),
-    ("App::PropertyString", "AlignDof", "Alignment",
-     QT_TRANSLATE_NOOP("App::Property", "Degrees of freedom of the best fit: all, or some of "
-                                        "x y z rx ry rz (xyz, z, rz, ...)"),
-     "all", 0),
-    ("App::PropertyString", "AlignRps", "Alignment",
-     QT_TRANSLATE_NOOP("App::Property", "3-2-1 point ids: P1,P2,P3;P4,P5;P6 (the file's ids, "
-                                        "or 1-based point numbers)"),
-     "", 0),
-    ("App::PropertyFloatList", "AlignTransform", "Alignment",
-     QT_TRANSLATE_NOOP("App::Property", "Known rigid transform applied first: 16 numbers, the "
-                                        "4x4 matrix row-major, measured -> nominal (empty: "
-                                        "none)"),
-     None, 0),
+    # the alignment's settings: the option registry's ALIGN table
+    option_row("App::PropertyEnumeration", "align", "Alignment", ALIGN),
+    option_row("App::PropertyString", "align_faces", "Alignment", ALIGN),
+    option_row("App::PropertyString", "align_dof", "Alignment", ALIGN),
+    option_row("App::PropertyString", "rps", "Alignment", ALIGN),
+    option_row("App::PropertyFloatList", "transform", "Alignment", ALIGN),
     ("App::PropertyInteger", "Version", "Base",
      QT_TRANSLATE_NOOP("App::Property", "Property set version of this object"),
      VERSION, _HIDDEN),
 )
 
 _IN, _RES = "Compensation", "Result"
-#: the property value of an unset option (:mod:`surfcomp.core.options`)
-_UNSET = {float: 0.0, str: "", int: 0}
 
 
 def options_of(obj):
@@ -170,12 +183,8 @@ def store_options(obj, options):
 
 
 def _option(typ, name):
-    """The row of the compensation option ``name`` of the option registry: its property,
-    tooltip and default (an enumeration: the choices, the first one set)."""
-    o = OPTIONS[name]
-    default = (list(o.choices) if o.choices is not None else
-               _UNSET[o.type] if o.default is None else o.default)
-    return (typ, o.prop, _IN, QT_TRANSLATE_NOOP("App::Property", tooltip(name)), default, 0)
+    """The row of the compensation option ``name`` of the option registry."""
+    return option_row(typ, name, _IN)
 
 
 #: the results of an alignment on the compensation (its settings are the measurement's)
@@ -193,9 +202,7 @@ COMPENSATION_PROPERTIES = (
     ("App::PropertyLink", "Nominal", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Object holding the nominal face"),
      None, 0),
-    ("App::PropertyString", "FaceName", _IN,
-     QT_TRANSLATE_NOOP("App::Property", "The nominal face (FaceN of Nominal)"),
-     "Face1", 0),
+    option_row("App::PropertyString", "face", _IN, INPUTS),
     ("App::PropertyLink", "Measurement", _IN,
      QT_TRANSLATE_NOOP("App::Property", "Measurement object (SurfComp_Measurement)"),
      None, 0),

@@ -4,9 +4,10 @@
 import sys
 import time
 
-from ..core.choices import MEASUREMENT_FORMATS as FORMATS
 from ..core.memory import collector_paused
+from ..core.option_tables import INPUTS
 from . import registry
+from .option_flags import shown
 from .options import add_arguments
 
 
@@ -20,21 +21,7 @@ def add_job_parser(subparsers, name, summary, description):
 def add_input_options(p, command):
     """NOMINAL MEASUREMENTS, face choice, units, and the measurement checks."""
     registry.add_options(p, command, flags=("nominal", "measurements"))
-    p.add_argument("--face", metavar="FaceN",
-                   help="the nominal face (default: the only B-spline face)")
-    p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
-    p.add_argument("--units", choices=("mm", "um", "in"), default=None,
-                   help="units of values that carry no unit of their own (column suffix, "
-                        "XYZIJK METRIC, QIF FileUnits); default mm")
-    p.add_argument("--deviation-units", choices=("mm", "um", "in"), default=None,
-                   help="unit of a deviation column without a unit of its own, when it is "
-                        "not the coordinates' (--units): a CMM report in mm with deviations "
-                        "in um; default the same as --units")
-    p.add_argument("--format", dest="fmt", choices=FORMATS, default="auto",
-                   help="measurement file format (default auto: detected from the content)")
-    p.add_argument("--sample", metavar="N|ID",
-                   help="which measured part of a QIF file holding several: 0-based index, "
-                        "serial number or MeasurementResults id (default the first)")
+    add_arguments(p, ("face", "object", "units", "deviation_units", "fmt", "sample"), INPUTS)
     add_arguments(p, ("max_offset", "flip_normals", "layout", "tip_radius"))
     registry.add_options(p, command, flags=("--plan",))
     registry.add_options(p, command, flags=("--report", "--transform"))
@@ -104,7 +91,7 @@ def options_from_args(args):
     from ..core.compensation.pipeline import Options
     from ..core.options import OPTIONS
 
-    kw = {name: getattr(args, o.flag[2:].replace("-", "_"), o.default)
+    kw = {name: getattr(args, o.arg, o.default)
           for name, o in OPTIONS.items() if o.flag}
     return Options(**kw)
 
@@ -154,7 +141,7 @@ def print_summary(comp, rep, out=None):
         for line in summary_lines(rep["alignment"]):
             print(line, file=out)
     for w in p.warnings:
-        print("warning: " + w, file=sys.stderr)
+        print("warning: " + shown(w), file=sys.stderr)
     o = comp.options
     c = comp.correction
     print("", file=out)

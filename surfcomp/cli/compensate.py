@@ -12,6 +12,7 @@ from .common import (
     options_from_args,
     run_job_command,
 )
+from .option_flags import shown
 
 
 def add_parser(subparsers):
@@ -115,5 +116,5 @@ def run_document(args):
     for line in summary_lines(res):
         print(line)
     for w in res.alignment_warnings:
-        print("warning: " + w, file=sys.stderr)
+        print("warning: " + shown(w), file=sys.stderr)
     return 0

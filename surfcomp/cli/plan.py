@@ -22,22 +22,23 @@ import hashlib
 import os
 
 from ..core.measurement.planning import (
-    LAYOUTS,
-    MAX_POINTS,
-    ORDERS,
     POINT_LAYOUTS,
     REASONS,
     PlanSettings,
     check_points,
     parse_count,
 )
+from ..core.option_tables import INPUTS, PLAN
 from ..errors import InputError
 from ..io.atomic import Transaction
-from ..io.plan_file import PLAN_FORMATS, dropped_text, plan_text
+from ..io.plan_file import dropped_text, plan_text
 from . import SUMMARIES, plan_program, registry
 from .common import ProgressLine, wrote
+from .option_flags import shown
+from .options import add_arguments
 
-_DEFAULTS = PlanSettings()
+#: the probe's options (the plan's reach checks and its probing program use them)
+PROBE = ("tip_radius", "edge_margin", "max_tilt", "stand_off", "clearance")
 #: printed examples per drop reason
 _EXAMPLES = 3
 
@@ -57,40 +58,11 @@ def add_parser(subparsers):
                "--clearance out along the normal) and along the normal to the touch. See "
                "README 'On-machine probing'.")
     registry.add_options(p, "plan", flags=("nominal",))
-    p.add_argument("--face", metavar="FaceN",
-                   help="the nominal face (default: the only B-spline face)")
-    p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
+    add_arguments(p, ("face", "object"), INPUTS)
     registry.add_options(p, "plan", flags=("-o",))
-    p.add_argument("--format", dest="plan_format", choices=PLAN_FORMATS, default="csv",
-                   help="csv: the measurement-file contract (default); xyzijk: PC-DMIS "
-                        "nominal points")
-    p.add_argument("--layout", choices=LAYOUTS, default="grid",
-                   help="grid: U x V along the parameter lines (default); xy: U x V in the "
-                        "machine's XY plane clipped to the face; adaptive: --points N, denser "
-                        "where the slope changes fast; uniform: --points N spread evenly")
-    p.add_argument("--count", metavar="UxV", default=None,
-                   help="grid and xy: points along u (x) and v (y) (default 10x10; at most "
-                        "%d in all)" % MAX_POINTS)
-    p.add_argument("--points", type=int, default=None, metavar="N",
-                   help="adaptive and uniform: number of points (default 100; at most %d)"
-                        % MAX_POINTS)
-    g = p.add_argument_group("probe")
-    g.add_argument("--tip-radius", type=float, default=_DEFAULTS.tip_radius, metavar="MM",
-                   help="stylus ball radius (default %g mm)" % _DEFAULTS.tip_radius)
-    g.add_argument("--edge-margin", type=float, default=_DEFAULTS.edge_margin, metavar="MM",
-                   help="distance kept from the boundary and holes beyond the tip radius "
-                        "(default %g mm)" % _DEFAULTS.edge_margin)
-    g.add_argument("--max-tilt", type=float, default=_DEFAULTS.max_tilt, metavar="DEG",
-                   help="largest angle between the outward normal and the spindle axis +Z "
-                        "(default %g)" % _DEFAULTS.max_tilt)
-    g.add_argument("--stand-off", type=float, default=_DEFAULTS.stand_off, metavar="MM",
-                   help="distance along the normal from which the probe starts its touch "
-                        "(default %g mm)" % _DEFAULTS.stand_off)
-    g.add_argument("--clearance", type=float, default=_DEFAULTS.clearance, metavar="MM",
-                   help="safe height above the part's top (default %g mm)" % _DEFAULTS.clearance)
-    p.add_argument("--order", choices=ORDERS, default="auto",
-                   help="visiting order: serpentine rows, nearest neighbour, or auto (the "
-                        "shorter; default)")
+    add_arguments(p, ("plan_format", "layout", "count", "points"), PLAN)
+    add_arguments(p.add_argument_group("probe"), PROBE, PLAN)
+    add_arguments(p, ("order",), PLAN)
     registry.add_options(p, "plan", flags=("--dropped",))
     plan_program.add_program_options(p)
     p.add_argument("--quiet", action="store_true", help="print no progress lines")
@@ -111,11 +83,13 @@ def layout_count(args):
         if args.count is not None:
             raise InputError("--count applies to the grid and xy layouts; the %s layout "
                              "takes --points N" % args.layout)
-        return args.layout, check_points(100 if args.points is None else args.points)
+        return args.layout, check_points(PLAN["points"].stored if args.points is None
+                                         else args.points)
     if args.points is not None:
         raise InputError("--points applies to the adaptive layout; the %s layout takes --count "
                          "UxV" % args.layout)
-    return args.layout, parse_count("10x10" if args.count is None else args.count)
+    return args.layout, parse_count(PLAN["count"].stored if args.count is None
+                                    else args.count)
 
 
 def make_plan(path, face_name, object_name, layout, count, settings, order="auto",
@@ -133,7 +107,7 @@ def make_plan(path, face_name, object_name, layout, count, settings, order="auto
 def _comments(args, plan, nominal):
     s = plan.settings
     count = ("%d points" % plan.requested if plan.layout in POINT_LAYOUTS
-             else "%s" % (args.count or "10x10"))
+             else "%s" % (args.count or PLAN["count"].stored))
     return ["surfcomp measurement plan of %s (%s)" % (os.path.basename(args.nominal),
                                                     nominal.face_name),
             "layout %s %s: %d placed, %d kept, %d dropped"
@@ -150,7 +124,7 @@ def _comments(args, plan, nominal):
 def _reason_text(key):
     from ..app.plan_reach import REASONS as PART
 
-    return REASONS.get(key) or PART.get(key, key)
+    return shown(REASONS.get(key) or PART.get(key, key))       # options named as flags
 
 
 def _write(args, plan, nominal):

@@ -11,45 +11,22 @@ one transaction. The tip radius, the stand-off and the clearance are the plan co
 program makes with them).
 """
 
+from ..core.option_tables import PROGRAM
 from ..io.atomic import write_text
-from ..io.probe_path import DIALECTS, WORK_OFFSETS
 from ..io.probe_program import ProbeSettings, program_summary, program_text
 from . import registry
 from .common import wrote
+from .options import add_arguments
 
 
 def add_program_options(parser):
     """Add ``--program`` and the options of the probing program to ``parser``."""
-    d = ProbeSettings()
     g = parser.add_argument_group(
         registry.PROBE_PROGRAM,
         "Positions are stylus tip centres (set the probe's tool length to the ball's centre); "
         "the points are probed in the plan's order along their normals.")
     registry.add_options(parser, "plan", {registry.PROBE_PROGRAM: g}, flags=("--program",))
-    g.add_argument("--dialect", choices=DIALECTS, default=d.dialect,
-                   help="linuxcnc: G38.2 and a PROBEOPEN log; fanuc: G31 and macro B, "
-                        "#5061-#5063 written by DPRNT (default linuxcnc)")
-    g.add_argument("--tool", type=int, default=d.tool, metavar="N",
-                   help="the probe's tool number (default %d)" % d.tool)
-    g.add_argument("--work-offset", choices=WORK_OFFSETS, default=d.work_offset,
-                   help="the work offset the part was machined in (default G54)")
-    g.add_argument("--overtravel", type=float, default=d.overtravel, metavar="MM",
-                   help="how far past the nominal contact the probe move may go (default %g)"
-                        % d.overtravel)
-    g.add_argument("--feed", type=float, default=d.feed, metavar="MM/MIN",
-                   help="fast approach and retract feed (default %g)" % d.feed)
-    g.add_argument("--touch-feed", type=float, default=d.touch_feed, metavar="MM/MIN",
-                   help="probing feed (default %g)" % d.touch_feed)
-    g.add_argument("--second-touch", action="store_true",
-                   help="back off and touch again slower (a LinuxCNC log then holds two lines "
-                        "per point: read it back with --touches 2)")
-    g.add_argument("--second-feed", type=float, default=None, metavar="MM/MIN",
-                   help="feed of the second touch (default a fifth of --touch-feed)")
-    g.add_argument("--backoff", type=float, default=d.backoff, metavar="MM",
-                   help="back-off before the second touch (default %g)" % d.backoff)
-    g.add_argument("--probe-log", default=d.log_file, metavar="NAME",
-                   help="file LinuxCNC writes the probe log to (PROBEOPEN; default %s)"
-                        % d.log_file)
+    add_arguments(g, tuple(PROGRAM), PROGRAM)
 
 
 def settings_from_args(args, safe_z, plan_hash):

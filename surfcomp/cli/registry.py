@@ -12,6 +12,9 @@ the command's own options, so one entry here is all such an option needs.
 
 from dataclasses import dataclass, field
 
+from ..core.option_tables import ALIGN, INPUTS
+from .options import kwargs
+
 
 @dataclass(frozen=True)
 class Entry:
@@ -52,6 +55,11 @@ def _memory_size(text):
         return parse_size(text)
     except InputError as exc:
         raise argparse.ArgumentTypeError(exc.message.split(": ", 1)[1]) from None
+
+
+def _kw(name, table=ALIGN):
+    """argparse's keywords of a registry option (:mod:`surfcomp.core.option_tables`)."""
+    return kwargs(name, table)
 
 
 JOB = ("compensate", "inspect")
@@ -102,31 +110,12 @@ ENTRIES = (
                help="post the regenerated program of the Job using the compensation"),
           group=DOCUMENT),
     # ------------------------------------------------------------------ alignment (job commands)
-    Entry(JOB + ("simulate",), ("--transform",), "input", "--transform",
-          dict(metavar="FILE",
-               help="known rigid transform applied to the measured points before anything "
-                    "else: a 4x4 matrix (text or JSON {\"matrix\": ...}) or a work offset "
-                    "(JSON {\"translation\": [x,y,z], \"rotation_z_deg\": a}); see README "
-                    "'Alignment'")),
-    Entry(JOB + ("simulate",), ("--align",), "option", "--align",
-          dict(choices=("none", "bestfit", "rps"), default="none",
-               help="align the measured points to the nominal before the deviations: none "
-                    "(default: they are in the nominal's frame), bestfit (robust least "
-                    "squares on the exact distance to the reference faces) or rps (3-2-1 on "
-                    "the points of --rps)")),
-    Entry(JOB, ("--align-faces",), "option", "--align-faces",
-          dict(metavar="F1,F2", default=None,
-               help="reference faces of the nominal shape for the alignment (datum faces); "
-                    "default the compensated face itself, which absorbs the machining "
-                    "error's mean and tilt (reported)")),
-    Entry(JOB + ("simulate",), ("--align-dof",), "option", "--align-dof",
-          dict(metavar="DOF", default=None,
-               help="degrees of freedom the best fit may move: all (default) or a "
-                    "combination of x y z rx ry rz, e.g. xyz, z, rz, xy,rz")),
-    Entry(JOB + ("simulate",), ("--rps",), "option", "--rps",
-          dict(metavar="FILE|IDS", default=None,
-               help="3-2-1 point ids for --align rps: a JSON file {\"primary\": [3 ids], "
-                    "\"secondary\": [2], \"tertiary\": [1]} or inline P1,P2,P3;P4,P5;P6")),
+    # (flags, defaults, choices and help from the option registry's ALIGN table)
+    Entry(JOB + ("simulate",), ("--transform",), "input", "--transform", _kw("transform")),
+    Entry(JOB + ("simulate",), ("--align",), "option", "--align", _kw("align")),
+    Entry(JOB, ("--align-faces",), "option", "--align-faces", _kw("align_faces")),
+    Entry(JOB + ("simulate",), ("--align-dof",), "option", "--align-dof", _kw("align_dof")),
+    Entry(JOB + ("simulate",), ("--rps",), "option", "--rps", _kw("rps")),
     # ------------------------------------------------------------------ simulate
     Entry(("simulate",), ("nominal",), "input", "NOMINAL",
           dict(metavar="NOMINAL", nargs="?",
@@ -172,11 +161,7 @@ ENTRIES = (
                help="compensated program (written atomically; - for standard output)")),
     Entry(("gcode",), ("--report",), "output", "--report",
           dict(metavar="OUT.json", help="write the JSON report")),
-    Entry(JOB, ("--touches",), "option", "--touches",
-          dict(type=int, default=1, metavar="K",
-               help="with --plan: probe moves per point in the log (2 for a LinuxCNC program "
-                    "written with --second-touch; the last one of each point is used; "
-                    "default 1)")),
+    Entry(JOB, ("--touches",), "option", "--touches", _kw("touches", INPUTS)),
     # ------------------------------------------------------------------ every command
     Entry(("compensate", "inspect", "simulate", "gcode"), ("--max-memory",), "option",
           "--max-memory",

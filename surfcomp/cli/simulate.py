@@ -51,11 +51,11 @@ extent (-1 .. 1). With the defaults the bundled example face spans about
 import json
 import os
 import sys
-from dataclasses import fields
 
 import numpy as np
 
 from ..core import budget
+from ..core.option_tables import INPUTS, MODEL
 from ..core.options import OPTIONS
 from ..core.progress import sub
 from ..core.simulation import presets as presets_
@@ -64,30 +64,16 @@ from ..errors import InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
-from . import SUMMARIES, registry, simulate_plan
+from . import SUMMARIES, option_flags, registry, simulate_plan
 from .common import ProgressLine, wrote
 from .options import add_arguments
 
-_DEFAULTS = {f.name: f.default for f in fields(sim.MachiningModel)}
-#: model options: (option name, metavar, help, values per option, may be negative)
-_MODEL_OPTIONS = (
-    ("offset", "MM", "constant error (tool radius/wear)", 1, True),
-    ("slope-gain", "MM", "error per unit slope along the feed (signed)", 1, True),
-    ("abs-slope-gain", "MM", "error per unit |slope| along the feed", 1, True),
-    ("tilt", "F,C", "linear error at the work-area border along,across the feed", 2, True),
-    ("bow", "F,C", "quadratic error at the border along,across the feed", 2, True),
-    ("deflection", "K0,KS,KA", "deflection per mm of engagement: constant, per unit slope, "
-                               "per unit |slope| (mm/mm)", 3, True),
-    ("waviness", "MM", "amplitude of a periodic error along the feed", 1, True),
-    ("wavelength", "MM", "wavelength of the waviness", 1, False),
-    ("feed", "X,Y,Z", "feed direction", 3, True),
-    ("tool-axis", "X,Y,Z", "tool axis", 3, True),
-    ("sigma", "MM", "random machining error of every pass, standard deviation", 1, False),
-    ("correlation-length", "MM", "correlation length of the random part (0: independent)", 1,
-     False),
-    ("probe-sigma", "MM", "measurement noise, standard deviation", 1, False),
-    ("semi-engagement", "MM", "depth the semi-finishing pass removes", 1, False),
-)
+
+def _count(o):
+    """How many comma-separated numbers a model option of the registry takes."""
+    return len(o.default) if o.type is tuple else 1
+
+
 _LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4, "between": 2}
 
 
@@ -115,9 +101,7 @@ def add_parser(subparsers):
                "removes: semi-engagement, then stock + the semi-finishing error). Presets: %s. "
                "See README 'Virtual machining'." % ", ".join(presets_.PRESETS))
     registry.add_options(p, "simulate", flags=("nominal",))
-    p.add_argument("--face", metavar="FaceN",
-                   help="the nominal face (default: the only B-spline face)")
-    p.add_argument("--object", metavar="NAME", help="object holding the face (FCStd only)")
+    add_arguments(p, ("face", "object"), INPUTS)
     p.add_argument("--preset", metavar="NAME",
                    help="a case imitating a paper: %s (its surface, model, grid and the "
                         "paper's table)" % ", ".join(presets_.PRESETS))
@@ -147,10 +131,9 @@ def add_parser(subparsers):
     add_arguments(g, ("refine",))
     g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
     m = p.add_argument_group(registry.SIM_MODEL)
-    for name, metavar, text, _, _ in _MODEL_OPTIONS:
-        key = name.replace("-", "_")
-        m.add_argument("--" + name, dest=key, metavar=metavar, default=None,
-                       help="%s (default %s, or the preset's)" % (text, _fmt(_DEFAULTS[key])))
+    for o in MODEL.values():        # the preset's values apply where an option is not given
+        m.add_argument(o.flag, dest=o.name, metavar=o.metavar, default=None,
+                       help="%s (default %s, or the preset's)" % (o.help, _fmt(o.default)))
     registry.add_options(p, "simulate", {registry.SIM_MODEL: m}, flags=("--axis-errors",))
     m.add_argument("--axis-units", choices=("mm", "um", "in"), default="mm",
                    help="units of the axis error file without unit suffixes (default mm)")
@@ -226,12 +209,11 @@ def model_from_args(args, preset=None):
     """The :class:`MachiningModel` of the command-line options: explicit options, else the
     preset's values, else the dataclass' defaults."""
     kw = dict(preset.model) if preset is not None else {}
-    for name, _, _, count, negative in _MODEL_OPTIONS:
-        key = name.replace("-", "_")
+    for key, o in MODEL.items():
         val = getattr(args, key)
         if val is not None:
-            vals = _numbers(val, count, "--" + name, negative)
-            kw[key] = vals[0] if count == 1 else vals
+            vals = _numbers(val, _count(o), o.flag, o.low is None)
+            kw[key] = vals[0] if _count(o) == 1 else vals
     if args.stock is not None:
         kw["stock"] = float(args.stock)
     if args.axis_errors:
@@ -356,7 +338,7 @@ def run(args):
     for line in aligner.summary() if aligner is not None else ():
         print(line)
     for line in _align_warnings(aligner):
-        print("warning: " + line, file=sys.stderr)
+        print("warning: " + option_flags.shown(line), file=sys.stderr)
     return 0
 
 

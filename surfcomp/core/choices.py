@@ -23,3 +23,18 @@ MASK_KINDS = ("box", "gaussian")
 #: how the measured points are arranged: found automatically (a complete grid, else
 #: scattered), or forced (:func:`surfcomp.core.compensation.pipeline.prepare`)
 LAYOUTS = ("auto", "grid", "scattered")
+#: units of values that carry no unit of their own (:mod:`surfcomp.io.measurements`)
+UNITS = ("mm", "um", "in")
+#: how measured points are aligned to the nominal
+#: (:data:`surfcomp.core.measurement.align_report.METHODS`)
+ALIGN_METHODS = ("none", "bestfit", "rps")
+#: where a measurement plan places its points; the layouts whose count is a number of
+#: points; visiting orders; plan file formats (:mod:`surfcomp.core.measurement.planning`,
+#: :data:`surfcomp.io.plan_file.PLAN_FORMATS`)
+PLAN_LAYOUTS = ("grid", "xy", "adaptive", "uniform")
+POINT_LAYOUTS = ("adaptive", "uniform")
+PLAN_ORDERS = ("auto", "serpentine", "nearest")
+PLAN_FORMATS = ("csv", "xyzijk")
+#: probing program dialects and work offsets (:mod:`surfcomp.io.probe_path`)
+PROBE_DIALECTS = ("linuxcnc", "fanuc")
+WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")

@@ -22,9 +22,9 @@ from PySide.QtCore import QT_TRANSLATE_NOOP
 from ..app import align_doc, features
 from ..app.undo import UndoStep
 from ..core.measurement.align import DOF_NAMES, parse_dof
-from ..core.measurement.align_report import METHODS
+from ..core.option_tables import ALIGN
 from ..errors import SurfcompError
-from . import dialogs
+from . import dialogs, option_labels
 from .commands import Command, selected
 from .task_panel import UndoTaskPanel
 
@@ -77,13 +77,10 @@ class AlignPanel(UndoTaskPanel):
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("SurfComp", "Align measurements"))
         lay = QtGui.QVBoxLayout(self.form)
+        methods = list(ALIGN["align"].choices)
         self.method = QtGui.QComboBox()
-        self.method.addItems(list(METHODS))
-        self.method.setCurrentIndex(list(METHODS).index(meas.AlignMethod))
-        self.method.setToolTip(translate(
-            "SurfComp", "none: the points are in the nominal's frame (after the transform, "
-                        "if any); bestfit: robust least squares on the exact distance; rps: "
-                        "3-2-1 on six point ids"))
+        self.method.addItems(methods)
+        self.method.setCurrentIndex(methods.index(meas.AlignMethod))
         self.faces = QtGui.QLineEdit(meas.AlignFaces)
         self.faces.setPlaceholderText(translate("SurfComp", "the compensated face"))
         self.faces_button = QtGui.QPushButton(translate("SurfComp", "From selection"))
@@ -109,18 +106,20 @@ class AlignPanel(UndoTaskPanel):
         self.result = QtGui.QPlainTextEdit()
         self.result.setReadOnly(True)
         self.result.setMinimumHeight(18 * self.result.fontMetrics().lineSpacing())
-        # labels above their fields: the task view is narrow
-        for label, field in ((translate("SurfComp", "Method"), self.method),
-                             (translate("SurfComp", "Reference faces"),
-                              _row(self.faces, self.faces_button)),
-                             (translate("SurfComp", "Degrees of freedom (best fit)"), dof_grid),
-                             (translate("SurfComp", "3-2-1 point ids"),
-                              _row(self.rps, self.rps_button)),
-                             (translate("SurfComp", "Known transform"), self.transform)):
-            lay.addWidget(QtGui.QLabel(label))
+        # labels above their fields (the task view is narrow); labels and tooltips are the
+        # option registry's, as messages name the options
+        for name, field in (("align", self.method),
+                            ("align_faces", _row(self.faces, self.faces_button)),
+                            ("align_dof", dof_grid),
+                            ("rps", _row(self.rps, self.rps_button)),
+                            ("transform", self.transform)):
+            label = QtGui.QLabel(option_labels.label(name, ("align",)))
+            label.setToolTip(option_labels.tip(name, "align"))
+            lay.addWidget(label)
             if isinstance(field, QtGui.QLayout):
                 lay.addLayout(field)
             else:
+                field.setToolTip(option_labels.tip(name, "align"))
                 lay.addWidget(field)
         lay.addWidget(_row(self.transform_button, self.clear_button))
         lay.addWidget(self.apply_button)
@@ -171,7 +170,7 @@ class AlignPanel(UndoTaskPanel):
         try:
             self.matrix = align_doc.transform_from_file(path)
         except SurfcompError as exc:
-            self._message(str(exc))
+            self._message(option_labels.shown(exc, ("align",)))
             return
         self._show_transform()
 
@@ -186,7 +185,7 @@ class AlignPanel(UndoTaskPanel):
         try:
             self.rps.setText(align_doc.rps_from_file(path))
         except SurfcompError as exc:
-            self._message(str(exc))
+            self._message(option_labels.shown(exc, ("align",)))
 
     def values(self):
         """The fields as property values."""
@@ -214,7 +213,7 @@ class AlignPanel(UndoTaskPanel):
                                           v["AlignDof"], v["AlignRps"], v["AlignTransform"])
             align_doc.trial(self.comp, opts)
         except SurfcompError as exc:
-            self._message(str(exc))
+            self._message(option_labels.shown(exc, ("align",)))
             return False
         lines = ["_meas = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.meas.Name)]
         lines += ["_meas.%s = %r" % (k, x) for k, x in v.items()]

@@ -19,7 +19,7 @@ from .. import paths
 from ..app import features
 from ..app.undo import UndoStep
 from ..errors import ComputationError, InputError, SurfcompError
-from . import dialogs, fcgui, plan_panel, prefs
+from . import dialogs, fcgui, option_labels, plan_panel, prefs
 
 translate = FreeCAD.Qt.translate
 
@@ -164,7 +164,8 @@ class Command:
         except SurfcompError as exc:
             if doc is not None and doc.HasPendingTransaction:
                 doc.abortTransaction()
-            dialogs.show_error(translate("SurfComp", "SurfComp: %s") % self.MENU, str(exc))
+            dialogs.show_error(translate("SurfComp", "SurfComp: %s") % self.MENU,
+                               option_labels.shown(exc))
 
     def run(self):
         raise NotImplementedError

@@ -20,7 +20,7 @@ from ..core.compensation import plausibility
 from ..core.compensation.deviations import Statistics, format_table
 from ..core.options import OPTIONS, tooltip
 from ..errors import SurfcompError
-from . import dialogs, prefs
+from . import dialogs, option_labels, prefs
 from .task_panel import ok_cancel_buttons
 
 translate = FreeCAD.Qt.translate
@@ -165,10 +165,9 @@ class FilterPanel:
         self.figures = QtGui.QLabel("")
         self.figures.setWordWrap(True)
         self.figures.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse)
-        lay.addRow(translate("SurfComp", "Mask size"), self.mask)
-        lay.addRow(translate("SurfComp", "Mask kind"), self.kind)
-        lay.addRow(translate("SurfComp", "Weights"), self.weights)
-        lay.addRow(translate("SurfComp", "Edge handling"), self.edge)
+        for name, field in (("mask_size", self.mask), ("mask_kind", self.kind),
+                            ("weights", self.weights), ("edge", self.edge)):
+            lay.addRow(option_labels.label(name), field)    # the names messages show
         lay.addRow(translate("SurfComp", "Show map"), self.show)
         lay.addRow(self.figures)
         lay.addRow(self.status)
@@ -211,7 +210,7 @@ class FilterPanel:
         try:
             size = check_filter(self.obj, **self.values())
         except SurfcompError as exc:
-            self._message(str(exc), bad=True)
+            self._message(option_labels.shown(exc), bad=True)
             return False
         if custom and size != self.mask.value():
             self.mask.blockSignals(True)

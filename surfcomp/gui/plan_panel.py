@@ -15,7 +15,9 @@ from PySide import QtGui
 
 from ..app import features
 from ..app.undo import UndoStep
-from ..core.measurement.planning import LAYOUTS, MAX_POINTS, POINT_LAYOUTS
+from ..core.measurement.planning import POINT_LAYOUTS
+from ..core.option_tables import PLAN
+from . import option_labels
 from .task_panel import UndoTaskPanel
 
 translate = FreeCAD.Qt.translate
@@ -66,27 +68,29 @@ class PlanPanel(UndoTaskPanel):
         self.form.setWindowTitle(translate("SurfComp", "Plan measurement"))
         lay = QtGui.QFormLayout(self.form)
         self.layout = QtGui.QComboBox()
-        self.layout.addItems(list(LAYOUTS))
-        self.layout.setToolTip(translate(
-            "SurfComp", "grid: U x V along the parameter lines; xy: U x V in the machine's XY "
-                        "plane; adaptive: denser where the slope changes fast; uniform: evenly "
-                        "spread"))
+        self.layout.addItems(list(PLAN["layout"].choices))
         u, v = (int(x) for x in obj.Count.lower().split("x"))
         self.count_u, self.count_v = _spin(u, 1, 1000), _spin(v, 1, 1000)
-        self.points = _spin(int(obj.Points), 1, MAX_POINTS)
+        self.points = _spin(int(obj.Points), PLAN["points"].low, PLAN["points"].high)
         self.tip = _spin(obj.TipRadius, 0.001, 100.0, 0.1, 3)
         self.margin = _spin(obj.EdgeMargin, 0.0, 100.0, 0.1, 3)
-        self.tilt = _spin(obj.MaxTilt, 0.0, 90.0, 5.0, 1)
+        tilt = PLAN["max_tilt"]
+        self.tilt = _spin(obj.MaxTilt, tilt.low, tilt.high, 5.0, 1)
         self.result = QtGui.QLabel("")
         self.result.setWordWrap(True)
         self.plan_button = QtGui.QPushButton(translate("SurfComp", "Plan"))
-        lay.addRow(translate("SurfComp", "Layout"), self.layout)
-        lay.addRow(translate("SurfComp", "Points along u (x)"), self.count_u)
-        lay.addRow(translate("SurfComp", "Points along v (y)"), self.count_v)
-        lay.addRow(translate("SurfComp", "Points"), self.points)
-        lay.addRow(translate("SurfComp", "Tip radius (mm)"), self.tip)
-        lay.addRow(translate("SurfComp", "Edge margin (mm)"), self.margin)
-        lay.addRow(translate("SurfComp", "Max tilt (deg)"), self.tilt)
+        # labels and tooltips are the option registry's, as messages name the options
+        # (the count, U x V, is two fields)
+        for name, field, text in (
+                ("layout", self.layout, None),
+                ("count", self.count_u, translate("SurfComp", "Points along u (x)")),
+                ("count", self.count_v, translate("SurfComp", "Points along v (y)")),
+                ("points", self.points, None), ("tip_radius", self.tip, "%s (mm)"),
+                ("edge_margin", self.margin, "%s (mm)"),
+                ("max_tilt", self.tilt, translate("SurfComp", "%s (deg)"))):
+            label = option_labels.label(name, ("plan",))
+            field.setToolTip(option_labels.tip(name, "plan"))
+            lay.addRow(label if text is None else text.replace("%s", label), field)
         lay.addRow(self.plan_button)
         lay.addRow(self.result)
         self.layout.currentIndexChanged.connect(self._enable)
@@ -116,7 +120,7 @@ class PlanPanel(UndoTaskPanel):
         try:
             trial_plan(self.obj, **self.values())
         except SurfcompError as exc:
-            self.result.setText(str(exc))
+            self.result.setText(option_labels.shown(exc, ("plan",)))
             self.result.setStyleSheet("color: #c53030;")
             return False
         lines = ["_plan = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]

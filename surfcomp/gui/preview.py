@@ -18,7 +18,7 @@ from PySide import QtGui
 from ..core.compensation import plausibility
 from ..errors import SurfcompError
 from ..io.units import UNIT_FACTORS
-from . import prefs
+from . import option_labels, prefs
 
 translate = FreeCAD.Qt.translate
 
@@ -91,7 +91,7 @@ def preview_text(ms, unit=None, max_offset=plausibility.DEFAULT_MAX_OFFSET, dev_
         lines += ["  " + e for e in errors]
     if problems:
         lines.append(translate("SurfComp", "Problems found (%d):") % len(problems))
-        lines += ["  " + w for w in problems[:50]]
+        lines += ["  " + option_labels.shown(w) for w in problems[:50]]
     elif not errors:
         lines.append(translate("SurfComp", "Problems found: none"))
     return "\n".join(lines)
@@ -163,11 +163,11 @@ class PreviewDialog(QtGui.QDialog):
             "SurfComp", "Unit of x, y, z columns without a unit of their own (nominal and "
                         "measured points); the points are checked against the nominal face "
                         "with it"))
-        row.addRow(translate("SurfComp", "Coordinates (x, y, z) in:"), self.coord_unit)
+        row.addRow(option_labels.label("units") + ":", self.coord_unit)
         self.unit = self._selector(start, translate(
             "SurfComp", "Unit of the deviation column when it has none of its own (a "
                         "deviation computed from the points keeps theirs)"))
-        row.addRow(translate("SurfComp", "Deviation column in:"), self.unit)
+        row.addRow(option_labels.label("deviation_units") + ":", self.unit)
         lay.addLayout(row)
         self.status = QtGui.QLabel("")
         self.status.setWordWrap(True)
@@ -209,8 +209,8 @@ class PreviewDialog(QtGui.QDialog):
             self.show_set(self.reader(self.units(), self.deviation_units()))
         except SurfcompError as exc:
             self.ms = None
-            self.text.setPlainText(str(exc))
-            self._state([str(exc)])
+            self.text.setPlainText(option_labels.shown(exc))
+            self._state([option_labels.shown(exc)])
 
     def show_set(self, ms):
         self.ms = ms

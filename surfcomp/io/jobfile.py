@@ -18,6 +18,7 @@ import math
 import os
 import stat
 
+from ..core.option_tables import ALIGN, INPUTS
 from ..core.options import OPTIONS
 from ..errors import InputError
 
@@ -54,9 +55,13 @@ _INTEGER = ("a whole number", _integer)
 
 
 
-def _option_type(o):
-    """What a job file's value of the registry's option ``o`` must be (the choices are
-    checked by :meth:`surfcomp.core.compensation.pipeline.Options.validate`)."""
+def _option_type(o, choices=False):
+    """What a job file's value of the registry's option ``o`` must be (with ``choices``
+    False the choices are left to :meth:`surfcomp.core.compensation.pipeline.Options.validate`
+    or the reader)."""
+    if choices and o.choices is not None:
+        return ("one of %s" % ", ".join('"%s"' % c for c in o.choices),
+                lambda v, c=o.choices: v in c)
     if o.type is bool:
         return _BOOL
     if o.type is int:
@@ -66,26 +71,25 @@ def _option_type(o):
     return _NAME
 
 
-#: known keys: (what is expected, test); paths, choices and numbers; the compensation's
-#: options (:data:`surfcomp.core.options.OPTIONS`) by their type
+#: known keys: (what is expected, test); paths and the registry's options by their type:
+#: the compensation's (:data:`surfcomp.core.options.OPTIONS`), the inputs and the alignment
+#: (:data:`surfcomp.core.option_tables.INPUTS`, :data:`~surfcomp.core.option_tables.ALIGN`;
+#: the alignment's method checked against its choices here)
 KEY_TYPES = {
     "command": _NAME,
     "nominal": _PATH, "measurements": _PATH,
     "output": _PATH, "report": _PATH, "points": _PATH, "curves": _PATH, "html": _PATH,
-    "face": _NAME, "object": _NAME, "units": _NAME, "deviation_units": _NAME, "fmt": _NAME,
-    "sample": _NAME, "face_only": _BOOL,
+    "face_only": _BOOL,
     **{name: _option_type(o) for name, o in OPTIONS.items()},
+    **{name: _option_type(o) for name, o in INPUTS.items()},
+    **{name: _option_type(o, choices=True) for name, o in ALIGN.items()},
     "weights": ("a weights text such as \"1 2 1; 2 4 2; 1 2 1\" or a square list of lists "
                 "of numbers, or null", lambda v: v is None or _weights(v)),
-    "plan": _PATH, "touches": _INTEGER,
-    "align": ("one of \"none\", \"bestfit\", \"rps\"",
-              lambda v: v in ("none", "bestfit", "rps")),
-    "align_faces": _NAME, "align_dof": _NAME, "rps": _NAME, "transform": _PATH,
+    "plan": _PATH, "transform": _PATH,
 }
 #: keys that may be null (meaning: not given)
-NULLABLE = {"output", "report", "points", "curves", "html", "face", "object", "units",
-            "deviation_units", "sample", "plan", "align_faces", "align_dof", "rps",
-            "transform"} | {name for name, o in OPTIONS.items() if o.optional}
+NULLABLE = {"output", "report", "points", "curves", "html", "plan"} | {
+    name for table in (OPTIONS, INPUTS, ALIGN) for name, o in table.items() if o.optional}
 
 
 def _describe(value):

@@ -16,9 +16,9 @@
 
 import numpy as np
 
+from ..core.choices import PLAN_FORMATS  # noqa: F401  (the option registry's choices)
 from ..errors import InputError
 
-PLAN_FORMATS = ("csv", "xyzijk")
 #: the header of the plan's CSV
 CSV_HEADER = "id,x_nom,y_nom,z_nom,i,j,k"
 

@@ -39,7 +39,7 @@ import re
 
 import numpy as np
 
-from ..errors import InputError, MeasurementFileError
+from ..errors import InputError, MeasurementFileError, note
 from .files import read_bytes
 from .measurement_set import (
     NORMAL_LENGTH_TOL,
@@ -115,9 +115,9 @@ def _resolve_units(units, file_units, warnings=None, line=0):
     """
     if (warnings is not None and units is not None and file_units is not None
             and unit_factor(units) != unit_factor(file_units)):
-        warnings.append((line, "the file states its units (%s); --units %s applies only to "
-                               "values without units of their own, so the file's units are used"
-                         % (file_units, units)))
+        warnings.append((line, note("the file states its units (%s); " % file_units,
+                                    ("units",), " %s applies only to values without units of "
+                                    "their own, so the file's units are used" % units)))
     name = file_units if file_units is not None else ("mm" if units is None else units)
     factor = unit_factor(name)
     return _UNIT_NAMES.get(factor, name.strip().lower()), factor
@@ -245,8 +245,8 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     check_coordinates(fields["measured"], fields["lines"], str(path))
     fields["columns"] = {_ROLE_NAMES[r]: name for r, name in fields["columns"].items()}
     source = str(path)
-    texts = ["%s:%d: %s" % (source, line, text) if line is not None else
-             "%s: %s" % (source, text) for line, text in warnings]
+    texts = [("%s:%d: " % (source, line) if line is not None else "%s: " % source) + text
+             for line, text in warnings]       # (a Note stays one)
     return MeasurementSet(nominal=None, deviation=None, row=None, col=None, ids=None,
                           source=source, sha256=hashlib.sha256(data).hexdigest(),
                           warnings=texts, tip_centres=is_tip_centre(fmt), **fields)

@@ -28,11 +28,11 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ..core.choices import PROBE_DIALECTS as DIALECTS
+from ..core.choices import WORK_OFFSETS  # noqa: F401
+from ..core.option_tables import PLAN, PROGRAM
 from ..errors import InputError
 
-DIALECTS = ("linuxcnc", "fanuc")
-#: work offsets a program may select
-WORK_OFFSETS = ("G54", "G55", "G56", "G57", "G58", "G59")
 #: largest accepted | |n| - 1 | of a plan's normal
 NORMAL_TOL = 1e-6
 #: largest coordinate (mm) a program may hold (LinuxCNC and Fanuc both take more; a larger
@@ -81,21 +81,21 @@ class ProbeSettings:
         Fanuc program number (``O....``).
     """
 
-    dialect: str = "linuxcnc"
-    tip_radius: float = 1.0
-    tool: int = 99
-    work_offset: str = "G54"
+    dialect: str = PROGRAM["dialect"].default
+    tip_radius: float = PLAN["tip_radius"].default
+    tool: int = PROGRAM["tool"].default
+    work_offset: str = PROGRAM["work_offset"].default
     safe_z: float = None
-    clearance: float = 5.0
-    standoff: float = 2.0
-    overtravel: float = 1.0
-    feed: float = 1000.0
-    touch_feed: float = 100.0
-    second_touch: bool = False
-    second_feed: float = None
-    backoff: float = 1.0
+    clearance: float = PLAN["clearance"].default
+    standoff: float = PLAN["stand_off"].default
+    overtravel: float = PROGRAM["overtravel"].default
+    feed: float = PROGRAM["feed"].default
+    touch_feed: float = PROGRAM["touch_feed"].default
+    second_touch: bool = PROGRAM["second_touch"].default
+    second_feed: float = PROGRAM["second_feed"].default
+    backoff: float = PROGRAM["backoff"].default
     plan_hash: str = ""
-    log_file: str = "probe.log"
+    log_file: str = PROGRAM["log_file"].default
     program_number: int = 1000
 
     def touch2_feed(self):

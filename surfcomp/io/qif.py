@@ -62,7 +62,7 @@ from xml.parsers import expat
 
 import numpy as np
 
-from ..errors import InputError, MeasurementFileError
+from ..errors import InputError, MeasurementFileError, note
 from .files import clip, read_bytes
 from .measurement_set import (
     DEV_CHECK_TOL,
@@ -171,9 +171,9 @@ class _Doc:
     def warn(self, message, el=None):
         line = None if el is None else self.line(el)
         if line is None:
-            self.warnings.append("%s: %s" % (self.source, message))
+            self.warnings.append("%s: " % self.source + message)     # (a Note stays one)
         else:
-            self.warnings.append("%s:%d: %s" % (self.source, line, message))
+            self.warnings.append("%s:%d: " % (self.source, line) + message)
 
     def find(self, el, path):
         return el.find(path, self.ns)
@@ -265,8 +265,9 @@ def _choose(doc, blocks, samples, sample):
     listing = "; ".join(s.describe() for s in samples)
     if sample is None:
         if len(samples) > 1:
-            doc.warn("the file holds %d measured parts (MeasurementResults): %s; the first is "
-                     "read, choose another with sample= (CLI: --sample)" % (len(samples), listing))
+            doc.warn(note("the file holds %d measured parts (MeasurementResults): %s; the first "
+                          "is read, choose another with " % (len(samples), listing),
+                          ("sample",)))
         return 0
     if isinstance(sample, (bool, np.bool_)) or not isinstance(sample, (int, np.integer, str)):
         raise InputError("sample=%r: expected a 0-based index, a serial number or a "

@@ -67,3 +67,55 @@ def test_options_stored_on_an_object_read_back_the_same(fresh_doc):
     properties.store_options(obj, Options(stock=0.3))
     assert features.options_of(obj) == Options(stock=0.3, context="document")
     assert (obj.Sigma, obj.Smoothing.Value, obj.Weights) == (0.0, 0.0, "")   # unset: 0, empty
+
+
+def test_the_other_objects_properties_are_the_registry_rows(fresh_doc):
+    """The measurement's Align* properties, the plan's settings and the probe operation's
+    are rows of the registry's tables (surfcomp.core.option_tables): a new object holds the
+    property, its tooltip, its default and its enumeration; the names stay the contract."""
+    from surfcomp.app import plan_feature, probe_op
+    from surfcomp.core.option_tables import ALIGN, INPUTS, PLAN, PROGRAM
+
+    assert [ALIGN[n].prop for n in ALIGN] == ["AlignMethod", "AlignFaces", "AlignDof",
+                                              "AlignRps", "AlignTransform"]
+    checked = 0
+    for rows, table, names in (
+            (properties.MEASUREMENT_PROPERTIES, ALIGN, tuple(ALIGN)),
+            (properties.COMPENSATION_PROPERTIES, INPUTS, ("face",)),
+            (plan_feature.PLAN_PROPERTIES, PLAN, ("layout", "count", "points", "tip_radius",
+                                                  "edge_margin", "max_tilt", "stand_off",
+                                                  "clearance")),
+            (probe_op.PROBE_OP_PROPERTIES, PROGRAM, ("work_offset", "overtravel", "feed",
+                                                     "touch_feed", "log_file"))):
+        by_prop = {r[1]: r for r in rows}
+        for name in names:
+            o = table[name]
+            typ, _prop, _group, tip, default, mode = by_prop[o.prop]
+            assert (tip, mode) == (tooltip(name, table), 0), name
+            if o.choices is not None:
+                assert typ == "App::PropertyEnumeration" and default == list(o.choices), name
+            elif typ.endswith("List"):
+                assert default is None, name
+            else:
+                unset = o.stored if o.stored is not None else o.type()    # 0 or empty
+                assert default == (o.default if o.default is not None else unset), name
+            checked += 1
+    assert checked == 19
+    meas = fresh_doc.addObject("Part::FeaturePython", "Measurement")
+    features.MeasurementFeature(meas)
+    for name, o in ALIGN.items():
+        assert meas.getDocumentationOfProperty(o.prop) == tooltip(name, ALIGN), name
+    assert meas.getEnumerationsOfProperty("AlignMethod") == list(ALIGN["align"].choices)
+    assert (meas.AlignMethod, meas.AlignDof, meas.AlignFaces) == ("none", "all", "")
+
+
+def test_document_warnings_name_the_properties():
+    """A warning that names options (a Note) is kept in a document with the options named
+    as its properties (the command line shows flags, the panels labels)."""
+    from surfcomp.errors import note
+
+    text = note("bring them near with ", ("transform",), ", or name datum faces with ",
+                ("align_faces",), " (a transform)")
+    assert properties.property_text(text) == \
+        "bring them near with AlignTransform, or name datum faces with AlignFaces (a transform)"
+    assert properties.property_text("plain") == "plain"

@@ -40,7 +40,8 @@ def test_plan_object_matches_the_command_line_plan(fresh_doc, tmp_path):
     plan_obj.Count = "8x8"
     fresh_doc.recompute()
     assert plan_obj.Placed == 64 and 0 < plan_obj.Kept < 64
-    assert plan_obj.Dropped[0].endswith("normal leans more than --max-tilt from +Z")
+    # the option named as the plan's property (the command line says --max-tilt)
+    assert plan_obj.Dropped[0].endswith("normal leans more than MaxTilt from +Z")
     assert int(plan_obj.Dropped[0].split()[0]) == 64 - plan_obj.Kept
     path = str(tmp_path / "plan.FCStd")
     fresh_doc.saveCopy(path)

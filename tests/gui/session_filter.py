@@ -29,7 +29,10 @@ RESULTS["panel_options"] = {
     "kind_items": [panel.kind.itemText(i) for i in range(panel.kind.count())],
     "edge_items": [panel.edge.itemText(i) for i in range(panel.edge.count())],
     "tooltips": {"mask_size": panel.mask.toolTip(), "weights": panel.weights.toolTip(),
-                 "mask_kind": panel.kind.toolTip(), "edge": panel.edge.toolTip()}}
+                 "mask_kind": panel.kind.toolTip(), "edge": panel.edge.toolTip()},
+    "labels": {name: panel.form.layout().labelForField(field).text()
+               for name, field in (("mask_size", panel.mask), ("weights", panel.weights),
+                                   ("mask_kind", panel.kind), ("edge", panel.edge))}}
 RESULTS["property_options"] = {
     name: [comp.getDocumentationOfProperty(name),
            comp.getEnumerationsOfProperty(name) if name in ("Method", "MaskKind", "Edge",

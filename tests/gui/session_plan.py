@@ -41,6 +41,12 @@ RESULTS["shot"] = shot(view, "plan")
 type_value(panel.tip, "60")
 click(panel.plan_button)
 RESULTS["bad"] = [panel.result.text(), panel.accept(), plan_panel.PlanPanel.instance is panel]
+# the panel as the user sees it: the message below the field it names
+Gui.updateGui()
+RESULTS["bad_png"] = os.path.join(TMP, "plan_bad.png")
+panel.form.grab().save(RESULTS["bad_png"])
+RESULTS["bad_labels"] = [panel.form.layout().labelForField(w).text()
+                         for w in (panel.layout, panel.points, panel.tip, panel.tilt)]
 type_value(panel.tip, "1.5")
 RESULTS["ok"] = [panel.accept(), plan_panel.PlanPanel.instance is None, obj.Kept,
                  obj.TipRadius, len(doc.Objects) - n0, list(obj.State)]

@@ -56,7 +56,9 @@ def test_panel_shows_rms_and_predicted_residual(session):
 
 def test_bad_mask_shown_in_the_panel_without_a_traceback(session):
     message, ok, accepted, state, state_before = session["filter_invalid"]
-    assert "mask_size 4: expected an odd whole number" in message
+    # the option named as the panel's field (the command line says --mask)
+    assert "Mask size 4: expected an odd whole number" in message
+    assert "mask_size" not in message
     assert ok is False and accepted is False
     assert state == state_before                            # no recompute was tried
     added = session["report_view_added"]
@@ -121,6 +123,9 @@ def test_panel_and_property_view_show_the_option_registry(session):
     for name, tip in seen["tooltips"].items():
         assert tip == tooltip(name), name
     assert "Weights" in seen["tooltips"]["mask_size"]       # the property's name, not a flag
+    # the fields' labels: the names the panel's messages use
+    assert seen["labels"] == {name: OPTIONS[name].label for name in seen["labels"]}
+    assert seen["labels"]["mask_size"] == "Mask size"
     props = {o.prop: o for o in OPTIONS.values()}
     for prop, (doc, items) in session["property_options"].items():
         assert doc == tooltip(props[prop].name), prop

@@ -51,7 +51,14 @@ def test_points_drawn_in_the_view(session):
 
 def test_tip_too_large_stays_in_the_panel(session):
     text, accepted, still_open = session["bad"]
-    assert "tip_radius 60 mm is larger than the face's smallest concave radius" in text
+    # the option named as the panel's field (the command line says --tip-radius)
+    assert "Tip radius 60 mm is larger than the face's smallest concave radius" in text
+    assert "tip_radius" not in text
+    # the field it names carries that label, and the message shows in red in the panel
+    assert session["bad_labels"] == ["Layout", "Points", "Tip radius (mm)", "Max tilt (deg)"]
+    img = read_image(session["bad_png"])
+    red = ((abs(img[..., :3] - [197 / 255, 48 / 255, 48 / 255]).sum(axis=2)) < 0.15).sum()
+    assert red > 50
     assert accepted is False and still_open is True
 
 

@@ -57,30 +57,75 @@ def test_document_messages_name_the_property():
         "the compensation's MaxOffset"
 
 
-def test_no_error_below_the_command_line_names_a_flag():
-    """Every ``raise`` in core and io names options, not flags (``--max-offset``): a
-    script and a job file get the names they pass."""
+def _messages_below_the_command_line():
+    """``(where, AST of a message)`` of core and io: every raised exception, and every
+    warning: an argument of ``*warn*.append/extend/insert(...)``, ``*.warn(...)`` and
+    ``note(...)``, and what a function named ``*warning*`` returns."""
     import ast
     import os
-    import re
 
     root = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
         os.path.abspath(__file__)))), "surfcomp")
-    found = []
     for layer in ("core", "io"):
         for folder, _dirs, files in os.walk(os.path.join(root, layer)):
-            for name in files:
+            for name in sorted(files):
                 if not name.endswith(".py"):
                     continue
                 path = os.path.join(folder, name)
                 with open(path, encoding="utf-8") as fh:
                     tree = ast.parse(fh.read())
+                where = os.path.relpath(path, root)
                 for node in ast.walk(tree):
-                    if not isinstance(node, ast.Raise) or node.exc is None:
-                        continue
-                    for sub in ast.walk(node.exc):
-                        if isinstance(sub, ast.Constant) and isinstance(sub.value, str) and \
-                                re.search(r"(?<![\w-])--[a-z]", sub.value):
-                            found.append("%s:%d: %s" % (os.path.relpath(path, root),
-                                                        node.lineno, sub.value))
+                    if isinstance(node, ast.Raise) and node.exc is not None:
+                        yield "raise", "%s:%d" % (where, node.lineno), node.exc
+                    elif isinstance(node, ast.Call) and _is_warning(node.func):
+                        for arg in node.args:
+                            yield "warning", "%s:%d" % (where, node.lineno), arg
+                    elif isinstance(node, ast.FunctionDef) and "warning" in node.name:
+                        for sub in ast.walk(node):
+                            if isinstance(sub, ast.Return) and sub.value is not None:
+                                yield "warning", "%s:%d" % (where, sub.lineno), sub.value
+
+
+def _is_warning(func):
+    import ast
+
+    if isinstance(func, ast.Name):
+        return func.id in ("Note", "note")
+    if not isinstance(func, ast.Attribute):
+        return False
+    if func.attr in ("warn", "Note", "note"):
+        return True
+    return func.attr in ("append", "extend", "insert") and "warn" in ast.unparse(func.value)
+
+
+def test_no_error_or_warning_below_the_command_line_names_a_flag():
+    """Every ``raise`` and every warning in core and io names options, not flags
+    (``--max-offset``): a script and a job file get the names they pass; the command line
+    shows the flags, the GUI the labels."""
+    import ast
+    import re
+
+    found, kinds = [], set()
+    for kind, where, node in _messages_below_the_command_line():
+        kinds.add(kind)
+        for sub in ast.walk(node):
+            if isinstance(sub, ast.Constant) and isinstance(sub.value, str) and \
+                    re.search(r"(?<![\w-])--[a-z]", sub.value):
+                found.append("%s: %s %s" % (where, kind, sub.value))
+    assert kinds == {"raise", "warning"}
     assert found == []
+
+
+def test_the_scan_finds_the_warnings():
+    """The warning scan above sees the warnings it is about (it would pass on nothing)."""
+    import ast
+
+    texts = [ast.unparse(node) for kind, _where, node in _messages_below_the_command_line()
+             if kind == "warning"]
+    joined = " ".join(texts)
+    for words in ("the filtered method or a larger", "the file states its units",
+                  "choose another with", "name datum faces with", "stylus tip centres",
+                  "used as a scattered layout"):
+        assert words in joined, words
+    assert len(texts) > 20

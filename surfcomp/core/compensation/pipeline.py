@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import ComputationError, GridError, InputError, MeasurementFileError
+from ...errors import ComputationError, GridError, InputError, MeasurementFileError, note
 from ..choices import LAYOUTS  # noqa: F401  (re-exported: Options.layout's choices)
 from ..limits import ACCEPT_TOL, NORMAL_WARNING_DEG, OVERSHOOT_TOL, SMOOTH_MATCH
 from ..memory import return_free_memory
@@ -233,8 +233,9 @@ def _tip_radius(ms, options, warnings):
         raise InputError("tip_radius needs measured points (tip centres) in the file",
                          file=ms.source, options=("tip_radius",))
     if getattr(ms, "tip_centres", False) and not tip:
-        warnings.append("%s: the points are stylus tip centres (probe log); without "
-                        "--tip-radius every deviation is off by the tip radius" % ms.source)
+        warnings.append(note("%s: the points are stylus tip centres (probe log); without "
+                             % ms.source, ("tip_radius", option_name(options, "tip_radius")),
+                             " every deviation is off by the tip radius"))
     return tip
 
 
@@ -360,9 +361,10 @@ def _grid_or_scattered(ms, proj, options, warnings):
     except GridError as exc:
         if options.layout == "grid":
             raise
-        warnings.append("%s; the points are used as a scattered layout (the determined "
-                        "component comes from a smoothing fit instead of the mask filter; "
-                        "--layout grid refuses such files)" % exc)
+        warnings.append(note("%s; the points are used as a scattered layout (the determined "
+                             "component comes from a smoothing fit instead of the mask filter; "
+                             % exc, ("layout", option_name(options, "layout")),
+                             " grid refuses such files)"))
         return Scattered(np.arange(proj.u.size), "scattered (not a complete grid)")
 
 
@@ -496,20 +498,21 @@ def build_surface(result, surface, outward, delta, progress=None):
     result.spacing = (du, dv)
     result.corrected, result.zero, result.field = built.corrected, built.zero, built.field
     result.iterations, result.checks = built.iterations, built.checks
+    refine = ("refine", option_name(result.options, "refine"))
     if built.checks.max_error_at_points > ACCEPT_TOL:
-        prepared.warnings.append(
+        prepared.warnings.append(note(
             "%s: the corrected face misses the intended correction by up to %.3f um at the "
             "measured points (more than %.1f um): neighbouring points closer than the knot "
             "spacing with different corrections (raw data?); the filtered method or a larger "
-            "--refine helps" % (prepared.source, built.checks.max_error_at_points * 1e3,
-                                ACCEPT_TOL * 1e3))
+            % (prepared.source, built.checks.max_error_at_points * 1e3, ACCEPT_TOL * 1e3),
+            refine, " helps"))
     over = built.checks.max_realised - built.checks.max_intended
     if over > OVERSHOOT_TOL:
-        prepared.warnings.append(
+        prepared.warnings.append(note(
             "%s: somewhere on the face the corrected face moves %.2f um more than the largest "
             "intended correction (more than %.1f um; usually beyond the measured region, "
-            "where noisy raw data are continued): the filtered method or a larger --refine "
-            "helps" % (prepared.source, over * 1e3, OVERSHOOT_TOL * 1e3))
+            "where noisy raw data are continued): the filtered method or a larger "
+            % (prepared.source, over * 1e3, OVERSHOOT_TOL * 1e3), refine, " helps"))
     return result
 
 

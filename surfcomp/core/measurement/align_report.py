@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError
+from ...errors import InputError, note
+from ..choices import ALIGN_METHODS as METHODS
 from .align import (
     DOF_NAMES,
     Distances,
@@ -30,8 +31,6 @@ from .align import (
 from .align import parse_dof as _parse_dof
 from .align_rps import rps_fit
 
-#: alignment methods
-METHODS = ("none", "bestfit", "rps")
 #: a fit that moves the compensated face's points farther (mm, along the normal) started
 #: in another frame: its absorbed mean and tilt are mostly that frame's offset
 FAR_START = 1.0
@@ -233,14 +232,16 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
 def _absorbed_warning(absorbed_, normal, shift):
     moved = float(np.abs(np.einsum("ij,ij->i", normal, shift)).max()) if shift.size else 0.0
     if moved > FAR_START:
-        return ("the best fit used the compensated face itself and moved its points up to "
-                "%.3f mm from where they came in: what it absorbed of the machining error's "
-                "mean and tilt cannot be told apart from that move (bring them near with "
-                "--transform, or name datum faces with --align-faces)" % moved)
-    return ("the best fit used the compensated face itself: it absorbed a mean offset of %.3f "
-            "um and a tilt of %.3f um of the machining error, which the corrected face will "
-            "leave in the part (name datum faces with --align-faces to keep them)"
-            % (absorbed_["mean_offset_um"], absorbed_["tilt_um"]))
+        return note("the best fit used the compensated face itself and moved its points up "
+                    "to %.3f mm from where they came in: what it absorbed of the machining "
+                    "error's mean and tilt cannot be told apart from that move (bring them "
+                    "near with " % moved, ("transform",), ", or name datum faces with ",
+                    ("align_faces",), ")")
+    return note("the best fit used the compensated face itself: it absorbed a mean offset of "
+                "%.3f um and a tilt of %.3f um of the machining error, which the corrected face "
+                "will leave in the part (name datum faces with "
+                % (absorbed_["mean_offset_um"], absorbed_["tilt_um"]), ("align_faces",),
+                " to keep them)")
 
 
 __all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms",

@@ -42,7 +42,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...errors import InputError
+from ...errors import InputError, note
+from ..choices import PLAN_LAYOUTS as LAYOUTS
+from ..choices import PLAN_ORDERS as ORDERS
+from ..choices import POINT_LAYOUTS  # noqa: F401
+from ..limits import MAX_PLAN_POINTS
+from ..option_tables import PLAN
 from ..progress import report
 from ..surface import bspline
 from .planning_adaptive import adaptive_layout
@@ -53,19 +58,15 @@ from .planning_reach import (
     visiting_order,
 )
 
-LAYOUTS = ("grid", "xy", "adaptive", "uniform")
-#: layouts whose count is a number of points (the others take U x V)
-POINT_LAYOUTS = ("adaptive", "uniform")
-ORDERS = ("auto", "serpentine", "nearest")
 #: most points a plan may have
-MAX_POINTS = 1_000_000
+MAX_POINTS = MAX_PLAN_POINTS
 #: face samples for the curvature check, the self-occlusion check and the xy seeds
 FACE_SAMPLES = 40000
 #: the reasons a point is dropped, in the order they are checked, and what they say
 REASONS = {
     "outside": "not on the trimmed face",
     "margin": "closer than the margin to the boundary or a hole",
-    "tilt": "normal leans more than --max-tilt from +Z",
+    "tilt": note("normal leans more than ", ("max_tilt",), " from +Z"),
     "approach": "the stylus meets the face on the approach along the normal",
     "descent": "the stylus meets the face on the descent from the safe height",
 }
@@ -75,11 +76,11 @@ REASONS = {
 class PlanSettings:
     """The probe and its clearances (mm, degrees)."""
 
-    tip_radius: float = 1.0
-    edge_margin: float = 0.5
-    max_tilt: float = 60.0
-    stand_off: float = 2.0
-    clearance: float = 5.0
+    tip_radius: float = PLAN["tip_radius"].default
+    edge_margin: float = PLAN["edge_margin"].default
+    max_tilt: float = PLAN["max_tilt"].default
+    stand_off: float = PLAN["stand_off"].default
+    clearance: float = PLAN["clearance"].default
 
     @property
     def retract(self):

@@ -77,6 +77,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...errors import InputError
+from ..option_tables import MODEL
 from ..surface import bspline
 
 #: slope along the feed beyond which the model clips (nearly vertical walls)
@@ -127,22 +128,22 @@ class MachiningModel:
     depth the semi-finishing pass removes (None: equal to ``stock``).
     """
 
-    offset: float = 0.0
-    slope_gain: float = 0.06
-    abs_slope_gain: float = 0.03
-    tilt: tuple = (0.0, 0.02)
-    bow: tuple = (-0.02, 0.02)
-    waviness: float = 0.0
-    wavelength: float = 10.0
-    feed: tuple = (1.0, 0.0, 0.0)
-    tool_axis: tuple = (0.0, 0.0, 1.0)
-    sigma: float = 0.0015
-    correlation_length: float = 0.0
-    probe_sigma: float = 0.0005
+    offset: float = MODEL["offset"].default
+    slope_gain: float = MODEL["slope_gain"].default
+    abs_slope_gain: float = MODEL["abs_slope_gain"].default
+    tilt: tuple = MODEL["tilt"].default
+    bow: tuple = MODEL["bow"].default
+    waviness: float = MODEL["waviness"].default
+    wavelength: float = MODEL["wavelength"].default
+    feed: tuple = MODEL["feed"].default
+    tool_axis: tuple = MODEL["tool_axis"].default
+    sigma: float = MODEL["sigma"].default
+    correlation_length: float = MODEL["correlation_length"].default
+    probe_sigma: float = MODEL["probe_sigma"].default
     axis_errors: object = None
-    deflection: tuple = (0.0, 0.0, 0.0)
+    deflection: tuple = MODEL["deflection"].default
     stock: float = DEFAULT_STOCK
-    semi_engagement: float = None
+    semi_engagement: float = MODEL["semi_engagement"].default
 
     def __post_init__(self):
         for name in _SCALARS:
