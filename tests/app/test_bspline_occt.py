@@ -12,7 +12,7 @@ from numpy.testing import assert_allclose
 from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.core.surface import bspline as bs
 from tests.conftest import REALDATA
-from tests.pure.test_bspline import quarter_cylinder, random_surface
+from tests.pure.surfaces import quarter_cylinder, random_surface
 
 BLADE = os.path.join(REALDATA, "cad", "BladeX", "upper.iges")
 SPHERE = os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")

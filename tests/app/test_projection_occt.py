@@ -19,7 +19,7 @@ from surfcomp.app.convert import surface_from_part, surface_to_part
 from surfcomp.core.surface import bspline as bs
 from surfcomp.core.surface.projection import Projector, project
 from tests.conftest import REALDATA
-from tests.pure.test_bspline import random_surface
+from tests.pure.surfaces import random_surface
 
 BLADE = os.path.join(REALDATA, "cad", "BladeX", "upper.iges")
 SPHERE = os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")

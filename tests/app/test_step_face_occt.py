@@ -13,7 +13,7 @@ from surfcomp.app.shapes import natural_face, rebuild_face
 from surfcomp.core.surface.bspline import Surface
 from surfcomp.io.step_face import write_natural_face
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
-from tests.pure.test_bspline import quarter_cylinder, random_surface
+from tests.pure.surfaces import quarter_cylinder, random_surface
 
 
 def _sample(face, n=7):

@@ -4,6 +4,7 @@
 import numpy as np
 
 from surfcomp.core.surface import bspline
+from surfcomp.core.surface.bspline import Surface
 
 
 def wavy_patch():
@@ -13,3 +14,52 @@ def wavy_patch():
     Z = 2.0 * np.sin(X / 12.0) * np.cos(Y / 15.0)
     k = np.array([0, 0, 0, 0, 0.5, 1, 1, 1, 1.0])
     return bspline.Surface(np.stack([X, Y, Z], axis=-1), k, k, 3, 3)
+
+
+def bezier_knots(p):
+    return np.r_[np.zeros(p + 1), np.ones(p + 1)]
+
+
+def random_surface(rng, nu=7, nv=6, pu=3, pv=2, rational=False, interior_double=True):
+    ku = np.r_[np.zeros(pu + 1), np.sort(rng.uniform(0.05, 0.95, nu - pu - 1)), np.ones(pu + 1)]
+    if interior_double and nu - pu - 1 >= 2:
+        ku[pu + 2] = ku[pu + 1]  # a double interior knot
+    kv = np.r_[np.zeros(pv + 1), np.sort(rng.uniform(0.05, 0.95, nv - pv - 1)), np.ones(pv + 1)]
+    kv = kv * 3.0 - 1.0  # v domain [-1, 2]
+    gu, gv = np.meshgrid(np.linspace(0, 100, nu), np.linspace(0, 60, nv), indexing="ij")
+    poles = np.stack([gu, gv, 10 * np.sin(gu / 30) * np.cos(gv / 20)], axis=2)
+    poles += rng.normal(scale=3.0, size=poles.shape)
+    w = rng.uniform(0.5, 2.0, (nu, nv)) if rational else None
+    return Surface(poles, ku, kv, pu, pv, w)
+
+
+def quarter_cylinder(R=25.0, H=40.0):
+    """Rational quadratic x linear quarter cylinder around the z axis."""
+    ring = np.array([[R, 0, 0], [R, R, 0], [0, R, 0]], float)
+    poles = np.stack([ring, ring + [0, 0, H]], axis=1)  # (3, 2, 3)
+    w = np.array([[1, 1], [np.sqrt(0.5)] * 2, [1, 1]])
+    return Surface(poles, bezier_knots(2), bezier_knots(1), 2, 1, w)
+
+def sphere_octant(R=10.0):
+    """Exact rational octant of a sphere; its u = 0 edge collapses into the pole (0, 0, R)."""
+    s = np.sqrt(0.5)
+    mer = np.array([[0, R], [R, R], [R, 0]], float)  # (x, z) of the meridian poles
+    wm = np.array([1, s, 1])
+    rot = lambda x, z: [[x, 0, z], [x, x, z], [0, x, z]]  # noqa: E731
+    poles = np.array([rot(x, z) for x, z in mer], float)
+    w = wm[:, None] * wm[None, :]
+    return Surface(poles, bezier_knots(2), bezier_knots(2), 2, 2, w)
+
+
+def hairpin(n=60):
+    """A hairpin profile (two parallel legs 2 mm apart joined by a 1 mm radius bend),
+    interpolated by a cubic and extruded 10 mm along y."""
+    k = np.r_[0, 0, 0, np.linspace(0, 1, n - 2), 1, 1, 1]
+    g = bspline.greville(k, 3)
+    t = g * (40 + np.pi)
+    x = np.where(t < 20, 20 - t, np.where(t < 20 + np.pi, -np.sin(t - 20), t - 20 - np.pi))
+    z = np.where(t < 20, 0.0, np.where(t < 20 + np.pi, 1 - np.cos(t - 20), 2.0))
+    prof = np.stack([x, np.zeros(n), z], 1)
+    pts = np.stack([prof, prof + [0, 10.0, 0]], axis=1)
+    kv = np.r_[0, 0, 1, 1.0]
+    return Surface(bspline.interpolate_grid(g, [0.0, 1.0], pts, k, kv, 3, 1), k, kv, 3, 1)

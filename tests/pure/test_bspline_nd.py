@@ -10,7 +10,7 @@ from surfcomp.core.simulation.presets import werner_surface
 from surfcomp.core.surface import bspline as bs
 from surfcomp.core.surface import bspline_nd
 from surfcomp.core.surface.bspline_basis import SCIPY_FROM
-from tests.pure.test_bspline import quarter_cylinder, random_surface
+from tests.pure.surfaces import quarter_cylinder, random_surface
 
 
 def reference(surf, u, v):

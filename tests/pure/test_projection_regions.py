@@ -10,7 +10,7 @@ from numpy.testing import assert_allclose
 
 from surfcomp.core.surface import bspline as bs
 from surfcomp.core.surface import projection as pj
-from tests.pure.test_bspline import hairpin, quarter_cylinder, random_surface
+from tests.pure.surfaces import hairpin, quarter_cylinder, random_surface
 
 
 def cylinder_points(surf, depth, n=60, seed=70):

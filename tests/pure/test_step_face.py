@@ -9,7 +9,7 @@ import pytest
 
 from surfcomp.core.surface.bspline import Surface
 from surfcomp.io import step_face
-from tests.pure.test_bspline import quarter_cylinder, random_surface
+from tests.pure.surfaces import quarter_cylinder, random_surface
 
 ENTITY = re.compile(rb"#(\d+)\s*=\s*(.*?);\s*(?=#\d+\s*=|ENDSEC;)", re.S)
 
