@@ -3,15 +3,14 @@
 solid with its neighbours re-trimmed, through one face builder for every route.
 
 Faces: the example surface trimmed by a circle in (u, v) (1 edge, 457.5 mm^2), the same with
-a hole, both as the top of a solid extruded 20 mm (raw deviations of about 14 um), B-spline
-faces of axom's ``boxed_sphere.step`` (all neighbours tangent: fillets, blends, a sphere
-half) and of PyGeM's pipe sewn into a solid.
+a hole, both as the top of a solid extruded 20 mm (raw deviations of about 14 um). Real
+parts whose neighbours are all tangent are in test_trim_neighbours.py; the shared cases and
+checks in trim_cases.py.
 """
 
 import json
 import os
 import subprocess
-import sys
 
 import FreeCAD
 import numpy as np
@@ -19,206 +18,30 @@ import Part
 import pytest
 
 from surfcomp.app import features
-from surfcomp.app.convert import surface_from_part, surface_to_part
+from surfcomp.app.convert import surface_to_part
 from surfcomp.app.file_route import Job, run_job
-from surfcomp.app.nominal import boundary_polylines, nominal_from_face
+from surfcomp.app.nominal import nominal_from_face
 from surfcomp.app.shapes import corrected_shape
 from surfcomp.core.compensation.pipeline import Options
-from surfcomp.core.surface import bspline
-from surfcomp.core.surface.trimmed import domain_integral, knots_of
-from surfcomp.errors import GeometryError
-from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt, write_cmm_csv
-from tests.conftest import REALDATA
-
-UM = 1e-3
-BOXED_SPHERE = os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")
-PIPE = os.path.join(REALDATA, "cad", "PyGeM", "test_pipe.step")
-
-
-# -- the test parts ------------------------------------------------------------------------
-
-def circle_face(r=0.35, hole=None):
-    """The example surface trimmed by the circle of radius ``r`` around (0.5, 0.5) in (u, v)
-    (r = 0.35: 1 edge, 457.5 mm^2), optionally with a circular hole ``((u, v), radius)``."""
-    bs = Part.read(EXAMPLE_STEP).Faces[0].Surface
-    c = Part.Geom2d.Circle2d(FreeCAD.Base.Vector2d(0.5, 0.5), r)
-    face = Part.Face(bs, Part.Wire([c.toShape(bs)]))
-    if hole:
-        h = Part.Geom2d.Circle2d(FreeCAD.Base.Vector2d(*hole[0]), hole[1])
-        face.cutHoles([Part.Wire([h.toShape(bs)])])
-        face.fix(1e-7, 1e-7, 1e-7)                  # the hole's wire runs the other way
-    assert face.isValid()
-    return face
-
-
-HOLE = ((0.5, 0.55), 0.1)
-
-
-def extruded(face, height=20.0):
-    """``face`` as the top of a solid extruded ``height`` mm down; (solid, top index)."""
-    solid = face.extrude(FreeCAD.Vector(0, 0, -height))
-    top = max(range(len(solid.Faces)), key=lambda k: solid.Faces[k].CenterOfMass.z)
-    assert solid.isValid() and solid.ShapeType == "Solid"
-    return solid, top
-
-
-def pipe_solid():
-    """PyGeM's pipe (6 NURBS faces, separate shells in the file) sewn into a solid."""
-    from surfcomp.app.cadread import read_cad
-
-    shell = Part.Shape(read_cad(PIPE))
-    shell.sewShape(1e-2)
-    solid = Part.Solid(shell)
-    if solid.Volume < 0:
-        solid.reverse()
-    assert solid.isValid() and len(solid.Faces) == 6 and len(solid.Edges) == 12
-    return solid
-
-
-def raw_deviation(P):
-    """The machined part's deviation (mm) at points P: 14 um mean, smooth."""
-    x, y = P[..., 0], P[..., 1]
-    return (0.0115 + 0.010 * np.sin(np.pi * x / 45.0) * np.cos(np.pi * y / 60.0)
-            - 0.004 * (y / 45.0) ** 2)
-
-
-def grid(nominal, n, box=None, margin=0.0):
-    """Points, outward normals and (u, v) of an n x n grid over ``box`` (fractions of the
-    face's UV range: (u0, u1, v0, v1)) shrunk by ``margin``."""
-    (u0, u1), (v0, v1) = nominal.surface.u_range, nominal.surface.v_range
-    a0, a1, b0, b1 = box or (0.0, 1.0, 0.0, 1.0)
-    s = np.linspace(a0 + margin, a1 - margin, n)
-    t = np.linspace(b0 + margin, b1 - margin, n)
-    U, V = np.meshgrid(u0 + (u1 - u0) * s, v0 + (v1 - v0) * t, indexing="ij")
-    P = bspline.evaluate(nominal.surface, U, V)
-    N = bspline.normals(nominal.surface, U, V) * nominal.outward
-    return P, N, U, V
-
-
-#: the square inscribed in the circle (fractions of the face's UV box, the circle's
-#: bounding square): the probe stays on the trimmed face
-INSIDE = (0.16, 0.84, 0.16, 0.84)
-
-
-def measure(path, nominal, n, dev, box=None, margin=0.0):
-    """Write a CMM file with deviations ``dev(P, U, V)``; return (P, N, U, V, d)."""
-    P, N, U, V = grid(nominal, n, box, margin)
-    d = dev(P, U, V)
-    write_cmm_csv(path, P, N, d)
-    return P, N, U, V, d
-
-
-def bump(nominal, amplitude=0.014, shrink=0.6):
-    """Deviations that vanish near the face's boundary: a cos^4 bump around the (u, v)
-    point farthest from the trim, of radius ``shrink`` times that distance."""
-    (u0, u1), (v0, v1) = nominal.surface.u_range, nominal.surface.v_range
-    face = nominal.bspline_face
-    edge = (np.concatenate(boundary_polylines(face, 200)) - [u0, v0]) / [u1 - u0, v1 - v0]
-    best, centre = 0.0, None
-    for a in np.linspace(0.05, 0.95, 31):
-        for b in np.linspace(0.05, 0.95, 31):
-            if face.isPartOfDomain(u0 + a * (u1 - u0), v0 + b * (v1 - v0)):
-                dist = np.hypot(edge[:, 0] - a, edge[:, 1] - b).min()
-                if dist > best:
-                    best, centre = dist, (a, b)
-    radius = shrink * best
-
-    def dev(P, U, V):
-        r = np.hypot((U - u0) / (u1 - u0) - centre[0], (V - v0) / (v1 - v0) - centre[1])
-        return amplitude * np.cos(0.5 * np.pi * np.minimum(r / radius, 1.0)) ** 4
-
-    return dev
-
-
-# -- independent checks --------------------------------------------------------------------
-
-def realised_ok(face, P, N, d, on_face=None, reach=0.5, sample=40):
-    """Largest |realised - intended| correction (mm) at a seeded sample of the measured
-    points on the face, measured by OCCT on ``face`` along the nominal normals (the
-    pipeline's own check figure covers every point)."""
-    P, N, d = P.reshape(-1, 3), N.reshape(-1, 3), np.ravel(d)
-    k = np.arange(d.size) if on_face is None else np.nonzero(on_face)[0]
-    k = np.random.default_rng(17).choice(k, size=min(sample, k.size), replace=False)
-    return float(np.abs(realised_by_occt(face, P[k], N[k], reach=reach) - d[k]).max())
-
-
-def max_tolerance(shape):
-    return max([e.Tolerance for e in shape.Edges] + [v.Tolerance for v in shape.Vertexes])
-
-
-def boundary_move(nominal_face, new_face, corrected, samples=60):
-    """Per sample of the nominal face's boundary: (distance to the new face's boundary,
-    the correction there = |S_c - S| at the same (u, v)) in mm."""
-    s = nominal_face.Surface
-    new_edges = Part.Compound(new_face.Edges)
-    out = []
-    for e in nominal_face.Edges:
-        c2d, a, b = nominal_face.curveOnSurface(e)[:3]
-        for t in np.linspace(a, b, samples):
-            w = c2d.value(float(t))
-            x = s.value(w.x, w.y)
-            out.append((new_edges.distToShape(Part.Vertex(x))[0],
-                        (corrected.value(w.x, w.y) - x).Length))
-    return np.array(out)
-
-
-def flux_change(old_face, new_face, field):
-    """Flux of ``field(points) . (Su x Sv)`` through ``new_face`` minus through
-    ``old_face`` (both B-spline faces, same parametrisation), on one scan grid: the volume
-    change of a solid whose other faces carry no flux of that field (div field = 1)."""
-    sa, sb = surface_from_part(old_face.Surface), surface_from_part(new_face.Surface)
-    la, lb = boundary_polylines(old_face), boundary_polylines(new_face)
-    pts = np.concatenate(la + lb)
-    box = (pts[:, 0].min(), pts[:, 0].max())
-    knots = knots_of(sa, sb)
-
-    def density(surf):
-        def f(u, v):
-            p, su, sv = bspline.derivatives(surf, u, v, order=1)
-            return np.einsum("ij,ij->i", field(p), np.cross(su, sv))
-        return f
-
-    sign = -1.0 if old_face.Orientation == "Reversed" else 1.0
-    return sign * (domain_integral(density(sb), lb, box=box, knots=knots)
-                   - domain_integral(density(sa), la, box=box, knots=knots))
-
-
-def z_field(p):
-    """(0, 0, z): no flux through vertical walls."""
-    out = np.zeros_like(p)
-    out[:, 2] = p[:, 2]
-    return out
-
-
-def radial_field(p):
-    """(x, y, 0) / 2: no flux through planes normal to z."""
-    out = 0.5 * p.copy()
-    out[:, 2] = 0.0
-    return out
-
-
-def mesh_volume(shape, max_length):
-    import MeshPart
-
-    return MeshPart.meshFromShape(Shape=shape, MaxLength=max_length).Volume
-
-
-def other_faces_untouched(before, after, changed):
-    """Faces other than ``changed`` (0-based) keep their surfaces: same type and points."""
-    for k, (a, b) in enumerate(zip(before.Faces, after.Faces)):
-        if k in changed:
-            continue
-        assert a.Surface.TypeId == b.Surface.TypeId, k
-        u0, u1, v0, v1 = a.ParameterRange
-        for s, t in ((0.3, 0.4), (0.7, 0.6)):
-            uv = (u0 + s * (u1 - u0), v0 + t * (v1 - v0))
-            assert (a.Surface.value(*uv) - b.Surface.value(*uv)).Length < 1e-12, k
-
-
-def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "surfcomp", *map(str, args)], cwd=ROOT,
-                          capture_output=True, text=True, timeout=600)
-
+from tests.app.helpers import ROOT
+from tests.app.trim_cases import (
+    HOLE,
+    INSIDE,
+    UM,
+    boundary_move,
+    brep_file,
+    circle_face,
+    extruded,
+    flux_change,
+    max_tolerance,
+    measure,
+    mesh_volume,
+    other_faces_untouched,
+    raw_deviation,
+    realised_ok,
+    run_cli,
+    z_field,
+)
 
 # -- a trimmed face alone -------------------------------------------------------------------
 
@@ -441,7 +264,7 @@ def test_face_with_a_hole_in_a_solid(tmp_path):
     nominal = nominal_from_face(solid.Faces[top], face_name="Face%d" % (top + 1), shape=solid)
     P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 12, lambda P, U, V:
                             raw_deviation(P), box=INSIDE)
-    comp, rep = run_job(Job(nominal=str(_brep(solid, tmp_path)),
+    comp, rep = run_job(Job(nominal=str(brep_file(solid, tmp_path)),
                             measurements=str(tmp_path / "m.csv"), face="Face%d" % (top + 1),
                             output=str(tmp_path / "out.brep"), options=Options(method="raw")))
     out = Part.read(str(tmp_path / "out.brep"))
@@ -459,149 +282,6 @@ def test_face_with_a_hole_in_a_solid(tmp_path):
                         for u, v in zip(U.ravel(), V.ravel())])
     assert realised_ok(new, P, N, d, on_face) <= 0.1 * UM
     assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
-
-
-def _brep(shape, tmp_path, name="part.brep"):
-    path = tmp_path / name
-    shape.exportBrep(str(path))
-    return path
-
-
-# -- real parts: every neighbour tangent (boxed_sphere), a sewn pipe --------------------------
-
-@pytest.fixture(scope="module")
-def boxed_sphere():
-    from surfcomp.app.cadread import read_cad
-
-    shape = read_cad(BOXED_SPHERE)
-    # the file is in cm; OCCT reads it in mm: a sphere of radius 5 mm in a 10 mm box
-    sphere = min(shape.Solids, key=lambda s: len(s.Faces))
-    assert sphere.Volume == pytest.approx(4 / 3 * np.pi * 5.0 ** 3, rel=1e-3)
-    assert shape.BoundBox.XLength == pytest.approx(10.0, abs=1e-6)
-    return shape
-
-
-#: a fillet (4 edges), a trimmed blend (9 edges, half of its UV box), a sphere half (two
-#: poles), each meeting all its neighbours tangentially
-SPHERE_FACES = ("Face5", "Face8", "Face191")
-
-
-@pytest.mark.parametrize("face", SPHERE_FACES)
-def test_tangent_neighbours_need_a_vanishing_correction(boxed_sphere, face, tmp_path):
-    """Where the correction vanishes along the tangent edges, the face is replaced without
-    re-trimming; a constant 14 um one gives the clear error, nothing is written."""
-    k = int(face[4:]) - 1
-    shape = boxed_sphere
-    nominal = nominal_from_face(shape.Faces[k], face_name=face, shape=shape)
-    P, N, U, V, d = measure(tmp_path / "bump.csv", nominal, 21, bump(nominal), margin=0.02)
-    comp, rep = run_job(Job(nominal=BOXED_SPHERE, measurements=str(tmp_path / "bump.csv"),
-                            face=face, output=str(tmp_path / "out.brep"),
-                            options=Options(method="raw")))
-    out = Part.read(str(tmp_path / "out.brep"))
-    info = rep["output_shape"]
-    assert info["kind"] == "shape" and info["retrimmed_faces"] == []
-    assert out.isValid() and len(out.Faces) == len(shape.Faces) == 192
-    assert len(out.Solids) == 2 and all(s.isClosed() for s in out.Shells)
-    new = out.Faces[k]
-    assert len(new.Edges) == len(shape.Faces[k].Edges)
-    # the file's own tolerances (up to 0.06 mm, from Rhino) stay; nothing is added
-    assert max_tolerance(new) <= max_tolerance(shape.Faces[k]) + 1e-4
-    other_faces_untouched(shape, out, {k})
-    # no neighbour moved: the volume change is the flux of any field of divergence 1
-    # through the face (before and after), here (0, 0, z)
-    exact = flux_change(shape.Faces[k], new, z_field)
-    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
-    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
-    on_face = np.array([nominal.bspline_face.isPartOfDomain(u, v)
-                        for u, v in zip(U.ravel(), V.ravel())])
-    assert realised_ok(new, P, N, d, on_face, reach=0.05) <= 0.1 * UM
-    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
-    # a constant correction lifts the face off its tangent neighbours
-    measure(tmp_path / "const.csv", nominal, 21, lambda P, U, V: np.full(U.shape, 0.014),
-            margin=0.02)
-    with pytest.raises(GeometryError, match=r"Edge\d+ between %s and Face\d+ is tangent to "
-                                            r"its neighbour \(0\.\d degrees\) and the "
-                                            r"corrected face lies up to 14\.\d\d um off"
-                       % face):
-        run_job(Job(nominal=BOXED_SPHERE, measurements=str(tmp_path / "const.csv"), face=face,
-                    output=str(tmp_path / "const.brep"), options=Options(method="raw")))
-    assert not os.path.exists(tmp_path / "const.brep")
-
-
-@pytest.fixture(scope="module")
-def pipe(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("pipe")
-    solid = pipe_solid()
-    return solid, _brep(solid, tmp, "pipe.brep")
-
-
-def _pipe_run(pipe, k, dev, tmp_path, box=None):
-    solid, src = pipe
-    nominal = nominal_from_face(solid.Faces[k], face_name="Face%d" % (k + 1), shape=solid)
-    P, N, U, V, d = measure(tmp_path / "m.csv", nominal, 13, dev(nominal), box=box)
-    comp, rep = run_job(Job(nominal=str(src), measurements=str(tmp_path / "m.csv"),
-                            face="Face%d" % (k + 1), output=str(tmp_path / "out.brep"),
-                            options=Options(method="raw")))
-    out = Part.read(str(tmp_path / "out.brep"))
-    assert out.isValid() and len(out.Solids) == 1 and out.Shells[0].isClosed()
-    assert len(out.Faces) == 6 and max_tolerance(out) <= 1e-4
-    assert realised_ok(out.Faces[k], P, N, d) <= 0.1 * UM
-    assert rep["corrected_face"]["max_error_at_points_mm"] <= 0.1 * UM
-    return out, rep["output_shape"]
-
-
-def _across(nominal, amplitude=0.014):
-    """Vanishes along the quarter's long edges (tangent to the next quarters), not at its
-    ends (the disks)."""
-    (v0, v1) = nominal.surface.v_range
-    return lambda P, U, V: amplitude * np.sin(np.pi * (V - v0) / (v1 - v0)) ** 2
-
-
-def test_pipe_quarter_retrims_the_disks(pipe, tmp_path):
-    solid, _ = pipe
-    out, info = _pipe_run(pipe, 1, _across, tmp_path)
-    assert info["retrimmed_faces"] == ["Face1", "Face3"]          # the two disks
-    other_faces_untouched(solid, out, {1})
-    exact = flux_change(solid.Faces[1], out.Faces[1], radial_field)
-    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
-    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
-    # the re-trimmed end of the quarter lies on OCCT's own intersection of the corrected
-    # surface with the disk's plane (the reference for the Newton samples)
-    disk = solid.Faces[0]
-    sc = out.Faces[1].Surface
-    curves = sc.intersectSS(disk.Surface, 1e-7)
-    pieces = Part.Compound([c.toShape() for c in curves])
-    end = [e for e in out.Faces[1].Edges if abs(e.CenterOfMass.z - disk.CenterOfMass.z) < 1.0]
-    assert len(end) == 1
-    dist = [pieces.distToShape(Part.Vertex(p))[0] for p in end[0].discretize(50)]
-    assert max(dist) < 1e-5
-
-
-def test_pipe_disk_retrims_the_four_quarters(pipe, tmp_path):
-    solid, _ = pipe
-    # measured inside the disk (the square inscribed in its circle)
-    out, info = _pipe_run(pipe, 0, lambda nominal: lambda P, U, V: raw_deviation(P / 100.0),
-                          tmp_path, box=(0.16, 0.84, 0.16, 0.84))
-    assert info["retrimmed_faces"] == ["Face2", "Face4", "Face5", "Face6"]
-    exact = flux_change(solid.Faces[0], out.Faces[0], z_field)
-    assert exact == pytest.approx(-info["correction_integral_mm3"], rel=0.02)
-    assert info["volume_change_mm3"] == pytest.approx(exact, rel=0.005)
-
-
-def test_pipe_quarter_with_a_constant_correction_is_refused(pipe, tmp_path):
-    solid, src = pipe
-    nominal = nominal_from_face(solid.Faces[1], face_name="Face2", shape=solid)
-    measure(tmp_path / "m.csv", nominal, 9, lambda P, U, V: np.full(U.shape, 0.014))
-    out = run_cli("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
-                  tmp_path / "out.brep", "--method", "raw", "--quiet")
-    assert out.returncode == 2 and "Traceback" not in out.stderr
-    assert "between Face2 and Face" in out.stderr and "14.00 um off" in out.stderr
-    assert not os.path.exists(tmp_path / "out.brep")
-    # the face alone is fine
-    out = run_cli("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
-                  tmp_path / "face.brep", "--method", "raw", "--face-only", "--quiet")
-    assert out.returncode == 0, out.stderr
-    assert len(Part.read(str(tmp_path / "face.brep")).Faces) == 1
 
 
 # -- the freecadcmd job and a saved document --------------------------------------------------
