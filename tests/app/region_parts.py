@@ -1,7 +1,47 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""Test parts and measurement files for the region compensation (issue 30)."""
+"""Test parts, documents and measurement files for the region compensation (issue 30)."""
+
+import hashlib
+import os
+import subprocess
+import sys
 
 import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def compensate(*args, timeout=900):
+    """``python3 -m surfcomp compensate ARGS`` from the checkout, its output captured."""
+    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *map(str, args)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=timeout)
+
+
+def sha256(path):
+    with open(path, "rb") as fh:
+        return hashlib.sha256(fh.read()).hexdigest()
+
+
+def block_document(path, solid, mirror=True, build=None):
+    """Save a document at ``path`` holding ``solid`` as the Part feature "Block", with a
+    "Mirror" of it (its user) unless ``mirror`` is false; ``build(doc, block)`` adds more
+    before it is saved. Returns what ``build`` returned."""
+    import FreeCAD
+
+    doc = FreeCAD.newDocument("regionshop")
+    try:
+        block = doc.addObject("Part::Feature", "Block")
+        block.Shape = solid
+        if mirror:
+            m = doc.addObject("Part::Mirroring", "Mirror")
+            m.Source = block
+            m.Normal = FreeCAD.Vector(1, 0, 0)
+        doc.recompute()
+        extra = build(doc, block) if build else None
+        doc.saveAs(str(path))
+        return extra
+    finally:
+        FreeCAD.closeDocument(doc.Name)
 
 
 def _h(x, y):

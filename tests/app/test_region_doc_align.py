@@ -6,11 +6,8 @@ transform; the region then corrects what it corrects from points in the nominal'
 A best fit on the region's own faces says what it absorbed; bad alignment input exits 2
 and writes nothing."""
 
-import hashlib
 import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -20,21 +17,10 @@ from scipy.spatial.transform import Rotation
 from surfcomp.core.measurement import align
 from tests.app import region_parts as rp
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 #: the measuring frame: nominal -> measured
 MOVE = align.rigid(Rotation.from_euler("xyz", [1.0, -0.5, 2.0], degrees=True).as_matrix(),
                    [0.5, -0.3, 0.2])
 DATUM = "Face3,Face4,Face5,Face6,Face7"
-
-
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *map(str, args)],
-                          cwd=ROOT, capture_output=True, text=True, timeout=900)
-
-
-def _sha(path):
-    with open(path, "rb") as fh:
-        return hashlib.sha256(fh.read()).hexdigest()
 
 
 def _volume(stdout):
@@ -44,19 +30,11 @@ def _volume(stdout):
 
 @pytest.fixture(scope="module")
 def shop(tmp_path_factory):
-    import FreeCAD
 
     tmp = tmp_path_factory.mktemp("regionalign")
     solid, tops = rp.g1_top_solid()
-    doc = FreeCAD.newDocument("regionalign")
-    try:
-        block = doc.addObject("Part::Feature", "Block")
-        block.Shape = solid
-        doc.recompute()
-        path = str(tmp / "shop.FCStd")
-        doc.saveAs(path)
-    finally:
-        FreeCAD.closeDocument(doc.Name)
+    path = str(tmp / "shop.FCStd")
+    rp.block_document(path, solid, mirror=False)
     pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 2000, rp.ridge_field,
                                     seed=11)
     nominal_csv = str(tmp / "nominal.csv")
@@ -72,8 +50,8 @@ def shop(tmp_path_factory):
         files[name] = str(path_xyz)
     back = tmp / "back.json"
     back.write_text(json.dumps({"matrix": np.linalg.inv(MOVE).tolist()}))
-    ref = _cli(path, nominal_csv, "--object", "Block", "--faces", "Face1,Face2", "--save",
-               tmp / "ref.FCStd")
+    ref = rp.compensate(path, nominal_csv, "--object", "Block", "--faces", "Face1,Face2", "--save",
+                        tmp / "ref.FCStd")
     assert ref.returncode == 0, ref.stderr
     return {"tmp": tmp, "doc": path, "files": files, "back": str(back), "csv": nominal_csv,
             "reference": _volume(ref.stdout), "datum_points": len(datum)}
@@ -96,12 +74,13 @@ def _region(out):
 
 def test_bestfit_on_datum_faces_brings_the_points_back(shop):
     tmp = shop["tmp"]
-    sha = _sha(shop["doc"])
+    sha = rp.sha256(shop["doc"])
     out = tmp / "datum.FCStd"
-    r = _cli(shop["doc"], shop["files"]["all"], "--object", "Block", "--faces", "Face1,Face2",
-             "--align", "bestfit", "--align-faces", DATUM, "--save", out)
+    r = rp.compensate(shop["doc"], shop["files"]["all"], "--object", "Block",
+                      "--faces", "Face1,Face2",
+                      "--align", "bestfit", "--align-faces", DATUM, "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert _sha(shop["doc"]) == sha
+    assert rp.sha256(shop["doc"]) == sha
     assert "Alignment:    bestfit: translation" in r.stdout
     assert "best fit on %s" % DATUM.replace(",", ", ") in r.stdout
     assert "iterations, converged" in r.stdout
@@ -125,8 +104,8 @@ def test_bestfit_on_datum_faces_brings_the_points_back(shop):
 
 def test_known_transform_alone_works_with_faces_auto(shop):
     out = shop["tmp"] / "known.FCStd"
-    r = _cli(shop["doc"], shop["files"]["tops"], "--object", "Block", "--faces", "auto",
-             "--transform", shop["back"], "--save", out)
+    r = rp.compensate(shop["doc"], shop["files"]["tops"], "--object", "Block", "--faces", "auto",
+                      "--transform", shop["back"], "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "points per face: Face1 2000, Face2 2000; on no face: 0" in r.stdout
     assert _volume(r.stdout) == pytest.approx(shop["reference"], rel=0.005)
@@ -137,9 +116,10 @@ def test_known_transform_alone_works_with_faces_auto(shop):
 
 def test_bestfit_on_the_region_itself_says_what_it_absorbed(shop):
     out = shop["tmp"] / "self.FCStd"
-    r = _cli(shop["doc"], shop["files"]["tops"], "--object", "Block", "--faces", "Face1,Face2",
-             "--align", "bestfit", "--align-dof", "z,rx,ry", "--transform", shop["back"],
-             "--save", out)
+    r = rp.compensate(shop["doc"], shop["files"]["tops"], "--object", "Block",
+                      "--faces", "Face1,Face2",
+                      "--align", "bestfit", "--align-dof", "z,rx,ry", "--transform", shop["back"],
+                      "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "warning: the best fit used the region's faces themselves: it absorbed a mean " \
            "offset of" in r.stderr
@@ -161,7 +141,7 @@ def test_bestfit_on_the_region_itself_says_what_it_absorbed(shop):
 
 def test_bad_alignment_input_exits_2_and_writes_nothing(shop):
     tmp, doc = shop["tmp"], shop["doc"]
-    sha = _sha(doc)
+    sha = rp.sha256(doc)
     out = tmp / "bad.FCStd"
     cases = [
         (shop["files"]["all"], ("--faces", "auto", "--align", "bestfit", "--align-faces",
@@ -173,12 +153,12 @@ def test_bad_alignment_input_exits_2_and_writes_nothing(shop):
          "needs --rps"),
     ]
     for meas, extra, message in cases:
-        r = _cli(doc, meas, "--object", "Block", *extra, "--save", out)
+        r = rp.compensate(doc, meas, "--object", "Block", *extra, "--save", out)
         assert r.returncode == 2, r.stdout + r.stderr
         assert message in r.stderr, r.stderr
-        assert not os.path.exists(out) and _sha(doc) == sha
+        assert not os.path.exists(out) and rp.sha256(doc) == sha
     # the file route of --faces has no alignment: refused, not ignored
-    r = _cli(doc, shop["files"]["tops"], "--object", "Block", "--faces", "Face1,Face2",
-             "--transform", shop["back"], "-o", tmp / "bad.step")
+    r = rp.compensate(doc, shop["files"]["tops"], "--object", "Block", "--faces", "Face1,Face2",
+                      "--transform", shop["back"], "-o", tmp / "bad.step")
     assert r.returncode == 2 and "--transform cannot be combined with --faces -o" in r.stderr
     assert not os.path.exists(tmp / "bad.step")

@@ -7,10 +7,7 @@ read by LinuxCNC's rs274, goes down by the correction where the ridge is and sta
 there is none; the summary's claims (operation regenerated, files written) are checked
 against the files."""
 
-import hashlib
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -19,19 +16,8 @@ from scipy.spatial import cKDTree
 from tests.app import region_parts as rp
 from tests.pure.test_gcode_rs274 import rs274
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 POST_ARGS = "--no-show-editor --no-header --precision=4"
 R = 3.0                     # the ball end mill's radius (mm)
-
-
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=900)
-
-
-def _sha(path):
-    with open(path, "rb") as fh:
-        return hashlib.sha256(fh.read()).hexdigest()
 
 
 @pytest.fixture(scope="module")
@@ -73,12 +59,13 @@ def shop(tmp_path_factory):
 @pytest.fixture(scope="module")
 def posted(shop):
     tmp, path, csv, _solid, _nominal = shop
-    sha = _sha(path)
+    sha = rp.sha256(path)
     out, ngc = str(tmp / "out.FCStd"), str(tmp / "out.ngc")
-    r = _cli(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--replace", "--save",
-             out, "--gcode", ngc, "--post", "linuxcnc", "--post-args", POST_ARGS)
+    r = rp.compensate(path, csv, "--object", "Block",
+                      "--faces", "Face1,Face2", "--replace", "--save",
+                      out, "--gcode", ngc, "--post", "linuxcnc", "--post-args", POST_ARGS)
     assert r.returncode == 0, r.stdout + r.stderr
-    assert _sha(path) == sha                 # the input document is untouched
+    assert rp.sha256(path) == sha                 # the input document is untouched
     return out, ngc, r.stdout
 
 
@@ -173,14 +160,14 @@ def test_posted_program_is_the_saved_documents(posted):
 
 def test_gcode_without_a_job_using_the_region_exits_2_and_writes_nothing(shop):
     tmp, path, csv, *_ = shop
-    sha = _sha(path)
+    sha = rp.sha256(path)
     out, ngc = str(tmp / "nojob.FCStd"), str(tmp / "nojob.ngc")
     # without --replace no Job uses the region object: nothing to post
-    r = _cli(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out,
-             "--gcode", ngc)
+    r = rp.compensate(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out,
+                      "--gcode", ngc)
     assert r.returncode == 2, r.stdout + r.stderr
     assert "no Path jobs use the compensation" in r.stderr
-    assert not os.path.exists(out) and not os.path.exists(ngc) and _sha(path) == sha
-    r = _cli(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--gcode", ngc)
+    assert not os.path.exists(out) and not os.path.exists(ngc) and rp.sha256(path) == sha
+    r = rp.compensate(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--gcode", ngc)
     assert r.returncode == 2 and "needs --save OUT.FCStd" in r.stderr
-    assert not os.path.exists(ngc) and _sha(path) == sha
+    assert not os.path.exists(ngc) and rp.sha256(path) == sha

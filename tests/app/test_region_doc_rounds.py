@@ -6,63 +6,38 @@ corrections add up, the same sum on both faces, so the shared G1 edge stays clos
 users of the first round move to the second; the saved document recomputes the same; a
 round on other faces, or on a Base that is not a region object, is refused."""
 
-import hashlib
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from tests.app import region_parts as rp
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 #: what is left of the error on the part machined from the first round's faces
 LEFT = 0.3
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=900)
-
-
-def _sha(path):
-    with open(path, "rb") as fh:
-        return hashlib.sha256(fh.read()).hexdigest()
-
-
 @pytest.fixture(scope="module")
 def rounds(tmp_path_factory):
-    import FreeCAD
 
     tmp = tmp_path_factory.mktemp("regionrounds")
     solid, tops = rp.g1_top_solid()
-    doc = FreeCAD.newDocument("regionrounds")
-    try:
-        block = doc.addObject("Part::Feature", "Block")
-        block.Shape = solid
-        mirror = doc.addObject("Part::Mirroring", "Mirror")
-        mirror.Source = block
-        mirror.Normal = FreeCAD.Vector(1, 0, 0)
-        doc.recompute()
-        path = str(tmp / "shop.FCStd")
-        doc.saveAs(path)
-    finally:
-        FreeCAD.closeDocument(doc.Name)
+    path = str(tmp / "shop.FCStd")
+    rp.block_document(path, solid)
     pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 2000, rp.ridge_field,
                                     seed=5)
     first, second = str(tmp / "first.csv"), str(tmp / "second.csv")
     rp.write_csv(first, pts, nrm, dev)
     rp.write_csv(second, pts, nrm, LEFT * dev)
     out1, out2 = str(tmp / "round1.FCStd"), str(tmp / "round2.FCStd")
-    r1 = _cli(path, first, "--object", "Block", "--faces", "Face1,Face2", "--replace",
-              "--save", out1)
+    r1 = rp.compensate(path, first, "--object", "Block", "--faces", "Face1,Face2", "--replace",
+                       "--save", out1)
     assert r1.returncode == 0, r1.stdout + r1.stderr
-    sha = _sha(out1)
-    r2 = _cli(out1, second, "--object", "RegionCompensation", "--faces", "Face1,Face2",
-              "--replace", "--save", out2)
+    sha = rp.sha256(out1)
+    r2 = rp.compensate(out1, second, "--object", "RegionCompensation", "--faces", "Face1,Face2",
+                       "--replace", "--save", out2)
     assert r2.returncode == 0, r2.stdout + r2.stderr
-    assert _sha(out1) == sha                     # the first round's document is untouched
+    assert rp.sha256(out1) == sha                     # the first round's document is untouched
     return {"tmp": tmp, "solid": solid, "pts": pts, "nrm": nrm, "dev": dev, "out1": out1,
             "out2": out2, "stdout1": r1.stdout, "stdout2": r2.stdout, "first": first,
             "second": second}
@@ -148,15 +123,15 @@ def test_corrections_add_up_on_both_faces(rounds):
 
 def test_round_on_other_faces_is_refused(rounds):
     out1 = rounds["out1"]
-    sha = _sha(out1)
+    sha = rp.sha256(out1)
     bad = str(rounds["tmp"] / "bad.FCStd")
-    r = _cli(out1, rounds["second"], "--object", "RegionCompensation", "--faces", "Face1",
-             "--save", bad)
+    r = rp.compensate(out1, rounds["second"], "--object", "RegionCompensation", "--faces", "Face1",
+                      "--save", bad)
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Block_region round 2: the region is Face1, but Base Block_region corrected " \
            "Face1,Face2 (a next round corrects what the earlier ones corrected: set --faces " \
            "to Face1,Face2)" in r.stderr
-    assert not os.path.exists(bad) and _sha(out1) == sha
+    assert not os.path.exists(bad) and rp.sha256(out1) == sha
 
 
 def test_base_must_be_a_region_object(rounds):
@@ -239,11 +214,12 @@ def test_a_region_object_of_version_1_opens_and_is_refused_as_base_until_recompu
         assert r1.getEditorMode("Base") == []
     finally:
         FreeCAD.closeDocument(doc.Name)
-    sha = _sha(old)
+    sha = rp.sha256(old)
     bad = str(rounds["tmp"] / "on_version1.FCStd")
-    r = _cli(old, rounds["second"], "--object", "RegionCompensation", "--faces", "Face1,Face2",
-             "--save", bad)
+    r = rp.compensate(old, rounds["second"], "--object", "RegionCompensation",
+                      "--faces", "Face1,Face2",
+                      "--save", bad)
     assert r.returncode == 2, r.stdout + r.stderr
     assert "Block_region holds no correction field to stack on (not computed, or saved by an " \
            "earlier surfcomp): recompute it first" in r.stderr
-    assert not os.path.exists(bad) and _sha(old) == sha
+    assert not os.path.exists(bad) and rp.sha256(old) == sha

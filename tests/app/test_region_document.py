@@ -4,11 +4,9 @@ compensated together in an FCStd, the block's user (a mirror) moved to the regio
 the saved copy reopened and recomputed in a fresh freecadcmd; bad input exits 2 and writes
 nothing."""
 
-import hashlib
 import json
 import os
 import subprocess
-import sys
 
 import pytest
 
@@ -52,34 +50,13 @@ print("RESULT " + json.dumps(out))
 '''
 
 
-def _cli(*args):
-    return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=600)
-
-
-def _sha(path):
-    with open(path, "rb") as fh:
-        return hashlib.sha256(fh.read()).hexdigest()
-
-
 @pytest.fixture(scope="module")
 def shop(tmp_path_factory):
-    import FreeCAD
 
     tmp = tmp_path_factory.mktemp("regiondoc")
     solid, tops = rp.g1_top_solid()
-    doc = FreeCAD.newDocument("regionshop")
-    try:
-        block = doc.addObject("Part::Feature", "Block")
-        block.Shape = solid
-        mirror = doc.addObject("Part::Mirroring", "Mirror")
-        mirror.Source = block
-        mirror.Normal = FreeCAD.Vector(1, 0, 0)
-        doc.recompute()
-        path = str(tmp / "shop.FCStd")
-        doc.saveAs(path)
-    finally:
-        FreeCAD.closeDocument(doc.Name)
+    path = str(tmp / "shop.FCStd")
+    rp.block_document(path, solid)
     pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 3000, rp.ridge_field,
                                     seed=1)
     csv = str(tmp / "g1.csv")
@@ -90,12 +67,12 @@ def shop(tmp_path_factory):
 @pytest.fixture(scope="module")
 def replaced(shop):
     tmp, path, csv, solid, *_ = shop
-    sha = _sha(path)
+    sha = rp.sha256(path)
     out = str(tmp / "out.FCStd")
-    r = _cli(path, csv, "--object", "Block", "--faces", "auto", "--replace", "--save", out,
-             "--min-coverage", "0.6")
+    r = rp.compensate(path, csv, "--object", "Block", "--faces", "auto", "--replace", "--save", out,
+                      "--min-coverage", "0.6")
     assert r.returncode == 0, r.stderr
-    assert _sha(path) == sha          # the input document is untouched
+    assert rp.sha256(path) == sha          # the input document is untouched
     return out, r.stdout, solid
 
 
@@ -160,7 +137,7 @@ def test_reopened_in_a_fresh_freecadcmd_recomputes_the_same(replaced, tmp_path):
 def test_save_without_replace_keeps_the_links(shop):
     tmp, path, csv, *_ = shop
     out = str(tmp / "plain.FCStd")
-    r = _cli(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out)
+    r = rp.compensate(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out)
     assert r.returncode == 0, r.stderr
     assert "replaced the nominal" not in r.stdout
     assert "faces Face1, Face2" in r.stdout and "Faces Face1,Face2" in r.stdout
@@ -169,11 +146,11 @@ def test_save_without_replace_keeps_the_links(shop):
 
 def _refused(shop, csv, *extra, save="bad.FCStd"):
     tmp, path = shop[0], shop[1]
-    sha = _sha(path)
+    sha = rp.sha256(path)
     out = save if os.path.isabs(save) else str(tmp / save)
-    r = _cli(path, csv, "--object", "Block", *extra, "--save", out)
+    r = rp.compensate(path, csv, "--object", "Block", *extra, "--save", out)
     assert r.returncode == 2, r.stdout + r.stderr
-    assert _sha(path) == sha
+    assert rp.sha256(path) == sha
     if out != path:
         assert not os.path.exists(out)
     return r.stderr
@@ -196,7 +173,7 @@ def test_bad_input_exits_2_and_writes_nothing(shop):
     assert "--overwrite-input" in err
     err = _refused(shop, csv, "--faces", "auto", "--face", "Face1")
     assert "--face cannot be combined with --faces on a document" in err
-    r = _cli(path, csv, "--faces", "auto", "--save", str(tmp / "x.FCStd"))
+    r = rp.compensate(path, csv, "--faces", "auto", "--save", str(tmp / "x.FCStd"))
     assert r.returncode == 2 and "--object NAME is required" in r.stderr
     err = _refused(shop, csv, "--faces", "auto", "--object", "Nothing")
     assert "no object 'Nothing'" in err
