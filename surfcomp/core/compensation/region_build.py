@@ -31,6 +31,7 @@ import numpy as np
 
 from ..surface.bspline import Surface, evaluate_grid, fit_grid_lsq, insert_knots
 from .region_edges import SharpEdges, knife_limit, smoothstep  # noqa: F401 (SharpEdges: API)
+from .region_fit import fit_ends_held
 
 #: largest angle (degrees) between the two normals of an edge that gets its full miter
 MITER_ANGLE = 120.0
@@ -221,12 +222,14 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
     if not np.any(D):       # zero correction: the nominal itself, not a refined copy
         return Built(surf, nominal, nominal, step)
+    # the boundary curves fitted on their own: an edge on both faces' boundaries takes
+    # each face's accuracy along it (region_fit)
     if ref.weights is None:
-        poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
-                                         ref.degree_v)
+        poles = ref.poles + fit_ends_held(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
+                                          ref.degree_v)
     else:       # rational: the moved points, the weights kept
-        poles = fit_grid_lsq(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
-                             ref.degree_v, weights=ref.weights)
+        poles = fit_ends_held(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
+                              ref.degree_v, weights=ref.weights)
     out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, ref.weights,
                   surf.u_range, surf.v_range)
     return Built(out, poles.shape[:2], nominal, step)

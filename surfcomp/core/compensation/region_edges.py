@@ -49,10 +49,12 @@ def vertex_miter(normals, limit):
     return m * (limit / size) if size > limit else m
 
 
-def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
+def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=None):
     """Turn each edge's miters to its vertex's vector near the vertex (see the module
     docstring). ``normals``: (K, 2, 3), both faces' normals at each sample; ``zone``: the
-    arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet.
+    arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet;
+    ``singular``: (S, 3) points where a face collapses (a cap's end: its normal takes every
+    direction of a fan there, so no vector but the vertex's own moves it as one point).
     Returns new ``miter`` and ``exact`` arrays."""
     miter, exact = miter.copy(), exact.astype(float).copy()
     ends = []
@@ -72,7 +74,8 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
         nv = np.concatenate([normals[ends[i][1][0]] for i in g])
         mv = vertex_miter(nv, limit)
         # a vertex whose faces' normals admit one miter (a box corner) keeps the correction
-        shorten = np.max(np.abs(nv @ mv - 1.0)) > 1e-6
+        shorten = np.max(np.abs(nv @ mv - 1.0)) > 1e-6 or _touches(tips[list(g)], singular,
+                                                                   tol)
         for i in g:
             idx = ends[i][1]
             arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[idx], axis=0), axis=1))]
@@ -81,6 +84,13 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
             if shorten:
                 exact[idx] *= smoothstep(arc / zone - 1.0)
     return miter, exact
+
+
+def _touches(tips, singular, tol):
+    """True when one of ``tips`` lies within ``tol`` of a ``singular`` point."""
+    if singular is None or not len(singular):
+        return False
+    return bool(np.any(cKDTree(np.asarray(singular, dtype=float)).query(tips, k=1)[0] <= tol))
 
 
 class SharpEdges:
