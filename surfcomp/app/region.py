@@ -275,7 +275,7 @@ def sharp_edges(faces, edges, band):
     are not G1, with the normals and in-face directions at their samples, each edge's vector
     turned to its vertices' near them
     (:func:`~surfcomp.core.compensation.region_edges.at_vertices`)."""
-    pts, mit, cl, eid, nrm = [], [], [], [], []
+    pts, mit, cl, eid, nrm, ids = [], [], [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:
             continue
@@ -288,13 +288,14 @@ def sharp_edges(faces, edges, band):
         cl.append(c)
         eid.append(np.full(len(m), k))
         nrm.append(np.stack([na, nb], axis=1))
+        ids.append(np.tile([e.a, e.b], (len(m), 1)))
     if not pts:
         return None
-    pts, eid = np.concatenate(pts), np.concatenate(eid)
+    pts, eid, nrm = np.concatenate(pts), np.concatenate(eid), np.concatenate(nrm)
     mit, exact = region_edges.at_vertices(
-        pts, np.concatenate(mit), np.concatenate(cl), eid, np.concatenate(nrm), 0.5 * band,
+        pts, np.concatenate(mit), np.concatenate(cl), eid, nrm, 0.5 * band,
         region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces))
-    return region_edges.SharpEdges(pts, mit, exact, eid, band)
+    return region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, np.concatenate(ids))
 
 
 def _collapsed(faces):

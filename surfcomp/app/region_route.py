@@ -139,8 +139,9 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     fld = region_field.RegionField(pts, filtered, field_radius)
     sharp = region.sharp_edges(faces, edges, band=field_radius)
     _check_neighbours(shape, faces, fld, sharp)
-    for f in faces:
-        f.built = region_build.corrected_surface(f.surface, f.outward, fld, sharp,
+    for i, f in enumerate(faces):
+        f.built = region_build.corrected_surface(f.surface, f.outward, fld,
+                                                 sharp and sharp.for_face(i),
                                                  knot_step=field_radius / 5.0,
                                                  max_factor=max_factor)
         from .convert import surface_to_part

@@ -180,15 +180,14 @@ def test_boxed_sphere_corner_blends_and_their_fillets(tmp_path):
         e = edges[key]
         assert not e["g1"] and e["nominal_angle_deg"] == pytest.approx(0.24, abs=0.02)
         assert e["max_angle_change_deg"] <= 0.05
-    # known limit: the blend Face1 (the solid's Face8) misses by up to 0.19 um at its points
-    # and opens its edge with Face2 by 0.12 um (0.09 um beyond the nominal's own gap); its
-    # mirror image Face4 stays within 0.03 um
-    assert edges[("Face3", "Face4")]["max_gap_um"] <= 0.1
-    assert edges[("Face1", "Face2")]["max_gap_um"] - \
-        edges[("Face1", "Face2")]["nominal_gap_um"] <= 0.1
+    # every edge closes within 0.1 um and every face meets its correction within 0.01 um
+    # (the blend Face1, the solid's Face8, curves with a 0.17 mm radius next to its edge:
+    # turned to the edge's miter itself it slid along itself by 8 um and missed by 0.19 um)
+    for e in edges.values():
+        assert e["max_gap_um"] <= 0.1
     fid = {f["face"]: f["max_realised_minus_intended_um"] for f in data["faces"]}
-    assert fid["Face2"] <= 0.1 and fid["Face3"] <= 0.1 and fid["Face4"] <= 0.1
-    assert fid["Face1"] <= 0.25
+    for name in ("Face1", "Face2", "Face3", "Face4"):
+        assert fid[name] <= 0.01
     for f in data["faces"]:
         assert f["poles"][0] * f["poles"][1] <= max(4 * f["nominal_poles"][0] *
                                                     f["nominal_poles"][1], 64 * 64)
@@ -297,8 +296,8 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     the boundary curves were fitted on their own, the tip cap's by 4.4 um before the faces
     were oriented and 36 um with a cap's collapsed end moved by more than one vector).
     Beyond the zones where the design shortens the correction, the root cap meets it
-    within 0.02 um; the sides miss by up to 2.5 and 7 um next to the trailing edge (see
-    docs/regions.md)."""
+    within 0.02 um; the sides miss by up to 1.8 and 3.3 um next to the trailing edge,
+    which curls with a 0.1 mm radius (see docs/regions.md)."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
@@ -322,12 +321,13 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     for e in edges:
         tip = "Face3" in e["faces"]
         # known limit: the pressure side folds onto the tip cap (179 deg between the
-        # outward normals), their edge opens by 1.9 um; the suction side's by 0.13 um
-        bound = (2.0 if "Face2" in e["faces"] else 0.15) if tip else 0.1
+        # outward normals; its normal turns by 130 deg within 0.5 mm at the trailing
+        # edge's end), their edge opens by 1.9 um; the suction side's by 0.16 um
+        bound = (2.0 if "Face2" in e["faces"] else 0.2) if tip else 0.1
         assert e["max_gap_beyond_nominal_um"] <= bound, e
     faces_rep = {f["face"]: f for f in data["faces"]}
     assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
-    for name, within in (("Face1", 3.0), ("Face2", 7.5), ("Face4", 0.02)):
+    for name, within in (("Face1", 2.0), ("Face2", 3.5), ("Face4", 0.02)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within

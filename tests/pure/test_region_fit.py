@@ -3,6 +3,7 @@
 face collapses (issue 30; no FreeCAD)."""
 
 import numpy as np
+import pytest
 
 from surfcomp.core.compensation import region_build, region_edges, region_fit
 from surfcomp.core.surface.bspline import Surface, evaluate_grid, fit_grid_lsq
@@ -87,3 +88,36 @@ def test_a_vertex_where_a_face_collapses_moves_as_one_point():
     x = np.array([[5.0, 0.0, 0.0]])
     dy = region_build.displacement(x, n["y"][None], delta, one)[0]
     np.testing.assert_allclose(dy @ n["y"], -0.02, atol=1e-15)
+
+
+def test_a_curved_face_turns_relative_to_its_own_normal_at_the_edge():
+    """A 2 deg edge along y between face 0 (normal +z there) and face 1: a point of face 0
+    next to the edge whose normal is tilted 30 deg along the edge (a blend curving along
+    it) slides along itself by the edge's excess only (0.017 of the correction), not by
+    the 30 deg between its normal and the miter (0.5); on the edge both faces move by the
+    miter."""
+    a = np.radians(2.0)
+    na, nb = np.array([0.0, 0.0, 1.0]), np.array([np.sin(a), 0.0, np.cos(a)])
+    edge = np.stack([np.zeros(50), np.linspace(0, 10, 50), np.zeros(50)], axis=1)
+    K = len(edge)
+    m, c = region_build.miters(np.tile(na, (K, 1)), np.tile(nb, (K, 1)),
+                               np.tile([-1.0, 0, 0], (K, 1)), np.tile([1.0, 0, 0], (K, 1)))
+    sharp = region_edges.SharpEdges(edge, m, c, np.zeros(K, int), 1.0,
+                                    np.tile(np.stack([na, nb]), (K, 1, 1)),
+                                    np.tile([0, 1], (K, 1)))
+    t = np.radians(30.0)
+    n = np.array([[0.0, np.sin(t), np.cos(t)]])
+    x = np.array([[-0.01, 5.0, 0.0]])
+    old = region_build.direction(x, n, sharp)[0]
+    new = region_build.direction(x, n, sharp.for_face(0))[0]
+    for d in (old, new):
+        assert d @ n[0] == pytest.approx(1.0, abs=1e-12)      # the correction is kept
+    slide = lambda d: np.linalg.norm(d - (d @ n[0]) * n[0])   # noqa: E731
+    assert slide(old) == pytest.approx(0.5, abs=0.01)
+    assert slide(new) == pytest.approx(np.linalg.norm(m[0] - na), abs=1e-3)
+    assert slide(new) < 0.018
+    on = np.array([[0.0, 5.0, 0.0]])
+    da = region_build.direction(on, na[None], sharp.for_face(0))[0]
+    db = region_build.direction(on, nb[None], sharp.for_face(1))[0]
+    np.testing.assert_allclose(da, m[0], atol=1e-12)
+    np.testing.assert_allclose(db, m[0], atol=1e-12)

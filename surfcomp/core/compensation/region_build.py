@@ -92,12 +92,15 @@ def direction(x, n, sharp=None):
     vectors within their band (see the module docstring)."""
     if sharp is None or len(sharp.points) == 0:
         return np.array(n, dtype=float)
-    d, m, exact = sharp.nearest(x)
+    d, m, exact, excess = sharp.nearest(x)
     s = d / sharp.band
     w = 1.0 - smoothstep((s - 0.1) / 0.9)
     lam = exact + (1.0 - exact) * smoothstep(s / 0.5)
     mn = np.einsum("ij,ij->i", m, n)
-    turned = m + (lam * (1.0 - mn))[:, None] * n
+    # lam = 1: n plus the excess's part along the face (the normal component kept); on
+    # the edge the face's normal is its own there and this is m; lam = 0: m alone
+    along = (excess - m) - np.einsum("ij,ij->i", excess - m, n)[:, None] * n
+    turned = m + lam[:, None] * ((1.0 - mn)[:, None] * n + along)
     return (1.0 - w)[:, None] * n + w[:, None] * turned
 
 
