@@ -6,8 +6,8 @@ orientations agree (every edge is run through once in each direction by the two 
 sharing it). A compound of faces read from separate files need not: the BladeX blade's
 pressure side and tip cap, as read from their IGES files, face into the blade (the pressure
 side's normal points at the suction side 3.5 mm away, the tip cap's to +z at the blade's -z
-end). Taken as they are, the sides would meet at 160 to 180 degrees where they really meet
-at 0 to 140, and their deviations would be taken along the wrong side.
+end). Taken as they are, the sides would meet at 40 to 180 degrees where they really meet
+at 0 to 143, and their deviations would be taken along the wrong side.
 
 :func:`orient` makes the faces of each connected part of the region agree, edge by edge:
 two faces sharing an edge must run through it in opposite directions (the edge's direction

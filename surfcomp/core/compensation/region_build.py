@@ -12,10 +12,11 @@ alike and the corrected edges coincide up to the fit (:func:`corrected_surface`)
 * near an edge where two corrected faces meet at an angle (:class:`SharpEdges`) a normal
   move would open the edge (the two normals differ), so the displacement turns, within a
   band around the edge, towards the edge's miter vector ``m = (n_A + n_B) / (1 + n_A.n_B)``:
-  ``D = -delta ((1 - w) n_F + w (m + n_F (1 - m.n_F)))``, ``w`` 1 on the edge and 0 beyond
-  the band. Its normal component is ``-delta`` on every face (the correction is realised;
-  the rest slides the face along itself, which is how the intersection of two offset faces
-  moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
+  ``D = -delta (n_F + w (e - (e.n_F) n_F))``, ``e = m - n_F(edge)`` the miter less the
+  face's own normal at the edge (:meth:`SharpEdges.for_face`), ``w`` 1 on the edge and 0
+  beyond the band. Its normal component is ``-delta`` on every face (the correction is
+  realised; the rest slides the face along itself, which is how the intersection of two
+  offset faces moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
   :data:`MITER_ANGLE` (a blade's knife edges) get a shortened miter along their bisector:
   there the edge stays closed and the realised correction falls short of ``delta`` within
   half the band (reported per point). Between 90 degrees and that angle the share of the
