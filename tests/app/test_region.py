@@ -240,6 +240,31 @@ def test_blade_points_on_their_nearest_face_and_shared_edges(blade):
     assert angles == pytest.approx([22.26, 143.33], abs=0.05)
 
 
+def test_orientation_of_a_compound_decided_by_its_edges_and_volume(blade):
+    """The blade with every face reversed: the faces still disagree in the same pairs, and
+    the enclosed volume turns the suction side and root cap back; an open set of faces
+    (the boxed_sphere blends with one fillet reversed) keeps what most faces have; faces of
+    one solid are left as the solid orients them."""
+    import Part
+
+    from surfcomp.app import region, region_orient
+    from tests.conftest import REALDATA
+
+    _tmp, _brep, faces = blade
+    shape = Part.Compound([f.reversed() for f in faces])
+    rf = [region.region_face(shape, k) for k in range(4)]
+    assert region_orient.orient(shape, rf) == ["Face1", "Face4"]
+    assert [f.outward for f in rf] == [1, -1, -1, 1]        # of the reversed faces
+    solid = Part.read(os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")).Solids[0]
+    blends = [solid.Faces[k - 1] for k in (8, 12, 24, 20)]
+    blends[1] = blends[1].reversed()
+    shape = Part.Compound(blends)
+    rf = [region.region_face(shape, k) for k in range(4)]
+    assert region_orient.orient(shape, rf) == ["Face2"]
+    rf = [region.region_face(solid, k - 1) for k in (8, 12, 24, 20)]
+    assert region_orient.orient(solid, rf) == []
+
+
 def test_faces_sharing_no_edge_are_corrected_apart(blade):
     """The blade's tip and root caps (alone in their file) share no edge: the run says so
     and corrects each."""
