@@ -121,3 +121,28 @@ def test_a_curved_face_turns_relative_to_its_own_normal_at_the_edge():
     db = region_build.direction(on, nb[None], sharp.for_face(1))[0]
     np.testing.assert_allclose(da, m[0], atol=1e-12)
     np.testing.assert_allclose(db, m[0], atol=1e-12)
+
+
+def test_the_edge_vector_between_samples_has_no_kink():
+    """Along an edge whose miter turns from sample to sample, the vector at the foot is
+    the samples' Catmull-Rom curve: its own values at the samples, and its slope the same
+    on both sides of a sample (a linear blend jumps in slope there by the change of the
+    miter's step)."""
+    K = 21
+    s = np.linspace(0.0, 10.0, K)
+    edge = np.stack([s, np.zeros(K), np.zeros(K)], axis=1)
+    ang = 0.02 * s ** 2
+    m = np.stack([np.sin(ang), np.zeros(K), np.cos(ang)], axis=1)
+    sharp = region_edges.SharpEdges(edge, m, np.ones(K), np.zeros(K, int), band=2.0)
+    at = np.stack([s[5:15], np.zeros(10), np.full(10, 1e-3)], axis=1)
+    np.testing.assert_allclose(sharp.nearest(at)[1], m[5:15], atol=1e-12)
+    h = 1e-4
+    for k in (7, 10, 13):
+        x = np.array([[s[k] - 2 * h, 0, 1e-3], [s[k] - h, 0, 1e-3], [s[k], 0, 1e-3],
+                      [s[k] + h, 0, 1e-3], [s[k] + 2 * h, 0, 1e-3]])
+        v = sharp.nearest(x)[1]
+        left, right = (v[2] - v[0]) / (2 * h), (v[4] - v[2]) / (2 * h)
+        np.testing.assert_allclose(left, right, atol=1e-3)
+        # the linear blend's slopes either side differ by the miter's step change
+        lin = (m[k + 1] - m[k]) / 0.5 - (m[k] - m[k - 1]) / 0.5
+        assert np.linalg.norm(lin) > 0.02

@@ -87,6 +87,17 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=
     return miter, exact
 
 
+def _catmull_rom(v, ks, t):
+    """Catmull-Rom interpolation of the samples ``v`` (K, n) between ``ks[1]`` and
+    ``ks[2]`` at ``t`` (M, 1) in [0, 1], ``ks[0]`` and ``ks[3]`` the neighbours (C1 along
+    the samples; the samples' own values at t = 0 and 1)."""
+    km, k0, k1, kp = ks
+    t2, t3 = t * t, t * t * t
+    d0, d1 = 0.5 * (v[k1] - v[km]), 0.5 * (v[kp] - v[k0])
+    return ((2 * t3 - 3 * t2 + 1) * v[k0] + (t3 - 2 * t2 + t) * d0
+            + (3 * t2 - 2 * t3) * v[k1] + (t3 - t2) * d1)
+
+
 def _touches(tips, singular, tol):
     """True when one of ``tips`` lies within ``tol`` of a ``singular`` point."""
     if singular is None or not len(singular):
@@ -170,8 +181,13 @@ class SharpEdges:
             better = d < best_d
             tt = t[better, None]
             best_d[better] = d[better]
-            best_m[better] = (1 - tt) * mit[k0[better]] + tt * mit[k1[better]]
-            best_e[better] = (1 - tt[:, 0]) * ex[k0[better]] + tt[:, 0] * ex[k1[better]]
+            # Catmull-Rom between the samples: the displacement's slope does not jump
+            # where the foot passes a sample (a linear blend kinks it there, and the fit
+            # of a face along the edge follows no kink)
+            ks = (np.maximum(k0 - 1, 0)[better], k0[better], k1[better],
+                  np.minimum(k1 + 1, last)[better])
+            best_m[better] = _catmull_rom(mit, ks, tt)
+            best_e[better] = _catmull_rom(ex[:, None], ks, tt)[:, 0]
         return best_d, best_m, best_e
 
     def nearest(self, x):
