@@ -57,7 +57,7 @@ def make_inputs(folder, points):
     areas = np.array([f.Area for f in faces])
     per = np.maximum((points * areas / areas.sum()).astype(int), 200)
     parts = [rp.sample_faces([f], int(k), field, seed=i) for i, (f, k) in
-             enumerate(zip(faces, per))]
+             enumerate(zip(rp.blade_outward(faces), per))]
     pts, nrm, dev = (np.concatenate([p[j] for p in parts]) for j in range(3))
     csv = os.path.join(folder, "points.csv")
     rp.write_csv(csv, pts, nrm, dev)

@@ -212,10 +212,11 @@ def _near_polyline(points, poly):
     return worst
 
 
-def shared_edges(shape, faces, all_faces=False):
+def shared_edges(shape, faces, all_faces=False, angles=True):
     """Edges shared by two faces of the region (and, with ``all_faces``, by a region face
     and any other face of ``shape``: ``b`` is then the shape's face index, negative-coded
-    as ``-1 - index``), found geometrically so unsewn shells count too."""
+    as ``-1 - index``), found geometrically so unsewn shells count too. Without ``angles``
+    the nominal angle along each edge is not measured (NaN)."""
     out = []
     polys = {}
 
@@ -245,7 +246,8 @@ def shared_edges(shape, faces, all_faces=False):
                         continue
                     pts = _edge_points(ea)
                     b = region[k] if not all_faces else -1 - k
-                    ang = _nominal_angle(f, faces[region[k]] if k in region else g, pts)
+                    ang = _nominal_angle(f, faces[region[k]] if k in region else g,
+                                         pts) if angles else float("nan")
                     out.append(SharedEdge(i, b, ja, jb, pts, ang))
     return out
 
@@ -273,36 +275,54 @@ def sharp_edges(faces, edges, band):
     are not G1, with the normals and in-face directions at their samples, each edge's vector
     turned to its vertices' near them
     (:func:`~surfcomp.core.compensation.region_edges.at_vertices`)."""
-    pts, mit, cl, eid, nrm = [], [], [], [], []
+    pts, mit, cl, eid, nrm, ids = [], [], [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:
             continue
         fa, fb = faces[e.a], faces[e.b]
-        tang = np.gradient(e.samples, axis=0)
         na, nb = normals_at(fa, e.samples)[0], normals_at(fb, e.samples)[0]
-        m, c = region_build.miters(na, nb, _inward(fa, e.samples, na, tang),
-                                   _inward(fb, e.samples, nb, tang))
+        m, c = region_build.miters(na, nb, _inward(fa, e.edge_a, e.samples, na),
+                                   _inward(fb, e.edge_b, e.samples, nb))
         pts.append(e.samples)
         mit.append(m)
         cl.append(c)
         eid.append(np.full(len(m), k))
         nrm.append(np.stack([na, nb], axis=1))
+        ids.append(np.tile([e.a, e.b], (len(m), 1)))
     if not pts:
         return None
-    pts, eid = np.concatenate(pts), np.concatenate(eid)
+    pts, eid, nrm = np.concatenate(pts), np.concatenate(eid), np.concatenate(nrm)
     mit, exact = region_edges.at_vertices(
-        pts, np.concatenate(mit), np.concatenate(cl), eid, np.concatenate(nrm), 0.5 * band,
-        region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL)
-    return region_edges.SharpEdges(pts, mit, exact, eid, band)
+        pts, np.concatenate(mit), np.concatenate(cl), eid, nrm, 0.5 * band,
+        region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces))
+    return region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, np.concatenate(ids))
 
 
-def _inward(f, p, n, t):
-    """Unit directions in face ``f`` at edge points ``p``, normal to the edge, into the face."""
-    d = np.cross(n, t)
-    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
-    probe = f.project(p + 1e-3 * d)
-    ok = inside(f.polylines, probe.u, probe.v)
-    return np.where(ok[:, None], d, -d)
+def _collapsed(faces):
+    """Points where a region face collapses (the vertices of its degenerated edges)."""
+    return np.array([tuple(e.Vertexes[0].Point) for f in faces for e in f.face.Edges
+                     if e.Degenerated and e.Vertexes]).reshape(-1, 3)
+
+
+def _inward(f, j, p, n):
+    """Unit directions in face ``f`` at the points ``p`` (K, 3) of its edge ``j`` (outward
+    normals ``n``), normal to the edge, into the face: the face's boundary runs with the
+    face on its left about the face's own normal (its surface's, turned by its
+    ``Orientation``), so no probe off the edge is needed (a probe is pulled back onto the
+    edge at a surface's natural boundary)."""
+    own = -1 if f.face.Orientation == "Reversed" else 1
+    t = np.gradient(p, axis=0) * run_direction(f.face.Edges[j], p)
+    d = np.cross(n * (f.outward * own), t)
+    return d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+
+
+def run_direction(edge, p):
+    """+1 where the face holding ``edge`` runs through it in the order of its points ``p``
+    (K, 3), -1 where against (the edge's curve direction, reversed where the face takes the
+    edge ``Reversed``, which includes the face's own orientation)."""
+    a, b = p[len(p) // 4], p[(3 * len(p)) // 4]
+    ta, tb = (edge.Curve.parameter(_vec(x)) for x in (a, b))
+    return (1 if tb > ta else -1) * (1 if edge.Orientation == "Forward" else -1)
 
 
 def continuity(faces, edges):

@@ -16,6 +16,7 @@ from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
 from . import fcenv, region
 from .file_route import cad_format
+from .region_orient import orient
 from .retrim import PRECISION
 
 #: faces with fewer points than this are not taken by --faces auto
@@ -32,7 +33,11 @@ def _base(ms):
 
 def _deviation(ms, normal, signed):
     if ms.deviation is not None:
-        return np.asarray(ms.deviation, dtype=float)
+        d = np.asarray(ms.deviation, dtype=float)
+        if ms.normal is None:
+            return d
+        # a deviation is along its given normal: turned to the outward normal's side
+        return np.where(np.einsum("ij,ij->i", np.asarray(ms.normal), normal) < 0, -d, d)
     if ms.nominal is not None and ms.measured is not None:
         return np.einsum("ij,ij->i", ms.measured - ms.nominal, normal)
     return signed
@@ -87,6 +92,10 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     candidates = chosen if chosen is not None else [
         k for k, f in enumerate(shape.Faces) if _near(f, base, max_offset)]
     faces = [region.region_face(shape, k) for k in candidates]
+    turned = orient(shape, faces)
+    if turned:
+        log("outward normals taken against the faces' own orientation (to agree with their "
+            "neighbours'): " + ", ".join(turned))
     dist, res = region.project_all(faces, base, max_offset)
     owner, u, v, normal, signed = region.locate(faces, base, max_offset, (dist, res))
     if chosen is None:
@@ -133,8 +142,9 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
         fld = stack(fld)
     sharp = region.sharp_edges(faces, edges, band=field_radius)
     _check_neighbours(shape, faces, fld, sharp)
-    for f in faces:
-        f.built = region_build.corrected_surface(f.surface, f.outward, fld, sharp,
+    for i, f in enumerate(faces):
+        f.built = region_build.corrected_surface(f.surface, f.outward, fld,
+                                                 sharp and sharp.for_face(i),
                                                  knot_step=field_radius / 5.0,
                                                  max_factor=max_factor)
         from .convert import surface_to_part

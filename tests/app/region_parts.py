@@ -162,6 +162,14 @@ def blade_faces(folder):
     return [Part.read(os.path.join(folder, name + ".iges")).Faces[0] for name in BLADE]
 
 
+def blade_outward(faces):
+    """The blade's faces turned so their normals point out of the blade: the pressure side
+    (``lower``: its normal points at the suction side, 3.5 mm away mid-chord) and the tip
+    cap (its normal points to +z at the blade's -z end) face into it as read. Measurements
+    carry outward normals; the region finds the same orientation itself."""
+    return [f.reversed() if name in ("lower", "tip") else f for name, f in zip(BLADE, faces)]
+
+
 def leading_edge(faces, samples=400):
     """Points along the spanwise edge the two sides share that is nearer the blade's
     axis of rotation (its leading edge as BladeX builds it), shape (samples, 3)."""

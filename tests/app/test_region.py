@@ -92,6 +92,28 @@ def test_zero_correction_gives_the_nominal(g1_part):
                                    atol=1e-12)
 
 
+def test_deviations_along_inward_normals_read_the_same(g1_part):
+    """A deviation is along its given normal: Face2's points given with inward normals and
+    negated deviations are the same readings, and correct the faces alike."""
+    tmp, step, csv, _solid, pts, nrm, dev = g1_part
+    flip = np.where(pts[:, 0] > 10.0, -1.0, 1.0)
+    inward = str(tmp / "inward.csv")
+    rp.write_csv(inward, pts, nrm * flip[:, None], dev * flip)
+    reps = []
+    for name, meas in (("plain", csv), ("inward", inward)):
+        rep = str(tmp / ("%s.json" % name))
+        r = _cli(step, meas, "--faces", "auto", "-o", str(tmp / ("%s.step" % name)),
+                 "--report", rep)
+        assert r.returncode == 0, r.stderr
+        reps.append(json.load(open(rep)))
+    a, b = reps
+    assert b["output"]["change_mm3"] == pytest.approx(a["output"]["change_mm3"], abs=1e-12)
+    assert b["output"]["change_mm3"] == pytest.approx(-0.64, abs=0.03)
+    for fa, fb in zip(a["faces"], b["faces"]):
+        assert fb["max_realised_minus_intended_um"] == pytest.approx(
+            fa["max_realised_minus_intended_um"], abs=1e-9)
+
+
 def test_min_coverage_names_the_face(g1_part):
     tmp, step, csv, _solid, pts, nrm, dev = g1_part
     keep = ~((pts[:, 0] > 10) & (pts[:, 1] > 3))      # Face2 measured on its y < 3 strip
@@ -158,15 +180,14 @@ def test_boxed_sphere_corner_blends_and_their_fillets(tmp_path):
         e = edges[key]
         assert not e["g1"] and e["nominal_angle_deg"] == pytest.approx(0.24, abs=0.02)
         assert e["max_angle_change_deg"] <= 0.05
-    # known limit: the blend Face1 (the solid's Face8) misses by up to 0.19 um at its points
-    # and opens its edge with Face2 by 0.12 um (0.09 um beyond the nominal's own gap); its
-    # mirror image Face4 stays within 0.03 um
-    assert edges[("Face3", "Face4")]["max_gap_um"] <= 0.1
-    assert edges[("Face1", "Face2")]["max_gap_um"] - \
-        edges[("Face1", "Face2")]["nominal_gap_um"] <= 0.1
+    # every edge closes within 0.1 um and every face meets its correction within 0.01 um
+    # (the blend Face1, the solid's Face8, curves with a 0.17 mm radius next to its edge:
+    # turned to the edge's miter itself it slid along itself by 8 um and missed by 0.19 um)
+    for e in edges.values():
+        assert e["max_gap_um"] <= 0.1
     fid = {f["face"]: f["max_realised_minus_intended_um"] for f in data["faces"]}
-    assert fid["Face2"] <= 0.1 and fid["Face3"] <= 0.1 and fid["Face4"] <= 0.1
-    assert fid["Face1"] <= 0.25
+    for name in ("Face1", "Face2", "Face3", "Face4"):
+        assert fid[name] <= 0.01
     for f in data["faces"]:
         assert f["poles"][0] * f["poles"][1] <= max(4 * f["nominal_poles"][0] *
                                                     f["nominal_poles"][1], 64 * 64)
@@ -193,7 +214,7 @@ def test_blade_points_on_their_nearest_face_and_shared_edges(blade):
     edges the faces share are found although OpenCASCADE does not sew the sides."""
     import Part
 
-    from surfcomp.app import region
+    from surfcomp.app import region, region_orient
 
     _tmp, brep, faces = blade
     shape = Part.read(brep)
@@ -209,8 +230,39 @@ def test_blade_points_on_their_nearest_face_and_shared_edges(blade):
     edges = region.shared_edges(shape, rf)
     pairs = sorted((e.a, e.b) for e in edges)
     assert pairs == [(0, 1), (0, 1), (0, 2), (0, 3), (1, 2), (1, 3)]
-    # the sides meet at knife edges: their outward normals more than 120 deg apart
+    # as read, the sides' normals are more than 120 deg apart along both their edges: the
+    # pressure side and the tip cap face into the blade (edges run through alike by two
+    # faces), and once oriented the sides meet at 22 and 143 deg at most
     assert all(e.nominal_angle > 120.0 for e in edges if (e.a, e.b) == (0, 1))
+    assert region_orient.orient(shape, rf) == ["Face2", "Face3"]
+    assert [f.outward for f in rf] == [1, -1, -1, 1]
+    angles = sorted(e.nominal_angle for e in region.shared_edges(shape, rf) if (e.a, e.b) == (0, 1))
+    assert angles == pytest.approx([22.26, 143.33], abs=0.05)
+
+
+def test_orientation_of_a_compound_decided_by_its_edges_and_volume(blade):
+    """The blade with every face reversed: the faces still disagree in the same pairs, and
+    the enclosed volume turns the suction side and root cap back; an open set of faces
+    (the boxed_sphere blends with one fillet reversed) keeps what most faces have; faces of
+    one solid are left as the solid orients them."""
+    import Part
+
+    from surfcomp.app import region, region_orient
+    from tests.conftest import REALDATA
+
+    _tmp, _brep, faces = blade
+    shape = Part.Compound([f.reversed() for f in faces])
+    rf = [region.region_face(shape, k) for k in range(4)]
+    assert region_orient.orient(shape, rf) == ["Face1", "Face4"]
+    assert [f.outward for f in rf] == [1, -1, -1, 1]        # of the reversed faces
+    solid = Part.read(os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")).Solids[0]
+    blends = [solid.Faces[k - 1] for k in (8, 12, 24, 20)]
+    blends[1] = blends[1].reversed()
+    shape = Part.Compound(blends)
+    rf = [region.region_face(shape, k) for k in range(4)]
+    assert region_orient.orient(shape, rf) == ["Face2"]
+    rf = [region.region_face(solid, k - 1) for k in (8, 12, 24, 20)]
+    assert region_orient.orient(solid, rf) == []
 
 
 def test_faces_sharing_no_edge_are_corrected_apart(blade):
@@ -236,9 +288,10 @@ def test_faces_sharing_no_edge_are_corrected_apart(blade):
     for f in data["faces"]:
         assert f["points"] == 600
         # known limit: the caps collapse to a point at both ends (their normals turn by up
-        # to 180 deg within a few mm there), where the fit is ill-conditioned: rounding-level
-        # changes of the basis move this figure; measured 1.21 um (FreeCAD 0.20), 1.24 (1.0)
-        # and 1.62 (1.1) with the same code
+        # to 180 deg within a few mm there: the offset of such a point is a fan, not a
+        # point), where the fit is ill-conditioned: rounding-level changes of the basis move
+        # this figure; measured tip 1.22 um and root 0.47 um on FreeCAD 0.20, 1.26 and
+        # 1.60 um on 1.1, with the same code
         assert f["max_realised_minus_intended_um"] <= 2.0
 
 
@@ -262,40 +315,45 @@ def test_unknown_face_named(g1_part):
 
 
 def test_blade_knife_edges_and_vertices_move_as_one(blade):
-    """The blade with a 30 um field around its leading edge: the two sides' common edges
-    (leading edge from 41 to 176 deg between the normals, trailing edge a 180 deg knife)
-    stay closed to within 0.1 um beyond the nominal's own gap, and the corners where they
-    meet the caps no longer open (52 um before each vertex got one vector). Beyond the
-    zones where the design shortens the correction, it is met within 1 um (the sides) and
-    0.02 um (the root cap)."""
+    """The blade with a 30 um field around its leading edge, measured with outward normals:
+    the region takes the pressure side and the tip cap against their own orientation (as
+    read they face into the blade), and every shared edge but the tip cap's stays closed
+    to within 0.1 um beyond the nominal's own gap (the root cap's opened by 0.5 um before
+    the boundary curves were fitted on their own, the tip cap's by 4.4 um before the faces
+    were oriented and 36 um with a cap's collapsed end moved by more than one vector).
+    Beyond the zones where the design shortens the correction, the root cap meets it
+    within 0.02 um; the sides miss by up to 1.8 and 3.5 um next to the trailing edge,
+    which curls with a 0.1 mm radius (see docs/regions.md)."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
-             for i, (f, k) in enumerate(zip(faces, (2500, 2500, 200, 300)))]
+             for i, (f, k) in enumerate(zip(rp.blade_outward(faces), (2500, 2500, 200, 300)))]
     pts, nrm, dev = (np.concatenate([p[j] for p in parts]) for j in range(3))
     csv = str(tmp / "knife.csv")
     rp.write_csv(csv, pts, nrm, dev)
     out, rep = str(tmp / "knife.brep"), str(tmp / "knife.json")
     r = _cli(brep, csv, "--faces", "auto", "-o", out, "--report", rep)
     assert r.returncode == 0, r.stderr
+    assert "outward normals taken against the faces' own orientation (to agree with their " \
+        "neighbours'): Face2, Face3" in r.stdout
     assert "points near knife edges or vertices" in r.stdout
     data = json.load(open(rep))
     edges = data["edges"]
     assert len(edges) == 6
     sides = [e for e in edges if e["faces"] == ["Face1", "Face2"]]
     assert len(sides) == 2
-    for e in sides:
-        assert e["max_gap_beyond_nominal_um"] <= 0.1
-    # known limits: the sides open from the root cap by 0.47 and 0.53 um, from the tip cap
-    # (which collapses to a point at both ends) by 4.4 um
+    # oriented, the sides meet at 0 to 22 deg (leading edge) and 10 to 143 deg (trailing)
+    assert sorted(round(e["nominal_angle_deg"]) for e in sides) == [22, 143]
     for e in edges:
-        cap = "Face3" if "Face3" in e["faces"] else "Face4" if "Face4" in e["faces"] else None
-        assert e["max_gap_beyond_nominal_um"] <= {None: 0.1, "Face4": 0.6, "Face3": 5.0}[cap]
+        tip = "Face3" in e["faces"]
+        # known limit: the pressure side folds onto the tip cap (179 deg between the
+        # outward normals; its normal turns by 130 deg within 0.5 mm at the trailing
+        # edge's end), their edge opens by 2.1 um; the suction side's by 0.15 um
+        bound = (2.5 if "Face2" in e["faces"] else 0.2) if tip else 0.1
+        assert e["max_gap_beyond_nominal_um"] <= bound, e
     faces_rep = {f["face"]: f for f in data["faces"]}
-    assert faces_rep["Face3"]["edge_zone_points"] == 200      # the tip cap: all in the zone
-    for name, within in (("Face1", 1.0), ("Face2", 1.0), ("Face4", 0.02)):
+    assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
+    for name, within in (("Face1", 2.0), ("Face2", 4.0), ("Face4", 0.02)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within
-        # within the zones the correction (at most 30 um) is short by design
-        assert 10.0 <= f["edge_zone_max_designed_shortfall_um"] <= 30.0

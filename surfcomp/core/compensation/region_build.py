@@ -12,10 +12,11 @@ alike and the corrected edges coincide up to the fit (:func:`corrected_surface`)
 * near an edge where two corrected faces meet at an angle (:class:`SharpEdges`) a normal
   move would open the edge (the two normals differ), so the displacement turns, within a
   band around the edge, towards the edge's miter vector ``m = (n_A + n_B) / (1 + n_A.n_B)``:
-  ``D = -delta ((1 - w) n_F + w (m + n_F (1 - m.n_F)))``, ``w`` 1 on the edge and 0 beyond
-  the band. Its normal component is ``-delta`` on every face (the correction is realised;
-  the rest slides the face along itself, which is how the intersection of two offset faces
-  moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
+  ``D = -delta (n_F + w (e - (e.n_F) n_F))``, ``e = m - n_F(edge)`` the miter less the
+  face's own normal at the edge (:meth:`SharpEdges.for_face`), ``w`` 1 on the edge and 0
+  beyond the band. Its normal component is ``-delta`` on every face (the correction is
+  realised; the rest slides the face along itself, which is how the intersection of two
+  offset faces moves), and on the edge it is ``-delta m`` from both sides. Edges sharper than
   :data:`MITER_ANGLE` (a blade's knife edges) get a shortened miter along their bisector:
   there the edge stays closed and the realised correction falls short of ``delta`` within
   half the band (reported per point). Between 90 degrees and that angle the share of the
@@ -31,6 +32,7 @@ import numpy as np
 
 from ..surface.bspline import Surface, evaluate_grid, fit_grid_lsq, insert_knots
 from .region_edges import SharpEdges, knife_limit, smoothstep  # noqa: F401 (SharpEdges: API)
+from .region_fit import fit_ends_held
 
 #: largest angle (degrees) between the two normals of an edge that gets its full miter
 MITER_ANGLE = 120.0
@@ -91,12 +93,15 @@ def direction(x, n, sharp=None):
     vectors within their band (see the module docstring)."""
     if sharp is None or len(sharp.points) == 0:
         return np.array(n, dtype=float)
-    d, m, exact = sharp.nearest(x)
+    d, m, exact, excess = sharp.nearest(x)
     s = d / sharp.band
     w = 1.0 - smoothstep((s - 0.1) / 0.9)
     lam = exact + (1.0 - exact) * smoothstep(s / 0.5)
     mn = np.einsum("ij,ij->i", m, n)
-    turned = m + (lam * (1.0 - mn))[:, None] * n
+    # lam = 1: n plus the excess's part along the face (the normal component kept); on
+    # the edge the face's normal is its own there and this is m; lam = 0: m alone
+    along = (excess - m) - np.einsum("ij,ij->i", excess - m, n)[:, None] * n
+    turned = m + lam[:, None] * ((1.0 - mn)[:, None] * n + along)
     return (1.0 - w)[:, None] * n + w[:, None] * turned
 
 
@@ -221,12 +226,14 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
     if not np.any(D):       # zero correction: the nominal itself, not a refined copy
         return Built(surf, nominal, nominal, step)
+    # the boundary curves fitted on their own: an edge on both faces' boundaries takes
+    # each face's accuracy along it (region_fit)
     if ref.weights is None:
-        poles = ref.poles + fit_grid_lsq(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
-                                         ref.degree_v)
+        poles = ref.poles + fit_ends_held(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
+                                          ref.degree_v)
     else:       # rational: the moved points, the weights kept
-        poles = fit_grid_lsq(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
-                             ref.degree_v, weights=ref.weights)
+        poles = fit_ends_held(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
+                              ref.degree_v, weights=ref.weights)
     out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, ref.weights,
                   surf.u_range, surf.v_range)
     return Built(out, poles.shape[:2], nominal, step)

@@ -24,6 +24,7 @@ as at a knife edge, so the faces meet at the vertex whichever edge is nearest.
 edge's vector alone, and continuous where the nearest edge changes.
 """
 
+import copy
 import math
 
 import numpy as np
@@ -49,10 +50,12 @@ def vertex_miter(normals, limit):
     return m * (limit / size) if size > limit else m
 
 
-def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
+def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=None):
     """Turn each edge's miters to its vertex's vector near the vertex (see the module
     docstring). ``normals``: (K, 2, 3), both faces' normals at each sample; ``zone``: the
-    arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet.
+    arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet;
+    ``singular``: (S, 3) points where a face collapses (a cap's end: its normal takes every
+    direction of a fan there, so no vector but the vertex's own moves it as one point).
     Returns new ``miter`` and ``exact`` arrays."""
     miter, exact = miter.copy(), exact.astype(float).copy()
     ends = []
@@ -72,7 +75,8 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
         nv = np.concatenate([normals[ends[i][1][0]] for i in g])
         mv = vertex_miter(nv, limit)
         # a vertex whose faces' normals admit one miter (a box corner) keeps the correction
-        shorten = np.max(np.abs(nv @ mv - 1.0)) > 1e-6
+        shorten = np.max(np.abs(nv @ mv - 1.0)) > 1e-6 or _touches(tips[list(g)], singular,
+                                                                   tol)
         for i in g:
             idx = ends[i][1]
             arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[idx], axis=0), axis=1))]
@@ -81,6 +85,24 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol):
             if shorten:
                 exact[idx] *= smoothstep(arc / zone - 1.0)
     return miter, exact
+
+
+def _catmull_rom(v, ks, t):
+    """Catmull-Rom interpolation of the samples ``v`` (K, n) between ``ks[1]`` and
+    ``ks[2]`` at ``t`` (M, 1) in [0, 1], ``ks[0]`` and ``ks[3]`` the neighbours (C1 along
+    the samples; the samples' own values at t = 0 and 1)."""
+    km, k0, k1, kp = ks
+    t2, t3 = t * t, t * t * t
+    d0, d1 = 0.5 * (v[k1] - v[km]), 0.5 * (v[kp] - v[k0])
+    return ((2 * t3 - 3 * t2 + 1) * v[k0] + (t3 - 2 * t2 + t) * d0
+            + (3 * t2 - 2 * t3) * v[k1] + (t3 - t2) * d1)
+
+
+def _touches(tips, singular, tol):
+    """True when one of ``tips`` lies within ``tol`` of a ``singular`` point."""
+    if singular is None or not len(singular):
+        return False
+    return bool(np.any(cKDTree(np.asarray(singular, dtype=float)).query(tips, k=1)[0] <= tol))
 
 
 class SharpEdges:
@@ -98,15 +120,25 @@ class SharpEdges:
         Which edge each sample belongs to (an edge's samples are consecutive).
     band : float
         Width (mm) of the band in which the displacement turns to the edge's vector.
+    normals : ndarray, shape (K, 2, 3), optional
+    faces : ndarray of int, shape (K, 2), optional
+        The two faces' outward normals at each sample and the faces' indices: with them,
+        :meth:`for_face` gives the edges as one face sees them (the turn taken relative to
+        that face's own normal at the edge).
     """
 
-    def __init__(self, points, miter, exact, edge, band):
+    def __init__(self, points, miter, exact, edge, band, normals=None, faces=None):
         self.points = np.asarray(points, dtype=float)
         self.miter = np.asarray(miter, dtype=float)
         exact = np.asarray(exact)
         self.exact = (~exact).astype(float) if exact.dtype == bool else exact.astype(float)
         self.edge = np.asarray(edge)
         self.band = float(band)
+        self.normals = None if normals is None else np.asarray(normals, dtype=float)
+        self.faces = None if faces is None else np.asarray(faces)
+        # what the displacement turns by along the face, per sample: the miter itself
+        # (seen from no face in particular), or the miter less the face's own normal
+        self.excess = self.miter
         self._edges = [np.flatnonzero(self.edge == k) for k in np.unique(self.edge)]
         self._trees = [cKDTree(self.points[idx]) for idx in self._edges]
         self._tree = cKDTree(self.points)
@@ -114,13 +146,30 @@ class SharpEdges:
         self._reach = float(np.max(np.linalg.norm(np.diff(self.points, axis=0), axis=1)[
             np.diff(self.edge) == 0], initial=0.0))
 
+    def for_face(self, i):
+        """The edges as face ``i`` sees them: along its own edges the turn is the miter
+        less the face's normal at the edge (on a strongly curved face the normal a little
+        way off the edge differs from the edge's, and turning to the miter itself would
+        slide the face along itself by that difference: a blend of 0.17 mm radius slid by
+        8 um misses its correction by 0.18 um, curvature x slide^2 / 2); along the others
+        the miter itself."""
+        if self.faces is None:
+            return self
+        out = copy.copy(self)
+        out.excess = self.miter.copy()
+        for side in (0, 1):
+            mine = self.faces[:, side] == i
+            out.excess[mine] = self.miter[mine] - self.normals[mine, side]
+        return out
+
     def _one(self, x, idx, tree):
-        """Distance to one edge polyline, the miter and exactness there."""
-        pts, mit, ex = self.points[idx], self.miter[idx], self.exact[idx]
+        """Distance to one edge polyline, the miter, exactness and excess there."""
+        pts, ex = self.points[idx], self.exact[idx]
+        mit = np.concatenate([self.miter[idx], self.excess[idx]], axis=1)
         last = len(idx) - 1
         _, j = tree.query(x, k=1)
         best_d = np.full(len(x), np.inf)
-        best_m = np.zeros((len(x), 3))
+        best_m = np.zeros((len(x), 6))
         best_e = np.zeros(len(x))
         for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
             a, b = pts[k0], pts[k1]
@@ -132,23 +181,29 @@ class SharpEdges:
             better = d < best_d
             tt = t[better, None]
             best_d[better] = d[better]
-            best_m[better] = (1 - tt) * mit[k0[better]] + tt * mit[k1[better]]
-            best_e[better] = (1 - tt[:, 0]) * ex[k0[better]] + tt[:, 0] * ex[k1[better]]
+            # Catmull-Rom between the samples: the displacement's slope does not jump
+            # where the foot passes a sample (a linear blend kinks it there, and the fit
+            # of a face along the edge follows no kink)
+            ks = (np.maximum(k0 - 1, 0)[better], k0[better], k1[better],
+                  np.minimum(k1 + 1, last)[better])
+            best_m[better] = _catmull_rom(mit, ks, tt)
+            best_e[better] = _catmull_rom(ex[:, None], ks, tt)[:, 0]
         return best_d, best_m, best_e
 
     def nearest(self, x):
-        """Distance to the nearest edge, and the blended miter and exactness at ``x``."""
+        """Distance to the nearest edge, and the blended miter, exactness and excess (the
+        turn along the face: :meth:`for_face`) at ``x``."""
         x = np.asarray(x, dtype=float)
         dmin = np.full(len(x), np.inf)
         wsum = np.zeros(len(x))
-        m = np.zeros((len(x), 3))
+        m = np.zeros((len(x), 6))
         e = np.zeros(len(x))
         eps2 = (1e-9 * self.band) ** 2
         # beyond the band of every edge nothing turns (their distance is not needed)
         near = np.flatnonzero(np.isfinite(self._tree.query(
             x, k=1, distance_upper_bound=self.band + self._reach)[0]))
         if not len(near):
-            return dmin, m, np.ones(len(x))
+            return dmin, m[:, :3], np.ones(len(x)), m[:, 3:]
         full = (dmin, wsum, m, e)
         x = x[near]
         dmin, wsum, m, e = (a[near] for a in full)
@@ -168,7 +223,7 @@ class SharpEdges:
         out_d, _, out_m, out_e = full
         out_e[:] = 1.0
         out_d[near], out_m[near], out_e[near] = dmin, m / wsum[:, None], e / wsum
-        return out_d, out_m, out_e
+        return out_d, out_m[:, :3], out_e, out_m[:, 3:]
 
 
 def knife_limit(angle):
