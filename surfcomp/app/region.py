@@ -10,9 +10,9 @@ an edge stay closed along it. The faces are then put back in the shape and sewn 
 edge), the volume change and the realised correction at the points are measured on the
 result, with OpenCASCADE.
 
-Not done for regions: re-trimming a face outside the region that meets a region face where
-the correction moves their edge (more than :data:`~surfcomp.app.retrim.PRECISION`); such a
-region is refused naming the two faces (add the neighbour to the region).
+In a closed solid the faces outside the region that meet it are re-trimmed
+(:mod:`surfcomp.app.region_retrim`); in a compound of faces a region whose correction moves
+an edge shared with a face outside it is refused naming the two faces.
 """
 
 import math
