@@ -70,8 +70,9 @@ def test_block_walls_retrimmed_to_a_constant_correction(block):
     back = Part.read(str(out))
     assert len(back.Solids) == 1 and back.Solids[0].isValid() and back.Shells[0].isClosed()
     assert len(back.Faces) == 7
-    # OCCT's own volume (off by about 1e-4 of the 1070 mm^3 on trimmed B-spline faces)
-    assert back.Solids[0].Volume - solid.Volume == pytest.approx(o["change_mm3"], abs=0.02)
+    # OCCT's own volume is off by a few 1e-5 of the block's on trimmed B-spline faces: its
+    # change differs from the flux by 0.006 mm^3 on FreeCAD 0.20, 0.032 mm^3 on 1.1
+    assert back.Solids[0].Volume - solid.Volume == pytest.approx(o["change_mm3"], abs=0.05)
     # the top's six vertices stay on the walls' planes, on the corrected top, 10 um below
     # the nominal one (the corners slid down the vertical edges, the ends of the common edge
     # along the walls; a corner's foot on the nominal lies beyond the face by the top's
@@ -193,3 +194,59 @@ def test_pipe_tangent_neighbour_refused_naming_the_faces(pipe):
         "its neighbour" in r.stderr
     assert "add Face4 to the region" in r.stderr
     assert not out.exists()
+
+
+# -- boxed_sphere.step: two corner blends and the fillets between them, inside the solid ----
+
+def test_boxed_sphere_blends_inside_the_solid(tmp_path):
+    """Face8 and Face20 (corner blends, 23 x 23 bicubic, trimmed to 9 edges) and the
+    fillets Face12, Face24 between them, inside the file's first solid (190 faces): every
+    face outside the region meets them tangentially, so a correction that moves their
+    border is refused naming the face and the neighbour; a 4.6 um bump nil within 0.15 mm
+    of the border keeps all 20 outside edges and gives one valid closed solid of 190
+    faces. (The file's trims lie up to 0.06 mm apart, Rhino's tolerance, so its volume and
+    edge tolerance are not compared here: docs/regions.md, Limits.)"""
+    import Part
+    from scipy.spatial import cKDTree
+
+    from tests.conftest import REALDATA
+
+    solid = Part.read(os.path.join(REALDATA, "cad", "axom_data", "boxed_sphere.step")).Solids[0]
+    brep = tmp_path / "box.brep"
+    solid.exportBrep(str(brep))
+    faces = [solid.Faces[k - 1] for k in (8, 12, 24, 20)]
+    border = [tuple(p) for f in faces for e in f.Edges
+              if not any(g.isSame(h) for g in solid.ancestorsOfType(e, Part.Face)
+                         for h in faces if not g.isSame(f))
+              for p in e.discretize(200)]
+    tree = cKDTree(np.array(border))
+    pts, nrm, dev = rp.sample_faces(
+        faces, 4000, lambda p: 0.01 * rp.smooth_window(tree.query(p)[0], 0.15, 0.15), seed=4)
+    assert 0.004 < dev.max() < 0.005
+    csv, out, rep = tmp_path / "bump.csv", tmp_path / "out.brep", tmp_path / "out.json"
+    rp.write_csv(str(csv), pts, nrm, dev)
+    region = "Face8,Face12,Face24,Face20"
+    r = _cli(brep, csv, "--faces", region, "-o", out, "--report", rep, "--method", "raw",
+             "--smoothing", "0.06")
+    assert r.returncode == 0, r.stderr
+    assert "re-trimmed neighbours: none" in r.stdout
+    data = json.load(open(rep))
+    o = data["output"]
+    assert o["kind"] == "solid" and o["faces"] == 190 and o["retrimmed_faces"] == []
+    edges = o["neighbour_edges"]
+    assert len(edges) == 20
+    assert all(e["kind"] == "kept" and e["move_um"] <= 0.1 for e in edges)
+    fid = {f["face"]: f["max_realised_minus_intended_um"] for f in data["faces"]}
+    assert fid["Face8"] <= 0.1 and fid["Face20"] <= 0.1
+    back = Part.read(str(out))
+    assert len(back.Solids) == 1 and back.Solids[0].isValid() and back.Shells[0].isClosed()
+    assert len(back.Faces) == 190
+    # a constant 5 um lifts the region off its tangent neighbours: exit 2, nothing written
+    rp.write_csv(str(csv), pts, nrm, np.full(len(pts), 0.005))
+    out2 = tmp_path / "const.brep"
+    r = _cli(brep, csv, "--faces", region, "-o", out2, "--method", "raw", "--smoothing",
+             "0.06")
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "cannot replace Face8 in its shape: Edge" in r.stderr
+    assert "is tangent to its neighbour" in r.stderr and "to the region" in r.stderr
+    assert not out2.exists()
