@@ -164,7 +164,10 @@ def _sample_distances(faces, base, max_offset, n=200):
         g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
         r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
                             np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
-        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1)
+        # a point farther than max_offset + r from every sample is not near the face: the
+        # bound ends its search early (most of a small cap's box is the sides' points)
+        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1,
+                                               distance_upper_bound=max_offset + r)
         low[i, idx] = d - r
         high[idx] = np.minimum(high[idx], d)
     return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)
