@@ -10,9 +10,9 @@ an edge stay closed along it. The faces are then put back in the shape and sewn 
 edge), the volume change and the realised correction at the points are measured on the
 result, with OpenCASCADE.
 
-Not done for regions: re-trimming a face outside the region that meets a region face where
-the correction moves their edge (more than :data:`~surfcomp.app.retrim.PRECISION`); such a
-region is refused naming the two faces (add the neighbour to the region).
+In a closed solid the faces outside the region that meet it are re-trimmed
+(:mod:`surfcomp.app.region_retrim`); in a compound of faces a region whose correction moves
+an edge shared with a face outside it is refused naming the two faces.
 """
 
 import math
@@ -164,7 +164,10 @@ def _sample_distances(faces, base, max_offset, n=200):
         g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
         r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
                             np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
-        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1)
+        # a point farther than max_offset + r from every sample is not near the face: the
+        # bound ends its search early (most of a small cap's box is the sides' points)
+        d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1,
+                                               distance_upper_bound=max_offset + r)
         low[i, idx] = d - r
         high[idx] = np.minimum(high[idx], d)
     return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)

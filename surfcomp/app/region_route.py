@@ -14,7 +14,7 @@ from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
-from . import fcenv, region
+from . import fcenv, region, region_retrim
 from .file_route import cad_format
 from .region_orient import orient
 from .retrim import PRECISION
@@ -141,7 +141,9 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     if stack is not None:
         fld = stack(fld)
     sharp = region.sharp_edges(faces, edges, band=field_radius)
-    _check_neighbours(shape, faces, fld, sharp)
+    closed = _closed(shape)
+    if not closed:      # a compound of faces: nothing to re-trim its neighbours in
+        _check_neighbours(shape, faces, fld, sharp)
     for i, f in enumerate(faces):
         f.built = region_build.corrected_surface(f.surface, f.outward, fld,
                                                  sharp and sharp.for_face(i),
@@ -156,9 +158,10 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
                   field_radius, step, method, mask_size)
     for line in summary(rep):
         log(line)
-    out_shape, kind, volume = _assemble(shape, faces, fld)
+    out_shape, kind, volume = _assemble(shape, faces, fld, closed)
     rep["output"] = {"kind": kind, "faces": len(out_shape.Faces), **volume}
-    log(output_line(rep["output"]))
+    for line in neighbour_lines(rep["output"]) + [output_line(rep["output"])]:
+        log(line)
     return out_shape, rep
 
 
@@ -182,7 +185,9 @@ def _check_connected(faces, edges, log):
 
 
 def _check_neighbours(shape, faces, fld, sharp):
-    """Refuse a region whose correction moves an edge shared with a face outside it."""
+    """Refuse a region of a shape that is no closed solid whose correction moves an edge
+    shared with a face outside it (in a solid, :mod:`surfcomp.app.region_retrim`
+    re-trims those neighbours)."""
     for e in region.shared_edges(shape, faces, all_faces=True):
         f = faces[e.a]
         n = region.normals_at(f, e.samples)[0]
@@ -192,8 +197,8 @@ def _check_neighbours(shape, faces, fld, sharp):
         if move > PRECISION:
             raise GeometryError(
                 "%s meets Face%d, which is not in the region, where the correction moves their "
-                "edge by %.2f um (more than %.2g um): re-trimming a neighbour of a region is "
-                "not done; add Face%d to faces"
+                "edge by %.2f um (more than %.2g um): a neighbour of a region is re-trimmed "
+                "in a closed solid only; add Face%d to faces"
                 % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
@@ -224,59 +229,29 @@ def realised(f, u, v, guess):
     return realised_correction(f.surface, f.built.surface, u, v, f.outward, guess)
 
 
-def _assemble(shape, faces, fld):
-    """The shape with the region's faces rebuilt, sewn at PRECISION, and its volume change
-    against ``-integral(delta dA)`` over the region."""
+def _assemble(shape, faces, fld, closed):
+    """The shape with the region's faces rebuilt: in a closed solid with its neighbours
+    re-trimmed (:func:`surfcomp.app.region_retrim.closed_solid`), else the faces; and the
+    volume change against ``-integral(delta dA)`` over the region."""
     import Part
 
     from .shapes import rebuild_face
 
-    new = {f.index: rebuild_face(f.bface, f.part_surface) for f in faces}
-    for face in new.values():    # its edges get 3D curves (sewing compares them)
-        face.fix(1e-7, 1e-7, PRECISION)
-    all_faces = [new.get(k, g) for k, g in enumerate(shape.Faces)]
     integral = 0.0
     for f in faces:
         pts, area = region.face_samples(f, 80)
         integral += float(np.sum(fld(pts) * area))
-    closed = len(shape.Solids) == 1 and shape.Solids[0].isValid() and \
+    if closed:
+        solid, figures = region_retrim.closed_solid(shape, faces, integral)
+        return solid, "solid", figures
+    new = {f.index: rebuild_face(f.bface, f.part_surface) for f in faces}
+    return (Part.Compound([new.get(k, g) for k, g in enumerate(shape.Faces)]), "faces",
+            {"integral_mm3": -integral})
+
+
+def _closed(shape):
+    return len(shape.Solids) == 1 and shape.Solids[0].isValid() and \
         all(s.isClosed() for s in shape.Shells)
-    if not closed:
-        return Part.Compound(all_faces), "faces", {"integral_mm3": -integral}
-    # OpenCASCADE's sewing leaves these edges apart even at 0.1 mm (FreeCAD 0.20); the
-    # general fuse with a fuzzy value of PRECISION shares the coincident edges
-    fused = all_faces[0].generalFuse(all_faces[1:], PRECISION)[0]
-    try:
-        shells = [Part.Shell(fused.Faces)]
-    except Part.OCCError:
-        shells = []
-    if len(shells) != 1 or not shells[0].isClosed():
-        raise GeometryError("the corrected faces do not close the solid again at %g mm (the "
-                            "continuity figures above show where)" % PRECISION)
-    solid = Part.Solid(shells[0])
-    if solid.Volume < 0:
-        solid.reverse()
-    tol = max(e.Tolerance for e in solid.Edges)
-    problems = []
-    if not solid.isValid():
-        problems.append("not valid")
-    if len(solid.Faces) != len(shape.Faces):
-        problems.append("%d faces instead of %d" % (len(solid.Faces), len(shape.Faces)))
-    # a nominal whose own edges carry a larger tolerance (a Rhino export: 0.06 mm, its faces'
-    # edges that far apart) keeps it; the correction may widen it by a tenth
-    nominal_tol = max(e.Tolerance for e in shape.Edges)
-    allowed = PRECISION + (1.1 * nominal_tol if nominal_tol > PRECISION else nominal_tol)
-    if tol > allowed:
-        problems.append("edge tolerance %.3g mm (more than %.3g mm)" % (tol, allowed))
-    if problems:
-        raise GeometryError("the corrected region does not give a valid solid (%s)"
-                            % ", ".join(problems))
-    change = solid.Volume - shape.Solids[0].Volume
-    return solid, "solid", {"integral_mm3": -integral, "change_mm3": change,
-                            "edge_tolerance_mm": tol,
-                            "nominal_edge_tolerance_mm": nominal_tol,
-                            "relative_error": abs(change + integral) / max(abs(integral),
-                                                                           1e-300)}
 
 
 def _report(nominal, measurements, faces, counts, none, figures, fidelity, radius, step,
@@ -335,11 +310,20 @@ def summary(rep):
 def output_line(o):
     """The printed line of the output shape and its volume check."""
     if o["kind"] == "solid":
-        return ("solid: %d faces, edge tolerance %.2g mm, volume change %.4f mm3 against "
-                "-integral(delta dA) %.4f mm3 (%.2f %%)"
-                % (o["faces"], o["edge_tolerance_mm"], o["change_mm3"], o["integral_mm3"],
-                   100 * o["relative_error"]))
+        return ("solid: %d faces, edge tolerance %.2g mm (%.2g mm on the corrected and "
+                "re-trimmed faces), volume change %.4f mm3 against -integral(delta dA) %.4f "
+                "mm3 (%.2f %%); re-trimmed neighbours: %s"
+                % (o["faces"], o["edge_tolerance_mm"], o["touched_edge_tolerance_mm"],
+                   o["change_mm3"], o["integral_mm3"], 100 * o["relative_error"],
+                   ", ".join(o["retrimmed_faces"]) or "none"))
     return "the nominal is not one closed solid: the output is its %d faces" % o["faces"]
+
+
+def neighbour_lines(o):
+    """Printed lines of the edges the region shares with faces outside it."""
+    return ["edge %s-%s (%s, outside the region): %s, moved by %.4f um"
+            % (e["face"], e["neighbour"], e["edge"], e["kind"], e["move_um"])
+            for e in o.get("neighbour_edges", ())]
 
 def _write(shape, path, Part):
     fmt = os.path.splitext(path)[1].lower()

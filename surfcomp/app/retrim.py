@@ -18,7 +18,10 @@ corrected face meets the rest of the shape:
   doubled until the curve between them stays within :data:`CURVE_TOL` of both surfaces;
 * **tangent**: a neighbour meets the face at less than :data:`TANGENT_ANGLE` while the
   correction moves the edge: no intersection exists or it runs far along the neighbour, so
-  the replacement is refused with the edge, the faces and the gap named.
+  the replacement is refused with the edge, the faces and the gap named;
+* **region**: the neighbour is corrected too (a region of faces, ``plan(region=...)``): the
+  edge keeps the nominal's pcurve, which both corrected surfaces follow. Where it ends at a
+  re-trimmed neighbour, its end slides to where it meets that neighbour's surface.
 
 A vertex the corrected surface moves by more than :data:`PRECISION` slides along the edge
 that leaves the face there (between its two neighbours) to the point where that edge's curve
@@ -52,7 +55,7 @@ _NEWTON_STEPS = 30
 _SAMPLES = 32
 _MAX_SAMPLES = 4096
 
-KEPT, FREE, DEGENERATE, RETRIM = "kept", "free", "degenerate", "re-trimmed"
+KEPT, FREE, DEGENERATE, RETRIM, REGION = "kept", "free", "degenerate", "re-trimmed", "region"
 
 
 @dataclass
@@ -111,9 +114,10 @@ class Plan:
 class Names:
     """``FaceN``/``EdgeN`` numbers of sub-shapes of ``shape`` (as FreeCAD numbers them)."""
 
-    def __init__(self, shape, face=None):
+    def __init__(self, shape, face=None, region=()):
         self.shape = shape
         self.face = face
+        self.region = list(region)      # faces corrected with ``face`` (a region's)
         self._faces = self._index(shape.Faces)
         self._edges = self._index(shape.Edges)
 
@@ -136,6 +140,9 @@ class Names:
 
     def edge_no(self, e):
         return self._find(self._edges, e)
+
+    def in_region(self, f):
+        return any(f.isSame(g) for g in self.region)
 
     def between(self, plan):
         return "Edge%d between Face%d and Face%d" % (
@@ -255,7 +262,9 @@ def _edge_plans(names, face, pface, sc):
                                     % (names.between(p), len(others) + 1))
             elif others:
                 p.neighbour = others[0]
-            p.kind = (FREE if p.neighbour is None else KEPT if p.move <= PRECISION else RETRIM)
+            p.kind = (FREE if p.neighbour is None else
+                      REGION if not p.seam and names.in_region(p.neighbour) else
+                      KEPT if p.move <= PRECISION else RETRIM)
         plans.append(p)
     return plans
 
@@ -274,14 +283,15 @@ def _check_tangency(names, pface, plans, label):
             n2 = _vec(sg.normal(*sg.parameter(x)))
             angle = min(angle, _angle(n1, n2))
         if p.seam or angle < TANGENT_ANGLE:
+            other = ("add Face%d to the region" % names.face_no(p.neighbour)) \
+                if names.region and not p.seam else "the face alone (--face-only, Output = face)"
             raise GeometryError(
                 "%s: cannot replace Face%d in its shape: %s is %s and the corrected face "
                 "lies up to %.2f um off it there (a tangent neighbour cannot be re-trimmed to "
-                "meet it); use a correction that vanishes along that edge, or the face alone "
-                "(--face-only, Output = face)"
+                "meet it); use a correction that vanishes along that edge, or %s"
                 % (label, names.face_no(names.face), names.between(p),
                    "a seam of the face" if p.seam else
-                   "tangent to its neighbour (%.1f degrees)" % angle, p.move * 1e3))
+                   "tangent to its neighbour (%.1f degrees)" % angle, p.move * 1e3, other))
 
 
 def _vertex_uv(face, plans):
@@ -318,6 +328,9 @@ def _move_vertex(names, face, sc, j, uv, plans, label):
     side = _side_edges(names, face, vertex)
     where = "%s: Vertex at (%.3f, %.3f, %.3f) of Face%d" % (
         (label,) + tuple(vertex.Point) + (names.face_no(face),))
+    joint = [p for p in at if p.kind == REGION]
+    if joint:
+        return _junction(names, sc, j, joint, [p for p in at if p.kind == RETRIM], side, where)
     if len(side) != 1:
         if not side and len({p.neighbour.hashCode() for p in at if p.neighbour}) <= 1:
             return None, None, uv           # on one neighbour only: from the edge's samples
@@ -342,6 +355,39 @@ def _move_vertex(names, face, sc, j, uv, plans, label):
         raise GeometryError("%s: the correction moves the vertex past the other end of Edge%d"
                             % (where, names.edge_no(e)))
     return point, SideEdge(e, first, last, j, at_last), tuple(nuv)
+
+
+def _junction(names, sc, j, joint, cut, side, where):
+    """Vertex ``j`` where an edge shared with another corrected face of the region
+    (``joint``) meets a re-trimmed neighbour (``cut``): the point where that edge, moved
+    with ``sc`` along its nominal pcurve, meets the neighbour's surface; the edge's pcurve
+    range ends there. ``(point, None, uv)``."""
+    if len(joint) != 1 or len({p.neighbour.hashCode() for p in cut}) != 1 or \
+            any(not any(names.in_region(f) for f in names.shape.ancestorsOfType(e, Part.Face))
+                for e in side):
+        raise GeometryError("%s: the correction moves it and more than one face outside the "
+                            "region meets it there (expected one neighbour to re-trim)" % where)
+    p = joint[0]
+    c2d, a, b = p.pcurve
+    last = p.ends[1] == j
+    sg = cut[0].neighbour.Surface
+    h = 1e-7 * (b - a)
+
+    def residual(x):
+        q, qa, qb = _d1(sg, x[1], x[2])
+        s, su, sv = _d1(sc, *_uv(c2d, x[0]))
+        duv = (np.array(_uv(c2d, x[0] + h)) - np.array(_uv(c2d, x[0] - h))) / (2 * h)
+        return s - q, np.stack([su * duv[0] + sv * duv[1], -qa, -qb], axis=1)
+
+    t = b if last else a
+    x = _solve(residual, np.array((t,) + tuple(sg.parameter(p.pedge.valueAt(t)))),
+               "%s (%s)" % (where, names.between(p)))
+    if not (x[0] > a if last else x[0] < b):
+        raise GeometryError("%s: the correction moves it past the other end of %s"
+                            % (where, names.between(p)))
+    p.pcurve = (c2d, a, float(x[0])) if last else (c2d, float(x[0]), b)
+    uv = _uv(c2d, x[0])
+    return _vec(sc.value(*uv)), None, uv
 
 
 def _frame(p, t):
@@ -478,7 +524,7 @@ def _edge_curve(names, sc, p, ends, label):
         n *= 2
 
 
-def plan(shape, index, pface, sc, label="compensation"):
+def plan(shape, index, pface, sc, label="compensation", region=()):
     """How ``shape.Faces[index]``, replaced by a face on ``sc``, meets the rest of ``shape``.
 
     Parameters
@@ -491,6 +537,9 @@ def plan(shape, index, pface, sc, label="compensation"):
         when it is a B-spline face; its ``toNurbs`` form otherwise), edges in the same order.
     sc : Part.BSplineSurface
         The corrected surface.
+    region : list of Part.Face, optional
+        Faces of ``shape`` corrected with this one (a region's): their common edges keep
+        their pcurves (kind ``region``), they are not re-trimmed.
 
     Returns
     -------
@@ -503,7 +552,7 @@ def plan(shape, index, pface, sc, label="compensation"):
         a pole the correction opens, a moved vertex with no single edge to slide along.
     """
     face = shape.Faces[index]
-    names = Names(shape, face)
+    names = Names(shape, face, region)
     plans = _edge_plans(names, face, pface, sc)
     _check_tangency(names, pface, plans, label)
     for p in plans:

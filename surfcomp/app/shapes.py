@@ -224,11 +224,23 @@ def replace_face(shape, index, pface, bs, label="compensation"):
         tolerances exceed :data:`PRECISION`.
     """
     plan = retrim.plan(shape, index, pface, bs, label)
-    old = shape.Faces[index]
     new = rebuild_face(pface, bs, plan.pcurves())
+    out = shape.replaceShape(replacement_pairs(shape.Faces[index], new, bs, plan))
+    out.fix(1e-7, 1e-7, PRECISION)
+    _check_replaced(shape, out, index, label)
+    return out, plan
+
+
+def replacement_pairs(old, new, bs, plan):
+    """``(old, new)`` sub-shape pairs for ``Shape.replaceShape``: the face ``old`` by ``new``
+    (on ``bs``), the edges and vertices its neighbours share with it by ``new``'s, the side
+    edges shortened as ``plan`` (:func:`surfcomp.app.retrim.plan`) says. Edges shared with
+    another corrected face of a region are left out (that face is replaced whole)."""
     pairs = [(old, new)]
     new_edges = new.Edges
     for p in plan.edges:
+        if p.kind == retrim.REGION:
+            continue
         c2d, a, b = p.pcurve
         mid = c2d.value(0.5 * (a + b))
         pairs.append((p.edge, _oriented(_nearest(new_edges, bs.value(mid.x, mid.y), "edge"),
@@ -245,10 +257,7 @@ def replace_face(shape, index, pface, bs, label="compensation"):
         far = _nearest(s.edge.Vertexes, kept.Point, "vertex")
         pairs += [(moved, _oriented(vmap[s.vertex], moved)), (kept, _oriented(far, kept)),
                   (s.edge, _oriented(e, s.edge))]
-    out = shape.replaceShape(pairs)
-    out.fix(1e-7, 1e-7, PRECISION)
-    _check_replaced(shape, out, index, label)
-    return out, plan
+    return pairs
 
 
 def _check_replaced(shape, out, index, label):

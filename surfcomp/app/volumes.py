@@ -77,15 +77,17 @@ def _strip_flux(p, centre):
     return -float(_trapezoid(density * move * speed, ts))
 
 
-def volume_change(nominal, corrected, new_face, plan):
+def volume_change(nominal, corrected, new_face, plan, centre=None):
     """The solid's volume after minus before (mm^3) when the nominal face is replaced by
     ``new_face`` on ``corrected`` and its neighbours re-trimmed as ``plan`` says
-    (:class:`surfcomp.app.retrim.Plan`)."""
+    (:class:`surfcomp.app.retrim.Plan`). ``centre`` (3,): the point F is taken from (the
+    face's centre by default); the faces of a region sum their changes with one centre."""
     old_lines = boundary_polylines(nominal.bspline_face)
     new_lines = boundary_polylines(new_face)
     box = _box(old_lines, new_lines)
-    bb = nominal.bspline_face.BoundBox
-    centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
+    if centre is None:
+        bb = nominal.bspline_face.BoundBox
+        centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
     knots = knots_of(nominal.surface, corrected)
     panels = 16
     if max(len(k) for k in knots) > MAX_KNOTS:      # very fine corrections: a fixed grid

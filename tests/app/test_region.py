@@ -138,17 +138,6 @@ def test_straddling_step_refused(g1_part):
     assert not os.path.exists(out)
 
 
-def test_uncorrected_neighbour_moved_is_refused(g1_part):
-    tmp, step, csv, _solid, pts, nrm, _dev = g1_part
-    flat = str(tmp / "flat.csv")
-    rp.write_csv(flat, pts, nrm, np.full(len(pts), 0.01))
-    out = str(tmp / "flat.step")
-    r = _cli(step, flat, "--faces", "auto", "-o", out)
-    assert r.returncode == 2
-    assert "which is not in the region" in r.stderr and "add Face" in r.stderr
-    assert not os.path.exists(out)
-
-
 def test_boxed_sphere_corner_blends_and_their_fillets(tmp_path):
     """Two adjacent corner blends of boxed_sphere.step (Face8 and Face20, 23 x 23 bicubic,
     trimmed to 9 edges) and the two cylinder fillets joining them (Face12, Face24, rational),
