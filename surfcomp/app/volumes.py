@@ -8,6 +8,8 @@ changed: with ``F(x) = (x - c) / 3`` (``div F = 1``),
 
     dV = [flux of F through the corrected face - through the nominal face]
          + sum over re-trimmed neighbours of the flux through the strip they gained or lost,
+         + the same for the kept edges (moved by at most retrim.PRECISION, the gap closed
+           by the edge's tolerance: up to 1 % of a change of micrometres over a long edge),
 
 the first term by :func:`surfcomp.core.surface.trimmed.domain_integral` over both faces' (u, v)
 regions on one scan grid broken at the knots of both surfaces, the strips from the re-trimmed
@@ -20,6 +22,7 @@ import numpy as np
 from ..core.surface import bspline
 from ..core.surface.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
 from .nominal import boundary_polylines
+from .retrim import KEPT
 
 #: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
 _trapezoid = getattr(np, "trapezoid", None) or np.trapz
@@ -55,13 +58,13 @@ def _box(*polylines):
     return u0, u1, v0, v1
 
 
-def _strip_flux(p, centre):
+def _strip_flux(p, centre, samples):
     """Flux of F through the strip the neighbour of re-trimmed edge ``p`` loses (its
     boundary moved into it) or gains: ``-integral (F . n_g) (d . m) ds``, ``d`` the move of
     the edge, ``m`` the unit vector into the neighbour across the edge."""
     import FreeCAD
 
-    ts, old, new, ab = p.samples
+    ts, old, new, ab = samples
     g = p.neighbour
     normals = np.array([tuple(g.normalAt(float(a), float(b))) for a, b in ab])
     deriv = np.gradient(old, ts, axis=0)
@@ -75,6 +78,21 @@ def _strip_flux(p, centre):
     move = np.einsum("ij,ij->i", new - old, across)
     density = np.einsum("ij,ij->i", (old - centre) / 3.0, normals)
     return -float(_trapezoid(density * move * speed, ts))
+
+
+def _kept_samples(p, nominal, corrected, n=33):
+    """``(t, nominal points, corrected points, (a, b) on the neighbour)`` along kept edge
+    ``p`` (its pcurve is the nominal's on both surfaces)."""
+    import FreeCAD
+
+    c2d, a, b = p.pcurve
+    ts = np.linspace(a, b, n)
+    uv = np.array([(w.x, w.y) for w in (c2d.value(float(t)) for t in ts)])
+    old = bspline.evaluate(nominal, uv[:, 0], uv[:, 1])
+    new = bspline.evaluate(corrected, uv[:, 0], uv[:, 1])
+    g = p.neighbour.Surface
+    ab = np.array([g.parameter(FreeCAD.Vector(*map(float, x))) for x in old])
+    return ts, old, new, ab
 
 
 def volume_change(nominal, corrected, new_face, plan, centre=None):
@@ -100,5 +118,7 @@ def volume_change(nominal, corrected, new_face, plan, centre=None):
     change -= domain_integral(func, old_lines, box=box, knots=knots, panels=panels, grid=grid)
     for p in plan.edges:
         if p.samples is not None:
-            change += _strip_flux(p, centre)
+            change += _strip_flux(p, centre, p.samples)
+        elif p.kind == KEPT and p.neighbour is not None and not p.seam and p.move > 0.0:
+            change += _strip_flux(p, centre, _kept_samples(p, nominal.surface, corrected))
     return change

@@ -12,7 +12,7 @@ from surfcomp.app.nominal import load_nominal, nominal_from_face
 from surfcomp.app.program_geometry import offset_of
 from surfcomp.core.surface import bspline
 from tests.app.helpers import EXAMPLE_STEP
-from tests.app.test_trim import HOLE, circle_face
+from tests.app.trim_cases import HOLE, circle_face
 
 R = 3.0
 DZ = 0.02

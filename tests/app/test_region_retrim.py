@@ -112,7 +112,7 @@ def test_compound_neighbour_still_refused(block, tmp_path):
 
 @pytest.fixture(scope="module")
 def pipe(tmp_path_factory):
-    from tests.app.test_trim import pipe_solid
+    from tests.app.trim_cases import pipe_solid
 
     tmp = tmp_path_factory.mktemp("pipe")
     solid = pipe_solid()
