@@ -330,11 +330,14 @@ def run_direction(edge, p):
 
 def continuity(faces, edges):
     """Largest gap (um) and normal angle (degrees) along every shared edge, measured on the
-    corrected surfaces at the nominal edge's points; fills ``edge.figures``."""
+    corrected surfaces at the nominal edge's points and halfway between them (the edge's
+    vectors are built at the points: a figure taken only there would not see a gap between
+    them); fills ``edge.figures``."""
     for e in edges:
         fa, fb = faces[e.a], faces[e.b]
-        ma, ua, va = normals_at(fa, e.samples)
-        mb, ub, vb = normals_at(fb, e.samples)
+        at = np.concatenate([e.samples, 0.5 * (e.samples[1:] + e.samples[:-1])])
+        ma, ua, va = normals_at(fa, at)
+        mb, ub, vb = normals_at(fb, at)
         pa, pb = evaluate(fa.built.surface, ua, va), evaluate(fb.built.surface, ub, vb)
         qa, qb = evaluate(fa.surface, ua, va), evaluate(fb.surface, ub, vb)
         na = normals(fa.built.surface, ua, va) * fa.outward
