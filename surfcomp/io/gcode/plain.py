@@ -80,8 +80,7 @@ def _candidates(lines):
     as :class:`PlainRun` has them), found by one :data:`_SCAN` of the block's text."""
     if not lines:
         return []
-    found = _SCAN.findall("\n".join([c for c, _e in lines]) + "\n")
-    cols = tuple(zip(*found))
+    cols = tuple(zip(*_SCAN.findall("\n".join([c for c, _e in lines]) + "\n")))
     flag = np.zeros(len(lines) + 2, dtype=np.int8)
     flag[1:-1] = np.array(cols[10]) == "\n"
     edge = np.flatnonzero(np.diff(flag))
@@ -101,11 +100,12 @@ def read_block(interp, lines, base, source):
     the whole block would be (so the first lexical error of the block is raised first),
     then the lines are interpreted in order."""
     runs = _candidates(lines) if ENABLED else []
-    inrun = np.zeros(len(lines), dtype=bool)
-    for s, e, _cols in runs:
-        inrun[s:e] = True
-    toks = [None if inrun[k] else tokenize(c, source, base + k + 1)
-            for k, (c, _e) in enumerate(lines)]
+    toks = [None] * len(lines)
+    pos = 0
+    for s, e in [(s, e) for s, e, _cols in runs] + [(len(lines), len(lines))]:
+        toks[pos:s] = [tokenize(c, source, base + k + 1)
+                       for k, (c, _e) in enumerate(lines[pos:s], pos)]
+        pos = e
     infos = []
     done = []
     pos = 0
