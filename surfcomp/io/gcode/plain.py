@@ -34,10 +34,15 @@ PLAIN = re.compile(r"(?:G(0?[01]))?( ?)(?:X%s)?( ?)(?:Y%s)?( ?)(?:Z%s)?( ?)(?:F%
 #: group of each axis number
 AXIS_GROUPS = (3, 5, 7)
 #: every line of a block with its ``"\n"`` in one pass (:func:`_candidates`): a plain line
-#: with an axis word (the groups of :data:`PLAIN`, then ``"\n"``, then ``""``), or any
-#: other line (``""`` eleven times, then ``"\n"``); a group of :data:`PLAIN` that took no
-#: part is ``""`` (no number or motion code is empty)
-_SCAN = re.compile(r"(?:(?=[^\n]*[XYZ])%s(\n)|[^\n]*(\n))" % PLAIN.pattern)
+#: (the groups of :data:`PLAIN`, then ``"\n"``, then ``""``), or any other line (``""``
+#: eleven times, then ``"\n"``); a group of :data:`PLAIN` that took no part is ``""`` (no
+#: number or motion code is empty). Its digits are matched possessively (nothing after a
+#: number's digits can match a digit, so the lines matched are the same)
+_SCAN = re.compile(r"(?:%s(\n)|[^\n]*(\n))"
+                   % PLAIN.pattern.replace(r"(?:\d+(?:\.\d*)?|\.\d+)",
+                                           r"(?:\d++(?:\.\d*+)?|\.\d++)"))
+#: the motion code of a plain line's G word (-1: none)
+_MOTION = {"": -1, "0": 0, "1": 1, "00": 0, "01": 1}
 #: shortest run read as arrays (shorter ones cost more to set up than they save)
 MIN_RUN = 8
 #: the switch tests use to compare both paths (False: every line one at a time)
@@ -81,8 +86,11 @@ def _candidates(lines):
     if not lines:
         return []
     cols = tuple(zip(*_SCAN.findall("\n".join([c for c, _e in lines]) + "\n")))
-    flag = np.zeros(len(lines) + 2, dtype=np.int8)
-    flag[1:-1] = np.array(cols[10]) == "\n"
+    n = len(lines)
+    flag = np.zeros(n + 2, dtype=np.int8)
+    axes = sum(np.fromiter(map(len, cols[g - 1]), dtype=np.int64, count=n)
+               for g in AXIS_GROUPS)
+    flag[1:-1] = (np.array(cols[10]) == "\n") & (axes > 0)
     edge = np.flatnonzero(np.diff(flag))
     out = []
     for s, e in zip(edge[0::2].tolist(), edge[1::2].tolist()):
@@ -141,21 +149,20 @@ def _read_run(interp, cols, first, base, start, stop):
     cols = tuple(c[start - first:] for c in cols)
     if cols[0][0] == "" and interp.motion not in (0, 1):
         return "line"
-    motion = np.array([int(g) if g else -1 for g in cols[0]], dtype=int)
+    n = len(cols[0])
+    motion = np.fromiter(map(_MOTION.__getitem__, cols[0]), dtype=int, count=n)
     if motion[0] < 0:
         motion[0] = interp.motion
-    n = len(cols[0])
     value = np.empty((n, 3))
-    present = np.empty((n, 3), dtype=bool)
     decimals = np.zeros((n, 3), dtype=np.int64)
     sizes = np.zeros((n, 3), dtype=np.int64)
     for a, g in enumerate(AXIS_GROUPS):
-        text = [t or "nan" for t in cols[g - 1]]
-        value[:, a] = list(map(float, text))
-        present[:, a] = np.array(cols[g - 1]) != ""
-        sizes[:, a] = size = np.fromiter(map(len, text), dtype=np.int64, count=n)
-        dot = np.fromiter(map(str.find, text, repeat(".")), dtype=np.int64, count=n)
-        decimals[:, a] = np.where(present[:, a] & (dot >= 0), size - dot - 1, 0)
+        col = cols[g - 1]
+        value[:, a] = list(map(float, [t or "nan" for t in col]))
+        sizes[:, a] = size = np.fromiter(map(len, col), dtype=np.int64, count=n)
+        dot = np.fromiter(map(str.find, col, repeat(".")), dtype=np.int64, count=n)
+        decimals[:, a] = np.where(dot >= 0, size - dot - 1, 0)
+    present = sizes > 0
     feeds = [float(t) for t in cols[8] if t]
     if not (np.abs(value[present]) <= MAX_POSITION).all() or \
             not np.isfinite(np.array(feeds, dtype=float)).all():
