@@ -17,6 +17,10 @@ from .emitter import _fmt
 from .plain import line_info
 from .plain_bytes import stretch_text
 
+#: numbers of at most this many units of their last decimal get their digits from
+#: :func:`.plain_bytes.number_bytes` (exact in binary64 below 2**52)
+_EXACT = 2 ** 52
+
 
 def _round_units(x, d):
     """``round(x * 10**d)`` as ``'%.*f' % (d, x)`` rounds (ties as the exact binary value
@@ -146,14 +150,15 @@ def _ffill_nan(event, initial):
 def _text(run, k0, k1, contents, comp, d, keep, change, units, file_sep):
     """The output text of lines ``k0`` to ``k1`` of a run (``contents`` their
     ``(content, ending)``): unchanged lines as they were; changed lines with all three
-    axis words and their new numbers' decimals not trimmed, as bytes
-    (:func:`.plain_bytes.stretch_text`); the other changed lines one at a time
-    (:func:`_assemble`, :func:`surfcomp.io.gcode.emitter._fmt`)."""
+    axis words and their new numbers' decimals not trimmed (and below :data:`_EXACT`
+    units), as bytes (:func:`.plain_bytes.stretch_text`); the other changed lines one at
+    a time (:func:`_assemble`, :func:`surfcomp.io.gcode.emitter._fmt`)."""
     edited = change.any(axis=1)
     if not edited.any():
         return "".join([c + e for c, e in contents])
     present = run.present[k0:k1]
-    plain = (present.all(axis=1) & ((d >= 1) & (d == keep) | ~change).all(axis=1)
+    plain = (present.all(axis=1)
+             & ((d >= 1) & (d == keep) & (np.abs(units) < _EXACT) | ~change).all(axis=1)
              & np.isfinite(comp).all(axis=1))
     rows = np.flatnonzero(edited & plain)
     other = {}
