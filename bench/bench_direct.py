@@ -2,7 +2,7 @@
 """Direct program compensation, whole process, beside FreeCAD's floor (issue 27).
 
     /usr/bin/python3 bench/bench_direct.py [--pairs 3] [--keep DIR] [--sizes 250000,1000000]
-                                           [--skip finish,large]
+                                           [--skip finish,large] [--tree DIR]
 
 Rows (each run a fresh process, timed from its start to its exit; CPU = user + system of
 the process and of the children it waited for, such as the STEP reader):
@@ -19,10 +19,13 @@ the process and of the children it waited for, such as the STEP reader):
   once), alternating the sizes; prints the times and t(largest) / t(smallest). Targets:
   1M moves within 10 s, t(1M) / t(250k) at most 4.5.
 
-Absolute seconds depend on the machine and on what else runs on it; ratios measured side
-by side much less. The figures measured, before and after plain G0/G1 runs were read and
-written as arrays and before and after the geometry followed the path (projection from the
-neighbours' feet, the realised correction at the projection's feet): docs/benchmarks.md
+Each command runs once before the timed runs (Python's compiled modules written and
+reused, as in an installation). ``--tree DIR`` runs another checkout's command in the same
+alternation (e.g. the code before a change). Absolute seconds depend on the machine and on
+what else runs on it; ratios measured side by side much less. The figures measured, before
+and after plain G0/G1 runs were read and written as arrays and before and after the
+geometry followed the path (projection from the neighbours' feet, the realised correction
+at the projection's feet): docs/benchmarks.md
 (bench_direct.py) and docs/direct_program.md (Speed).
 """
 
@@ -71,10 +74,16 @@ Part.read(sys.argv[1]).exportStep(sys.argv[2])
 """
 
 
-def timed(cmd):
-    """Wall and CPU seconds of a child process (exit status checked)."""
+#: the environment of the runs: Python's compiled modules are written and reused, as in an
+#: installation (as bench_lean.py runs; a warm-up run of each command writes them)
+ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+
+
+def timed(cmd, root=ROOT):
+    """Wall and CPU seconds of a child process run in the checkout ``root`` (exit status
+    checked)."""
     t = time.perf_counter()
-    proc = subprocess.Popen(cmd, cwd=ROOT, env=dict(os.environ, PYTHONPATH=ROOT),
+    proc = subprocess.Popen(cmd, cwd=root, env=dict(ENV, PYTHONPATH=root),
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     _pid, status, ru = os.wait4(proc.pid, 0)
     wall = time.perf_counter() - t
@@ -136,40 +145,58 @@ def moves_of(path):
         return sum(1 for line in fh if line.startswith((b"G0", b"G1", b"G2", b"G3")))
 
 
-def bench_finish(keep, tmp, pairs):
+def _roots(tree):
+    """``{label: checkout}``: this one, and ``tree`` (another checkout run in the same
+    alternation) when given."""
+    return dict([("", ROOT)] + ([(" (%s)" % tree, os.path.abspath(tree))] if tree else []))
+
+
+def bench_finish(keep, tmp, pairs, tree=None):
     program = finish_program(keep)
     out = os.path.join(tmp, "out.ngc")
     floor_cmd = [sys.executable, "-c", _FLOOR, NOMINAL, os.path.join(tmp, "copy.step")]
     print("finish: %s (%d move lines)" % (program, moves_of(program)))
-    rows = {"floor": [], "direct": []}
+    cases = [("floor", floor_cmd, ROOT)] + [("direct" + label, direct(program, out), root)
+                                            for label, root in _roots(tree).items()]
+    for _name, cmd, root in cases:          # warm-up: compiled modules, page cache
+        timed(cmd, root)
+    rows = {name: [] for name, _c, _r in cases}
     for k in range(pairs):
-        for name, cmd in (("floor", floor_cmd), ("direct", direct(program, out))):
-            rows[name].append(timed(cmd))
+        for name, cmd, root in cases:
+            rows[name].append(timed(cmd, root))
             print("  pair %d %-6s wall %6.2f s  cpu %6.2f s" % ((k + 1, name)
                                                                + rows[name][-1]), flush=True)
     med = {n: [statistics.median(v[i] for v in rows[n]) for i in (0, 1)] for n in rows}
-    print("finish: floor (read + write the STEP) wall %.2f s cpu %.2f s; direct wall %.2f s "
-          "cpu %.2f s; ratio wall %.2f, cpu %.2f (target <= 3)"
-          % (tuple(med["floor"]) + tuple(med["direct"])
-             + (med["direct"][0] / med["floor"][0], med["direct"][1] / med["floor"][1])))
+    for name, _c, _r in cases[1:]:
+        print("finish: floor (read + write the STEP) wall %.2f s cpu %.2f s; %s wall %.2f s "
+              "cpu %.2f s; ratio wall %.2f, cpu %.2f (target <= 3)"
+              % (tuple(med["floor"]) + (name,) + tuple(med[name])
+                 + (med[name][0] / med["floor"][0], med[name][1] / med["floor"][1])))
 
 
-def bench_large(keep, tmp, sizes, pairs):
+def bench_large(keep, tmp, sizes, pairs, tree=None):
     programs = {n: raster_program(keep, n) for n in sizes}
     out = os.path.join(tmp, "out_large.ngc")
-    rows = {n: [] for n in sizes}
+    roots = _roots(tree)
+    for root in roots.values():             # warm-up: compiled modules
+        timed(direct(programs[min(sizes)], out), root)
+    rows = {(n, label): [] for n in sizes for label in roots}
     for k in range(pairs):
         for n in sizes:
-            rows[n].append(timed(direct(programs[n], out)))
-            print("  pair %d %8d moves wall %6.2f s  cpu %6.2f s" % ((k + 1, n) + rows[n][-1]),
-                  flush=True)
-    med = {n: [statistics.median(v[i] for v in rows[n]) for i in (0, 1)] for n in sizes}
-    for n in sizes:
-        print("large: %8d moves wall %.2f s cpu %.2f s" % ((n,) + tuple(med[n])))
+            for label, root in roots.items():
+                rows[n, label].append(timed(direct(programs[n], out), root))
+                print("  pair %d %8d moves%s wall %6.2f s  cpu %6.2f s"
+                      % ((k + 1, n, label) + rows[n, label][-1]), flush=True)
+    med = {key: [statistics.median(v[i] for v in rows[key]) for i in (0, 1)] for key in rows}
     lo, hi = min(sizes), max(sizes)
-    print("large: t(%d) / t(%d) wall %.2f, cpu %.2f (target <= 4.5 for 1M / 250k); %d moves "
-          "in %.2f s wall (target <= 10 s for 1M)"
-          % (hi, lo, med[hi][0] / med[lo][0], med[hi][1] / med[lo][1], hi, med[hi][0]))
+    for label in roots:
+        for n in sizes:
+            print("large: %8d moves%s wall %.2f s cpu %.2f s"
+                  % ((n, label) + tuple(med[n, label])))
+        print("large%s: t(%d) / t(%d) wall %.2f, cpu %.2f (target <= 4.5 for 1M / 250k); %d "
+              "moves in %.2f s wall (target <= 10 s for 1M)"
+              % (label, hi, lo, med[hi, label][0] / med[lo, label][0],
+                 med[hi, label][1] / med[lo, label][1], hi, med[hi, label][0]))
 
 
 def main(argv=None):
@@ -179,15 +206,18 @@ def main(argv=None):
                                    "one)")
     ap.add_argument("--sizes", default="250000,1000000")
     ap.add_argument("--skip", default="", help="comma list of finish,large")
+    ap.add_argument("--tree", help="another checkout whose command runs in the same "
+                                   "alternation (e.g. the code before a change)")
     a = ap.parse_args(argv)
     skip = set(filter(None, a.skip.split(",")))
     with tempfile.TemporaryDirectory() as tmp:
         keep = a.keep or tmp
         os.makedirs(keep, exist_ok=True)
         if "finish" not in skip:
-            bench_finish(keep, tmp, a.pairs)
+            bench_finish(keep, tmp, a.pairs, a.tree)
         if "large" not in skip:
-            bench_large(keep, tmp, sorted(int(s) for s in a.sizes.split(",")), a.pairs)
+            bench_large(keep, tmp, sorted(int(s) for s in a.sizes.split(",")), a.pairs,
+                        a.tree)
     return 0
 
 

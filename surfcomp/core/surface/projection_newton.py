@@ -51,14 +51,15 @@ class SpanTable:
         flat = np.ascontiguousarray(Pw.transpose(1, 0, 2)).reshape(nv, nu * dim)
         # coefficient table laid out (Ku, Kv, b, a, c)
         C = np.empty((Ku, Kv, pv + 1, pu + 1, dim))
+        Bu = [bspline.basis_matrix(surf.knots_u, pu, nu, self.bu[:-1], a)
+              for a in range(pu + 1)]
         for b in range(pv + 1):
             Bv = bspline.basis_matrix(surf.knots_v, pv, nv, self.bv[:-1], b)
             Tv = (Bv @ flat).reshape(Kv, nu, dim).transpose(1, 0, 2).reshape(nu, Kv * dim)
             fv = (self.hv ** b / math.factorial(b))[None, :, None]
             for a in range(pu + 1):
-                Bu = bspline.basis_matrix(surf.knots_u, pu, nu, self.bu[:-1], a)
                 fu = (self.hu ** a / math.factorial(a))[:, None, None]
-                C[:, :, b, a, :] = (Bu @ Tv).reshape(Ku, Kv, dim) * fu * fv
+                C[:, :, b, a, :] = (Bu[a] @ Tv).reshape(Ku, Kv, dim) * fu * fv
         self.Kv = Kv
         self.row = (pv + 1) * (pu + 1) * dim
         # transposed: one column per span pair, gathered with table[:, keys]

@@ -14,8 +14,11 @@ face; cutting points that cut into the nominal (a larger ball than the program's
 off its ball offset (another radius, stock, or another face): see :meth:`ProgramOffset.finish`.
 """
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
+from ...core.chunks import threads
 from ...core.compensation.program_offset import CONTACT_TOL, fit_contact, plan_offset
 from ...errors import GCodeError
 from .commands import _CommandWriter, command_words
@@ -63,6 +66,37 @@ class ProgramOffset:
     def lines(self, lines):
         """Read, interpret, move and write the next block of ``(content, ending)`` lines;
         its output text."""
+        got = self.read(lines)
+        return self.write(self.plan(got[0]), *got)
+
+    def run(self, blocks, write):
+        """:meth:`lines` of every block of ``blocks``, each output passed to ``write``;
+        with more than one thread (:func:`surfcomp.core.chunks.threads`) a block's moves
+        are planned on a second thread while the next block is read and the one before
+        written. The output, and the first refusal raised, are those of :meth:`lines`
+        block after block."""
+        if threads() < 2:
+            for block in blocks:
+                write(self.lines(block))
+            return
+        with ThreadPoolExecutor(1, thread_name_prefix="surfcomp-plan") as pool:
+            pending = None
+            for block in blocks:
+                try:
+                    got = self.read(block)
+                except BaseException:
+                    if pending is not None:      # what the block before raises first
+                        write(self.write(pending[0].result(), *pending[1]))
+                    raise
+                if pending is not None:
+                    write(self.write(pending[0].result(), *pending[1]))
+                pending = (pool.submit(self.plan, got[0]), got)
+            if pending is not None:
+                write(self.write(pending[0].result(), *pending[1]))
+
+    def read(self, lines):
+        """Read and interpret a block: ``(prog, lines, base, runs)``; a move in inch or
+        incremental mode is refused."""
         base = self.n_lines
         infos, runs = read_block(self.interp, lines, base, self.source)
         prog = self.interp.take_moves(infos, self.interp.warnings)
@@ -70,16 +104,23 @@ class ProgramOffset:
         self.words = self.words or not prog.is_empty()
         self._check_modes(prog, base)
         self.n_moves += prog.n_moves
+        return prog, lines, base, runs
+
+    def plan(self, prog):
+        """The :func:`plan_offset` of a block read by :meth:`read` (blocks in order)."""
         op = plan_offset(prog, self.offset, self.tolerance, self.segment_length, self.still,
                          self.start_move)
-        plan = op.plan
         if prog.n_moves:
-            self.start_move = plan.compensated[-1] - plan.nominal[-1]
+            self.start_move = op.plan.compensated[-1] - op.plan.nominal[-1]
+        return op
+
+    def write(self, op, prog, lines, base, runs):
+        """The output text of a block read by :meth:`read` and planned (``op``)."""
         self.moved += int(op.moved.sum())
         self.checked += op.checked
         self._collect(prog, op)
         w = self.writer
-        w.block(prog, plan, base)
+        w.block(prog, op.plan, base)
         out = write_block(w, lines, base, runs)
         nominal, emitted, _known, _line = w.state.take_points()
         if nominal.shape[0]:

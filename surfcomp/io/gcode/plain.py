@@ -33,6 +33,16 @@ PLAIN = re.compile(r"(?:G(0?[01]))?( ?)(?:X%s)?( ?)(?:Y%s)?( ?)(?:Z%s)?( ?)(?:F%
                    % ((_NUM,) * 4))
 #: group of each axis number
 AXIS_GROUPS = (3, 5, 7)
+#: every line of a block with its ``"\n"`` in one pass (:func:`_candidates`): a plain line
+#: (the groups of :data:`PLAIN`, then ``"\n"``, then ``""``), or any other line (``""``
+#: eleven times, then ``"\n"``); a group of :data:`PLAIN` that took no part is ``""`` (no
+#: number or motion code is empty). Its digits are matched possessively (nothing after a
+#: number's digits can match a digit, so the lines matched are the same)
+_SCAN = re.compile(r"(?:%s(\n)|[^\n]*(\n))"
+                   % PLAIN.pattern.replace(r"(?:\d+(?:\.\d*)?|\.\d+)",
+                                           r"(?:\d++(?:\.\d*+)?|\.\d++)"))
+#: the motion code of a plain line's G word (-1: none)
+_MOTION = {"": -1, "0": 0, "1": 1, "00": 0, "01": 1}
 #: shortest run read as arrays (shorter ones cost more to set up than they save)
 MIN_RUN = 8
 #: the switch tests use to compare both paths (False: every line one at a time)
@@ -52,43 +62,40 @@ PLAIN_LINE = PlainLine()
 class PlainRun:
     """Lines ``start`` to ``stop`` (exclusive, indices in the block) read as arrays.
 
-    ``matches``: their :data:`PLAIN` matches; ``first_move``: the block's index of the
+    ``cols``: the :data:`PLAIN` groups of the lines, column by column (tuples; ``""`` for
+    an absent word); ``first_move``: the block's index of the
     first line's move (line ``k`` of the run has move ``first_move + k``); ``motion``
     (n,): 0 or 1 per line; ``present`` (n, 3) bool, ``value`` (n, 3) (mm), ``decimals``
-    (n, 3) int: the axis words; ``groups``: the matches' groups.
+    (n, 3) int, ``size`` (n, 3) int (the number's length): the axis words.
     """
 
-    __slots__ = ("start", "stop", "matches", "first_move", "motion", "present", "value",
-                 "decimals", "groups")
+    __slots__ = ("start", "stop", "cols", "first_move", "motion", "present", "value",
+                 "decimals", "size")
 
-    def __init__(self, start, stop, matches, first_move, motion, present, value, decimals,
-                 groups):
-        self.start, self.stop, self.matches = start, stop, matches
+    def __init__(self, start, stop, cols, first_move, motion, present, value, decimals,
+                 size):
+        self.start, self.stop, self.cols = start, stop, cols
         self.first_move, self.motion, self.present, self.value = (first_move, motion,
                                                                    present, value)
-        self.decimals, self.groups = decimals, groups
+        self.decimals, self.size = decimals, size
 
 
 def _candidates(lines):
-    """``(start, stop, matches)`` of the runs of at least :data:`MIN_RUN` plain lines."""
+    """``(start, stop, cols)`` of the runs of at least :data:`MIN_RUN` plain lines (``cols``
+    as :class:`PlainRun` has them), found by one :data:`_SCAN` of the block's text."""
+    if not lines:
+        return []
+    cols = tuple(zip(*_SCAN.findall("\n".join([c for c, _e in lines]) + "\n")))
+    n = len(lines)
+    flag = np.zeros(n + 2, dtype=np.int8)
+    axes = sum(np.fromiter(map(len, cols[g - 1]), dtype=np.int64, count=n)
+               for g in AXIS_GROUPS)
+    flag[1:-1] = (np.array(cols[10]) == "\n") & (axes > 0)
+    edge = np.flatnonzero(np.diff(flag))
     out = []
-    match = PLAIN.fullmatch
-    ms = [match(c) for c, _e in lines]
-    k, n = 0, len(ms)
-    while k < n:
-        m = ms[k]
-        if m is None or (m.group(3) is None and m.group(5) is None and m.group(7) is None):
-            k += 1
-            continue
-        s = k
-        while k < n:
-            m = ms[k]
-            if m is None or (m.group(3) is None and m.group(5) is None
-                             and m.group(7) is None):
-                break
-            k += 1
-        if k - s >= MIN_RUN:
-            out.append((s, k, ms[s:k]))
+    for s, e in zip(edge[0::2].tolist(), edge[1::2].tolist()):
+        if e - s >= MIN_RUN:
+            out.append((s, e, tuple(c[s:e] for c in cols[:10])))
     return out
 
 
@@ -101,19 +108,20 @@ def read_block(interp, lines, base, source):
     the whole block would be (so the first lexical error of the block is raised first),
     then the lines are interpreted in order."""
     runs = _candidates(lines) if ENABLED else []
-    inrun = np.zeros(len(lines), dtype=bool)
-    for s, e, _ms in runs:
-        inrun[s:e] = True
-    toks = [None if inrun[k] else tokenize(c, source, base + k + 1)
-            for k, (c, _e) in enumerate(lines)]
+    toks = [None] * len(lines)
+    pos = 0
+    for s, e in [(s, e) for s, e, _cols in runs] + [(len(lines), len(lines))]:
+        toks[pos:s] = [tokenize(c, source, base + k + 1)
+                       for k, (c, _e) in enumerate(lines[pos:s], pos)]
+        pos = e
     infos = []
     done = []
     pos = 0
-    for s, e, ms in runs:
+    for s, e, cols in runs:
         infos.extend(interp.lines(toks[pos:s], base + pos))
         pos = s
         while pos < e:
-            run = _read_run(interp, ms, s, base, pos, e)
+            run = _read_run(interp, cols, s, base, pos, e)
             if isinstance(run, PlainRun):
                 done.append(run)
                 infos.extend([PLAIN_LINE] * (e - pos))
@@ -129,35 +137,33 @@ def read_block(interp, lines, base, source):
     return infos, done
 
 
-def _read_run(interp, ms, first, base, start, stop):
-    """The :class:`PlainRun` of lines ``start`` to ``stop`` (their matches from
-    ``ms[start - first]`` on), its moves added to the interpreter; or where the
+def _read_run(interp, cols, first, base, start, stop):
+    """The :class:`PlainRun` of lines ``start`` to ``stop`` (their groups from row
+    ``start - first`` of ``cols`` on), its moves added to the interpreter; or where the
     line-by-line interpreter could do otherwise: ``"line"`` when it should read the first
     line (after which a run may start), ``"rest"`` when it should read them all."""
     if not interp.absolute or interp.factor != 1.0 or interp.path:
         return "rest"
     if not (interp.moved and all(interp.known)):
         return "line"
-    ms = ms[start - first:]
-    if ms[0].group(1) is None and interp.motion not in (0, 1):
+    cols = tuple(c[start - first:] for c in cols)
+    if cols[0][0] == "" and interp.motion not in (0, 1):
         return "line"
-    groups = [m.groups() for m in ms]
-    cols = list(zip(*groups))
-    motion = np.array([-1 if g is None else int(g) for g in cols[0]], dtype=int)
+    n = len(cols[0])
+    motion = np.fromiter(map(_MOTION.__getitem__, cols[0]), dtype=int, count=n)
     if motion[0] < 0:
         motion[0] = interp.motion
-    n = len(ms)
     value = np.empty((n, 3))
-    present = np.empty((n, 3), dtype=bool)
     decimals = np.zeros((n, 3), dtype=np.int64)
+    sizes = np.zeros((n, 3), dtype=np.int64)
     for a, g in enumerate(AXIS_GROUPS):
-        text = ["nan" if t is None else t for t in cols[g - 1]]
-        value[:, a] = list(map(float, text))
-        present[:, a] = [t is not None for t in cols[g - 1]]
-        size = np.fromiter(map(len, text), dtype=np.int64, count=n)
-        dot = np.fromiter(map(str.find, text, repeat(".")), dtype=np.int64, count=n)
-        decimals[:, a] = np.where(present[:, a] & (dot >= 0), size - dot - 1, 0)
-    feeds = [float(t) for t in cols[8] if t is not None]
+        col = cols[g - 1]
+        value[:, a] = list(map(float, [t or "nan" for t in col]))
+        sizes[:, a] = size = np.fromiter(map(len, col), dtype=np.int64, count=n)
+        dot = np.fromiter(map(str.find, col, repeat(".")), dtype=np.int64, count=n)
+        decimals[:, a] = np.where(dot >= 0, size - dot - 1, 0)
+    present = sizes > 0
+    feeds = [float(t) for t in cols[8] if t]
     if not (np.abs(value[present]) <= MAX_POSITION).all() or \
             not np.isfinite(np.array(feeds, dtype=float)).all():
         return "rest"       # the interpreter names the line and the word
@@ -174,7 +180,7 @@ def _read_run(interp, ms, first, base, start, stop):
         "factor": np.ones(n), "absolute": ones})
     interp.pos = end[-1].tolist()
     interp.motion = int(motion[-1])
-    return PlainRun(start, stop, ms, first, motion, present, value, decimals, groups)
+    return PlainRun(start, stop, cols, first, motion, present, value, decimals, sizes)
 
 
 def _ffill(value, present, initial):
@@ -187,10 +193,10 @@ def _ffill(value, present, initial):
     return np.take_along_axis(full, idx, axis=0)
 
 
-def line_info(run, k, move):
-    """The :class:`LineInfo` of line ``k`` of a run (its move ``move``), as the
-    line-by-line reader builds it."""
-    m = run.matches[k]
+def line_info(run, k, move, content):
+    """The :class:`LineInfo` of line ``k`` of a run (its move ``move``, its text
+    ``content``), as the line-by-line reader builds it."""
+    m = PLAIN.fullmatch(content)
     words = []
     if m.group(1) is not None:
         words.append(Word("G", float(m.group(1)), m.group(1), m.start(1) - 1, m.end(1)))

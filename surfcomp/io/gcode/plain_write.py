@@ -15,6 +15,11 @@ import numpy as np
 
 from .emitter import _fmt
 from .plain import line_info
+from .plain_bytes import stretch_text
+
+#: numbers of at most this many units of their last decimal get their digits from
+#: :func:`.plain_bytes.number_bytes` (exact in binary64 below 2**52)
+_EXACT = 2 ** 52
 
 
 def _round_units(x, d):
@@ -50,8 +55,8 @@ def write_block(w, lines, base, runs):
 def _one(w, run, k, lines, base, out):
     """Line ``k`` of the run through the line-by-line writer."""
     i = run.start + k
-    w.prog.lines[i] = line_info(run, k, run.first_move + k)
     c, e = lines[i]
+    w.prog.lines[i] = line_info(run, k, run.first_move + k, c)
     out.append(w.line(base + i, c, e))
 
 
@@ -67,7 +72,7 @@ def _write_run(w, run, lines, base, out):
     special = plan.split[moves] | plan.keep[moves] | (plan.offsets[moves + 1]
                                                       - plan.offsets[moves] != 1)
     k = 0
-    if run.matches[0].group(1) is None and w.out_motion != int(run.motion[0]):
+    if run.cols[0][0] == "" and w.out_motion != int(run.motion[0]):
         special[0] = True
     for s in np.flatnonzero(special).tolist() + [n]:
         if s > k:
@@ -87,7 +92,6 @@ def _write_plain(w, run, k0, k1, lines, base, out):
     nom = plan.nominal[offs]
     present = run.present[k0:k1]
     pv = run.value[k0:k1]
-    groups = run.groups[k0:k1]
     dec = run.decimals[k0:k1]
     dmin = w.dmin_mm
     # decimals of the last word of each axis, after each line (the writer's last_dec)
@@ -129,11 +133,8 @@ def _write_plain(w, run, k0, k1, lines, base, out):
     edited = change.any(axis=1)
     st.changed += int(edited.sum())
     i0 = run.start + k0
-    sep = w.file_sep
-    text = _numbers(comp, d, keep, change)
-    for k, (c, e) in enumerate(lines[i0:i0 + n]):
-        nums = text[k]
-        out.append(c + e if nums is None else _assemble(groups[k], nums, sep) + e)
+    out.append(_text(run, k0, k1, lines[i0:i0 + n], comp, d, keep, change, ncomp,
+                     w.file_sep))
 
 
 def _ffill_nan(event, initial):
@@ -146,24 +147,27 @@ def _ffill_nan(event, initial):
     return np.take_along_axis(full, idx, axis=0)
 
 
-def _numbers(comp, d, keep, change):
-    """Per line, None when nothing changes, else the number text of each changed axis
-    (None for the others): :func:`surfcomp.io.gcode.emitter._fmt`, whose trailing zeros
-    and minus sign of a zero matter only where ``d > keep`` or the text starts with
-    ``-``."""
-    cl, dl, kl, chl = comp.tolist(), d.tolist(), keep.tolist(), change.tolist()
-    out = []
-    for v, dd, kk, ch in zip(cl, dl, kl, chl):
-        if not (ch[0] or ch[1] or ch[2]):
-            out.append(None)
-            continue
-        nums = [None, None, None]
-        for a in (0, 1, 2):
-            if ch[a]:
-                t = "%.*f" % (dd[a], v[a])
-                nums[a] = t if dd[a] == kk[a] and t[0] != "-" else _fmt(v[a], dd[a], kk[a])
-        out.append(nums)
-    return out
+def _text(run, k0, k1, contents, comp, d, keep, change, units, file_sep):
+    """The output text of lines ``k0`` to ``k1`` of a run (``contents`` their
+    ``(content, ending)``): unchanged lines as they were; changed lines with all three
+    axis words and their new numbers' decimals not trimmed (and below :data:`_EXACT`
+    units), as bytes (:func:`.plain_bytes.stretch_text`); the other changed lines one at
+    a time (:func:`_assemble`, :func:`surfcomp.io.gcode.emitter._fmt`)."""
+    edited = change.any(axis=1)
+    if not edited.any():
+        return "".join([c + e for c, e in contents])
+    present = run.present[k0:k1]
+    plain = (present.all(axis=1)
+             & ((d >= 1) & (d == keep) & (np.abs(units) < _EXACT) | ~change).all(axis=1)
+             & np.isfinite(comp).all(axis=1))
+    rows = np.flatnonzero(edited & plain)
+    other = {}
+    for k in np.flatnonzero(edited & ~plain).tolist():
+        t = tuple(c[k0 + k] for c in run.cols)
+        nums = [_fmt(float(comp[k, a]), int(d[k, a]), int(keep[k, a])) if change[k, a]
+                else None for a in (0, 1, 2)]
+        other[k] = _assemble(t, nums, file_sep) + contents[k][1]
+    return stretch_text(contents, run.size[k0:k1], units, d, change, rows, other)
 
 
 def _blank(s):
@@ -171,31 +175,31 @@ def _blank(s):
 
 
 def _assemble(t, nums, file_sep):
-    """A plain line from its :data:`surfcomp.io.gcode.plain.PLAIN` groups ``t`` with the
-    axis numbers ``nums`` (text, or None to keep the word's): words of the line get their
-    number replaced, the others are added next to the nearest axis word before them (or
-    before the first one), as the line-by-line writer does."""
+    """A plain line from its :data:`surfcomp.io.gcode.plain.PLAIN` groups ``t`` (``""``
+    for an absent word) with the axis numbers ``nums`` (text, or None to keep the word's):
+    words of the line get their number replaced, the others are added next to the nearest
+    axis word before them (or before the first one), as the line-by-line writer does."""
     g, s1, x, s2, y, s3, z, s4, f, tail = t
-    if x is not None and y is not None and z is not None:
+    if x and y and z:
         return "".join((
-            "" if g is None else "G" + g, s1,
+            "G" + g if g else "", s1,
             "X", x if nums[0] is None else nums[0], s2,
             "Y", y if nums[1] is None else nums[1], s3,
             "Z", z if nums[2] is None else nums[2], s4,
-            "" if f is None else "F" + f, tail))
+            "F" + f if f else "", tail))
     # separators: between the first two words, and between the first two axis words
-    words = [(k, w) for k, w in enumerate((g, x, y, z, f)) if w is not None]
+    words = [(k, w) for k, w in enumerate((g, x, y, z, f)) if w]
     blanks = (s1, s2, s3, s4)
     general = (_blank("".join(blanks[words[0][0]:words[1][0]])) if len(words) > 1
                else file_sep)
     axes = [k for k, _w in words if 1 <= k <= 3]
     asep = _blank("".join(blanks[axes[0]:axes[1]])) if len(axes) > 1 else general
-    parts = ["" if g is None else "G" + g, s1]
+    parts = ["G" + g if g else "", s1]
     pending = []
     anchor = None           # where words after the last axis word go
     for a, w in enumerate((x, y, z)):
         s = nums[a]
-        if w is None:
+        if not w:
             if s is None:
                 pass
             elif anchor is not None:
@@ -209,6 +213,6 @@ def _assemble(t, nums, file_sep):
             parts.append("XYZ"[a] + (w if s is None else s))
             anchor = len(parts)
         parts.append(blanks[a + 1])
-    parts.append("" if f is None else "F" + f)
+    parts.append("F" + f if f else "")
     parts.append(tail)
     return "".join(parts)

@@ -20,6 +20,7 @@ import io
 import math
 import os
 import stat
+from itertools import repeat
 
 import numpy as np
 
@@ -51,6 +52,12 @@ def iter_lines(fh, chunk=1 << 14):
     """``(content, ending)`` of every line of the binary file ``fh`` as Latin-1 text
     (as :func:`surfcomp.io.gcode.split_lines` of the whole text), without a UTF-8
     byte-order mark at the start; read ``chunk`` bytes at a time."""
+    for part in iter_line_lists(fh, chunk):
+        yield from part
+
+
+def iter_line_lists(fh, chunk=1 << 14):
+    """The lines of :func:`iter_lines` in lists (those of each ``chunk`` read)."""
     rest = ""
     first = True
     pending = []            # pieces of a line longer than a chunk (joined once)
@@ -72,10 +79,13 @@ def iter_lines(fh, chunk=1 << 14):
                 text = text[len(BOM):]
         parts = text.split("\n")
         rest = parts.pop()
-        yield from [(p[:-1], "\r\n") if p.endswith("\r") else (p, "\n") for p in parts]
+        if "\r" in text:
+            yield [(p[:-1], "\r\n") if p.endswith("\r") else (p, "\n") for p in parts]
+        else:
+            yield list(zip(parts, repeat("\n")))
     rest = "".join([rest] + pending)
     if rest:
-        yield rest, ""
+        yield [(rest, "")]
 
 
 class ProgramFile:
@@ -111,6 +121,13 @@ class ProgramFile:
         names the program (errors of whoever consumes the lines are theirs)."""
         try:
             yield from (fh if raw else iter_lines(fh))
+        except OSError as exc:
+            raise self.error(exc) from exc
+
+    def line_lists(self, fh, chunk=1 << 14):
+        """:func:`iter_line_lists` of ``fh``; a read error names the program."""
+        try:
+            yield from iter_line_lists(fh, chunk)
         except OSError as exc:
             raise self.error(exc) from exc
 
@@ -262,12 +279,17 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
 
 def stream_program(program, write, make, block_lines=None, source=None):
     """Feed a :class:`ProgramFile` a block at a time to the worker ``make(sep, eol)``
-    returns (its ``lines(block)`` gives each block's output text, passed to ``write``),
-    the byte-order mark first when the file has one; returns the worker."""
+    returns (its ``lines(block)`` gives each block's output text, passed to ``write``; or
+    its ``run(blocks, write)`` does so), the byte-order mark first when the file has one;
+    returns the worker."""
     sep, bom, eol = program_style(program, source)
     worker = make(sep, eol)
     if bom:
         write(BOM)
+    run = getattr(worker, "run", None)      # a worker that drives the blocks itself
+    if run is not None:
+        run(program_blocks(program, block_lines), write)
+        return worker
     for block in program_blocks(program, block_lines):
         write(worker.lines(block))
     return worker
@@ -293,11 +315,11 @@ def program_blocks(program, block_lines=None):
     block_lines = BLOCK_LINES if block_lines is None else max(1, int(block_lines))
     with program.open() as fh:
         block = []
-        for pair in program.lines(fh):
-            block.append(pair)
-            if len(block) >= block_lines:
-                yield block
-                block = []
+        for part in program.line_lists(fh):
+            block.extend(part)
+            while len(block) >= block_lines:
+                yield block[:block_lines]
+                block = block[block_lines:]
         if block:
             yield block
 
