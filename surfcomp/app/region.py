@@ -53,6 +53,7 @@ class RegionFace:
     built: object = None
     part_surface: object = None
     projector: object = None
+    normals_cache: dict = field(default_factory=dict, repr=False)
 
     def project(self, points, max_distance=None):
         """Closest points on the face's nominal; one projection engine per face (its seed
@@ -192,9 +193,14 @@ def _edge_points(edge, n=EDGE_SAMPLES):
 
 def normals_at(f, pts):
     """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
-    and their parameters."""
-    p = f.project(pts)
-    return normals(f.surface, p.u, p.v) * f.outward, p.u, p.v
+    and their parameters. Kept per face and point set: the sharp edges, the neighbour check
+    and the continuity figures ask for the same edge samples."""
+    pts = np.ascontiguousarray(pts, dtype=float)
+    key = pts.tobytes()
+    if key not in f.normals_cache:
+        p = f.project(pts)
+        f.normals_cache[key] = (normals(f.surface, p.u, p.v) * f.outward, p.u, p.v)
+    return f.normals_cache[key]
 
 
 def _vec(p):
@@ -335,9 +341,11 @@ def continuity(faces, edges):
     them); fills ``edge.figures``."""
     for e in edges:
         fa, fb = faces[e.a], faces[e.b]
-        at = np.concatenate([e.samples, 0.5 * (e.samples[1:] + e.samples[:-1])])
-        ma, ua, va = normals_at(fa, at)
-        mb, ub, vb = normals_at(fb, at)
+        mids = 0.5 * (e.samples[1:] + e.samples[:-1])
+        ma, ua, va = (np.concatenate(x) for x in zip(normals_at(fa, e.samples),
+                                                      normals_at(fa, mids)))
+        mb, ub, vb = (np.concatenate(x) for x in zip(normals_at(fb, e.samples),
+                                                      normals_at(fb, mids)))
         pa, pb = evaluate(fa.built.surface, ua, va), evaluate(fb.built.surface, ub, vb)
         qa, qb = evaluate(fa.surface, ua, va), evaluate(fb.surface, ub, vb)
         na = normals(fa.built.surface, ua, va) * fa.outward
