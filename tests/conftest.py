@@ -4,6 +4,8 @@
 import os
 import sys
 
+import pytest
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
@@ -35,10 +37,12 @@ def pytest_configure(config):
         config.pluginmanager.register(Recorder(), "surfcomp-durations")
 
 
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
     """Work units for parallel runs (``pytest -n 2 --dist loadgroup``, tools/test.sh),
     longest first (tests/schedule.py). Without xdist the marks are unused and the order is
-    the collection's."""
+    the collection's. It runs before pytest-xdist's own hook, which reads the groups (as
+    the last hook it would see no group and spread every test)."""
     from tests.schedule import assign
 
     parallel = hasattr(config, "workerinput") or bool(config.getoption("numprocesses", None))
