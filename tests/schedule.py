@@ -5,12 +5,14 @@ pytest-xdist's ``loadgroup`` hands a worker one unit at a time, in the order the
 first appear in the collection: a test of its own, or every test of one ``xdist_group``.
 Two rules keep both workers busy to the end:
 
-- **small units**: a ``tests/app`` test that uses a module-scoped fixture runs on the
-  worker that built it, together with every other test of its module sharing one of its
-  module fixtures (so each fixture is still built once, and tests that hand results on
-  through a fixture keep their order); a test without such a fixture is a unit of its own.
-  Every ``tests/gui`` module runs in one group ``gui``, one FreeCAD GUI session after the
-  other, so two sessions never share the X server and the cores.
+- **small units**: a ``tests/app`` or ``tests/gui`` test that uses a module-scoped
+  fixture (a shop document, a FreeCAD GUI session) runs on the worker that built it,
+  together with every other test of its module sharing one of its module fixtures (so each
+  fixture is still built once, and tests that hand results on through a fixture keep their
+  order); a test without such a fixture is a unit of its own. In a parallel run each
+  worker's GUI sessions have their own X server (tests/gui/harness.py); the sessions that
+  measure the GUI's response time (marked ``latency``) run after the parallel part, alone
+  on the machine (tools/test.sh).
 - **longest first**: units are ordered by their expected time, from
   ``tests/durations.json`` (seconds per test of the last recorded run, the tests that took
   at least :data:`RECORD_FROM`), a new test counting :data:`DEFAULT` of its folder. A long
@@ -52,8 +54,8 @@ def _shared_fixtures(item):
     return sorted(names)
 
 
-def _app_groups(items):
-    """``{nodeid: group}`` for the tests/app tests that share a module fixture: per module,
+def _fixture_groups(items):
+    """``{nodeid: group}`` for the tests that share a module fixture: per module,
     the tests connected through the module fixtures they use form one group."""
     parent = {}
 
@@ -87,10 +89,10 @@ def assign(items, parallel, durations=None):
     place longest unit first (stable: the tests of a unit keep their order)."""
     import pytest
 
-    groups = _app_groups([i for i in items if _folder(i.nodeid) == "app"])
+    groups = _fixture_groups([i for i in items if _folder(i.nodeid) in ("app", "gui")])
     unit = {}
     for item in items:
-        group = "gui" if _folder(item.nodeid) == "gui" else groups.get(item.nodeid)
+        group = groups.get(item.nodeid)
         if group:
             item.add_marker(pytest.mark.xdist_group(group))
         unit[item.nodeid] = group or item.nodeid
