@@ -124,6 +124,8 @@ class Recorder:
         for nodeid in self.seconds:
             old.pop(nodeid, None)
         old.update({k: round(v, 1) for k, v in self.seconds.items() if v >= RECORD_FROM})
-        with open(DURATIONS, "w", encoding="utf-8") as f:
+        part = DURATIONS + ".%d" % os.getpid()
+        with open(part, "w", encoding="utf-8") as f:
             json.dump(dict(sorted(old.items())), f, indent=0, ensure_ascii=True)
             f.write("\n")
+        os.replace(part, DURATIONS)

@@ -18,7 +18,8 @@ if [ $# -eq 0 ]; then
   for kernel in Haswell:avx2 SkylakeX:avx512f; do
     if grep -qw "${kernel#*:}" /proc/cpuinfo; then
       # shellcheck disable=SC2086
-      OPENBLAS_CORETYPE=${kernel%%:*} /usr/bin/python3 -m pytest -q -p no:cacheprovider \
+      OPENBLAS_CORETYPE=${kernel%%:*} SURFCOMP_RECORD_DURATIONS="" \
+        /usr/bin/python3 -m pytest -q -p no:cacheprovider \
         -m reference_solver $reference_files >"$logs/${kernel%%:*}" 2>&1 &
       pids+=("$!:${kernel%%:*}")
     fi
