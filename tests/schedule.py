@@ -110,6 +110,12 @@ def assign(items, parallel, durations=None):
     items.sort(key=lambda i: (-cost[unit[i.nodeid]], first[unit[i.nodeid]]))
 
 
+def plain_nodeid(nodeid):
+    """``nodeid`` without the ``@group`` that pytest-xdist appends to a grouped test's."""
+    at = nodeid.rfind("@")
+    return nodeid[:at] if at > nodeid.rfind("]") else nodeid
+
+
 class Recorder:
     """Collects each test's time (set-up, call and tear-down) and writes ``durations.json``."""
 
@@ -117,7 +123,8 @@ class Recorder:
         self.seconds = {}
 
     def pytest_runtest_logreport(self, report):
-        self.seconds[report.nodeid] = self.seconds.get(report.nodeid, 0.0) + report.duration
+        nodeid = plain_nodeid(report.nodeid)
+        self.seconds[nodeid] = self.seconds.get(nodeid, 0.0) + report.duration
 
     def pytest_sessionfinish(self, session):
         old = load_durations()
