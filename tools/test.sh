@@ -10,7 +10,8 @@ if [ $# -eq 0 ]; then
   # the tests against converged reference solvers, once per OpenBLAS kernel this CPU can run
   # (OpenBLAS picks its kernel by CPU; a reference that stopped at rounding level passed on
   # one kernel and failed on another); only the modules that hold such tests are collected
-  # (the kernels side by side, one process each, their output in turn)
+  # (the kernels side by side, one process and one OpenBLAS thread each, so that neither
+  # spins on the other's core; their output in turn)
   reference_files=$(grep -l "mark.reference_solver" tests/pure/test_*.py)
   logs=$(mktemp -d)
   trap 'rm -rf "$logs"' EXIT
@@ -18,7 +19,7 @@ if [ $# -eq 0 ]; then
   for kernel in Haswell:avx2 SkylakeX:avx512f; do
     if grep -qw "${kernel#*:}" /proc/cpuinfo; then
       # shellcheck disable=SC2086
-      OPENBLAS_CORETYPE=${kernel%%:*} SURFCOMP_RECORD_DURATIONS="" \
+      OPENBLAS_CORETYPE=${kernel%%:*} OPENBLAS_NUM_THREADS=1 SURFCOMP_RECORD_DURATIONS="" \
         /usr/bin/python3 -m pytest -q -p no:cacheprovider \
         -m reference_solver $reference_files >"$logs/${kernel%%:*}" 2>&1 &
       pids+=("$!:${kernel%%:*}")
