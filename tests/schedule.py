@@ -5,8 +5,8 @@ pytest-xdist's ``loadgroup`` hands a worker one unit at a time, in the order the
 first appear in the collection: a test of its own, or every test of one ``xdist_group``.
 Two rules keep both workers busy to the end:
 
-- **small units**: a ``tests/app`` or ``tests/gui`` test that uses a module-scoped
-  fixture (a shop document, a FreeCAD GUI session) runs on the worker that built it,
+- **small units**: a test that uses a module-scoped fixture (a shop document, a FreeCAD
+  GUI session, a simulated part) runs on the worker that built it,
   together with every other test of its module sharing one of its module fixtures (so each
   fixture is still built once, and tests that hand results on through a fixture keep their
   order); a test without such a fixture is a unit of its own. In a parallel run each
@@ -89,7 +89,7 @@ def assign(items, parallel, durations=None):
     place longest unit first (stable: the tests of a unit keep their order)."""
     import pytest
 
-    groups = _fixture_groups([i for i in items if _folder(i.nodeid) in ("app", "gui")])
+    groups = _fixture_groups(items)
     unit = {}
     for item in items:
         group = groups.get(item.nodeid)
