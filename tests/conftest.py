@@ -4,6 +4,8 @@
 import os
 import sys
 
+import pytest
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
@@ -26,21 +28,22 @@ def default_signals():
         signal.signal(sig, signal.SIG_DFL)
 
 
+def pytest_configure(config):
+    """``SURFCOMP_RECORD_DURATIONS=1``: record each test's time in tests/durations.json
+    (in the controlling process of a parallel run, which sees every worker's reports)."""
+    if os.environ.get("SURFCOMP_RECORD_DURATIONS") and not hasattr(config, "workerinput"):
+        from tests.schedule import Recorder
+
+        config.pluginmanager.register(Recorder(), "surfcomp-durations")
+
+
+@pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(config, items):
-    """Work units for parallel runs (``pytest -n 2 --dist loadgroup``, tools/test.sh).
+    """Work units for parallel runs (``pytest -n 2 --dist loadgroup``, tools/test.sh),
+    longest first (tests/schedule.py). Without xdist the marks are unused and the order is
+    the collection's. It runs before pytest-xdist's own hook, which reads the groups (as
+    the last hook it would see no group and spread every test)."""
+    from tests.schedule import assign
 
-    A module of ``tests/app`` stays on one worker, so its module-scoped fixtures (a solid
-    read once, a shop document regenerated once) are built once. Every ``tests/gui`` module
-    runs on the same worker, one FreeCAD GUI session after the other, so two sessions never
-    share the X server and the cores (their latency checks allow for the machine's load,
-    not for a second GUI). ``tests/pure`` and ``tests/fuzz`` are spread test by test.
-    Without xdist the marks are unused.
-    """
-    import pytest
-
-    for item in items:
-        parts = item.nodeid.split("/")
-        if len(parts) > 2 and parts[0] == "tests" and parts[1] == "gui":
-            item.add_marker(pytest.mark.xdist_group("gui"))
-        elif len(parts) > 2 and parts[0] == "tests" and parts[1] == "app":
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+    parallel = hasattr(config, "workerinput") or bool(config.getoption("numprocesses", None))
+    assign(items, parallel)

@@ -175,7 +175,7 @@ run_entry() {
     versions=$(in_root "$root" /usr/bin/python3 /root/surfcomp/tools/versions.py --summary 2>/dev/null) || true
   fi
   # pytest's result lines: "560 passed in 347.38s (0:05:47)" or "2 failed, 558 passed in
-  # ..." (a full parallel run has two: the rest, then the GUI sessions); every one counts
+  # ..." (a full parallel run has two: the rest, then the latency GUI sessions); every one counts
   local results
   results=$(grep -E '[0-9]+ (passed|failed|errors?)\b.* in [0-9.]+s' "$log" | sed -E 's/^=+ //; s/ =+$//')
   result=$(tr '\n' ';' <<<"$results" | sed -E 's/;$//; s/;/; /g')

@@ -10,20 +10,34 @@ if [ $# -eq 0 ]; then
   # the tests against converged reference solvers, once per OpenBLAS kernel this CPU can run
   # (OpenBLAS picks its kernel by CPU; a reference that stopped at rounding level passed on
   # one kernel and failed on another); only the modules that hold such tests are collected
+  # (the kernels side by side, one process and one OpenBLAS thread each, so that neither
+  # spins on the other's core; their output in turn)
   reference_files=$(grep -l "mark.reference_solver" tests/pure/test_*.py)
+  logs=$(mktemp -d)
+  trap 'rm -rf "$logs"' EXIT
+  pids=()
   for kernel in Haswell:avx2 SkylakeX:avx512f; do
     if grep -qw "${kernel#*:}" /proc/cpuinfo; then
-      echo "surfcomp tests: reference solves with OPENBLAS_CORETYPE=${kernel%%:*}"
       # shellcheck disable=SC2086
-      OPENBLAS_CORETYPE=${kernel%%:*} /usr/bin/python3 -m pytest -q -p no:cacheprovider \
-        -m reference_solver $reference_files
+      OPENBLAS_CORETYPE=${kernel%%:*} OPENBLAS_NUM_THREADS=1 SURFCOMP_RECORD_DURATIONS="" \
+        /usr/bin/python3 -m pytest -q -p no:cacheprovider \
+        -m reference_solver $reference_files >"$logs/${kernel%%:*}" 2>&1 &
+      pids+=("$!:${kernel%%:*}")
     fi
+  done
+  for entry in "${pids[@]}"; do
+    ok=0
+    wait "${entry%%:*}" || ok=$?
+    echo "surfcomp tests: reference solves with OPENBLAS_CORETYPE=${entry#*:}"
+    cat "$logs/${entry#*:}"
+    [ "$ok" -eq 0 ] || exit "$ok"
   done
 fi
 # In parallel on the machine's cores with pytest-xdist where it is installed (Debian's
-# python3-pytest-xdist, tools/install.sh): pure and fuzz tests spread test by test, each
-# tests/app module on one worker, the GUI sessions one after the other on one worker
-# (tests/conftest.py). SURFCOMP_TEST_WORKERS=1 runs everything in this one process.
+# python3-pytest-xdist, tools/install.sh): the tests that share a module fixture (a shop
+# document, a GUI session) on one worker, the rest spread test by test, the longest first
+# (tests/conftest.py, tests/schedule.py). SURFCOMP_TEST_WORKERS=1 runs everything in this
+# one process.
 workers="${SURFCOMP_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}"
 parallel=()
 if [ "$workers" -gt 1 ] && /usr/bin/python3 -c "import xdist" 2>/dev/null; then
@@ -31,18 +45,32 @@ if [ "$workers" -gt 1 ] && /usr/bin/python3 -c "import xdist" 2>/dev/null; then
 fi
 export QTWEBENGINE_CHROMIUM_FLAGS="${QTWEBENGINE_CHROMIUM_FLAGS:---no-sandbox}"
 # -a: the first free X server number from SURFCOMP_XVFB_FROM (default 99; the version
-# matrix gives each root its own range)
+# matrix gives each root its own range); in a parallel run each worker's GUI sessions
+# start their own X server 5, 10 ... numbers above it (tests/gui/harness.py)
+export SURFCOMP_XVFB_FROM="${SURFCOMP_XVFB_FROM:-99}"
 run_pytest() {
-  xvfb-run -a -n "${SURFCOMP_XVFB_FROM:-99}" -s "-screen 0 1600x1200x24" \
+  xvfb-run -a -n "$SURFCOMP_XVFB_FROM" -s "-screen 0 1600x1200x24" \
     /usr/bin/python3 -m pytest "$@"
 }
-if [ $# -eq 0 ] && [ ${#parallel[@]} -gt 0 ]; then
-  # a full parallel run: the GUI sessions come after the rest, alone on the machine, so
-  # their latency checks (every key press repainted, answered within a bound) measure the
-  # GUI and not a neighbouring worker's load; both parts always run
+# a parallel run in two parts: everything but the GUI sessions that measure response times
+# on the workers, then those (marked latency) alone on the machine, so that their checks
+# (every key press repainted, answered within a bound) measure the GUI and not a
+# neighbouring worker's load; both parts always run. Arguments that choose tests by mark
+# (-m) run as given, in one part.
+chooses_marks() {
+  local a
+  for a in "$@"; do case "$a" in -m|-m*) return 0 ;; esac; done
+  return 1
+}
+if [ ${#parallel[@]} -gt 0 ] && ! chooses_marks "$@"; then
+  [ $# -gt 0 ] || set -- tests/pure tests/fuzz tests/app tests/gui
   rc=0
-  run_pytest "${parallel[@]}" tests/pure tests/fuzz tests/app || rc=$?
-  run_pytest tests/gui || rc=$?
+  run_pytest "${parallel[@]}" -m "not scale and not latency" "$@" || rc=$?
+  late=0
+  run_pytest -m "latency and not scale" "$@" || late=$?
+  # 5: no test chosen, as when the arguments name no latency test (or only latency tests)
+  if [ "$rc" -eq 5 ] && [ "$late" -ne 5 ]; then rc=0; fi
+  if [ "$late" -ne 0 ] && [ "$late" -ne 5 ]; then rc=$late; fi
   exit "$rc"
 fi
 run_pytest "${parallel[@]}" "$@"

@@ -5,7 +5,8 @@ Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cf
 ``Mod`` folder that holds only what the test puts there (a link to this checkout, or an
 Addon-Manager-like clone). The script writes a JSON report to ``$SURFCOMP_GUI_OUT``;
 the report view's text and the process output come back too, for the "no traceback"
-checks. Without a DISPLAY the run is wrapped in ``xvfb-run``.
+checks. Without a DISPLAY, or in a worker of a parallel run, the run is wrapped in
+``xvfb-run`` (its own X server).
 """
 
 import json
@@ -64,6 +65,18 @@ def make_home(tmp_path, link_checkout=True):
     return home
 
 
+def first_server(worker):
+    """Where ``xvfb-run -a`` starts looking for a free X server number: in a parallel run
+    each worker's sessions get their own X server (a session sharing one with another
+    would see its windows and input), searched from 5, 10 ... above ``SURFCOMP_XVFB_FROM``
+    (tools/test.sh), so that two workers do not race for one and the version matrix's roots
+    (20 numbers apart, tools/matrix.sh) keep to their ranges."""
+    base = int(os.environ.get("SURFCOMP_XVFB_FROM", "99"))
+    if not worker:
+        return base
+    return base + 5 * (1 + int("".join(c for c in worker if c.isdigit()) or 0))
+
+
 def run_gui(body, tmp_path, home=None, timeout=240, env=None):
     """Run ``body`` (Python code, indented by the caller's ``textwrap`` as top level) in
     the FreeCAD GUI; return ``(results, output)``.
@@ -82,8 +95,10 @@ def run_gui(body, tmp_path, home=None, timeout=240, env=None):
               "QTWEBENGINE_CHROMIUM_FLAGS": e.get("QTWEBENGINE_CHROMIUM_FLAGS", "--no-sandbox")})
     e.update(env or {})
     cmd = [FREECAD, str(script)]
-    if not e.get("DISPLAY"):
-        cmd = ["xvfb-run", "-a", "-s", "-screen 0 " + SCREEN] + cmd
+    worker = os.environ.get("PYTEST_XDIST_WORKER")
+    if not e.get("DISPLAY") or worker:
+        cmd = ["xvfb-run", "-a", "-n", str(first_server(worker)), "-s",
+               "-screen 0 " + SCREEN] + cmd
     proc = subprocess.run(cmd, env=e, cwd=str(tmp_path), capture_output=True, text=True,
                           timeout=timeout)
     output = proc.stdout + proc.stderr

@@ -16,6 +16,9 @@ import pytest
 
 from tests.gui.harness import run_session
 
+#: response times: alone on the machine, after the parallel part (tools/test.sh)
+pytestmark = pytest.mark.latency
+
 #: issue 24: the map on screen within 0.3 s of the last key press
 LIMIT = 0.3
 

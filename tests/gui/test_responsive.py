@@ -8,6 +8,9 @@ import pytest
 
 from tests.gui.harness import run_session
 
+#: response times: alone on the machine, after the parallel part (tools/test.sh)
+pytestmark = pytest.mark.latency
+
 #: the window must paint at least this often during Replace and Restore (s)
 MAX_GAP = 0.5
 
