@@ -197,10 +197,11 @@ def normals_at(f, pts):
     and the continuity figures ask for the same edge samples."""
     pts = np.ascontiguousarray(pts, dtype=float)
     key = pts.tobytes()
-    if key not in f.normals_cache:
+    if key not in f.normals_cache:      # the surface's normals: the orientation may change
         p = f.project(pts)
-        f.normals_cache[key] = (normals(f.surface, p.u, p.v) * f.outward, p.u, p.v)
-    return f.normals_cache[key]
+        f.normals_cache[key] = (normals(f.surface, p.u, p.v), p.u, p.v)
+    n, u, v = f.normals_cache[key]
+    return n * f.outward, u, v
 
 
 def _vec(p):
