@@ -30,7 +30,6 @@ def _volume(stdout):
 
 @pytest.fixture(scope="module")
 def shop(tmp_path_factory):
-
     tmp = tmp_path_factory.mktemp("regionalign")
     solid, tops = rp.g1_top_solid()
     path = str(tmp / "shop.FCStd")

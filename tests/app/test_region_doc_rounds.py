@@ -19,7 +19,6 @@ LEFT = 0.3
 
 @pytest.fixture(scope="module")
 def rounds(tmp_path_factory):
-
     tmp = tmp_path_factory.mktemp("regionrounds")
     solid, tops = rp.g1_top_solid()
     path = str(tmp / "shop.FCStd")

@@ -52,7 +52,6 @@ print("RESULT " + json.dumps(out))
 
 @pytest.fixture(scope="module")
 def shop(tmp_path_factory):
-
     tmp = tmp_path_factory.mktemp("regiondoc")
     solid, tops = rp.g1_top_solid()
     path = str(tmp / "shop.FCStd")

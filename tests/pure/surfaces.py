@@ -63,3 +63,25 @@ def hairpin(n=60):
     pts = np.stack([prof, prof + [0, 10.0, 0]], axis=1)
     kv = np.r_[0, 0, 1, 1.0]
     return Surface(bspline.interpolate_grid(g, [0.0, 1.0], pts, k, kv, 3, 1), k, kv, 3, 1)
+
+
+def cube_corner_edges():
+    """The corner of the cube [0, 10]^3 at the origin: three sharp edges (along x, y, z, 101
+    samples each) ending at one vertex, each between two of the faces x = 0, y = 0, z = 0.
+    Returns ``(points, miters, extents, edge ids, the two faces' normals)`` as
+    :func:`surfcomp.core.compensation.region_edges.at_vertices` takes them, and the faces'
+    outward normals by axis."""
+    from surfcomp.core.compensation import region_build
+
+    t = np.linspace(0.0, 10.0, 101)
+    z = np.zeros_like(t)
+    n = {"x": np.array([-1.0, 0, 0]), "y": np.array([0, -1.0, 0]), "z": np.array([0, 0, -1.0])}
+    specs = [(np.stack([t, z, z], 1), "y", "z"), (np.stack([z, t, z], 1), "x", "z"),
+             (np.stack([z, z, t], 1), "x", "y")]
+    pts, mit, ex, eid, nrm = [], [], [], [], []
+    for k, (p, a, b) in enumerate(specs):
+        na, nb = np.tile(n[a], (len(p), 1)), np.tile(n[b], (len(p), 1))
+        m, e = region_build.miters(na, nb, -nb, -na)
+        pts.append(p), mit.append(m), ex.append(e), eid.append(np.full(len(p), k))
+        nrm.append(np.stack([na, nb], 1))
+    return tuple(np.concatenate(x) for x in (pts, mit, ex, eid, nrm)), n

@@ -8,6 +8,7 @@ import pytest
 
 from surfcomp.core.compensation import region_build, region_field
 from surfcomp.errors import MeasurementFileError
+from tests.pure.surfaces import cube_corner_edges
 
 
 def _grid(n=41, step=0.5):
@@ -128,24 +129,12 @@ def test_displacement_same_on_both_faces_at_a_sharp_edge():
 
 
 def _cube_corner(band=2.0):
-    """The corner of the cube [0, 10]^3 at the origin: three sharp edges (along x, y, z)
-    ending at one vertex, each between two of the faces x = 0, y = 0, z = 0."""
+    """The cube corner's sharp edges (:func:`tests.pure.surfaces.cube_corner_edges`) with
+    their vertex, and the faces' normals."""
     from surfcomp.core.compensation import region_edges
 
-    t = np.linspace(0.0, 10.0, 101)
-    z = np.zeros_like(t)
-    n = {"x": np.array([-1.0, 0, 0]), "y": np.array([0, -1.0, 0]), "z": np.array([0, 0, -1.0])}
-    specs = [(np.stack([t, z, z], 1), "y", "z"), (np.stack([z, t, z], 1), "x", "z"),
-             (np.stack([z, z, t], 1), "x", "y")]
-    pts, mit, ex, eid, nrm = [], [], [], [], []
-    for k, (p, a, b) in enumerate(specs):
-        na, nb = np.tile(n[a], (len(p), 1)), np.tile(n[b], (len(p), 1))
-        m, e = region_build.miters(na, nb, -nb, -na)
-        pts.append(p), mit.append(m), ex.append(e), eid.append(np.full(len(p), k))
-        nrm.append(np.stack([na, nb], 1))
-    pts, eid = np.concatenate(pts), np.concatenate(eid)
-    mit, ex = region_edges.at_vertices(pts, np.concatenate(mit), np.concatenate(ex), eid,
-                                       np.concatenate(nrm), 0.5 * band,
+    (pts, mit, ex, eid, nrm), n = cube_corner_edges()
+    mit, ex = region_edges.at_vertices(pts, mit, ex, eid, nrm, 0.5 * band,
                                        region_edges.knife_limit(region_build.MITER_ANGLE), 1e-6)
     return region_edges.SharpEdges(pts, mit, ex, eid, band), n
 

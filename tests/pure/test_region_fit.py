@@ -7,6 +7,7 @@ import pytest
 
 from surfcomp.core.compensation import region_build, region_edges, region_fit
 from surfcomp.core.surface.bspline import Surface, evaluate_grid, fit_grid_lsq
+from tests.pure.surfaces import cube_corner_edges
 
 
 def _knots(spans, degree):
@@ -61,19 +62,8 @@ def test_a_vertex_where_a_face_collapses_moves_as_one_point():
     """At a cube corner the three faces' normals admit one miter, which keeps each face's
     correction; where a face collapses at the vertex (a cap's end: its normal takes every
     direction of a fan there) the vertex moves by its vector whatever the normal."""
-    t = np.linspace(0.0, 10.0, 101)
-    z = np.zeros_like(t)
-    n = {"x": np.array([-1.0, 0, 0]), "y": np.array([0, -1.0, 0]), "z": np.array([0, 0, -1.0])}
-    specs = [(np.stack([t, z, z], 1), "y", "z"), (np.stack([z, t, z], 1), "x", "z"),
-             (np.stack([z, z, t], 1), "x", "y")]
-    pts, mit, ex, eid, nrm = [], [], [], [], []
-    for k, (p, a, b) in enumerate(specs):
-        na, nb = np.tile(n[a], (len(p), 1)), np.tile(n[b], (len(p), 1))
-        m, e = region_build.miters(na, nb, -nb, -na)
-        pts.append(p), mit.append(m), ex.append(e), eid.append(np.full(len(p), k))
-        nrm.append(np.stack([na, nb], 1))
-    args = (np.concatenate(pts), np.concatenate(mit), np.concatenate(ex), np.concatenate(eid),
-            np.concatenate(nrm), 1.0, region_edges.knife_limit(region_build.MITER_ANGLE), 1e-6)
+    edges, n = cube_corner_edges()
+    args = (*edges, 1.0, region_edges.knife_limit(region_build.MITER_ANGLE), 1e-6)
     o, delta = np.zeros((1, 3)), np.array([0.02])
     fan = [np.array([[0.0, -0.6, -0.8]]), np.array([[-0.8, 0.0, -0.6]])]
     kept = region_edges.SharpEdges(args[0], *region_edges.at_vertices(*args), args[3], band=2.0)
