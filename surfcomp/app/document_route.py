@@ -251,8 +251,15 @@ def _recompute(doc):
     bad = [o for o in doc.Objects if "Invalid" in o.State or "Error" in o.State]
     if bad:
         raise ComputationError("after the recompute %d object(s) are invalid: %s"
-                               % (len(bad), ", ".join("%s (%s)" % (o.Label, o.Name)
+                               % (len(bad), "; ".join("%s (%s): %s" % (o.Label, o.Name,
+                                                                       _status(o))
                                                       for o in bad)))
+
+
+def _status(obj):
+    """What FreeCAD says is wrong with ``obj`` (its status string), or its state."""
+    text = obj.getStatusString() if hasattr(obj, "getStatusString") else ""
+    return text or ", ".join(obj.State)
 
 
 def _one_job(jobs, job_name):
