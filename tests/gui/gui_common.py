@@ -219,10 +219,11 @@ def legend_shot(label, name):
 
 
 # -- real input events on widgets ------------------------------------------------------
-def click(widget):
-    """A real left click in the middle of ``widget``."""
+def click(widget, pos=None):
+    """A real left click at ``pos`` (QPointF) in ``widget``, by default in its middle."""
     Gui.updateGui()
-    pos = QtCore.QPointF(widget.width() / 2.0, widget.height() / 2.0)
+    if pos is None:
+        pos = QtCore.QPointF(widget.width() / 2.0, widget.height() / 2.0)
     glob = QtCore.QPointF(widget.mapToGlobal(pos.toPoint()))
     for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
                           (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):

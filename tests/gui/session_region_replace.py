@@ -37,14 +37,7 @@ def click_tree(label):
     t.scrollToItem(item)
     Gui.updateGui()
     r = t.visualItemRect(item)
-    w = t.viewport()
-    pos = QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y())
-    glob = QtCore.QPointF(w.mapToGlobal(pos.toPoint()))
-    for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
-                          (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        ev = QtGui.QMouseEvent(kind, pos, glob, QtCore.Qt.LeftButton, buttons,
-                               QtCore.Qt.NoModifier)
-        QtGui.QApplication.sendEvent(w, ev)
+    click(t.viewport(), QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y()))
     wait_for_actions()
     return [o.Name for o in Gui.Selection.getSelection()]
 
