@@ -15,6 +15,9 @@ ACCEPT_TOL = 1e-4
 #: ... and move nowhere (on the dense check grid) more than the largest intended
 #: correction plus this (1 um); a face that does is reported
 OVERSHOOT_TOL = 1e-3
+#: below this integral of the correction (mm^3) a volume check gives no relative figure
+#: (a nil correction: the difference alone is reported)
+NIL_INTEGRAL = 1e-9
 #: target of the residual iteration at the measured points (0.02 um)
 MATCH_TOL = 2e-5
 #: iterations of the residual iteration at most
