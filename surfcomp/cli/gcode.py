@@ -17,6 +17,7 @@ from ..core import budget
 from ..core.axis.axis_checks import volumetric_map
 from ..core.axis.axis_errors import MODEL_CHOICES, fit_axis_errors
 from ..core.axis.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH
+from ..core.command_options import GCODE_AXIS_FILE
 from ..errors import GCodeError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
@@ -26,6 +27,7 @@ from ..io.hashing import sha256_file
 from ..io.outpath import shown
 from . import SUMMARIES, registry
 from .common import wrote
+from .options import add_arguments
 
 SCHEMA = "surfcomp-gcode-report/1"
 
@@ -46,15 +48,7 @@ def add_parser(subparsers):
                    help="degree of every error function, or auto: quadratic where the "
                         "F-test of the quadratic term is significant at 5%% (default auto)")
     registry.add_options(p, "gcode", flags=("--report",))
-    p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
-                   help="units of error-file columns without a unit suffix (default mm)")
-    p.add_argument("--max-error", type=float, default=1.0, metavar="MM",
-                   help="largest plausible machine error: a larger value in the error file, "
-                        "or a larger predicted error at a programmed point, is refused as a "
-                        "likely unit mistake (default 1 mm)")
-    p.add_argument("--reference", metavar="X,Y,Z", default="0,0,0",
-                   help="where the other slides stood while one slide was measured "
-                        "(error-file coordinates, mm; default 0,0,0)")
+    add_arguments(p, GCODE_AXIS_FILE, GCODE_AXIS_FILE)
     p.add_argument("--work-offset", metavar="X,Y,Z",
                    help="error-file (machine) coordinates of the program zero, when they "
                         "differ (mm; default: the same coordinates)")
