@@ -57,3 +57,11 @@ MAX_GRID = 800
 #: most replicas (parts machined per method; the mirror paper machines 4); each takes
 #: seconds to minutes
 MAX_REPLICAS = 1000
+
+# ------------------------------------------------------------------ G-code programs
+#: shortest accepted segment length (mm): 1 um, finer than any machine's resolution matters
+MIN_SEGMENT_LENGTH = 1e-3
+#: most points a compensated program may be sampled at. Measured on the 2-core development
+#: machine (23 GB): about 0.8 kB of memory per output segment from planning to the written
+#: text, so 10 million segments take about 8 GB (bench/bench_memory.py).
+MAX_SEGMENTS = 10_000_000

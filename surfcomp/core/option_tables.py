@@ -41,7 +41,7 @@ from .choices import (
     UNITS,
     WORK_OFFSETS,
 )
-from .command_options import AXIS_FILE, GCODE_AXIS_FILE, SIMULATE
+from .command_options import AXIS_FILE, COMPENSATE, GCODE, PROGRAM_MOVE, SIMULATE
 from .limits import MAX_PLAN_POINTS
 from .options import OPTIONS, Option
 
@@ -220,7 +220,8 @@ SIM_PLAN = _table(
 #: every table by its name (the compensation's first)
 TABLES = {"compensation": OPTIONS, "inputs": INPUTS, "align": ALIGN, "plan": PLAN,
           "program": PROGRAM, "model": MODEL, "simulate": SIMULATE, "sim_plan": SIM_PLAN,
-          "axis_file": AXIS_FILE, "gcode_axis_file": GCODE_AXIS_FILE}
+          "axis_file": AXIS_FILE, "gcode": GCODE, "program_move": PROGRAM_MOVE,
+          "compensate": COMPENSATE}
 
 
 def find(name, tables=None):

@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The registry's tables of the commands without a document object
-(surfcomp.core.command_options: simulate's loop, the axis error file; and
-option_tables.SIM_PLAN, simulate's plan options) are the one place those options are
-defined: the parsers of simulate and gcode read their flags, defaults, choices and help
-from them, simulate's checks their domains, and the core's defaults agree with them."""
+"""The registry's tables of the commands' own options (surfcomp.core.command_options:
+simulate's loop, the axis error file, gcode, compensate --program, compensate's region and
+post-processing; and option_tables.SIM_PLAN, simulate's plan options) are the one place
+those options are defined: the parsers of simulate, gcode and compensate read their flags,
+defaults, choices and help from them, the checks their domains, and the core's and io's
+defaults agree with them (the region object's properties: tests/app/test_command_options.py)."""
 
 import inspect
 
@@ -13,8 +14,10 @@ from surfcomp.cli import build_parser
 from surfcomp.cli.option_flags import flag
 from surfcomp.core.command_options import (
     AXIS_FILE,
-    GCODE_AXIS_FILE,
+    COMPENSATE,
+    GCODE,
     PRESET_SET,
+    PROGRAM_MOVE,
     SIMULATE,
 )
 from surfcomp.core.option_tables import PLAN, SIM_PLAN, TABLES, find
@@ -62,14 +65,63 @@ def test_simulate_takes_the_plan_records_for_its_plan_options():
     assert (acts["--points"].type, acts["--compare-layouts"].type) == (int, int)
 
 
-def test_gcode_takes_the_axis_file_from_the_registry():
+def test_gcode_takes_its_options_from_the_registry():
     acts = _actions("gcode")
-    for name, o in GCODE_AXIS_FILE.items():
-        _agrees(acts[o.flag], name, GCODE_AXIS_FILE)
+    for name, o in GCODE.items():
+        _agrees(acts[o.flag], name, GCODE)
     assert acts["--units"].dest == "units" and acts["--units"].choices == ("mm", "um", "in")
+    assert acts["--model"].choices == ("linear", "quadratic", "auto")
     assert acts["--reference"].help.endswith("(default 0,0,0)")
-    for name in ("max_error", "reference"):
-        assert GCODE_AXIS_FILE[name].default == AXIS_FILE[name].default, name
+    assert acts["--tolerance"].help.endswith("(default 0.0001, > 0)")
+    assert acts["--segment-length"].help.endswith(
+        "at least 0.001 mm, and at most 10000000 segments in all (default 2)")
+    # the axis file as simulate reads it, under gcode's flag of the units
+    for name, mine in (("axis_units", "units"), ("max_error", "max_error"),
+                       ("reference", "reference")):
+        assert (GCODE[mine].default, GCODE[mine].choices) == \
+            (AXIS_FILE[name].default, AXIS_FILE[name].choices), name
+
+
+def test_gcode_defaults_are_the_io_and_core_defaults():
+    from surfcomp.core.axis import axis_errors, moves
+    from surfcomp.io.gcode.stream import compensate_gcode
+
+    params = inspect.signature(compensate_gcode).parameters
+    for name in ("segment_length", "tolerance", "arc_tolerance", "decimals", "start"):
+        assert params[name].default == GCODE[name].default, name
+    assert inspect.signature(axis_errors.fit_axis_errors).parameters["model"].default == \
+        GCODE["model"].default
+    assert axis_errors.MODEL_CHOICES == GCODE["model"].choices
+    assert (moves.MIN_SEGMENT_LENGTH, moves.MAX_SEGMENTS) == \
+        (GCODE["segment_length"].low, 10_000_000)
+
+
+def test_compensate_takes_the_program_region_and_post_options_from_the_registry():
+    acts = _actions("compensate")
+    for table in (PROGRAM_MOVE, COMPENSATE):
+        for name, o in table.items():
+            _agrees(acts[o.flag], name, table)
+    assert (acts["--tolerance"].default, acts["--blend"].default) == (5e-4, 1.0)
+    assert acts["--min-coverage"].help == ("with --faces: least share of every face's area "
+                                           "with measured points near (default 0.5)")
+    assert acts["--post"].default == "linuxcnc"
+    from surfcomp.io.gcode.offset_stream import offset_commands
+
+    params = inspect.signature(offset_commands).parameters
+    for name in ("tolerance", "segment_length"):
+        assert params[name].default == PROGRAM_MOVE[name].default, name
+
+
+@pytest.mark.parametrize("value", ["-0.01", "1.01", "nan"])
+def test_the_region_refuses_a_coverage_outside_the_registry_domain(value):
+    from surfcomp.cli.region import run_region_command
+
+    args = build_parser("compensate").parse_args(
+        ["compensate", "n.step", "m.csv", "--faces", "auto", "-o", "out.step",
+         "--min-coverage", value])
+    with pytest.raises(InputError) as exc:
+        run_region_command(args)
+    assert str(exc.value) == "--min-coverage must be between 0 and 1 (got %s)" % value
 
 
 def test_the_loop_without_a_preset_runs_the_registry_defaults():
@@ -127,7 +179,7 @@ def test_the_loop_refuses_just_outside_the_registry_domain(option, value, messag
 
 
 def test_every_new_name_maps_to_its_flag():
-    for key in ("simulate", "sim_plan", "axis_file"):
+    for key in ("simulate", "sim_plan", "axis_file", "gcode", "program_move", "compensate"):
         for name, o in TABLES[key].items():
             if find(name) is o:
                 assert flag(name) == o.flag, name
