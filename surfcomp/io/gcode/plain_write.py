@@ -14,7 +14,7 @@ through the line-by-line writer (their ``LineInfo`` built by
 import numpy as np
 
 from .emitter import _fmt
-from .plain import line_info
+from .plain import line_info, plain_groups
 from .plain_bytes import stretch_text
 
 #: numbers of at most this many units of their last decimal get their digits from
@@ -72,7 +72,7 @@ def _write_run(w, run, lines, base, out):
     special = plan.split[moves] | plan.keep[moves] | (plan.offsets[moves + 1]
                                                       - plan.offsets[moves] != 1)
     k = 0
-    if run.cols[0][0] == "" and w.out_motion != int(run.motion[0]):
+    if not run.g_word[0] and w.out_motion != int(run.motion[0]):
         special[0] = True
     for s in np.flatnonzero(special).tolist() + [n]:
         if s > k:
@@ -163,7 +163,7 @@ def _text(run, k0, k1, contents, comp, d, keep, change, units, file_sep):
     rows = np.flatnonzero(edited & plain)
     other = {}
     for k in np.flatnonzero(edited & ~plain).tolist():
-        t = tuple(c[k0 + k] for c in run.cols)
+        t = plain_groups(contents[k][0])
         nums = [_fmt(float(comp[k, a]), int(d[k, a]), int(keep[k, a])) if change[k, a]
                 else None for a in (0, 1, 2)]
         other[k] = _assemble(t, nums, file_sep) + contents[k][1]
