@@ -37,6 +37,8 @@ EDGE_SAMPLES = 200
 G1_ANGLE = 0.1
 #: field radius as a share of the shape's diagonal, at least 4 point spacings
 FIELD_SHARE = 0.05
+#: the shortest length (share of the band) over which a sharp edge's exactness changes
+EASE_SHARE = 0.5
 
 
 @dataclass
@@ -334,6 +336,7 @@ def sharp_edges(faces, edges, band):
     mit, exact = region_edges.at_vertices(
         pts, np.concatenate(mit), np.concatenate(cl), eid, nrm, 0.5 * band,
         region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces))
+    exact = region_edges.eased(exact, eid, pts, EASE_SHARE * band)
     return region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, np.concatenate(ids))
 
 

@@ -314,8 +314,8 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     curves were fitted on their own, the tip cap's by 4.4 um before the faces were oriented
     and 36 um with a cap's collapsed end moved by more than one vector). Beyond the zones
     where the design shortens the correction, the root cap meets it within 0.02 um; the
-    sides miss by up to 1.8 and 3.5 um next to the trailing edge, which curls with a 0.1 mm
-    radius (see docs/regions.md)."""
+    sides miss by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
+    (see docs/regions.md)."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
@@ -336,12 +336,12 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert len(sides) == 2
     # oriented, the sides meet at 0 to 22 deg (leading edge) and 10 to 143 deg (trailing)
     assert sorted(round(e["nominal_angle_deg"]) for e in sides) == [22, 143]
-    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.066 um, the
-    # rounded edge 0.0000, the suction side - tip cap 0.0006, the pressure side - tip cap
-    # 0.046 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.2 um
+    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.023 um, the
+    # rounded edge 0.0000, the suction side - tip cap 0.0003, the pressure side - tip cap
+    # 0.046 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.3 um
     # (trailing edge), 8.9, 12.3 (suction side - tip cap), 11.7, 10.7 and 10.8 um apart
     # (a wrong foot of one edge sample read 40 um before)
-    bounds = {("Face1", "Face2", 143): 0.08, ("Face1", "Face2", 22): 0.001,
+    bounds = {("Face1", "Face2", 143): 0.04, ("Face1", "Face2", 22): 0.001,
               ("Face1", "Face3", 14): 0.005, ("Face1", "Face4", 97): 0.01,
               ("Face2", "Face3", 179): 0.07, ("Face2", "Face4", 95): 0.015}
     for e in edges:
@@ -349,10 +349,13 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
         assert e["max_gap_beyond_nominal_um"] <= bounds[key], e
         assert e["nominal_gap_um"] <= 13.0, e
     (trailing,) = [e for e in sides if round(e["nominal_angle_deg"]) == 143]
-    assert trailing["nominal_gap_um"] == pytest.approx(3.24, abs=0.05)
+    assert trailing["nominal_gap_um"] == pytest.approx(3.27, abs=0.03)
     faces_rep = {f["face"]: f for f in data["faces"]}
     assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
-    for name, within in (("Face1", 2.0), ("Face2", 4.0), ("Face4", 0.02)):
+    # measured: 0.449, 0.426 and 0.0059 um (1.8 and 3.5 um on the sides before the edges'
+    # exactness was eased along them: the trailing edge turns from 143 to 95 deg within
+    # 3.5 mm near the tip, and the displacement turned as fast, over 3 mm spanwise spans)
+    for name, within in (("Face1", 0.6), ("Face2", 0.6), ("Face4", 0.02)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within

@@ -74,3 +74,25 @@ def test_a_boundary_curve_is_refined_where_it_misses_the_displacement():
     assert miss(refined) <= 2 * region_build.EDGE_TOL      # between the check points too
     assert refined.poles[0] > plain.poles[0] and refined.poles[1] == plain.poles[1]
     assert refined.poles[0] * refined.poles[1] <= region_build.MIN_BUDGET
+
+
+def test_an_edge_turning_sharp_within_a_mm_eases_over_the_length_given():
+    """An edge whose exactness drops from 1 to 0 within 1 mm (its angle crossing the knife
+    limit, from s = 15 to 16 mm) and a second edge that stays exact: eased over 4 mm, the
+    first never rises above what it was, changes by at most 1/40 from one 0.1 mm sample to
+    the next (a 4 mm wide average of values in [0, 1]), is 1 up to twice the length before
+    the drop and 0 from its end on, and passes 0.5 about halfway; the second stays 1."""
+    s = np.arange(0.0, 30.0001, 0.1)
+    K = len(s)
+    points = np.concatenate([np.stack([s, np.zeros(K), np.zeros(K)], axis=1),
+                             np.stack([s, np.ones(K), np.zeros(K)], axis=1)])
+    edge = np.repeat([0, 1], K)
+    exact = np.r_[1.0 - region_edges.smoothstep(s - 15.0), np.ones(K)]
+    out = region_edges.eased(exact, edge, points, 4.0)
+    first, second = out[:K], out[K:]
+    assert np.all(first <= exact[:K] + 1e-12)
+    np.testing.assert_allclose(second, 1.0, atol=1e-12)
+    assert np.max(np.abs(np.diff(first))) <= 1.0 / 40.0 + 1e-9
+    np.testing.assert_allclose(first[s <= 15.0 - 8.0 + 1e-9], 1.0, atol=1e-12)
+    np.testing.assert_allclose(first[s >= 16.0 - 1e-9], 0.0, atol=1e-12)
+    assert 0.3 < first[np.argmin(np.abs(s - 11.5))] < 0.7      # halfway down the ramp
