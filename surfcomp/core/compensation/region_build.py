@@ -191,6 +191,11 @@ class Built:
 def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=4.0):
     """The corrected surface of one face of a region.
 
+    The nominal's knots refined to ``knot_step`` within the pole budget; then, for up to
+    :data:`REFINE_ROUNDS` rounds while the budget holds, the knot spans along a boundary
+    where the boundary curve misses the displacement by more than :data:`EDGE_TOL`
+    halfway between two fit samples are halved and the face fitted again.
+
     Parameters
     ----------
     surf : Surface
