@@ -61,7 +61,7 @@ def check(args):
         raise InputError("--html shows the maps of grid measurements; it does not go with %s"
                          % (given[0] if given else "--count/--points"))
     if args.compare_layouts is not None:
-        check_points(args.compare_layouts, "--compare-layouts")
+        check_points(args.compare_layouts, "compare_layouts")
     if (args.plan_count is not None or args.plan_points is not None) and not args.plan_layout:
         raise InputError("--count and --points go with --layout")
     if args.plan_layout:
