@@ -18,15 +18,28 @@ def task_area(form):
 def place(widget, area=None):
     """Where ``widget`` shows, in the pixels of the task view's viewport (``area``) or its
     window: ``{top, bottom, height, need, room}``: ``need`` is the height its text needs at
-    its width (a label's height for its width; a text box: its own), ``room`` the bottom of
-    what the user sees (the viewport's or window's height)."""
+    its width (a label's height for its width; a text box: its lines'), ``room`` the bottom
+    of what the user sees (the viewport's or window's height)."""
     Gui.updateGui()
     frame = area.viewport() if area is not None else widget.window()
     top = widget.mapTo(frame, QtCore.QPoint(0, 0)).y()
-    need = (widget.heightForWidth(widget.width()) if isinstance(widget, QtGui.QLabel)
-            else widget.height())
+    if isinstance(widget, QtGui.QLabel):
+        need = widget.heightForWidth(widget.width())
+    elif isinstance(widget, QtGui.QPlainTextEdit):
+        need = text_height(widget)
+    else:
+        need = widget.height()
     return {"top": top, "bottom": top + widget.height(), "height": widget.height(),
             "need": need, "room": frame.height()}
+
+
+def text_height(box):
+    """The height of a text box's wrapped lines with its frame and margins (pixels)."""
+    height, block = 0.0, box.document().firstBlock()
+    while block.isValid():
+        height += box.blockBoundingRect(block).height()
+        block = block.next()
+    return int(height + 2 * box.document().documentMargin() + 2 * box.frameWidth())
 
 
 def box_state(box):
