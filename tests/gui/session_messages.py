@@ -4,6 +4,8 @@
 # short one; the alignment's and the plan's errors naming options; the refused stock; the
 # report's note), driven by real key and mouse events; where each message lands and how
 # much of it the user sees, with screenshots.
+import math  # noqa: E402
+
 from surfcomp.gui import align_panel, plan_panel  # noqa: E402
 
 
@@ -34,12 +36,11 @@ def place(widget, area=None):
 
 
 def text_height(box):
-    """The height of a text box's wrapped lines with its frame and margins (pixels)."""
-    height, block = 0.0, box.document().firstBlock()
-    while block.isValid():
-        height += box.blockBoundingRect(block).height()
-        block = block.next()
-    return int(height + 2 * box.document().documentMargin() + 2 * box.frameWidth())
+    """Where a text box's last line ends as the box paints it, from the box's top (pixels):
+    the lines' geometry moved by the scrolled offset, in the viewport inside the frame."""
+    doc = box.document()
+    last = box.blockBoundingGeometry(doc.lastBlock()).translated(box.contentOffset())
+    return int(math.ceil(box.viewport().geometry().top() + last.bottom()))
 
 
 def box_state(box):
