@@ -160,6 +160,9 @@ click(dlg.buttons.button(QtGui.QDialogButtonBox.Ok))
 shown(dlg)
 RESULTS["stock"] = {"text": dlg.check_text.text(), "visible": dlg.isVisible(),
                     "places": [place(w) for w in (dlg.check_text, dlg.buttons)],
+                    "labels": dlg.drawing.label_places(),
+                    "drawing": [dlg.drawing.width(), dlg.drawing.height(),
+                                dlg.drawing.fontMetrics().lineSpacing()],
                     "png": grab(dlg, "stock_refused")}
 dlg.close()
 

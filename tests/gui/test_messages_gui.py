@@ -107,3 +107,17 @@ def test_report_note_shows_whole(session):
     assert s["text"].startswith("Predicted residual: the mirror method's predicted residual")
     table, note = s["places"]
     assert shows(table) and shows(note) and table["bottom"] <= note["top"]
+
+
+def test_stock_drawing_labels_apart(session):
+    s = session["stock"]
+    width, height, spacing = s["drawing"]
+    labels = s["labels"]
+    assert sorted(t for t, _x, _y in labels) == ["corrected face", "measured (d)", "nominal",
+                                                 "nominal + stock"]
+    ys = sorted(y for _t, _x, y in labels)
+    # a line apart (measured and corrected end closer than a line on the curves), inside
+    # the drawing
+    assert min(b - a for a, b in zip(ys[:-1], ys[1:])) >= spacing - 1e-9
+    assert spacing <= ys[0] and ys[-1] <= height
+    assert all(0 < x < width - 60 for _t, x, _y in labels)
