@@ -26,6 +26,7 @@ from ..core.option_tables import ALIGN
 from ..errors import SurfcompError
 from . import dialogs, option_labels
 from .commands import Command, selected
+from .result_box import result_box, show_message
 from .task_panel import UndoTaskPanel
 
 translate = FreeCAD.Qt.translate
@@ -36,8 +37,6 @@ TEXTS = (QT_TRANSLATE_NOOP(ID, "Align measurements"),
                                "transform, with what the alignment absorbed"))
 TRANSFORM_FILTER = "Transform (*.json *.txt *.csv);;All files (*)"
 RPS_FILTER = "3-2-1 set (*.json);;All files (*)"
-#: colour of a message the user must act on
-RED = "color: #c53030;"
 
 
 def compensation_of_selection(doc):
@@ -102,10 +101,8 @@ class AlignPanel(UndoTaskPanel):
         self.transform_button = QtGui.QPushButton(translate("SurfComp", "Transform file..."))
         self.clear_button = QtGui.QPushButton(translate("SurfComp", "No transform"))
         self.apply_button = QtGui.QPushButton(translate("SurfComp", "Apply"))
-        # read-only text that wraps at the panel's width (a label would widen the panel)
-        self.result = QtGui.QPlainTextEdit()
-        self.result.setReadOnly(True)
-        self.result.setMinimumHeight(18 * self.result.fontMetrics().lineSpacing())
+        # the transform, the RMS and what the fit absorbed: a label would widen the panel
+        self.result = result_box(18)
         # labels above their fields (the task view is narrow); labels and tooltips are the
         # option registry's, as messages name the options
         for name, field in (("align", self.method),
@@ -149,8 +146,7 @@ class AlignPanel(UndoTaskPanel):
         self.clear_button.setEnabled(bool(self.matrix))
 
     def _message(self, text):
-        self.result.setPlainText(text)
-        self.result.setStyleSheet(RED)
+        show_message(self.result, text, bad=True)
 
     def faces_from_selection(self):
         """The faces selected in the 3D view (of any object) into the faces field."""
@@ -230,8 +226,7 @@ class AlignPanel(UndoTaskPanel):
             return False
         lines = list(comp.Alignment) or [translate(
             "SurfComp", "No alignment: the measured points are used in the nominal's frame")]
-        self.result.setPlainText("\n".join(lines))
-        self.result.setStyleSheet("")
+        show_message(self.result, "\n".join(lines))
         return True
 
 

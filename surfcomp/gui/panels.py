@@ -345,33 +345,55 @@ class StockDrawing(QtGui.QWidget):
         self.setMinimumSize(360, 190)
         self.stock = 0.1
 
-    def paintEvent(self, _event):
+    def _curves(self):
+        """``[(offset(t), colour, label, dashed)]``: t in [0, 1] along the face, the offset
+        in units of the stock."""
         import math
 
-        p = QtGui.QPainter(self)
-        p.setRenderHint(QtGui.QPainter.Antialiasing)
-        p.fillRect(self.rect(), QtGui.QColor(255, 255, 255))
-        w, h = self.width(), self.height()
-        y0, scale = 0.62 * h, 0.22 * h      # nominal line; 1 unit of stock in pixels
         s = 1.0
-
-        def curve(offset, color, label, dash=False):
-            pen = QtGui.QPen(QtGui.QColor(*color), 2)
-            if dash:
-                pen.setStyle(QtCore.Qt.DashLine)
-            p.setPen(pen)
-            pts = [QtCore.QPointF(x, y0 - scale * offset(x / w)) for x in range(10, w - 110, 4)]
-            for a, b in zip(pts[:-1], pts[1:]):
-                p.drawLine(a, b)
-            p.drawText(QtCore.QPointF(w - 105, pts[-1].y() + 4), label)
 
         def d(t):
             return s + 0.45 * math.sin(6.0 * t)          # measured: stock + machining error
 
-        curve(lambda t: 0.0, (0, 0, 0), translate("SurfComp", "nominal"))
-        curve(lambda t: s, (120, 120, 120), translate("SurfComp", "nominal + stock"), True)
-        curve(d, (43, 108, 176), translate("SurfComp", "measured (d)"))
-        curve(lambda t: -(d(t) - s), (197, 48, 48), translate("SurfComp", "corrected face"))
+        return [(lambda t: 0.0, (0, 0, 0), translate("SurfComp", "nominal"), False),
+                (lambda t: s, (120, 120, 120), translate("SurfComp", "nominal + stock"), True),
+                (d, (43, 108, 176), translate("SurfComp", "measured (d)"), False),
+                (lambda t: -(d(t) - s), (197, 48, 48), translate("SurfComp", "corrected face"),
+                 False)]
+
+    def _line(self, offset):
+        w, h = self.width(), self.height()
+        y0, scale = 0.62 * h, 0.22 * h      # nominal line; 1 unit of stock in pixels
+        return [QtCore.QPointF(x, y0 - scale * offset(x / w)) for x in range(10, w - 110, 4)]
+
+    def label_places(self):
+        """Each curve's label and its baseline ``(text, x, y)`` at the curve's right end,
+        pushed apart by a line where the curves end close together (there "measured (d)"
+        and "corrected face" were drawn over each other)."""
+        spacing = self.fontMetrics().lineSpacing()
+        ends = sorted((self._line(offset)[-1].y() + 4, label)
+                      for offset, _colour, label, _dash in self._curves())
+        places, last = [], None
+        for y, label in ends:
+            y = y if last is None else max(y, last + spacing)
+            places.append((label, self.width() - 105, y))
+            last = y
+        return places
+
+    def paintEvent(self, _event):
+        p = QtGui.QPainter(self)
+        p.setRenderHint(QtGui.QPainter.Antialiasing)
+        p.fillRect(self.rect(), QtGui.QColor(255, 255, 255))
+        at = {label: (x, y) for label, x, y in self.label_places()}
+        for offset, colour, label, dash in self._curves():
+            pen = QtGui.QPen(QtGui.QColor(*colour), 2)
+            if dash:
+                pen.setStyle(QtCore.Qt.DashLine)
+            p.setPen(pen)
+            pts = self._line(offset)
+            for a, b in zip(pts[:-1], pts[1:]):
+                p.drawLine(a, b)
+            p.drawText(QtCore.QPointF(*at[label]), label)
         p.setPen(QtGui.QColor(0, 0, 0))
         p.drawText(QtCore.QPointF(8, 16), translate("SurfComp", "corrected = nominal - (d - "
                                                                 "stock) along the normal"))

@@ -18,6 +18,7 @@ from ..app.undo import UndoStep
 from ..core.measurement.planning import POINT_LAYOUTS
 from ..core.option_tables import PLAN
 from . import option_labels
+from .result_box import result_box, show_message
 from .task_panel import UndoTaskPanel
 
 translate = FreeCAD.Qt.translate
@@ -76,12 +77,9 @@ class PlanPanel(UndoTaskPanel):
         self.margin = _spin(obj.EdgeMargin, 0.0, 100.0, 0.1, 3)
         tilt = PLAN["max_tilt"]
         self.tilt = _spin(obj.MaxTilt, tilt.low, tilt.high, 5.0, 1)
-        # read-only text that wraps at the panel's width and scrolls: the task box keeps the
-        # height it opened with, so a label growing with the message (an error with its
-        # position, the dropped points' reasons) would be cut off below it
-        self.result = QtGui.QPlainTextEdit()
-        self.result.setReadOnly(True)
-        self.result.setMinimumHeight(8 * self.result.fontMetrics().lineSpacing())
+        # the task box keeps the height it opened with: an error with its position or the
+        # dropped points' reasons would be cut off below a label
+        self.result = result_box(8)
         self.plan_button = QtGui.QPushButton(translate("SurfComp", "Plan"))
         # labels and tooltips are the option registry's, as messages name the options
         # (the count, U x V, is two fields)
@@ -124,8 +122,7 @@ class PlanPanel(UndoTaskPanel):
         try:
             plan = trial_plan(self.obj, **self.values())
         except SurfcompError as exc:
-            self.result.setPlainText(option_labels.shown(exc, ("plan",)))
-            self.result.setStyleSheet("color: #c53030;")
+            show_message(self.result, option_labels.shown(exc, ("plan",)), bad=True)
             return False
         lines = ["_plan = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]
         lines += ["_plan.%s = %r" % (k, v) for k, v in self.values().items()]
@@ -135,8 +132,7 @@ class PlanPanel(UndoTaskPanel):
         show_points(self.obj)
         obj = self.obj
         if "Invalid" in obj.State or "Error" in obj.State:
-            self.result.setPlainText(obj.getStatusString())
-            self.result.setStyleSheet("color: #c53030;")
+            show_message(self.result, obj.getStatusString(), bad=True)
             return False
         text = translate("SurfComp", "%d of %d points kept; travel %.1f mm (%s order); "
                                      "safe Z %.3f mm") % (obj.Kept, obj.Placed, obj.Travel,
@@ -146,8 +142,7 @@ class PlanPanel(UndoTaskPanel):
             # by the fields' labels, where the property names them by the properties
             text += "\n" + translate("SurfComp", "Dropped: %s") % "; ".join(
                 option_labels.shown(reason, ("plan",)) for reason in dropped(plan))
-        self.result.setPlainText(text)
-        self.result.setStyleSheet("")
+        show_message(self.result, text)
         return True
 
 

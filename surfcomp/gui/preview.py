@@ -19,6 +19,7 @@ from ..core.compensation import plausibility
 from ..errors import SurfcompError
 from ..io.units import UNIT_FACTORS
 from . import option_labels, prefs
+from .result_box import result_box, show_message
 
 translate = FreeCAD.Qt.translate
 
@@ -169,8 +170,9 @@ class PreviewDialog(QtGui.QDialog):
                         "deviation computed from the points keeps theirs)"))
         row.addRow(option_labels.label("deviation_units") + ":", self.unit)
         lay.addLayout(row)
-        self.status = QtGui.QLabel("")
-        self.status.setWordWrap(True)
+        # the dialog keeps the size it was shown at: an error of three lines in a label
+        # pushed the preview under the buttons
+        self.status = result_box(3)
         lay.addWidget(self.status)
         self.text = QtGui.QPlainTextEdit()
         self.text.setReadOnly(True)
@@ -229,11 +231,11 @@ class PreviewDialog(QtGui.QDialog):
         ok = self.buttons.button(QtGui.QDialogButtonBox.Ok)
         ok.setEnabled(not errors)
         if errors:
-            self.status.setText(translate("SurfComp", "Cannot import: %s") % errors[0])
-            self.status.setStyleSheet("color: #c53030; font-weight: bold;")
+            show_message(self.status, translate("SurfComp", "Cannot import: %s") % errors[0],
+                         bad=True, bold=True)
         else:
-            self.status.setText(translate("SurfComp", "%d points, no errors") % len(self.ms))
-            self.status.setStyleSheet("")
+            show_message(self.status, translate("SurfComp", "%d points, no errors")
+                         % len(self.ms))
 
     def accept(self):
         if self.ms is None or self.errors:

@@ -57,10 +57,10 @@ state = {}
 
 
 def look(dlg):
-    state["mm"] = [dlg.text.toPlainText(), dlg.status.text(), dlg.accepted_ok(),
+    state["mm"] = [dlg.text.toPlainText(), dlg.status.toPlainText(), dlg.accepted_ok(),
                    dlg.units()]
     dlg.unit.setCurrentIndex(preview.UNIT_CHOICES.index("um"))   # the unit selector
-    state["um"] = [dlg.text.toPlainText(), dlg.status.text(), dlg.accepted_ok(), dlg.units()]
+    state["um"] = [dlg.text.toPlainText(), dlg.status.toPlainText(), dlg.accepted_ok(), dlg.units()]
     dlg.unit.setCurrentIndex(0)
     return True     # "OK" pressed while the errors are shown
 

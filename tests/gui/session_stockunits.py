@@ -34,21 +34,21 @@ def look(dlg):
     """Read as mm; the deviation selector to um (Down key); then the coordinate selector to
     um too: the points fall off the face; OK clicked there; back to mm (Up key), OK."""
     shown(dlg)
-    state["mm"] = [dlg.text.toPlainText(), dlg.status.text(), ok_button(dlg).isEnabled()]
+    state["mm"] = [dlg.text.toPlainText(), dlg.status.toPlainText(), ok_button(dlg).isEnabled()]
     dlg.unit.setFocus()
     key(dlg.unit, QtCore.Qt.Key_Down)
-    state["dev_um"] = [dlg.text.toPlainText(), dlg.status.text(), ok_button(dlg).isEnabled(),
+    state["dev_um"] = [dlg.text.toPlainText(), dlg.status.toPlainText(), ok_button(dlg).isEnabled(),
                        dlg.units(), dlg.deviation_units()]
     dlg.coord_unit.setFocus()
     key(dlg.coord_unit, QtCore.Qt.Key_Down)
-    state["both_um"] = [dlg.text.toPlainText(), dlg.status.text(), ok_button(dlg).isEnabled(),
-                        dlg.units(), dlg.deviation_units()]
+    state["both_um"] = [dlg.text.toPlainText(), dlg.status.toPlainText(),
+                        ok_button(dlg).isEnabled(), dlg.units(), dlg.deviation_units()]
     state["png"] = os.path.join(TMP, "preview_off_face.png")
     dlg.grab().save(state["png"])
     click(ok_button(dlg))
     state["after_ok_click"] = [dlg.isVisible(), dlg.result()]
     key(dlg.coord_unit, QtCore.Qt.Key_Up)
-    state["back"] = [dlg.status.text(), ok_button(dlg).isEnabled(), dlg.units(),
+    state["back"] = [dlg.status.toPlainText(), ok_button(dlg).isEnabled(), dlg.units(),
                      dlg.deviation_units()]
     state["png_ok"] = os.path.join(TMP, "preview_dev_um.png")
     dlg.grab().save(state["png_ok"])
