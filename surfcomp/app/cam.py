@@ -256,7 +256,8 @@ def command_end_point(cmd, start):
 
 def plain_shape(shape):
     """``shape`` with its sub-elements named by their index only, as a shape read from a
-    file: on 1.x a copy whose element map is cleared; on 0.20 (no element map) ``shape``.
+    file: on 1.x the shape read back from its BREP text (the same geometry to the last
+    digit, no element map); on 0.20 (no element map) ``shape``.
 
     A shape assembled from separately built faces (the region's corrected faces, sewn into
     their solid, :mod:`surfcomp.app.region_retrim`) has, on 1.x, an element map in which
@@ -266,13 +267,18 @@ def plain_shape(shape):
     model) gets a new name for those faces at every recompute. The links of the Job's
     operations to them then miss, FreeCAD looks for the face by geometry instead
     (``Part::Feature::searchElementCache``), and OpenCASCADE fails comparing the old and
-    the new B-spline surfaces: the clone reports "Unknown C++ exception". With plain names a
-    feature's faces keep their names from one recompute to the next, as a nominal's do.
+    the new B-spline surfaces: the clone reports "Unknown C++ exception". A shape without
+    an element map gets the plain names (``Face1;:H<tag>,F``) from the feature that holds
+    it, the same at every recompute, as a nominal's. Clearing the map of a copy
+    (``ElementMap = {}``) is not the same: that shape counts as mapped, with no names, so a
+    clone of it names no faces and its links miss as well.
     """
     if not hasattr(shape, "ElementMap"):
         return shape
-    out = shape.copy(False)      # the topology copied, the geometry shared
-    out.ElementMap = {}
+    import Part
+
+    out = Part.Shape()
+    out.importBrepFromString(shape.exportBrepToString())
     return out
 
 

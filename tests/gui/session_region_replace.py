@@ -18,60 +18,6 @@ mirror.ViewObject.Visibility = True
 Gui.updateGui()
 
 
-def tree():
-    trees = [t for t in mw.findChildren(QtGui.QTreeWidget) if t.isVisible()]
-    return max(trees, key=lambda t: t.topLevelItemCount() and t.width())
-
-
-def tree_item(label):
-    t = tree()
-    found = t.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive, 0)
-    return t, found[0]
-
-
-def click_tree(label):
-    """A real left click on the tree item ``label`` (its document expanded first)."""
-    tree().expandAll()
-    Gui.updateGui()
-    t, item = tree_item(label)
-    t.scrollToItem(item)
-    Gui.updateGui()
-    r = t.visualItemRect(item)
-    click(t.viewport(), QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y()))
-    wait_for_actions()
-    return [o.Name for o in Gui.Selection.getSelection()]
-
-
-def wait_for_actions():
-    """FreeCAD enables and disables the commands' actions on a timer: let it run."""
-    for _ in range(12):
-        Gui.updateGui()
-        time.sleep(0.05)
-
-
-def button(command):
-    """The toolbar button of ``command`` (a QToolButton); FreeCAD's Undo button (a drop-down
-    of the undo steps) has no object name: found by its text."""
-    for bar in mw.findChildren(QtGui.QToolBar):
-        for action in bar.actions():
-            if action.objectName() == command or (command == "Std_Undo" and not
-                                                  action.objectName() and
-                                                  action.text().replace("&", "") == "Undo"):
-                w = bar.widgetForAction(action)
-                if w is not None and w.isVisible():
-                    return action, w
-    raise RuntimeError("no toolbar button for %s" % command)
-
-
-def press(command):
-    """A real click on the command's toolbar button; whether it was enabled."""
-    action, w = button(command)
-    enabled = action.isEnabled()
-    click(w)
-    wait_for_actions()
-    return enabled
-
-
 def state():
     return {"source": mirror.Source.Name, "block_visible": block.ViewObject.Visibility,
             "region_visible": region.ViewObject.Visibility, "record": bool(region.ReplacedLinks),
