@@ -98,9 +98,10 @@ def test_replace_moves_the_job_to_the_region_and_the_tool_down_the_ridge(session
     dz, share = drop(nominal["tips"], after["tips"])
     assert share > 0.95
     # the ridge is 20 um high on the common edge: the tool goes down by up to that much,
-    # and never up (the correction is a cut everywhere)
+    # and never up (the correction is a cut everywhere; measured: down 20.49 um at most,
+    # up 0.36 um at most, on 0.20, 1.0 and 1.1)
     assert -21.5 < dz.min() < -18.0
-    assert dz.max() < 0.5
+    assert dz.max() < 1.0
     assert (dz < -10.0).sum() > 20
 
 
@@ -120,8 +121,9 @@ def test_undo_restore_and_replace_again_keep_the_job_valid(session):
         assert after["source"] == (["Block"] if back else ["RegionCompensation"])
         expected = nominal["tips"] if back else replaced["tips"]
         assert len(after["tips"]) == len(expected)
-        # the same program as the first time (the recompute of the region object agrees to
-        # well below a micrometre)
+        # the same program as the first time, within 1 um: the region object read from the
+        # file (after Undo) and the one recomputed in the session give tool tips up to
+        # 0.27 um apart (measured on 0.20 and 1.0); Restore gives the nominal's to 0.5 nm
         np.testing.assert_allclose(after["tips"], expected, atol=1e-3)
 
 
