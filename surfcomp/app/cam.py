@@ -21,7 +21,11 @@ version string, so a build between the releases takes the branch its modules sup
 - documents saved by 0.20 name their CAM proxies by ``PathScripts.*`` modules that 1.x does
   not have: those names resolve to the 1.x modules (:data:`LEGACY_MODULES`, the same hook);
 - Qt: PySide2/Qt5 (0.20, 1.0) or PySide6/Qt6 (1.1); GUI code imports FreeCAD's ``PySide``
-  shim only, so it needs no branch here.
+  shim only, so it needs no branch here;
+- topological naming: 1.x shapes carry an element map (the history of their faces', edges'
+  and vertices' names); a shape built from several shapes can come out with names that
+  change at every recompute, which breaks the links of CAM operations to its faces
+  (:func:`plain_shape` gives it the plain ``FaceN`` names instead); 0.20 has no such map.
 
 No FreeCADGui: everything here works in ``freecadcmd`` and in a plain ``python3`` once
 :func:`setup_workbench` has run.
@@ -248,6 +252,34 @@ def edge_for_command(cmd, start):
 def command_end_point(cmd, start):
     """Where a command leaves the tool, from ``start``."""
     return module("Geom").commandEndPoint(cmd, start)
+
+
+def plain_shape(shape):
+    """``shape`` with its sub-elements named by their index only, as a shape read from a
+    file: on 1.x the shape read back from its BREP text (the same geometry to the last
+    digit, no element map); on 0.20 (no element map) ``shape``.
+
+    A shape assembled from separately built faces (the region's corrected faces, sewn into
+    their solid, :mod:`surfcomp.app.region_retrim`) has, on 1.x, an element map in which
+    several faces descend from the same ``Face1`` (each was the one face of its own shape).
+    FreeCAD tells such duplicates apart by a tag (``Face1;D1a18;...``) drawn from the
+    document's string table, so a feature recomputed from it (Draft's clone: a CAM Job's
+    model) gets a new name for those faces at every recompute. The links of the Job's
+    operations to them then miss, FreeCAD looks for the face by geometry instead
+    (``Part::Feature::searchElementCache``), and OpenCASCADE fails comparing the old and
+    the new B-spline surfaces: the clone reports "Unknown C++ exception". A shape without
+    an element map gets the plain names (``Face1;:H<tag>,F``) from the feature that holds
+    it, the same at every recompute, as a nominal's. Clearing the map of a copy
+    (``ElementMap = {}``) is not the same: that shape counts as mapped, with no names, so a
+    clone of it names no faces and its links miss as well.
+    """
+    if not hasattr(shape, "ElementMap"):
+        return shape
+    import Part
+
+    out = Part.Shape()
+    out.importBrepFromString(shape.exportBrepToString())
+    return out
 
 
 # --------------------------------------------------------------------------- post-processing

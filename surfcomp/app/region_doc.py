@@ -36,7 +36,7 @@ from ..core.choices import MASK_KINDS
 from ..core.command_options import COMPENSATE
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import InputError
-from . import features
+from . import cam, features
 from .properties import QT_TRANSLATE_NOOP, option_row
 from .proxies import Proxy
 
@@ -242,7 +242,9 @@ def compute(obj, log=None):
     rep["round"] = len(earlier) + 1
     rep["base"] = [b.Name for b in earlier]
     rep["alignment"] = None if alignment is None else alignment.as_dict()
-    return RegionRun(shape, rep, own[0], alignment)
+    # the faces named by their index, as the nominal's: CAM links to them keep working
+    # when the region object or a clone of it recomputes (FreeCAD 1.x)
+    return RegionRun(cam.plain_shape(shape), rep, own[0], alignment)
 
 
 def _same_faces(obj, base, names):

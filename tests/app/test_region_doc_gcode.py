@@ -65,25 +65,8 @@ def posted(shop):
                       "--faces", "Face1,Face2", "--replace", "--save",
                       out, "--gcode", ngc, "--post", "linuxcnc", "--post-args", POST_ARGS)
     assert rp.sha256(path) == sha                 # the input document is untouched
-    if _known_element_map_failure():
-        # Known limit on FreeCAD 1.x (docs/regions.md): the region goes back into its
-        # solid re-trimmed, and the Job's model clone cannot map the nominal's element
-        # names onto that solid ("Unknown C++ exception" in Draft's clone). The route
-        # says so and writes nothing; the tests below run once it works.
-        assert r.returncode == 1, r.stdout + r.stderr      # a computation error
-        assert "after the recompute 1 object(s) are invalid: Model-Block_region (Clone): " \
-               "Unknown C++ exception" in r.stderr
-        assert not os.path.exists(out) and not os.path.exists(ngc)
-        pytest.xfail("FreeCAD 1.x: the Job's model clone of a re-trimmed region solid fails")
     assert r.returncode == 0, r.stdout + r.stderr
     return out, ngc, r.stdout
-
-
-def _known_element_map_failure():
-    """FreeCAD 1.0 and later, whose shapes carry element maps (topological naming)."""
-    import FreeCAD
-
-    return int(FreeCAD.Version()[0]) >= 1
 
 
 def feed_ends(path, tmp_path):

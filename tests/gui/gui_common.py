@@ -282,3 +282,27 @@ def type_value(spin, text):
             key(spin, QtCore.Qt.Key_Period if point == "." else QtCore.Qt.Key_Comma, point)
         else:
             key(spin, getattr(QtCore.Qt, "Key_" + ch), ch)
+
+
+# -- the toolbar, with real clicks ------------------------------------------------------
+def button(command):
+    """The toolbar button of ``command`` (a QToolButton); FreeCAD's Undo button (a drop-down
+    of the undo steps) has no object name: found by its text."""
+    for bar in mw.findChildren(QtGui.QToolBar):
+        for action in bar.actions():
+            if action.objectName() == command or (command == "Std_Undo" and not
+                                                  action.objectName() and
+                                                  action.text().replace("&", "") == "Undo"):
+                w = bar.widgetForAction(action)
+                if w is not None and w.isVisible():
+                    return action, w
+    raise RuntimeError("no toolbar button for %s" % command)
+
+
+def press(command):
+    """A real click on the command's toolbar button; whether it was enabled."""
+    action, w = button(command)
+    enabled = action.isEnabled()
+    click(w)
+    wait_for_actions()
+    return enabled
