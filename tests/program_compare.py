@@ -14,7 +14,7 @@ along their normal.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from tests.toolpath_checks import drop_cutter
+from tests.toolpath_checks import drop_cutter, projector
 
 
 def feed_points(moves):
@@ -40,13 +40,11 @@ def surface_distance(surface, outward, radius, a, b, carry=None, near=0.5, windo
     (distance, xy_shift)
         ``distance`` (k,) and the XY distance to the sample of B each was carried from.
     """
-    from surfcomp.core.surface.projection import project
-
     carry = surface if carry is None else carry
     z_here, pr = drop_cutter(carry, outward, a[:, :2], a[:, 2], radius)
     dist, k = cKDTree(b[:, :2]).query(a[:, :2])
     z_there, _ = drop_cutter(carry, outward, b[k, :2], b[k, 2], radius)
-    own = project(surface, a + [0.0, 0.0, radius])
+    own = projector(surface, len(a)).project(a + [0.0, 0.0, radius])
     touching = ~own.outside & (np.abs(own.distance * outward - radius) <= 0.2)
     use = touching & ~pr.outside & (dist <= near) & (np.abs(a[:, 2] - z_here) <= window)
     zb = b[k, 2] + (z_here - z_there)

@@ -9,7 +9,8 @@ Two rules keep both workers busy to the end:
   GUI session, a simulated part) runs on the worker that built it,
   together with every other test of its module sharing one of its module fixtures (so each
   fixture is still built once, and tests that hand results on through a fixture keep their
-  order); a test without such a fixture is a unit of its own. In a parallel run each
+  order); a session-scoped fixture ties its tests of every module into one unit; a test
+  without such a fixture is a unit of its own. In a parallel run each
   worker's GUI sessions have their own X server (tests/gui/harness.py); the sessions that
   measure the GUI's response time (marked ``latency``) run after the parallel part, alone
   on the machine (tools/test.sh).
@@ -44,19 +45,20 @@ def _folder(nodeid):
 
 def _shared_fixtures(item):
     """Names of the module- (or wider) scoped fixtures that this checkout's tests define and
-    ``item`` uses, directly or through another fixture."""
+    ``item`` uses, directly or through another fixture, each with its scope."""
     info = getattr(item, "_fixtureinfo", None)
     names = []
     for name, defs in (info.name2fixturedefs.items() if info else ()):
         fixture = defs[-1]
         if fixture.scope in SHARED_SCOPES and getattr(fixture, "baseid", ""):
-            names.append(name)
+            names.append((name, fixture.scope))
     return sorted(names)
 
 
 def _fixture_groups(items):
     """``{nodeid: group}`` for the tests that share a module fixture: per module,
-    the tests connected through the module fixtures they use form one group."""
+    the tests connected through the module fixtures they use form one group; a
+    session-scoped fixture joins its tests of every module (it is built once a worker)."""
     parent = {}
 
     def find(key):
@@ -68,7 +70,8 @@ def _fixture_groups(items):
     members = {}
     for item in items:
         module = item.nodeid.split("::")[0]
-        keys = [module + "::" + name for name in _shared_fixtures(item)]
+        keys = [name if scope == "session" else module + "::" + name
+                for name, scope in _shared_fixtures(item)]
         if keys:
             members[item.nodeid] = keys[0]
             for key in keys[1:]:

@@ -11,7 +11,24 @@ import numpy as np
 
 from surfcomp.core.compensation.corrected import realised_correction
 from surfcomp.core.surface.bspline import Surface
-from surfcomp.core.surface.projection import project
+from surfcomp.core.surface.projection import Projector
+
+#: ``{(id(surface), min_samples): (surface, Projector)}`` of :func:`projector`
+_PROJECTORS = {}
+
+
+def projector(surface, n):
+    """The :class:`Projector` that ``project(surface, points)`` builds for ``n`` points
+    (the same seed grid, so the same answers), built once per surface and size: building
+    one takes about a second on a refined face, and a drop-cutter check projects nine
+    times."""
+    key = (id(surface), n // 16)
+    hit = _PROJECTORS.get(key)
+    if hit is None or hit[0] is not surface:
+        if len(_PROJECTORS) >= 8:
+            _PROJECTORS.clear()
+        hit = _PROJECTORS[key] = (surface, Projector(surface, min_samples=n // 16))
+    return hit[1]
 
 
 def drop_cutter(surface, outward, xy, z_guess, r, iterations=8):
@@ -19,10 +36,11 @@ def drop_cutter(surface, outward, xy, z_guess, r, iterations=8):
     (N, 2): the ball centre lies at distance r from the surface (Newton on the centre
     height, d(distance)/dz = n_z at the foot point). Returns (z_tip (N,), projection)."""
     zc = np.asarray(z_guess, dtype=float) + r
+    proj = projector(surface, len(zc))
     for _ in range(iterations):
-        pr = project(surface, np.column_stack([xy, zc]))
+        pr = proj.project(np.column_stack([xy, zc]))
         zc = zc - (pr.distance * outward - r) / (pr.normal[:, 2] * outward)
-    return zc - r, project(surface, np.column_stack([xy, zc]))
+    return zc - r, proj.project(np.column_stack([xy, zc]))
 
 
 def surface_to_json(s):

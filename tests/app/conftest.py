@@ -19,3 +19,18 @@ def fresh_doc():
     d = FreeCAD.newDocument("test")
     yield d
     FreeCAD.closeDocument(d.Name)
+
+
+@pytest.fixture(scope="session")
+def cam_example(tmp_path_factory):
+    """The example's finishing Job before and after the compensation replaces the nominal
+    (tests/app/cam_example.py), built once for the modules that check it. A test that
+    changes its document (test_path_regen.py's restore) runs last in its module and the
+    others read only what the build recorded."""
+    import FreeCAD
+
+    from tests.app import cam_example as example
+
+    built = example.build(tmp_path_factory.mktemp("cam_example"))
+    yield built
+    FreeCAD.closeDocument(built.doc.Name)

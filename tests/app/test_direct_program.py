@@ -33,12 +33,11 @@ import pytest
 
 from surfcomp.app import cam, cam_job, features, replace, reports
 from surfcomp.app.nominal import load_nominal
+from tests.app.cam_example import POST_ARGS, R, with_dressup
 from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
 from tests.program_compare import feed_points, surface_distance
 from tests.pure.test_gcode_rs274 import rs274
 
-R = 3.0
-POST_ARGS = "--no-show-editor --no-header --precision=4"
 #: the operation's mesh deflection (mm) plus 1 um
 AGREE = 0.001 + 0.001
 
@@ -50,13 +49,12 @@ def run_cli(*args):
 
 
 @pytest.fixture(scope="module")
-def programs(tmp_path_factory):
+def programs(cam_example):
     """FINISH.ngc (nominal) and CAM.ngc (regenerated on the corrected face) of the example,
-    the corrected surface; one Path computation each."""
-    tmp = tmp_path_factory.mktemp("direct")
-    found = {}
-    return (tmp,) + cam_programs(tmp, EXAMPLE_STEP, EXAMPLE_CSV, 0.001,
-                                 dressup=found) + (found,)
+    the corrected surface, the dressup's results (tests/app/cam_example.py: one Path
+    computation each, shared with test_path_regen.py)."""
+    ex = cam_example
+    return ex.tmp, ex.finish, ex.regen, ex.corrected, ex.found
 
 
 BLADE = os.path.join(ROOT, "tests", "data", "real", "cad", "BladeX", "upper.iges")
@@ -97,6 +95,7 @@ def cam_programs(tmp, step, csv, deflection, refine=1, dressup=None):
     doc.recompute()
     # Path's stock follows the model clone's bounding box, tight once the operation has
     # meshed the clone: settle it, so that only the compensation changes the program
+    # (tests/app/cam_example.py settles it before the operation exists)
     cam_job.model_clone(job, nom).touch()
     doc.recompute()
     finish = tmp / "FINISH.ngc"
@@ -110,25 +109,6 @@ def cam_programs(tmp, step, csv, deflection, refine=1, dressup=None):
     corrected = reports.corrected_surface(comp)
     FreeCAD.closeDocument(doc.Name)
     return finish, regen, corrected
-
-
-def with_dressup(doc, job, comp, tmp, found):
-    """Post the Job with a surface correction dressup on its operation (DRESSUP.ngc)."""
-    from surfcomp.app import dressup_surface
-
-    op = [o for o in job.Operations.Group if o.Name.startswith("Surface")][0]
-    before = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
-    d = dressup_surface.Create(op, comp)
-    doc.recompute()
-    found.update(state=list(d.State), radius=float(d.BallRadius.Value),
-                 moved=d.MovedMoves, max_move=float(d.MaxMove.Value),
-                 contact=d.ContactPoints, ops=[o.Name for o in job.Operations.Group],
-                 op_kept=[(c.Name, dict(c.Parameters)) for c in op.Path.Commands] == before,
-                 touched="Touched" in op.State)
-    (tmp / "DRESSUP.ngc").write_text(cam_job.post_process(job, "linuxcnc", POST_ARGS))
-    d.Proxy.onDelete(d, None)
-    doc.removeObject(d.Name)
-    doc.recompute()
 
 
 def agreement(tmp, step, csv, finish, regen, corrected):

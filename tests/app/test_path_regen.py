@@ -15,19 +15,14 @@ OpenCamLib drops the cutter on has a 1 um deflection). Measured: median 0.13 um,
 
 import re
 
-import FreeCAD
 import numpy as np
-import Part
 import pytest
 
-from surfcomp.app import cam, cam_job, features, replace, reports
+from surfcomp.app import cam_job, replace, reports
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.compensation.corrected import realised_correction
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
+from tests.app.cam_example import POST_ARGS, R
 from tests.toolpath_checks import drop_cutter
-
-R = 3.0                       # ball radius (mm)
-POST_ARGS = "--no-show-editor --no-header --precision=4"
 
 
 def test_drop_cutter_reference_on_a_tilted_plane():
@@ -60,40 +55,11 @@ def g1_points(gcode):
 
 
 @pytest.fixture(scope="module")
-def regenerated():
-    """The document before and after replace (one Path computation each, ~15 s)."""
-    cam.setup_workbench()
-    doc = FreeCAD.newDocument("pathregen")
-    nom = doc.addObject("Part::Feature", "Nominal")
-    nom.Shape = Part.read(EXAMPLE_STEP)
-    doc.recompute()
-    job = cam_job.create_job(doc, [nom])
-    # Path's stock follows the model clones' bounding boxes, which become tight once the
-    # clone is meshed (OCCT then bounds the triangulation): mesh it as the operation will
-    # and settle the stock before the operation exists, so that only the compensation
-    # changes the program (and the operation is computed once, not again for the stock)
-    clone = cam_job.model_clone(job, nom)
-    clone.Shape.tessellate(0.001)
-    clone.touch()
-    doc.recompute()
-    tc = cam_job.ball_end_tool_controller(job, 2 * R)
-    op = cam_job.surface_operation(job, nom, ["Face1"], tc, step_over=50.0, sample_interval=1.0,
-                                   linear_deflection=0.001)
-    m = features.make_measurement(doc, EXAMPLE_CSV)
-    comp = features.make_compensation(doc, nom, "Face1", m)
-    comp.Refine = 1          # fewer knots: OCCT meshes the corrected face 7x faster
-    doc.recompute()
-    before = {"cl": cam_job.cutter_locations(op),
-              "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
-              "state": list(op.State), "nominal": nom.Shape.copy()}
-    links = replace.replace(doc, comp)
-    doc.recompute()
-    after = {"cl": cam_job.cutter_locations(op),
-             "gcode": cam_job.post_process(job, "linuxcnc", POST_ARGS),
-             "invalid": [o.Name for o in doc.Objects if "Invalid" in o.State or "Error" in o.State],
-             "links": links}
-    yield doc, nom, comp, job, op, before, after
-    FreeCAD.closeDocument(doc.Name)
+def regenerated(cam_example):
+    """The document before and after replace (tests/app/cam_example.py: one Path
+    computation each, shared with test_direct_program.py)."""
+    ex = cam_example
+    return ex.doc, ex.nom, ex.comp, ex.job, ex.op, ex.before, ex.after
 
 
 def test_replace_regenerates_the_operation(regenerated):

@@ -46,15 +46,24 @@ SPECIAL = ["nan", "NaN", "-nan", "inf", "-inf", "Infinity", "1e308", "-1e308", "
            "0x10", "+.5", "1e", "--1", "1_000", "\u0661", "\x00", "1e-5", "12e3"]
 
 
+def _formatter(spec):
+    """``spec % x`` as a named function: Hypothesis 6.67 describes the function of every
+    mapped value it draws, and for a lambda it reads and parses its source each time (half
+    the time of a table test)."""
+    def format_number(x):
+        return spec % x
+    return format_number
+
+
 @functools.lru_cache(maxsize=None)
 def number_text(plain=4):
     """Texts a number field may hold: mostly plausible coordinates (``plain`` times as often
     as the rest), finite floats in several notations, special values, garbage."""
     finite = st.floats(allow_nan=False, allow_infinity=False)
-    plausible = st.floats(-100, 100).map(lambda x: "%.6f" % x)
+    plausible = st.floats(-100, 100).map(_formatter("%.6f"))
     return st.one_of(
-        *[plausible] * plain, finite.map(repr), finite.map(lambda x: "%g" % x),
-        finite.map(lambda x: "%.17e" % x), st.integers(-10 ** 30, 10 ** 30).map(str),
+        *[plausible] * plain, finite.map(repr), finite.map(_formatter("%g")),
+        finite.map(_formatter("%.17e")), st.integers(-10 ** 30, 10 ** 30).map(str),
         st.sampled_from(SPECIAL), st.text(alphabet="0123456789.-+eE ,;", max_size=12))
 
 
@@ -322,7 +331,7 @@ def test_axis_error_files(text, max_error):
 
 # ------------------------------------------------------------------------ G-code
 WORDS = "GGGGMXXYYZZIJKRFPSNT"
-_WORD_VALUE = st.one_of(st.floats(-200, 200).map(lambda x: "%.4f" % x),
+_WORD_VALUE = st.one_of(st.floats(-200, 200).map(_formatter("%.4f")),
                         st.integers(-50, 50).map(str), st.sampled_from(SPECIAL))
 
 

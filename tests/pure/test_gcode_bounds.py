@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Bounds on G-code values and axis errors (issue 12): every refusal exits 2, writes nothing."""
 
+import functools
 import math
 import os
 
@@ -8,6 +9,7 @@ import numpy as np
 import pytest
 from numpy.testing import assert_allclose
 
+from surfcomp.cli import gcode as gcode_cli
 from surfcomp.core.axis import axis_errors, machine
 from surfcomp.core.axis.arcs import arc_steps
 from surfcomp.core.axis.axis_errors import AxisErrorModel, fit_axis_errors
@@ -26,6 +28,7 @@ from surfcomp.io.gcode import (
     GCodeResult,
     compensate_commands,
     compensate_gcode,
+    compensate_stream,
     parse_gcode,
     read_gcode,
 )
@@ -105,19 +108,37 @@ def test_smallest_segment_length_is_accepted(tmp_path, capsys):
     assert out.read_bytes().startswith(b"G21 G90\n")
 
 
-def test_too_many_segments_are_refused_before_planning(tmp_path, capsys):
+def test_too_many_segments_are_refused_before_planning(tmp_path, capsys, monkeypatch):
     """bear.nc has 14 806 mm of cutting moves: 1 um pieces would be 14.8 million points
-    (the bound is 10 million); the estimate is exact and refused without sampling."""
+    (the bound is 10 million); the estimate is exact and refused without sampling.
+
+    The command line's refusal is checked with the limit lowered to 200 000 points (0.05 mm
+    pieces, 304 000 points): the program is read in blocks, and the blocks below the limit
+    are compensated before the total is known, so at the real limit the run would first
+    plan 10 million points for nothing but time."""
     prog, _ = parse_gcode(read_gcode(BEAR))
     est = estimate_segments(prog, 0.001, 0.001)
     assert est.total > MAX_SEGMENTS
     assert_allclose(est.length, 14805.65, atol=0.01)
-    err = _refused(tmp_path, capsys, BEAR, "--segment-length", "0.001")
+    with pytest.raises(InputError) as refused:
+        check_segments(prog, 0.001, 0.001, names=("--segment-length", "--arc-tolerance"),
+                       source=BEAR)
+    err = str(refused.value)
     assert "%s: --segment-length 0.001 mm" % BEAR in err
     assert "about 1.48e+07 segments, more than the 10000000" in err
     assert "expected a --segment-length of at least 0.00149 mm" in err
     # the suggested length is enough
     assert estimate_segments(prog, 0.00149, 0.001).total <= MAX_SEGMENTS
+    # the command line: the same refusal, exit 2, nothing written
+    limit = 200000
+    assert estimate_segments(prog, 0.05, 0.001).total > limit
+    monkeypatch.setattr(gcode_cli, "compensate_stream",
+                        functools.partial(compensate_stream, max_segments=limit))
+    err = _refused(tmp_path, capsys, BEAR, "--segment-length", "0.05")
+    assert "%s: --segment-length 0.05 mm" % BEAR in err
+    assert "about 3.04e+05 segments, more than the 200000" in err
+    assert "expected a --segment-length of at least 0.0801 mm" in err
+    assert estimate_segments(prog, 0.0801, 0.001).total <= limit
 
 
 def test_tiny_arc_tolerance_names_its_option(tmp_path, capsys):

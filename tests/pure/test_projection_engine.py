@@ -4,6 +4,8 @@ answers and converged reference solves (no FreeCAD); its OCCT comparison is
 tests/app/test_projection_occt.py.
 """
 
+import bisect
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -30,16 +32,14 @@ def reference_projection(surf, P, n_grid=120, n_starts=6):
     G = bs.evaluate_grid(surf, us, vs).reshape(-1, 3)
     lo = [surf.u_range[0], surf.v_range[0]]
     hi = [surf.u_range[1], surf.v_range[1]]
+    at = _point_at(surf)
     out = []
     for p in P:
         best = None
         for k in np.argsort(np.sum((G - p) ** 2, axis=1))[:n_starts]:
             x0 = [us[k // n_grid], vs[k % n_grid]]
-            fun = lambda x, p=p: bs.evaluate(surf, x[:1], x[1:])[0] - p  # noqa: E731
-
-            def jac(x):
-                _, Su, Sv = bs.derivatives(surf, x[:1], x[1:])
-                return np.stack([Su[0], Sv[0]], axis=1)
+            fun = lambda x, p=p: at(x)[0] - p  # noqa: E731
+            jac = lambda x: np.stack(at(x)[1:], axis=1)  # noqa: E731
             sol = least_squares(fun, x0, jac=jac, bounds=(lo, hi), xtol=1e-15, ftol=1e-15,
                                 gtol=1e-15, method="trf")
             if best is None or sol.cost < best.cost:
@@ -47,6 +47,49 @@ def reference_projection(surf, P, n_grid=120, n_starts=6):
         out.append(_polish_foot(surf, p, best.x, lo, hi))
     uv = np.array(out)
     return uv[:, 0], uv[:, 1], bs.evaluate(surf, uv[:, 0], uv[:, 1])
+
+
+def _point_at(surf):
+    """``at((u, v))``: the point and its u and v derivatives of ``surf`` at one parameter
+    pair, by the B-spline recurrences on Python floats (The NURBS Book, A2.2): code of its
+    own for the reference, and at one point some 30 times faster than
+    bspline.derivatives, whose arrays are made for many points (the reference's
+    least_squares evaluates some 8000 single points a test)."""
+    w = np.ones(surf.shape) if surf.weights is None else np.asarray(surf.weights, float)
+    hom = np.concatenate([surf.poles * w[..., None], w[..., None]], axis=2)   # (nu, nv, 4)
+    ku, kv = list(map(float, surf.knots_u)), list(map(float, surf.knots_v))
+
+    def at(x):
+        iu, nu, du = _basis(ku, surf.degree_u, surf.shape[0], float(x[0]))
+        iv, nv, dv = _basis(kv, surf.degree_v, surf.shape[1], float(x[1]))
+        block = hom[iu:iu + len(nu), iv:iv + len(nv)].transpose(0, 2, 1)   # (u, 4, v)
+        along_u = block @ nv
+        A, Au, Av = nu @ along_u, du @ along_u, nu @ (block @ dv)
+        S = A[:3] / A[3]
+        return S, (Au[:3] - Au[3] * S) / A[3], (Av[:3] - Av[3] * S) / A[3]
+    return at
+
+
+def _basis(knots, p, n, t):
+    """First index, values and first derivatives of the p + 1 B-splines of degree p that
+    are nonzero at t (``n`` of them on ``knots``)."""
+    i = min(max(bisect.bisect_right(knots, t) - 1, p), n - 1)
+    left, right = [0.0] * (p + 1), [0.0] * (p + 1)
+    rows = [[1.0]]                      # rows[j]: the j + 1 B-splines of degree j
+    for j in range(1, p + 1):
+        left[j], right[j] = t - knots[i + 1 - j], knots[i + j] - t
+        row, saved = [], 0.0
+        for r in range(j):
+            tmp = rows[-1][r] / (right[r + 1] + left[j - r])
+            row.append(saved + right[r + 1] * tmp)
+            saved = left[j - r] * tmp
+        rows.append(row + [saved])
+    low = [0.0] + (rows[p - 1] if p else []) + [0.0]     # degree p - 1, padded
+    deriv = []
+    for r in range(p + 1):
+        a, b = knots[i + r] - knots[i - p + r], knots[i + r + 1] - knots[i - p + r + 1]
+        deriv.append(p * ((low[r] / a if a else 0.0) - (low[r + 1] / b if b else 0.0)))
+    return i - p, np.array(rows[p]), np.array(deriv)
 
 
 def _polish_foot(surf, p, x, lo, hi, steps=40):
