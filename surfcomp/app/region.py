@@ -191,6 +191,30 @@ def _edge_points(edge, n=EDGE_SAMPLES):
     return np.array([tuple(edge.valueAt(float(t))) for t in ts])
 
 
+def prefetch_normals(faces, sets):
+    """Fill the faces' normal caches (:func:`normals_at`) for the point sets ``sets``
+    (``(face index, points (K, 3))``) with one projection per face: the projection of a
+    point does not depend on the others projected with it, and one call of a few thousand
+    edge points costs about what one of two hundred does (the edge points need the
+    engine's search for other minima, set up per call)."""
+    todo = {}
+    for i, pts in sets:
+        pts = np.ascontiguousarray(pts, dtype=float)
+        key = pts.tobytes()
+        if len(pts) and key not in faces[i].normals_cache:
+            todo.setdefault(i, {})[key] = pts
+    for i, parts in todo.items():
+        f = faces[i]
+        allp = np.concatenate(list(parts.values()))
+        p = f.project(allp)
+        n = normals(f.surface, p.u, p.v)
+        start = 0
+        for key, pts in parts.items():
+            sl = slice(start, start + len(pts))
+            f.normals_cache[key] = (n[sl], p.u[sl], p.v[sl])
+            start += len(pts)
+
+
 def normals_at(f, pts):
     """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
     and their parameters. Kept per face and point set: the sharp edges, the neighbour check
@@ -254,12 +278,26 @@ def shared_edges(shape, faces, all_faces=False, angles=True):
                         continue
                     if _near_polyline(pa[::8], poly(k, jb, eb)) > SHARE_TOL:
                         continue
-                    pts = _edge_points(ea)
                     b = region[k] if not all_faces else -1 - k
-                    ang = _nominal_angle(f, faces[region[k]] if k in region else g,
-                                         pts) if angles else float("nan")
-                    out.append(SharedEdge(i, b, ja, jb, pts, ang))
+                    out.append(SharedEdge(i, b, ja, jb, _edge_points(ea), float("nan")))
+    if angles:
+        # every normal the run asks for along the edges, one projection per face
+        prefetch_normals(faces, [(j, p) for e in out for j in (e.a, e.b) if j >= 0
+                                 for p in edge_point_sets(e.samples)])
+        for e in out:
+            g = faces[e.b] if e.b >= 0 else shape.Faces[-1 - e.b]
+            e.nominal_angle = _nominal_angle(faces[e.a], g, e.samples)
     return out
+
+
+def edge_point_sets(samples):
+    """The point sets along an edge whose normals the run takes: the samples (sharp
+    edges, continuity), every tenth (the nominal angle) and the midpoints (continuity)."""
+    return samples, samples[::10], midpoints(samples)
+
+
+def midpoints(samples):
+    return 0.5 * (samples[1:] + samples[:-1])
 
 
 def _nominal_angle(f, g, pts):
@@ -342,7 +380,7 @@ def continuity(faces, edges):
     them); fills ``edge.figures``."""
     for e in edges:
         fa, fb = faces[e.a], faces[e.b]
-        mids = 0.5 * (e.samples[1:] + e.samples[:-1])
+        mids = midpoints(e.samples)
         ma, ua, va = (np.concatenate(x) for x in zip(normals_at(fa, e.samples),
                                                       normals_at(fa, mids)))
         mb, ub, vb = (np.concatenate(x) for x in zip(normals_at(fb, e.samples),

@@ -38,12 +38,24 @@ FALLBACK = ((4.0, 1e-3), (16.0, 1e-6))
 MEAN_WEIGHT = 1e-12
 #: cell size of the field's kernel centres, as a share of R
 CELL = 1.0 / 3.0
+#: block size of the field's kernel sums, as a share of the kernel's radius
+BLOCK = 0.5
+#: kernel values of one dense block of the field's sums at most (memory: 8 bytes each)
+BLOCK_VALUES = 1 << 20
 
 
 def wendland(s):
     """Wendland's C2 kernel ``(1 - s)^4 (4 s + 1)`` for ``s < 1``, else 0."""
     s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
     return (1.0 - s) ** 4 * (4.0 * s + 1.0)
+
+
+def wendland_unclipped(s):
+    """:func:`wendland` of ``s`` already in ``[0, 1]`` (no copy, fewer passes)."""
+    t = 1.0 - s
+    t *= t
+    t *= t
+    return t * (4.0 * s + 1.0)
 
 
 def spacing(points):
@@ -149,19 +161,42 @@ class RegionField:
         self._tree = cKDTree(self.centres)
 
     def _sums(self, x, radius):
-        num = np.zeros(len(x))
-        den = np.zeros(len(x))
-        for start in range(0, len(x), 20000):
-            xs = x[start:start + 20000]
-            other = cKDTree(xs)
-            m = other.sparse_distance_matrix(self._tree, radius, output_type="ndarray")
-            if len(m) == 0:
+        """``sum_j phi_j w_j c_j`` and ``sum_j phi_j w_j`` at the points ``x`` (M, 3).
+
+        The points are taken in blocks of :data:`BLOCK` x ``radius`` (sorted by block);
+        each block's candidate centres are those within ``radius`` plus the block's half
+        diagonal of its middle (one ball query for all blocks), and the block's kernel
+        values are one dense matrix against them, summed by a matrix product (candidates
+        beyond ``radius`` get ``phi = 0``). About twice as fast as the pairs of a sparse
+        distance matrix, and the same sums up to rounding."""
+        out = np.zeros((len(x), 2))
+        if not len(x):
+            return out[:, 0], out[:, 1]
+        key = np.floor(x / (BLOCK * radius)).astype(np.int64)
+        order = np.lexsort(key.T[::-1])
+        xs, key = x[order], key[order]
+        starts = np.r_[0, np.flatnonzero(np.any(np.diff(key, axis=0) != 0, axis=1)) + 1]
+        ends = np.r_[starts[1:], len(x)]
+        lo, hi = np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts)
+        mid = 0.5 * (lo + hi)
+        half = 0.5 * np.linalg.norm(hi - lo, axis=1)
+        candidates = self._tree.query_ball_point(mid, radius + half)
+        wv = np.stack([self.weights * self.values, self.weights], axis=1)
+        sums = np.zeros((len(x), 2))
+        for a, b, c, m in zip(starts, ends, candidates, mid):
+            if not c:
                 continue
-            w = wendland(m["v"] / radius) * self.weights[m["j"]]
-            num[start:start + len(xs)] += np.bincount(m["i"], weights=w * self.values[m["j"]],
-                                                      minlength=len(xs))
-            den[start:start + len(xs)] += np.bincount(m["i"], weights=w, minlength=len(xs))
-        return num, den
+            c = np.asarray(c)
+            q = self.centres[c] - m         # about the block's middle: no cancellation
+            qq = np.einsum("ij,ij->i", q, q)
+            rows = max(1, BLOCK_VALUES // len(c))
+            for s in range(a, b, rows):
+                p = xs[s:min(s + rows, b)] - m
+                d2 = np.einsum("ij,ij->i", p, p)[:, None] + qq[None, :] - 2.0 * (p @ q.T)
+                t = np.sqrt(np.maximum(d2, 0.0)) / radius
+                sums[s:s + len(p)] = wendland_unclipped(np.minimum(t, 1.0)) @ wv[c]
+        out[order] = sums
+        return out[:, 0], out[:, 1]
 
     def __call__(self, x):
         """``delta`` at points ``x`` (shape (M, 3)), mm."""
