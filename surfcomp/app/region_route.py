@@ -9,6 +9,7 @@ import os
 
 import numpy as np
 
+from ..core.chunks import for_chunks
 from ..core.compensation import region_build, region_field
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import GeometryError, InputError, MeasurementFileError
@@ -144,14 +145,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     closed = _closed(shape)
     if not closed:      # a compound of faces: nothing to re-trim its neighbours in
         _check_neighbours(shape, faces, fld, sharp)
-    for i, f in enumerate(faces):
-        f.built = region_build.corrected_surface(f.surface, f.outward, fld,
-                                                 sharp and sharp.for_face(i),
-                                                 knot_step=field_radius / 5.0,
-                                                 max_factor=max_factor)
-        from .convert import surface_to_part
-
-        f.part_surface = surface_to_part(f.built.surface)
+    _build(faces, fld, sharp, field_radius, max_factor)
     figures = region.continuity(faces, edges)
     fidelity = _fidelity(faces, owner, u, v, fld, base, normal, sharp)
     rep = _report(nominal, measurements, faces, counts, int(np.sum(~on)), figures, fidelity,
@@ -202,25 +196,54 @@ def _check_neighbours(shape, faces, fld, sharp):
                 % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
+def per_face(faces, job):
+    """``job(i)`` for every face, the faces on the chunk threads at once (the work is numpy
+    and scipy, which release the interpreter lock; a blade's two sides hold most of the
+    points); the results in the faces' order."""
+    out = [None] * len(faces)
+
+    def run(sl):
+        for i in range(sl.start, sl.stop):
+            out[i] = job(i)
+
+    for_chunks(run, len(faces), 1)
+    return out
+
+
+def _build(faces, fld, sharp, field_radius, max_factor):
+    """Every face's corrected surface (``f.built``, ``f.part_surface``)."""
+    from .convert import surface_to_part
+
+    def one(i):
+        return region_build.corrected_surface(faces[i].surface, faces[i].outward, fld,
+                                              sharp and sharp.for_face(i),
+                                              knot_step=field_radius / 5.0,
+                                              max_factor=max_factor)
+
+    for f, built in zip(faces, per_face(faces, one)):
+        f.built = built
+        f.part_surface = surface_to_part(built.surface)
+
+
 def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
     """Per face: the largest |realised - intended| at its points (um), and the same beyond
     the zones where a knife edge or a vertex is moved by one vector (there the design
     itself falls short of the correction: those points' count and largest shortfall)."""
-    out = {}
-    for i, f in enumerate(faces):
+    def one(i):
         k = np.flatnonzero(owner == i)
         if not len(k):
-            continue
+            return None
         intended = fld(base[k])
-        miss = np.abs(realised(f, u[k], v[k], intended) - intended) * 1e3
+        miss = np.abs(realised(faces[i], u[k], v[k], intended) - intended) * 1e3
         share = region_build.designed_share(base[k], normal[k], sharp)
         zone = np.abs(share - 1.0) > 1e-9
-        out[f.name] = {"all": float(np.max(miss)),
-                       "beyond": float(np.max(miss[~zone])) if np.any(~zone) else None,
-                       "zone_points": int(np.sum(zone)),
-                       "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
-                       * 1e3 if np.any(zone) else 0.0}
-    return out
+        return {"all": float(np.max(miss)),
+                "beyond": float(np.max(miss[~zone])) if np.any(~zone) else None,
+                "zone_points": int(np.sum(zone)),
+                "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
+                * 1e3 if np.any(zone) else 0.0}
+
+    return {f.name: fid for f, fid in zip(faces, per_face(faces, one)) if fid is not None}
 
 
 def realised(f, u, v, guess):
