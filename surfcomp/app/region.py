@@ -59,9 +59,13 @@ class RegionFace:
         """Closest points on the face's nominal; one projection engine per face (its seed
         grid and tables cost about a second on a blade side, and a run projects onto each
         face a dozen times)."""
+        return self.engine(len(points)).project(np.asarray(points, dtype=float), max_distance)
+
+    def engine(self, count):
+        """The face's projection engine, made for ``count`` points on first use."""
         if self.projector is None:      # seeds as dense as project() takes for a cloud
-            self.projector = Projector(self.surface, min_samples=len(points) // 16)
-        return self.projector.project(np.asarray(points, dtype=float), max_distance)
+            self.projector = Projector(self.surface, min_samples=count // 16)
+        return self.projector
 
 
 @dataclass
@@ -128,32 +132,28 @@ def locate(faces, base, max_offset, found=None):
 
 
 def project_all(faces, base, max_offset):
-    """Each face's distance from every point in its widened bounding box, inside its trim
-    (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face."""
-    dist = np.full((len(faces), len(base)), np.inf)
-    res = []
-    may = _sample_distances(faces, base, max_offset)
-    for i, f in enumerate(faces):
-        idx = np.flatnonzero(may[i])
-        p = f.project(base[idx], max_distance=max_offset) if len(idx) else None
-        res.append((idx, p))
-        if p is None:
-            continue
-        ok = p.converged.copy()
-        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
-        dist[i, idx[ok]] = np.abs(p.distance[ok])
-    return dist, res
+    """Each face's distance from every point that may have it as its nearest face, inside
+    its trim (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face.
+
+    In two rounds (:mod:`surfcomp.app.region_project`): each point first on the face of
+    its nearest sample, then on the other faces only where a lower bound of their distance
+    does not exceed the distance found (a blade side's box holds the other side's points,
+    which lie off the face and cost twice a point on it)."""
+    from .region_project import two_rounds
+
+    return two_rounds(faces, base, max_offset, _sample_distances(faces, base, max_offset))
 
 
 def _sample_distances(faces, base, max_offset, n=200):
     """Per face, which points may have it as their nearest face, from an n x n grid of
     samples on each: a face's distance from a point is at least its nearest sample's less
     the grid's covering radius, and at most the nearest sample's on any face. (A blade
-    side's box holds the other side's points too; projecting them would double the work.)"""
+    side's box holds the other side's points too; projecting them would double the work.)
+    Returns that (F, N) mask and, per point, the face of its nearest sample (-1: none)."""
     from ..core.surface.bspline import evaluate_grid
 
     low = np.full((len(faces), len(base)), np.inf)
-    high = np.full(len(base), np.inf)
+    near = np.full((len(faces), len(base)), np.inf)
     for i, f in enumerate(faces):
         bb = f.face.BoundBox
         idx = np.flatnonzero(np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset)
@@ -163,15 +163,24 @@ def _sample_distances(faces, base, max_offset, n=200):
             continue
         u0, u1, v0, v1 = f.bface.ParameterRange
         g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
-        r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
-                            np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
+        r = covering_radius(g)
         # a point farther than max_offset + r from every sample is not near the face: the
         # bound ends its search early (most of a small cap's box is the sides' points)
         d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1,
-                                               distance_upper_bound=max_offset + r)
+                                               distance_upper_bound=max_offset + r,
+                                               workers=-1)
         low[i, idx] = d - r
-        high[idx] = np.minimum(high[idx], d)
-    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)
+        near[i, idx] = d
+    high = np.min(near, axis=0)
+    first = np.where(np.isfinite(high), np.argmin(near, axis=0), -1)
+    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9), first
+
+
+def covering_radius(g):
+    """Half the longest cell diagonal of a grid of points ``g`` (nu, nv, 3): every point
+    of the surface lies within it of a sample."""
+    return 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
+                           np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
 
 
 def face_samples(f, n=60):

@@ -91,3 +91,43 @@ def test_prefetched_edge_normals_equal_one_projection_per_set(blade):
         alone = region.normals_at(faces[j], p)
         for x, y in zip(alone, b):
             np.testing.assert_array_equal(x, y)
+
+
+def _faces(shape):
+    faces = [region.region_face(shape, k) for k in range(4)]
+    orient(shape, faces)
+    return faces
+
+
+def test_two_round_location_equals_projecting_every_masked_point(blade):
+    """The blade's points, each on the face of its nearest sample first and on the others
+    only where they may be nearer: the same nearest faces, parameters, normals and
+    distances (bit for bit) as projecting every point of each face's sample mask on it,
+    and the points left out are the mask's off-face points only."""
+    shape, pts, _dev = blade
+    faces = _faces(shape)
+    dist, res = region.project_all(faces, pts, 1.0)
+    new = region.locate(faces, pts, 1.0, (dist, res))
+    plain = _faces(shape)
+    may, first = region._sample_distances(plain, pts, 1.0)
+    dist0, res0 = np.full((4, len(pts)), np.inf), []
+    for i, f in enumerate(plain):
+        idx = np.flatnonzero(may[i])
+        p = f.project(pts[idx], max_distance=1.0)
+        res0.append((idx, p))
+        ok = p.converged.copy()
+        ok[ok] = region.inside(f.polylines, p.u[ok], p.v[ok])
+        dist0[i, idx[ok]] = np.abs(p.distance[ok])
+    old = region.locate(plain, pts, 1.0, (dist0, res0))
+    np.testing.assert_array_equal(new[0], old[0])
+    assert np.bincount(new[0]).tolist() == [3000, 3000, 150, 250]
+    for a, b in zip(new[1:], old[1:]):
+        np.testing.assert_array_equal(a, b)
+    left_out = sum(len(i0) - len(i) for (i, _), (i0, _) in zip(res, res0))
+    assert left_out > 100                 # the other side's points near the knife edges
+    for i in range(4):
+        idx = res[i][0]
+        assert set(idx) <= set(res0[i][0])
+        assert set(np.flatnonzero(new[0] == i)) <= set(idx)
+        fin = np.isfinite(dist[i])
+        np.testing.assert_array_equal(dist[i][fin], dist0[i][fin])
