@@ -269,26 +269,29 @@ def shared_edges(shape, faces, all_faces=False, angles=True):
         return polys[(k, j)]
 
     region = {f.index: i for i, f in enumerate(faces)}
+    shape_faces = shape.Faces
+    boxes, edges = {}, {}
+
+    def of(k):      # a face's box and (edge, degenerated, length), read from OCC once
+        if k not in edges:
+            g = shape_faces[k]
+            boxes[k] = g.BoundBox
+            edges[k] = [(e, e.Degenerated, e.Length) for e in g.Edges]
+        return boxes[k], edges[k]
+
     for i, f in enumerate(faces):
-        others = range(len(shape.Faces)) if all_faces else [g.index for g in faces[i + 1:]]
+        others = range(len(shape_faces)) if all_faces else [g.index for g in faces[i + 1:]]
+        box_a, edges_a = of(f.index)
         for k in others:
             if k == f.index or (all_faces and k in region):
                 continue
-            g = shape.Faces[k]
-            if not f.face.BoundBox.intersect(g.BoundBox):
+            box_b, edges_b = of(k)
+            if not box_a.intersect(box_b):
                 continue
-            for ja, ea in enumerate(f.face.Edges):
-                if ea.Degenerated or ea.Length < 1e-6:
-                    continue
-                pa = poly(f.index, ja, ea)
-                for jb, eb in enumerate(g.Edges):
-                    if eb.Degenerated or abs(eb.Length - ea.Length) > 0.01 * ea.Length + \
-                            SHARE_TOL:
-                        continue
-                    if _near_polyline(pa[::8], poly(k, jb, eb)) > SHARE_TOL:
-                        continue
-                    b = region[k] if not all_faces else -1 - k
-                    out.append(SharedEdge(i, b, ja, jb, _edge_points(ea), float("nan")))
+            for ja, jb, ea in _matches(edges_a, edges_b, lambda j, e, k=f.index: poly(k, j, e),
+                                       lambda j, e, k=k: poly(k, j, e)):
+                b = region[k] if not all_faces else -1 - k
+                out.append(SharedEdge(i, b, ja, jb, _edge_points(ea), float("nan")))
     if angles:
         # every normal the run asks for along the edges, one projection per face
         prefetch_normals(faces, [(j, p) for e in out for j in (e.a, e.b) if j >= 0
@@ -307,6 +310,21 @@ def edge_point_sets(samples):
 
 def midpoints(samples):
     return 0.5 * (samples[1:] + samples[:-1])
+
+
+def _matches(edges_a, edges_b, poly_a, poly_b):
+    """``(ja, jb, edge a)`` of the edges of two faces (``(edge, degenerated, length)``)
+    that are one edge: lengths within 1 %, and every eighth point of a's polyline
+    (``poly_a(j, edge)``) within SHARE_TOL of b's."""
+    for ja, (ea, degenerated_a, length_a) in enumerate(edges_a):
+        if degenerated_a or length_a < 1e-6:
+            continue
+        pa = poly_a(ja, ea)
+        for jb, (eb, degenerated_b, length_b) in enumerate(edges_b):
+            if degenerated_b or abs(length_b - length_a) > 0.01 * length_a + SHARE_TOL:
+                continue
+            if _near_polyline(pa[::8], poly_b(jb, eb)) <= SHARE_TOL:
+                yield ja, jb, ea
 
 
 def _nominal_angle(f, g, pts):

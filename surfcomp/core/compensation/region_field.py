@@ -63,7 +63,7 @@ def spacing(points):
     points = np.asarray(points, dtype=float)
     if len(points) < 2:
         raise InputError("a region needs at least two measured points")
-    d, _ = cKDTree(points).query(points, k=2)
+    d, _ = cKDTree(points).query(points, k=2, workers=-1)
     return float(np.median(d[:, 1]))
 
 
