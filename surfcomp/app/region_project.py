@@ -17,6 +17,7 @@ the others projected with it)."""
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ..core.chunks import for_chunks
 from ..core.surface.projection import Projection
 from ..core.surface.trimmed import inside
 
@@ -30,9 +31,8 @@ def two_rounds(faces, base, max_offset, sampled):
     may, first = sampled
     dist = np.full((len(faces), len(base)), np.inf)
     parts = [[] for _ in faces]
-    for i, f in enumerate(faces):       # each engine made for all the points it may get
-        if np.any(may[i]):
-            f.engine(int(np.sum(may[i])))
+    # each engine made for all the points it may get, the faces' at once
+    per_face(faces, lambda i: faces[i].engine(int(np.sum(may[i]))) if np.any(may[i]) else None)
     for i in range(len(faces)):
         _project(faces, i, np.flatnonzero(may[i] & (first == i)), base, max_offset, dist,
                  parts)
@@ -84,3 +84,17 @@ def _merged(parts):
     for name in ("u", "v", "foot", "normal", "distance", "outside", "converged"):
         fields[name] = np.concatenate([getattr(p, name) for _, p in parts])[order]
     return idx[order], Projection(**fields)
+
+
+def per_face(faces, job):
+    """``job(i)`` for every face, the faces on the chunk threads at once (the work is numpy
+    and scipy, which release the interpreter lock; a blade's two sides hold most of the
+    points); the results in the faces' order."""
+    out = [None] * len(faces)
+
+    def run(sl):
+        for i in range(sl.start, sl.stop):
+            out[i] = job(i)
+
+    for_chunks(run, len(faces), 1)
+    return out

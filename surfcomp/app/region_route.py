@@ -9,7 +9,6 @@ import os
 
 import numpy as np
 
-from ..core.chunks import for_chunks
 from ..core.compensation import region_build, region_field
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import GeometryError, InputError, MeasurementFileError
@@ -18,6 +17,7 @@ from ..io.readers import read_any
 from . import fcenv, region, region_retrim
 from .file_route import cad_format
 from .region_orient import orient
+from .region_project import per_face
 from .retrim import PRECISION
 
 #: faces with fewer points than this are not taken by --faces auto
@@ -194,20 +194,6 @@ def _check_neighbours(shape, faces, fld, sharp):
                 "edge by %.2f um (more than %.2g um): a neighbour of a region is re-trimmed "
                 "in a closed solid only; add Face%d to faces"
                 % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
-
-
-def per_face(faces, job):
-    """``job(i)`` for every face, the faces on the chunk threads at once (the work is numpy
-    and scipy, which release the interpreter lock; a blade's two sides hold most of the
-    points); the results in the faces' order."""
-    out = [None] * len(faces)
-
-    def run(sl):
-        for i in range(sl.start, sl.stop):
-            out[i] = job(i)
-
-    for_chunks(run, len(faces), 1)
-    return out
 
 
 def _build(faces, fld, sharp, field_radius, max_factor):
