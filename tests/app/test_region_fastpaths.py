@@ -131,3 +131,19 @@ def test_two_round_location_equals_projecting_every_masked_point(blade):
         assert set(np.flatnonzero(new[0] == i)) <= set(idx)
         fin = np.isfinite(dist[i])
         np.testing.assert_array_equal(dist[i][fin], dist0[i][fin])
+
+
+def test_field_cells_in_the_order_of_unique_rows(blade):
+    """The field's cells of the blade's points (and of keys either side of zero) are those
+    of ``np.unique`` over the rows: the same inverse and counts, so the same centres in
+    the same order."""
+    shape, pts, _dev = blade
+    cell = region_field.CELL * region.FIELD_SHARE * shape.BoundBox.DiagonalLength
+    for key in (np.floor(pts / cell).astype(np.int64),
+                np.floor((pts - pts.mean(axis=0)) / (0.1 * cell)).astype(np.int64)):
+        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        inv2, count2 = region_field._cells(key)
+        assert len(count) > 100
+        np.testing.assert_array_equal(inv2, inv.ravel())
+        np.testing.assert_array_equal(count2, count)
+    assert np.min(key) < 0

@@ -132,6 +132,22 @@ def mask_filter_3d(points, d, mask_size=WERNER_MASK_SIZE, kind="box", sigma=None
     return num / den
 
 
+def _cells(key):
+    """``np.unique(key, axis=0, return_inverse=True, return_counts=True)[1:]`` for integer
+    rows (M, 3): the cells in the same (lexicographic) order, from one integer per row
+    (several times faster than sorting the rows)."""
+    if not len(key):
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    k = key - key.min(axis=0)
+    ext = k.max(axis=0) + 1
+    if float(ext[0]) * float(ext[1]) * float(ext[2]) >= 2.0 ** 62:
+        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        return inv.ravel(), count
+    _, inv, count = np.unique((k[:, 0] * ext[1] + k[:, 1]) * ext[2] + k[:, 2],
+                              return_inverse=True, return_counts=True)
+    return inv, count
+
+
 class RegionField:
     """The correction field ``delta(x)`` of a region (mm, positive: into the material).
 
@@ -150,9 +166,7 @@ class RegionField:
         values = np.asarray(values, dtype=float)
         self.radius = float(radius)
         cell = CELL * self.radius
-        key = np.floor(points / cell).astype(np.int64)
-        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-        inv = inv.ravel()
+        inv, count = _cells(np.floor(points / cell).astype(np.int64))
         self.centres = np.stack([np.bincount(inv, weights=points[:, k]) / count
                                  for k in range(3)], axis=1)
         self.values = np.bincount(inv, weights=values) / count
