@@ -2,8 +2,8 @@
 """Region compensation of the 4-face BladeX blade (issue 30), whole process, beside
 FreeCAD's floor of reading and writing the same STEP file.
 
-    /usr/bin/python3 bench/bench_region.py [--points 200000] [--keep DIR] [--tree DIR]
-        [--repeat 1]
+    /usr/bin/python3 bench/bench_region.py [--points 200000] [--keep DIR [--reuse]]
+        [--tree DIR] [--repeat 1]
 
 * the blade (tests/data/real/cad/BladeX: upper, lower, tip, root; a compound of faces, as
   OpenCASCADE does not sew its knife edges) written as STEP, with N points spread over its
@@ -119,10 +119,18 @@ def main(argv=None):
     ap.add_argument("--keep", metavar="DIR")
     ap.add_argument("--tree", metavar="DIR", help="also run the command of this checkout")
     ap.add_argument("--repeat", type=int, default=1, help="runs of each, alternated")
+    ap.add_argument("--reuse", action="store_true",
+                    help="take blade.step and points.csv of --keep DIR as they are")
     a = ap.parse_args(argv)
+    if a.reuse and not a.keep:
+        ap.error("--reuse takes the files of --keep DIR")
     folder = a.keep or tempfile.mkdtemp(prefix="bench-region-")
     os.makedirs(folder, exist_ok=True)
-    step, csv, n = make_inputs(folder, a.points)
+    if a.reuse:
+        step, csv = os.path.join(folder, "blade.step"), os.path.join(folder, "points.csv")
+        n = sum(1 for _ in open(csv)) - 1
+    else:
+        step, csv, n = make_inputs(folder, a.points)
     load = os.getloadavg()
     medians, first = alternate(folder, step, csv, a.tree, max(1, a.repeat))
     (t_region, cpu), (r, rep) = medians[ROOT], first[ROOT]
