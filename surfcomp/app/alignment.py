@@ -7,14 +7,13 @@ compensated face itself), reads the transform and 3-2-1 files, and calls
 """
 
 import dataclasses
-import os
 
 import numpy as np
 
 from ..core.measurement.align import Reference
 from ..core.measurement.align_report import AlignOptions, align
 from ..errors import InputError
-from ..io.align_files import face_column, read_rps, read_transform
+from ..io.align_files import read_rps, read_transform
 
 
 def align_options(job):
@@ -86,8 +85,9 @@ def align_set(opts, nominal, ms, tip_radius=0.0, source=None, progress=None):
 
 
 def assigned_faces(ms, refs):
-    """The reference index of every point from the file's face column, or None."""
-    named = face_column(ms) if os.path.isfile(str(ms.source)) else None
+    """The reference index of every point from the file's face column (read with the
+    points, and stored with them in a document), or None."""
+    named = ms.faces
     if named is None:
         return None
     index = {r.name: k for k, r in enumerate(refs)}
@@ -106,6 +106,7 @@ def subset(ms, keep):
     arrays = {f: getattr(ms, f)[keep] for f in ("nominal", "measured", "normal", "deviation",
                                                 "row", "col", "lines")
               if getattr(ms, f) is not None}
-    if ms.ids is not None:
-        arrays["ids"] = [i for i, k in zip(ms.ids, keep) if k]
+    for name in ("ids", "faces"):
+        if getattr(ms, name) is not None:
+            arrays[name] = [i for i, k in zip(getattr(ms, name), keep) if k]
     return dataclasses.replace(ms, **arrays)

@@ -134,6 +134,7 @@ def set_measurement_data(obj, ms):
                      [int(np.max(ms.row)) + 1, int(np.max(ms.col)) + 1])
     obj.Lines = [int(x) for x in ms.lines]
     obj.Ids = [] if ms.ids is None else [str(x) for x in ms.ids]
+    obj.PointFaces = [] if ms.faces is None else [str(x) for x in ms.faces]
     obj.SourceName = os.path.basename(str(ms.source))
     obj.SourceSha256 = ms.sha256 or ""
     obj.Units = ms.units or "mm"
@@ -164,7 +165,7 @@ def measurement_set(obj):
     lists = {"NominalX/Y/Z": nominal, "MeasuredX/Y/Z": measured, "NormalI/J/K": normal,
              "Deviation": dev}
     lengths = {k: len(a) for k, a in lists.items() if a is not None}
-    for name in ("Row", "Col", "Lines", "Ids"):
+    for name in ("Row", "Col", "Lines", "Ids", "PointFaces"):
         if len(getattr(obj, name)):
             lengths[name] = len(getattr(obj, name))
     if not lengths:
@@ -182,7 +183,8 @@ def measurement_set(obj):
                           row=row, col=col, ids=ids, lines=lines,
                           source=obj.SourceName or obj.Label, sha256=obj.SourceSha256,
                           units=obj.Units, columns=json.loads(obj.Columns or "{}"),
-                          warnings=list(obj.ReadWarnings))
+                          warnings=list(obj.ReadWarnings),
+                          faces=list(obj.PointFaces) if len(obj.PointFaces) else None)
 
 
 def make_measurement(doc, path, units="mm", name="Measurement", fmt=None, sample=None,

@@ -94,8 +94,6 @@ def compute_plan(obj):
     """Plan on the linked face and write the results (and the points' Shape) to ``obj``."""
     import Part
 
-    from .plan_reach import REASONS as PART_REASONS
-
     plan = trial_plan(obj)
     V = FreeCAD.Vector
     obj.PlanPoints = [V(*p) for p in plan.points]
@@ -103,13 +101,23 @@ def compute_plan(obj):
     obj.PointIds = list(plan.ids)
     obj.Placed = int(plan.requested)
     obj.Kept = len(plan)
-    obj.Dropped = [property_text("%d " % n + (REASONS.get(k) or PART_REASONS.get(k, k)))
-                   for k, n in plan.drop_counts().items()]
+    obj.Dropped = [property_text(text) for text in dropped(plan)]
     obj.Travel = float(plan.travel)
     obj.SafeZ = float(plan.safe_z)
     obj.Order = plan.order
     obj.Shape = Part.makeCompound([Part.Vertex(V(*p)) for p in plan.points])
     return plan
+
+
+def dropped(plan):
+    """The dropped points of ``plan`` per reason (``3 normal leans more than max_tilt from
+    +Z``), in the order of the reasons: :class:`~surfcomp.errors.Note` texts naming the
+    options as the API does, which the ``Dropped`` property shows as properties and the
+    Plan measurement panel as its fields' labels."""
+    from .plan_reach import REASONS as PART_REASONS
+
+    return ["%d " % n + (REASONS.get(k) or PART_REASONS.get(k, k))
+            for k, n in plan.drop_counts().items()]
 
 
 def make_measurement_plan(doc, nominal, face="Face1", name="MeasurementPlan", **values):

@@ -13,6 +13,7 @@ never over an input; nothing is written when it is refused.
 from dataclasses import dataclass
 
 from ..core import budget
+from ..core.command_options import PROGRAM_MOVE
 from ..core.compensation.pipeline import compensate, prepare
 from ..core.compensation.program_offset import parse_tool
 from ..core.progress import report, sub
@@ -38,9 +39,9 @@ class ProgramJob:
     program: str
     output: str
     tool: str
-    blend: float = 1.0
-    tolerance: float = 5e-4
-    segment_length: float = 2.0
+    blend: float = PROGRAM_MOVE["blend"].default
+    tolerance: float = PROGRAM_MOVE["tolerance"].default
+    segment_length: float = PROGRAM_MOVE["segment_length"].default
     decimals: int = None
 
 

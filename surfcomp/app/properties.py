@@ -132,6 +132,10 @@ MEASUREMENT_PROPERTIES = (
     ("App::PropertyStringList", "Ids", _MEAS,
      QT_TRANSLATE_NOOP("App::Property", "Point names (when given)"),
      None, _RO),
+    ("App::PropertyStringList", "PointFaces", _MEAS,
+     QT_TRANSLATE_NOOP("App::Property", "Reference face of every point (the file's face "
+                                        "column, when given)"),
+     None, _RO),
     ("App::PropertyString", "Columns", _MEAS,
      QT_TRANSLATE_NOOP("App::Property", "Role -> column name as written in the file (JSON)"),
      "{}", _RO),

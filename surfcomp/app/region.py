@@ -37,6 +37,8 @@ EDGE_SAMPLES = 200
 G1_ANGLE = 0.1
 #: field radius as a share of the shape's diagonal, at least 4 point spacings
 FIELD_SHARE = 0.05
+#: the shortest length (share of the band) over which a sharp edge's exactness changes
+EASE_SHARE = 0.5
 
 
 @dataclass
@@ -231,10 +233,39 @@ def normals_at(f, pts):
     pts = np.ascontiguousarray(pts, dtype=float)
     key = pts.tobytes()
     if key not in f.normals_cache:      # the surface's normals: the orientation may change
-        p = f.project(pts)
-        f.normals_cache[key] = (normals(f.surface, p.u, p.v), p.u, p.v)
+        u, v = _project_along(f, pts)
+        f.normals_cache[key] = (normals(f.surface, u, v), u, v)
     n, u, v = f.normals_cache[key]
     return n * f.outward, u, v
+
+
+def _project_along(f, pts):
+    """Parameters of the points nearest ``pts`` (K, 3), points in order along a curve (an
+    edge's samples). Each point is tried again by Newton from its neighbours' feet, the
+    closest foot kept: next to a blade side's boundary the projection stopped
+    1 um off the face once in 200 samples, and where the pressure side
+    curls back on itself (0.08 mm radius) it found a foot 0.06 um away with its normal
+    115 degrees off the edge's own; either turned the sharp edge's vector there."""
+    p = f.project(pts)
+    u, v = p.u.copy(), p.v.copy()
+    ok = np.isfinite(u) & np.isfinite(v)
+    if len(pts) < 2 or not ok.any():
+        return u, v
+    P = np.ascontiguousarray(pts.T)
+    best = np.full(len(pts), np.inf)
+    best[ok] = np.linalg.norm(evaluate(f.surface, u[ok], v[ok]) - pts[ok], axis=1)
+    for _ in range(2):      # a wrong foot's neighbours may have been wrong too
+        for seed in (np.r_[1, np.arange(len(pts) - 1)], np.r_[np.arange(1, len(pts)),
+                                                                  len(pts) - 2]):
+            ok = np.isfinite(best[seed])
+            u2, v2, D, _conv = f.projector.newton.run(P[:, ok], u[seed[ok]], v[seed[ok]])
+            # the closer point on the face wins, converged or not (Newton stops short of
+            # a foot on the face's boundary at times; it is still a point of the face)
+            d = np.linalg.norm(D[0] - P[:, ok], axis=0)
+            k = np.flatnonzero(ok)
+            take = d < best[k] - 1e-12
+            best[k[take]], u[k[take]], v[k[take]] = d[take], u2[take], v2[take]
+    return u, v
 
 
 def _vec(p):
@@ -370,6 +401,7 @@ def sharp_edges(faces, edges, band):
     mit, exact = region_edges.at_vertices(
         pts, np.concatenate(mit), np.concatenate(cl), eid, nrm, 0.5 * band,
         region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces))
+    exact = region_edges.eased(exact, eid, pts, EASE_SHARE * band)
     return region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, np.concatenate(ids))
 
 

@@ -33,10 +33,11 @@ import json
 from dataclasses import dataclass
 
 from ..core.choices import MASK_KINDS
+from ..core.command_options import COMPENSATE
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..errors import InputError
 from . import features
-from .properties import QT_TRANSLATE_NOOP
+from .properties import QT_TRANSLATE_NOOP, option_row
 from .proxies import Proxy
 
 REGION_TYPE = "SurfComp_RegionCompensation"
@@ -50,9 +51,7 @@ _T = "App::Property"
 REGION_PROPERTIES = (
     ("App::PropertyLink", "Nominal", _IN,
      QT_TRANSLATE_NOOP(_T, "The object whose faces are compensated"), None, 0),
-    ("App::PropertyString", "Faces", _IN,
-     QT_TRANSLATE_NOOP(_T, "The region: FaceN names separated by commas, or auto (the faces "
-                           "the measurements cover)"), "auto", 0),
+    option_row("App::PropertyString", "faces", _IN, COMPENSATE),
     ("App::PropertyLink", "Measurement", _IN,
      QT_TRANSLATE_NOOP(_T, "The measurement object (points stored in the document)"), None, 0),
     ("App::PropertyEnumeration", "Method", _IN,
@@ -67,9 +66,7 @@ REGION_PROPERTIES = (
     ("App::PropertyLength", "MaxOffset", _IN,
      QT_TRANSLATE_NOOP(_T, "Largest distance of a point from its face, and largest step "
                            "between the readings of two faces across an edge"), 1.0, 0),
-    ("App::PropertyFloat", "MinCoverage", _IN,
-     QT_TRANSLATE_NOOP(_T, "Least share of every face's area with measured points near"),
-     0.5, 0),
+    option_row("App::PropertyFloat", "min_coverage", _IN, COMPENSATE),
     ("App::PropertyLength", "Smoothing", _IN,
      QT_TRANSLATE_NOOP(_T, "Radius of the correction field (0: 5 % of the shape's diagonal, "
                            "at least 4 point spacings)"), 0.0, 0),

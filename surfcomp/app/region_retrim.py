@@ -23,6 +23,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
+from ..core.limits import NIL_INTEGRAL
 from ..errors import GeometryError
 from . import retrim
 from .shapes import _nearest, _oriented, rebuild_face, replacement_pairs
@@ -181,5 +182,6 @@ def closed_solid(shape, faces, integral, label="faces"):
                    "occt_change_mm3": solid.Volume - shape.Solids[0].Volume,
                    "edge_tolerance_mm": tol, "nominal_edge_tolerance_mm": nominal_tol,
                    "touched_edge_tolerance_mm": local,
-                   "relative_error": abs(change + integral) / max(abs(integral), 1e-300),
+                   "relative_error": (abs(change + integral) / abs(integral)
+                                      if abs(integral) >= NIL_INTEGRAL else None),
                    "retrimmed_faces": cut, "neighbour_edges": edges}

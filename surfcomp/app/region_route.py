@@ -319,11 +319,14 @@ def summary(rep):
 def output_line(o):
     """The printed line of the output shape and its volume check."""
     if o["kind"] == "solid":
+        rel = o["relative_error"]
         return ("solid: %d faces, edge tolerance %.2g mm (%.2g mm on the corrected and "
                 "re-trimmed faces), volume change %.4f mm3 against -integral(delta dA) %.4f "
-                "mm3 (%.2f %%); re-trimmed neighbours: %s"
+                "mm3 (%s); re-trimmed neighbours: %s"
                 % (o["faces"], o["edge_tolerance_mm"], o["touched_edge_tolerance_mm"],
-                   o["change_mm3"], o["integral_mm3"], 100 * o["relative_error"],
+                   o["change_mm3"], o["integral_mm3"],
+                   "%.2f %%" % (100 * rel) if rel is not None else
+                   "a nil correction: %.4f mm3 apart" % (o["change_mm3"] - o["integral_mm3"]),
                    ", ".join(o["retrimmed_faces"]) or "none"))
     return "the nominal is not one closed solid: the output is its %d faces" % o["faces"]
 

@@ -53,8 +53,11 @@ class Output:
     natural: object = None
 
     def volume_mismatch(self):
-        """``volume_change / -correction_volume - 1`` (None without a volume change)."""
-        if self.volume_change is None or not self.correction_volume:
+        """``volume_change / -correction_volume - 1`` (None without a volume change, or for
+        a nil correction)."""
+        from ..core.limits import NIL_INTEGRAL
+
+        if self.volume_change is None or not abs(self.correction_volume) >= NIL_INTEGRAL:
             return None
         return self.volume_change / -self.correction_volume - 1.0
 

@@ -3,6 +3,7 @@
 
 import sys
 
+from ..core.command_options import COMPENSATE
 from ..errors import InputError
 from . import SUMMARIES, registry
 from .common import (
@@ -13,6 +14,7 @@ from .common import (
     run_job_command,
 )
 from .option_flags import shown
+from .options import add_arguments
 
 
 def add_parser(subparsers):
@@ -25,12 +27,7 @@ def add_parser(subparsers):
                    help="write the corrected face alone, also when it is a face of a solid or "
                         "shell")
     add_method_options(p)
-    p.add_argument("--faces", metavar="F1,F2|auto",
-                   help="compensate a region of several faces at once, continuity kept "
-                        "(FaceN names, or auto: the faces the measurements cover)")
-    p.add_argument("--min-coverage", type=float, default=0.5, metavar="SHARE",
-                   help="with --faces: least share of every face's area with measured points "
-                        "near (default 0.5)")
+    add_arguments(p, ("faces", "min_coverage"), COMPENSATE)
     registry.add_options(p, "compensate", flags=("--points", "--curves", "--html"))
     from .program import add_program_options
 
@@ -44,11 +41,7 @@ def add_parser(subparsers):
                      help="rebind every user of the nominal (Path Job models, operations, "
                           "links) to the compensation and recompute")
     registry.add_options(p, "compensate", {registry.DOCUMENT: doc}, flags=("--save", "--gcode"))
-    doc.add_argument("--post", default="linuxcnc", metavar="NAME",
-                     help="Path post-processor for --gcode (default linuxcnc)")
-    doc.add_argument("--post-args", default="--no-show-editor", metavar="ARGS",
-                     help="argument string for the post-processor (default --no-show-editor)")
-    doc.add_argument("--job", metavar="NAME", help="which Job to post when several use the face")
+    add_arguments(doc, ("post", "post_args", "job"), COMPENSATE)
     doc.add_argument("--overwrite-input", action="store_true",
                      help="allow --save to overwrite the input document")
     p.set_defaults(run=run)

@@ -15,8 +15,9 @@ import numpy as np
 from .. import __version__
 from ..core import budget
 from ..core.axis.axis_checks import volumetric_map
-from ..core.axis.axis_errors import MODEL_CHOICES, fit_axis_errors
-from ..core.axis.moves import MAX_SEGMENTS, MIN_SEGMENT_LENGTH
+from ..core.axis.axis_errors import fit_axis_errors
+from ..core.axis.moves import MIN_SEGMENT_LENGTH
+from ..core.command_options import GCODE
 from ..errors import GCodeError, InputError
 from ..io.atomic import Transaction, check_outputs
 from ..io.axis_csv import read_axis_errors
@@ -26,6 +27,7 @@ from ..io.hashing import sha256_file
 from ..io.outpath import shown
 from . import SUMMARIES, registry
 from .common import wrote
+from .options import add_arguments
 
 SCHEMA = "surfcomp-gcode-report/1"
 
@@ -38,37 +40,9 @@ def add_parser(subparsers):
                     "squareness; linear or quadratic per axis) lands on the programmed "
                     "points. Lines that need no change are kept byte for byte.")
     registry.add_options(p, "gcode", flags=("program", "--axis-errors", "-o"))
-    p.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
-                   help="longest piece of a split G1 move or of an arc turned into G1 "
-                        "segments (default 2 mm; at least %g mm, and at most %d segments "
-                        "in all)" % (MIN_SEGMENT_LENGTH, MAX_SEGMENTS))
-    p.add_argument("--model", choices=MODEL_CHOICES, default="auto",
-                   help="degree of every error function, or auto: quadratic where the "
-                        "F-test of the quadratic term is significant at 5%% (default auto)")
+    add_arguments(p, ("segment_length", "model"), GCODE)
     registry.add_options(p, "gcode", flags=("--report",))
-    p.add_argument("--units", choices=("mm", "um", "in"), default="mm",
-                   help="units of error-file columns without a unit suffix (default mm)")
-    p.add_argument("--max-error", type=float, default=1.0, metavar="MM",
-                   help="largest plausible machine error: a larger value in the error file, "
-                        "or a larger predicted error at a programmed point, is refused as a "
-                        "likely unit mistake (default 1 mm)")
-    p.add_argument("--reference", metavar="X,Y,Z", default="0,0,0",
-                   help="where the other slides stood while one slide was measured "
-                        "(error-file coordinates, mm; default 0,0,0)")
-    p.add_argument("--work-offset", metavar="X,Y,Z",
-                   help="error-file (machine) coordinates of the program zero, when they "
-                        "differ (mm; default: the same coordinates)")
-    p.add_argument("--start", metavar="X,Y,Z",
-                   help="machine position at the program start (program coordinates, mm); "
-                        "default unknown: an axis is not written before the program sets it")
-    p.add_argument("--tolerance", type=float, default=1e-4, metavar="MM",
-                   help="split a long G1 move only where the compensated path leaves its "
-                        "chord by more than this (default 0.0001 mm; > 0)")
-    p.add_argument("--arc-tolerance", type=float, default=1e-3, metavar="MM",
-                   help="largest chord-to-arc deviation of converted arcs (default 0.001 mm; "
-                        "> 0)")
-    p.add_argument("--decimals", type=int, metavar="N",
-                   help="least decimals of rewritten numbers (default 4 in mm, 5 in inch)")
+    add_arguments(p, tuple(GCODE)[2:], GCODE)
     p.set_defaults(run=run)
     return p
 

@@ -4,10 +4,12 @@ program by the correction (:mod:`surfcomp.app.program_route`) instead of writing
 
 import math
 
+from ..core.command_options import PROGRAM_MOVE
 from ..core.memory import collector_paused
 from ..errors import InputError
 from . import registry
 from .common import ProgressLine, job_from_args, wrote
+from .options import add_arguments
 
 
 def add_program_options(p):
@@ -20,21 +22,7 @@ def add_program_options(p):
         "regenerating the CAM operation on the corrected face. Flat and bull-nose cutters "
         "are refused.")
     registry.add_options(p, "compensate", {registry.PROGRAM: g}, flags=("--program",))
-    g.add_argument("--tool", metavar="ball:R",
-                   help="the program's cutter: ball:R, a ball end mill of radius R mm (the "
-                        "program gives the tip, the ball's lowest point)")
-    g.add_argument("--tolerance", type=float, default=5e-4, metavar="MM",
-                   help="largest distance of the moved program from the exactly moved path: "
-                        "long moves are split until they stay within it (default 0.0005 mm)")
-    g.add_argument("--blend", type=float, default=1.0, metavar="MM",
-                   help="beyond the face (its edge plus the ball radius, or above it) the "
-                        "correction fades out over this clearance (default 1 mm; > 0)")
-    g.add_argument("--segment-length", type=float, default=2.0, metavar="MM",
-                   help="long moves are first sampled at this spacing, so that nothing near "
-                        "the face between their ends is missed (default 2 mm)")
-    g.add_argument("--decimals", type=int, metavar="N",
-                   help="least decimals of rewritten numbers (default 4)")
-
+    add_arguments(g, PROGRAM_MOVE, PROGRAM_MOVE)
 
 #: outputs and modes that do not go with --program
 _NOT_WITH = (("replace", "--replace"), ("save", "--save"), ("gcode", "--gcode"),

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """``compensate SOLID MEAS --faces F1,F2,...|auto -o OUT``: a region of faces (issue 30)."""
 
+from ..core.command_options import COMPENSATE
 from ..errors import InputError
 
 
@@ -25,8 +26,10 @@ def run_region_command(args):
                              "a document: --save OUT.FCStd)" % flag
                              if flag.startswith(("--align", "--transform", "--rps")) else
                              "%s cannot be combined with --faces" % flag)
-    if not 0.0 <= args.min_coverage <= 1.0:
-        raise InputError("--min-coverage must be between 0 and 1 (got %g)" % args.min_coverage)
+    share = COMPENSATE["min_coverage"]                 # the registry's domain
+    if not share.low <= args.min_coverage <= share.high:
+        raise InputError("%s must be between %g and %g (got %g)"
+                         % (share.flag, share.low, share.high, args.min_coverage))
     from ..app import fcenv
 
     fcenv.import_freecad()

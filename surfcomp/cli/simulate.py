@@ -55,6 +55,7 @@ import sys
 import numpy as np
 
 from ..core import budget
+from ..core.command_options import AXIS_FILE, PRESET_SET, SIMULATE
 from ..core.option_tables import INPUTS, MODEL
 from ..core.options import OPTIONS
 from ..core.progress import sub
@@ -74,7 +75,8 @@ def _count(o):
     return len(o.default) if o.type is tuple else 1
 
 
-_LOOP_DEFAULTS = {"grid": (45, 45), "replicas": 4, "between": 2}
+#: the loop's options a preset sets are unset (None) when not given
+_PRESET = {name: dict(default=None) for name in PRESET_SET}
 
 
 ALIGN_GROUP = "alignment of the simulated measurements"
@@ -106,42 +108,20 @@ def add_parser(subparsers):
                    help="a case imitating a paper: %s (its surface, model, grid and the "
                         "paper's table)" % ", ".join(presets_.PRESETS))
     g = p.add_argument_group("loop")
-    g.add_argument("--grid", default=None, metavar="NxM",
-                   help="measurement grid, uniform in the face parameters, at most %d x %d "
-                        "(default 45x45, Werner 2022, or the preset's)"
-                        % (sim.MAX_GRID, sim.MAX_GRID))
-    g.add_argument("--margin", type=float, default=0.02, metavar="FRACTION",
-                   help="parameter range left free at each border (default 0.02)")
-    g.add_argument("--between", type=int, default=None, metavar="K",
-                   help="the corrected parts are measured on a grid K times denser (grid nodes "
-                        "and points between them; default 2, or the preset's)")
-    g.add_argument("--replicas", type=int, default=None, metavar="N",
-                   help="parts machined per method (default 4, as the mirror paper; at most "
-                        "%d)" % sim.MAX_REPLICAS)
-    g.add_argument("--methods", default="none,offset,raw,filtered,mirror", metavar="LIST",
-                   help="comma-separated methods: none, offset, raw, filtered, mirror "
-                        "(default all)")
+    add_arguments(g, ("grid", "margin", "between", "replicas", "methods"), SIMULATE, **_PRESET)
     add_arguments(g, ("mask_size", "mask_kind", "edge"), mask_size=dict(
         type=str, default=str(OPTIONS["mask_size"].default), metavar="N[,N...]",
         help="odd mask size(s) of the filtered method; one column per size (default %d)"
              % OPTIONS["mask_size"].default))
-    g.add_argument("--stock", type=float, default=None, metavar="MM",
-                   help="allowance the semi-finishing pass leaves, and the mirror method's stock "
-                        "(default 0.3 mm, or the preset's)")
+    add_arguments(g, ("stock",), SIMULATE, **_PRESET)
     add_arguments(g, ("refine",))
-    g.add_argument("--seed", type=int, default=0, metavar="N", help="random seed (default 0)")
+    add_arguments(g, ("seed",), SIMULATE)
     m = p.add_argument_group(registry.SIM_MODEL)
     for o in MODEL.values():        # the preset's values apply where an option is not given
         m.add_argument(o.flag, dest=o.name, metavar=o.metavar, default=None,
                        help="%s (default %s, or the preset's)" % (o.help, _fmt(o.default)))
     registry.add_options(p, "simulate", {registry.SIM_MODEL: m}, flags=("--axis-errors",))
-    m.add_argument("--axis-units", choices=("mm", "um", "in"), default="mm",
-                   help="units of the axis error file without unit suffixes (default mm)")
-    m.add_argument("--max-error", type=float, default=1.0, metavar="MM",
-                   help="largest plausible error in the axis error file: a larger one is "
-                        "refused as a likely unit mistake (default 1 mm, as for gcode)")
-    m.add_argument("--reference", default="0,0,0", metavar="X,Y,Z",
-                   help="reference point of the axis error measurements (default 0,0,0)")
+    add_arguments(m, AXIS_FILE, AXIS_FILE)
     simulate_plan.add_options(p)
     a = p.add_argument_group(
         ALIGN_GROUP, "Align every simulated measurement before its compensation, as "
@@ -191,18 +171,34 @@ def parse_grid(text):
 
 
 def check_loop_options(args):
-    """Refuse non-finite or out-of-range loop options, naming the option (exit 2)."""
-    if not (np.isfinite(args.margin) and 0 <= args.margin < 0.5):
-        raise InputError("--margin %r: expected a fraction >= 0 and < 0.5" % (args.margin,))
-    if args.stock is not None and not (np.isfinite(args.stock) and args.stock >= 0):
-        raise InputError("--stock %r: expected a finite allowance >= 0 mm" % (args.stock,))
-    for name, low in (("between", 1), ("replicas", 1), ("refine", 1), ("seed", 0)):
-        val = getattr(args, name)
-        if val is not None and val < low:
-            raise InputError("--%s %d: expected a whole number >= %d" % (name, val, low))
-    if args.replicas is not None and args.replicas > sim.MAX_REPLICAS:
-        raise InputError("--replicas %d: expected at most %d (the mirror paper machines 4 "
-                         "parts per method)" % (args.replicas, sim.MAX_REPLICAS))
+    """Refuse non-finite or out-of-range loop options, naming the option (exit 2); the
+    domains are the registry's (:data:`~surfcomp.core.command_options.SIMULATE`)."""
+    margin, stock, replicas = SIMULATE["margin"], SIMULATE["stock"], SIMULATE["replicas"]
+    if not (np.isfinite(args.margin) and margin.low <= args.margin < margin.high):
+        raise InputError("%s %r: expected %s" % (margin.flag, args.margin, margin.what))
+    if args.stock is not None and not (np.isfinite(args.stock) and args.stock >= stock.low):
+        raise InputError("%s %r: expected a finite allowance >= %g mm"
+                         % (stock.flag, args.stock, stock.low))
+    for o in (SIMULATE["between"], replicas, OPTIONS["refine"], SIMULATE["seed"]):
+        val = getattr(args, o.arg)
+        if val is not None and val < o.low:
+            raise InputError("%s %d: expected a whole number >= %d" % (o.flag, val, o.low))
+    if args.replicas is not None and args.replicas > replicas.high:
+        raise InputError("%s %d: expected at most %d (the mirror paper machines 4 parts per "
+                         "method)" % (replicas.flag, args.replicas, replicas.high))
+
+
+def loop_value(args, preset, name):
+    """Option ``name`` of :data:`~surfcomp.core.command_options.SIMULATE` that a preset
+    sets: the command line's, else the preset's, else the registry's default (the grid
+    as ``(n, m)``)."""
+    given = getattr(args, name)
+    if name == "grid":
+        return (parse_grid(given) if given is not None
+                else preset.grid if preset else parse_grid(SIMULATE["grid"].default))
+    if given is not None:
+        return given
+    return getattr(preset, name) if preset else SIMULATE[name].default
 
 
 def model_from_args(args, preset=None):
@@ -286,10 +282,8 @@ def run(args):
         raise InputError("give NOMINAL (a face file) or --preset NAME (one of %s)"
                          % ", ".join(presets_.PRESETS))
     check_loop_options(args)
-    grid = (parse_grid(args.grid) if args.grid is not None
-            else (preset.grid if preset else _LOOP_DEFAULTS["grid"]))
-    replicas = args.replicas or (preset.replicas if preset else _LOOP_DEFAULTS["replicas"])
-    between = args.between or (preset.between if preset else _LOOP_DEFAULTS["between"])
+    grid, replicas, between = (loop_value(args, preset, name)
+                               for name in ("grid", "replicas", "between"))
     try:
         masks = [int(x) for x in args.mask.split(",")]
     except ValueError:

@@ -12,14 +12,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.measurement.planning import (
-    LAYOUTS,
     POINT_LAYOUTS,
     PlanSettings,
     check_points,
     parse_count,
 )
+from ..core.option_tables import SIM_PLAN
 from ..errors import InputError, MeasurementFileError
 from . import registry
+from .options import add_arguments
 
 #: a plan's point farther than this (mm) from the nominal face is refused
 PLAN_TOLERANCE = 0.01
@@ -29,16 +30,7 @@ GROUP = "measurement plan (instead of the --grid nodes)"
 def add_options(p):
     g = p.add_argument_group(GROUP)
     registry.add_options(p, "simulate", {GROUP: g}, flags=("--plan",))
-    g.add_argument("--layout", dest="plan_layout", choices=LAYOUTS, default=None,
-                   help="measure at points planned on the face: grid or xy (--count UxV), "
-                        "adaptive or uniform (--points N)")
-    g.add_argument("--count", dest="plan_count", metavar="UxV", default=None,
-                   help="grid and xy layouts: points along u (x) and v (y)")
-    g.add_argument("--points", dest="plan_points", type=int, default=None, metavar="N",
-                   help="adaptive and uniform layouts: number of points")
-    g.add_argument("--compare-layouts", type=int, default=None, metavar="N",
-                   help="run the loop at N uniform and N adaptive points and say which "
-                        "predicts the lower residual after compensation (mirror paper 2.3)")
+    add_arguments(g, SIM_PLAN, SIM_PLAN)      # the plan's records (option_tables.PLAN)
 
 
 @dataclass
@@ -69,7 +61,7 @@ def check(args):
         raise InputError("--html shows the maps of grid measurements; it does not go with %s"
                          % (given[0] if given else "--count/--points"))
     if args.compare_layouts is not None:
-        check_points(args.compare_layouts, "--compare-layouts")
+        check_points(args.compare_layouts, "compare_layouts")
     if (args.plan_count is not None or args.plan_points is not None) and not args.plan_layout:
         raise InputError("--count and --points go with --layout")
     if args.plan_layout:

@@ -15,6 +15,9 @@ ACCEPT_TOL = 1e-4
 #: ... and move nowhere (on the dense check grid) more than the largest intended
 #: correction plus this (1 um); a face that does is reported
 OVERSHOOT_TOL = 1e-3
+#: below this integral of the correction (mm^3) a volume check gives no relative figure
+#: (a nil correction: the difference alone is reported)
+NIL_INTEGRAL = 1e-9
 #: target of the residual iteration at the measured points (0.02 um)
 MATCH_TOL = 2e-5
 #: iterations of the residual iteration at most
@@ -47,3 +50,21 @@ MAX_PLAN_POINTS = 1_000_000
 #: the smoothing length of a scattered layout's fit: at least, at most
 MIN_SMOOTHING = 1e-3
 MAX_SMOOTHING = 1e4
+
+# ------------------------------------------------------------------ the simulation loop
+#: largest measurement grid per direction: 800 x 800 with the default ``between`` = 2 is
+#: estimated at 3.7 GB (:mod:`surfcomp.core.budget`; measured 1.6 GB); the
+#: former 4000 x 4000 ran out of memory at 6.5 GB (it needs about 80 GB) and would have run
+#: for days
+MAX_GRID = 800
+#: most replicas (parts machined per method; the mirror paper machines 4); each takes
+#: seconds to minutes
+MAX_REPLICAS = 1000
+
+# ------------------------------------------------------------------ G-code programs
+#: shortest accepted segment length (mm): 1 um, finer than any machine's resolution matters
+MIN_SEGMENT_LENGTH = 1e-3
+#: most points a compensated program may be sampled at. Measured on the 2-core development
+#: machine (23 GB): about 0.8 kB of memory per output segment from planning to the written
+#: text, so 10 million segments take about 8 GB (bench/bench_memory.py).
+MAX_SEGMENTS = 10_000_000

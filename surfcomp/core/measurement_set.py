@@ -58,6 +58,9 @@ class MeasurementSet:
     tip_centres : bool
         The measured points are stylus tip centres (LinuxCNC probe logs), not contact
         points: they need the tip radius (``Options.tip_radius``).
+    faces : list of str or None
+        The reference face each point names (a plain point file's ``face`` column, read
+        with the file and stored with the points), or None.
     """
 
     nominal: np.ndarray = None
@@ -77,6 +80,7 @@ class MeasurementSet:
     separator: str = ","
     decimal_comma: bool = False
     tip_centres: bool = False
+    faces: list = None
 
     def __post_init__(self):
         if self.lines is None:

@@ -18,12 +18,18 @@ flag, document property, GUI label and help. Who reads them:
   :class:`ProbeSettings <surfcomp.io.probe_path.ProbeSettings>`' defaults and the probe
   operation's properties (:mod:`surfcomp.app.probe_op`);
 - :data:`MODEL`: ``simulate``'s model options (:mod:`surfcomp.cli.simulate`) and
-  :class:`MachiningModel <surfcomp.core.simulation.process_model.MachiningModel>`' defaults.
+  :class:`MachiningModel <surfcomp.core.simulation.process_model.MachiningModel>`' defaults;
+- :data:`SIM_PLAN`: ``simulate``'s plan options (:mod:`surfcomp.cli.simulate_plan`), the
+  plan's layout, count and points under ``simulate``'s own attributes;
+- the loop of ``simulate`` and the axis error file: the tables of
+  :mod:`surfcomp.core.command_options`.
 
 :func:`find` looks a name up in every table (the compensation's first): the command line
 shows it as the flag (:mod:`surfcomp.cli.option_flags`), the GUI as the label
 (:mod:`surfcomp.gui.option_labels`).
 """
+
+from dataclasses import replace
 
 from .choices import (
     ALIGN_METHODS,
@@ -35,6 +41,7 @@ from .choices import (
     UNITS,
     WORK_OFFSETS,
 )
+from .command_options import AXIS_FILE, COMPENSATE, GCODE, PROGRAM_MOVE, SIMULATE
 from .limits import MAX_PLAN_POINTS
 from .options import OPTIONS, Option
 
@@ -193,9 +200,28 @@ MODEL = _table(
     _model("semi_engagement", None, "MM", "depth the semi-finishing pass removes", low=0.0),
 )
 
+#: ``simulate``'s measurement plan: :data:`PLAN`'s layout, count and points (unset: the
+#: grid nodes; attributes ``plan_layout`` ... beside the compensation's ``layout``) and
+#: the comparison of layouts
+SIM_PLAN = _table(
+    replace(PLAN["layout"], default=None, dest="plan_layout",
+            help="measure at points planned on the face: grid or xy ({count} UxV), "
+                 "adaptive or uniform ({points} N)"),
+    replace(PLAN["count"], dest="plan_count", unset=None,
+            help="grid and xy layouts: points along u (x) and v (y)"),
+    replace(PLAN["points"], dest="plan_points", unset=None,
+            help="adaptive and uniform layouts: number of points"),
+    Option("compare_layouts", int, None, None, flag="--compare-layouts", metavar="N", low=1,
+           high=MAX_PLAN_POINTS, what="a whole number of points",
+           help="run the loop at N uniform and N adaptive points and say which predicts the "
+                "lower residual after compensation (mirror paper 2.3)"),
+)
+
 #: every table by its name (the compensation's first)
 TABLES = {"compensation": OPTIONS, "inputs": INPUTS, "align": ALIGN, "plan": PLAN,
-          "program": PROGRAM, "model": MODEL}
+          "program": PROGRAM, "model": MODEL, "simulate": SIMULATE, "sim_plan": SIM_PLAN,
+          "axis_file": AXIS_FILE, "gcode": GCODE, "program_move": PROGRAM_MOVE,
+          "compensate": COMPENSATE}
 
 
 def find(name, tables=None):

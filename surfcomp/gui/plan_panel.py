@@ -76,8 +76,12 @@ class PlanPanel(UndoTaskPanel):
         self.margin = _spin(obj.EdgeMargin, 0.0, 100.0, 0.1, 3)
         tilt = PLAN["max_tilt"]
         self.tilt = _spin(obj.MaxTilt, tilt.low, tilt.high, 5.0, 1)
-        self.result = QtGui.QLabel("")
-        self.result.setWordWrap(True)
+        # read-only text that wraps at the panel's width and scrolls: the task box keeps the
+        # height it opened with, so a label growing with the message (an error with its
+        # position, the dropped points' reasons) would be cut off below it
+        self.result = QtGui.QPlainTextEdit()
+        self.result.setReadOnly(True)
+        self.result.setMinimumHeight(8 * self.result.fontMetrics().lineSpacing())
         self.plan_button = QtGui.QPushButton(translate("SurfComp", "Plan"))
         # labels and tooltips are the option registry's, as messages name the options
         # (the count, U x V, is two fields)
@@ -114,13 +118,13 @@ class PlanPanel(UndoTaskPanel):
         """Check the fields (a trial plan, nothing written), then write them to the object
         (macro lines) and recompute; show the outcome. Returns True when the plan has
         points."""
-        from ..app.plan_feature import trial_plan
+        from ..app.plan_feature import dropped, trial_plan
         from ..errors import SurfcompError
 
         try:
-            trial_plan(self.obj, **self.values())
+            plan = trial_plan(self.obj, **self.values())
         except SurfcompError as exc:
-            self.result.setText(option_labels.shown(exc, ("plan",)))
+            self.result.setPlainText(option_labels.shown(exc, ("plan",)))
             self.result.setStyleSheet("color: #c53030;")
             return False
         lines = ["_plan = App.getDocument(%r).getObject(%r)" % (self.doc.Name, self.obj.Name)]
@@ -131,15 +135,18 @@ class PlanPanel(UndoTaskPanel):
         show_points(self.obj)
         obj = self.obj
         if "Invalid" in obj.State or "Error" in obj.State:
-            self.result.setText(obj.getStatusString())
+            self.result.setPlainText(obj.getStatusString())
             self.result.setStyleSheet("color: #c53030;")
             return False
         text = translate("SurfComp", "%d of %d points kept; travel %.1f mm (%s order); "
                                      "safe Z %.3f mm") % (obj.Kept, obj.Placed, obj.Travel,
                                                           obj.Order, obj.SafeZ)
         if obj.Dropped:
-            text += "\n" + translate("SurfComp", "Dropped: %s") % "; ".join(obj.Dropped)
-        self.result.setText(text)
+            # the plan the object now holds (the same fields): its reasons name the options
+            # by the fields' labels, where the property names them by the properties
+            text += "\n" + translate("SurfComp", "Dropped: %s") % "; ".join(
+                option_labels.shown(reason, ("plan",)) for reason in dropped(plan))
+        self.result.setPlainText(text)
         self.result.setStyleSheet("")
         return True
 

@@ -11,6 +11,7 @@ import dataclasses
 
 from ..core.choices import MEASUREMENT_FORMATS
 from ..errors import InputError, MeasurementFileError
+from .align_files import face_column
 from .files import read_once
 from .measurements import read_measurements
 from .pointfiles import detect_format, read_point_file
@@ -56,7 +57,9 @@ def _read_any(path, units, fmt, sample):
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)
     with read_once(path):
-        return _read(path, units, fmt, sample)
+        ms = _read(path, units, fmt, sample)
+        faces = face_column(ms)    # the same bytes as the points (read_once)
+    return ms if faces is None else dataclasses.replace(ms, faces=faces)
 
 
 def _read(path, units, fmt, sample):

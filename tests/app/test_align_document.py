@@ -56,3 +56,50 @@ def test_bad_alignment_properties_name_the_property(tmp_path, fresh_doc):
     assert "AlignDof 'q'" in comp.getStatusString()
     with pytest.raises(ValueError):
         meas.AlignMethod = "magic"
+
+
+def test_face_column_is_stored_with_the_points(tmp_path, fresh_doc, monkeypatch):
+    """A point file's face column goes into the measurement object (``PointFaces``) with
+    the points: the alignment uses it after the file is gone, never a file of the same name
+    in the working folder, and it survives save and reopen."""
+    import shutil
+
+    import FreeCAD
+
+    from surfcomp.app import align_doc, features
+    from tests.app.test_align_cli import block_points
+
+    top_name, names, _dev, faces, pts = block_points(tmp_path)
+    rows = ["x,y,z,face"] + ["%.10f,%.10f,%.10f,%s" % (tuple(p) + (f,))
+                             for p, f in zip(pts, faces)]
+    rows[5] = rows[5].rsplit(",", 1)[0] + ",Face9"       # no reference face: refused
+    (tmp_path / "f.csv").write_text("\n".join(rows) + "\n")
+    doc = fresh_doc
+    box = doc.addObject("Part::Feature", "Box")
+    box.Shape = Part.read(str(tmp_path / "box.step"))
+    meas = make_measurement(doc, str(tmp_path / "f.csv"))
+    (tmp_path / "f.csv").unlink()
+    decoy = tmp_path / "cwd"
+    decoy.mkdir()
+    (decoy / "f.csv").write_text("\n".join(rows[:5] + rows[6:]) + "\n")
+    monkeypatch.chdir(decoy)
+    assert list(meas.PointFaces) == faces[:4] + ["Face9"] + faces[5:]
+    assert features.measurement_set(meas).faces == list(meas.PointFaces)
+    meas.AlignMethod = "bestfit"
+    meas.AlignFaces = ",".join(names)
+    comp = make_compensation(doc, box, top_name, meas)
+    doc.recompute()
+    status = " ".join(comp.getStatusString().split())
+    assert "f.csv:6: face 'Face9' is not a reference face" in status, status
+    doc.saveAs(str(tmp_path / "faces.FCStd"))
+    shutil.copy(tmp_path / "faces.FCStd", tmp_path / "reopened.FCStd")
+    again = FreeCAD.openDocument(str(tmp_path / "reopened.FCStd"))
+    try:
+        m2 = again.getObject(meas.Name)
+        assert list(m2.PointFaces)[:6] == faces[:4] + ["Face9", faces[5]]
+        m2.PointFaces = faces                        # the column without the bad name
+        nominal, _placement = features.nominal_of(again.getObject(comp.Name))
+        _ms, rec = align_doc.aligned(m2, nominal, features.measurement_set(m2))
+        assert rec.as_dict()["points"] == {**{n: 150 for n in names}, top_name: 300}
+    finally:
+        FreeCAD.closeDocument(again.Name)

@@ -306,14 +306,16 @@ def test_unknown_face_named(g1_part):
 def test_blade_knife_edges_and_vertices_move_as_one(blade):
     """The blade with a 30 um field around its leading edge, measured with outward normals:
     the region takes the pressure side and the tip cap against their own orientation (as
-    read they face into the blade), and every shared edge but the tip cap's and the
-    trailing edge (0.12 um between its samples) stays closed to within 0.1 um beyond the
-    nominal's own gap (the root cap's opened by 0.5 um before
-    the boundary curves were fitted on their own, the tip cap's by 4.4 um before the faces
-    were oriented and 36 um with a cap's collapsed end moved by more than one vector).
-    Beyond the zones where the design shortens the correction, the root cap meets it
-    within 0.02 um; the sides miss by up to 1.8 and 3.5 um next to the trailing edge,
-    which curls with a 0.1 mm radius (see docs/regions.md)."""
+    read they face into the blade), and every shared edge stays closed to within 0.1 um
+    beyond the nominal's own gap, at the edge's samples and halfway between them (before:
+    the trailing edge 0.12 um, the tip cap's edges 0.34 and 2.1 um, from wrong feet of
+    single edge samples, the pressure side's fold vector turning round between two samples
+    and the tip cap's boundary fit; the root cap's opened by 0.5 um before the boundary
+    curves were fitted on their own, the tip cap's by 4.4 um before the faces were oriented
+    and 36 um with a cap's collapsed end moved by more than one vector). Beyond the zones
+    where the design shortens the correction, the root cap meets it within 0.02 um; the
+    sides miss by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
+    (see docs/regions.md)."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
@@ -334,20 +336,26 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert len(sides) == 2
     # oriented, the sides meet at 0 to 22 deg (leading edge) and 10 to 143 deg (trailing)
     assert sorted(round(e["nominal_angle_deg"]) for e in sides) == [22, 143]
+    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.023 um, the
+    # rounded edge 0.0000, the suction side - tip cap 0.0003, the pressure side - tip cap
+    # 0.046 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.3 um
+    # (trailing edge), 8.9, 12.3 (suction side - tip cap), 11.7, 10.7 and 10.8 um apart
+    # (a wrong foot of one edge sample read 40 um before)
+    bounds = {("Face1", "Face2", 143): 0.04, ("Face1", "Face2", 22): 0.001,
+              ("Face1", "Face3", 14): 0.005, ("Face1", "Face4", 97): 0.01,
+              ("Face2", "Face3", 179): 0.07, ("Face2", "Face4", 95): 0.015}
     for e in edges:
-        tip = "Face3" in e["faces"]
-        # known limit: the pressure side folds onto the tip cap (179 deg between the
-        # outward normals; its normal turns by 130 deg within 0.5 mm at the trailing
-        # edge's end), their edge opens by 2.1 um; the suction side's by 0.14 um at the
-        # edge's samples and 0.34 um halfway between them
-        # the sides' trailing edge: 0.066 um at the edge's samples, 0.122 um halfway
-        # between them (the edge's vectors are built at the samples), over the 0.1 um target
-        trailing = e["faces"] == ["Face1", "Face2"] and round(e["nominal_angle_deg"]) == 143
-        bound = (2.5 if "Face2" in e["faces"] else 0.4) if tip else 0.13 if trailing else 0.1
-        assert e["max_gap_beyond_nominal_um"] <= bound, e
+        key = (*e["faces"], round(e["nominal_angle_deg"]))
+        assert e["max_gap_beyond_nominal_um"] <= bounds[key], e
+        assert e["nominal_gap_um"] <= 13.0, e
+    (trailing,) = [e for e in sides if round(e["nominal_angle_deg"]) == 143]
+    assert trailing["nominal_gap_um"] == pytest.approx(3.27, abs=0.03)
     faces_rep = {f["face"]: f for f in data["faces"]}
     assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
-    for name, within in (("Face1", 2.0), ("Face2", 4.0), ("Face4", 0.02)):
+    # measured: 0.449, 0.426 and 0.0059 um (1.8 and 3.5 um on the sides before the edges'
+    # exactness was eased along them: the trailing edge turns from 143 to 95 deg within
+    # 3.5 mm near the tip, and the displacement turned as fast, over 3 mm spanwise spans)
+    for name, within in (("Face1", 0.6), ("Face2", 0.6), ("Face4", 0.02)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within

@@ -204,8 +204,10 @@ def test_boxed_sphere_blends_inside_the_solid(tmp_path):
     face outside the region meets them tangentially, so a correction that moves their
     border is refused naming the face and the neighbour; a 4.6 um bump nil within 0.15 mm
     of the border keeps all 20 outside edges and gives one valid closed solid of 190
-    faces. (The file's trims lie up to 0.06 mm apart, Rhino's tolerance, so its volume and
-    edge tolerance are not compared here: docs/regions.md, Limits.)"""
+    faces. The file's trims lie up to 0.06 mm apart (Rhino's tolerance), and joining the
+    region's faces moves them onto each other: the zero correction changes the volume by
+    0.054 mm^3 alone (docs/regions.md, Limits), so the bump's volume change is checked
+    against the zero correction's, and the edge tolerance against the file's."""
     import Part
     from scipy.spatial import cKDTree
 
@@ -241,6 +243,18 @@ def test_boxed_sphere_blends_inside_the_solid(tmp_path):
     back = Part.read(str(out))
     assert len(back.Solids) == 1 and back.Solids[0].isValid() and back.Shells[0].isClosed()
     assert len(back.Faces) == 190
+    assert o["edge_tolerance_mm"] <= o["nominal_edge_tolerance_mm"] * (1 + 1e-9)
+    assert -0.0016 < o["integral_mm3"] < -0.0014
+    # the zero correction: the trims' share of the volume change, no relative figure
+    rp.write_csv(str(csv), pts, nrm, np.zeros(len(pts)))
+    r = _cli(brep, csv, "--faces", region, "-o", tmp_path / "zero.brep", "--report", rep,
+             "--method", "raw", "--smoothing", "0.06")
+    assert r.returncode == 0, r.stderr
+    zero = json.load(open(rep))["output"]
+    assert zero["integral_mm3"] == 0.0 and zero["relative_error"] is None
+    assert "(a nil correction: %.4f mm3 apart)" % zero["change_mm3"] in r.stdout
+    assert 0.04 < zero["change_mm3"] < 0.07
+    assert o["change_mm3"] - zero["change_mm3"] == pytest.approx(o["integral_mm3"], rel=0.02)
     # a constant 5 um lifts the region off its tangent neighbours: exit 2, nothing written
     rp.write_csv(str(csv), pts, nrm, np.full(len(pts), 0.005))
     out2 = tmp_path / "const.brep"

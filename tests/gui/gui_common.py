@@ -219,18 +219,48 @@ def legend_shot(label, name):
 
 
 # -- real input events on widgets ------------------------------------------------------
-def click(widget, pos=None):
-    """A real left click at ``pos`` (QPointF) in ``widget``, by default in its middle."""
+def click(widget, pos=None, modifiers=None):
+    """A real left click at ``pos`` (QPointF) in ``widget``, by default in its middle, with
+    keyboard ``modifiers`` (Ctrl adds to the selection)."""
     Gui.updateGui()
     if pos is None:
         pos = QtCore.QPointF(widget.width() / 2.0, widget.height() / 2.0)
+    mods = QtCore.Qt.NoModifier if modifiers is None else modifiers
     glob = QtCore.QPointF(widget.mapToGlobal(pos.toPoint()))
     for kind, buttons in ((QtCore.QEvent.MouseButtonPress, QtCore.Qt.LeftButton),
                           (QtCore.QEvent.MouseButtonRelease, QtCore.Qt.NoButton)):
-        ev = QtGui.QMouseEvent(kind, pos, glob, QtCore.Qt.LeftButton, buttons,
-                               QtCore.Qt.NoModifier)
+        ev = QtGui.QMouseEvent(kind, pos, glob, QtCore.Qt.LeftButton, buttons, mods)
         QtGui.QApplication.sendEvent(widget, ev)
     Gui.updateGui()
+
+
+def wait_for_actions():
+    """FreeCAD enables and disables the commands' actions on a timer: let it run."""
+    for _ in range(12):
+        Gui.updateGui()
+        time.sleep(0.05)
+
+
+def tree():
+    """The visible model tree."""
+    trees = [t for t in mw.findChildren(QtGui.QTreeWidget) if t.isVisible()]
+    return max(trees, key=lambda t: t.topLevelItemCount() and t.width())
+
+
+def click_tree(label, modifiers=None):
+    """A real left click on the tree item ``label`` (its document expanded first); the
+    selected objects' names after it."""
+    t = tree()
+    t.expandAll()
+    Gui.updateGui()
+    item = t.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive, 0)[0]
+    t.scrollToItem(item)
+    Gui.updateGui()
+    r = t.visualItemRect(item)
+    click(t.viewport(), QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y()),
+          modifiers)
+    wait_for_actions()
+    return [o.Name for o in Gui.Selection.getSelection()]
 
 
 def key(widget, code, text="", modifiers=None):

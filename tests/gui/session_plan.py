@@ -16,15 +16,29 @@ Gui.runCommand("SurfComp_PlanMeasurement")
 Gui.updateGui()
 panel = plan_panel.PlanPanel.instance
 obj = panel.obj
-RESULTS["default"] = [panel.result.text(), obj.Layout, obj.Kept, obj.Placed,
+RESULTS["default"] = [panel.result.toPlainText(), obj.Layout, obj.Kept, obj.Placed,
                       len(obj.Shape.Vertexes), panel.points.isEnabled()]
+# on the default grid, a max tilt of 15 degrees drops the steeper points: the panel names
+# the option as its field, the Dropped property as the property; the panel as the user
+# sees it
+type_value(panel.tilt, "15")
+click(panel.plan_button)
+Gui.updateGui()
+RESULTS["tilt"] = [panel.result.toPlainText(), list(obj.Dropped), obj.Kept, obj.Placed, obj.MaxTilt]
+RESULTS["tilt_png"] = os.path.join(TMP, "plan_tilt.png")
+panel.form.grab().save(RESULTS["tilt_png"])
+# every line of the message shows without scrolling
+RESULTS["tilt_scroll"] = panel.result.verticalScrollBar().maximum()
+type_value(panel.tilt, "60")
+click(panel.plan_button)
+RESULTS["tilt_back"] = [obj.Kept, obj.MaxTilt]
 # the adaptive layout with 60 points, chosen with the keyboard, planned with the button
 panel.layout.setFocus()
 key(panel.layout, QtCore.Qt.Key_Down)
 key(panel.layout, QtCore.Qt.Key_Down)
 type_value(panel.points, "60")
 click(panel.plan_button)
-RESULTS["adaptive"] = [panel.layout.currentText(), panel.result.text(), obj.Layout, obj.Kept,
+RESULTS["adaptive"] = [panel.layout.currentText(), panel.result.toPlainText(), obj.Layout, obj.Kept,
                        obj.Placed, panel.points.isEnabled(), panel.count_u.isEnabled(),
                        [tuple(p) for p in obj.PlanPoints[:3]]]
 vo = obj.ViewObject
@@ -40,7 +54,8 @@ RESULTS["shot"] = shot(view, "plan")
 # OK keeps the panel open
 type_value(panel.tip, "60")
 click(panel.plan_button)
-RESULTS["bad"] = [panel.result.text(), panel.accept(), plan_panel.PlanPanel.instance is panel]
+RESULTS["bad"] = [panel.result.toPlainText(), panel.accept(),
+                  plan_panel.PlanPanel.instance is panel]
 # the panel as the user sees it: the message below the field it names
 Gui.updateGui()
 RESULTS["bad_png"] = os.path.join(TMP, "plan_bad.png")

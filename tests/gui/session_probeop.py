@@ -24,7 +24,7 @@ plan = panel.obj
 type_value(panel.count_u, "5")
 type_value(panel.count_v, "4")
 click(panel.plan_button)
-RESULTS["plan"] = [panel.result.text(), panel.accept(), plan.Kept]
+RESULTS["plan"] = [panel.result.toPlainText(), panel.accept(), plan.Kept]
 Gui.Selection.clearSelection()
 Gui.Selection.addSelection(doc.Name, plan.Name)
 RESULTS["active_with_plan"] = active(probe_op_cmd.AddProbeOperation)

@@ -18,37 +18,6 @@ mirror.ViewObject.Visibility = True
 Gui.updateGui()
 
 
-def tree():
-    trees = [t for t in mw.findChildren(QtGui.QTreeWidget) if t.isVisible()]
-    return max(trees, key=lambda t: t.topLevelItemCount() and t.width())
-
-
-def tree_item(label):
-    t = tree()
-    found = t.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive, 0)
-    return t, found[0]
-
-
-def click_tree(label):
-    """A real left click on the tree item ``label`` (its document expanded first)."""
-    tree().expandAll()
-    Gui.updateGui()
-    t, item = tree_item(label)
-    t.scrollToItem(item)
-    Gui.updateGui()
-    r = t.visualItemRect(item)
-    click(t.viewport(), QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y()))
-    wait_for_actions()
-    return [o.Name for o in Gui.Selection.getSelection()]
-
-
-def wait_for_actions():
-    """FreeCAD enables and disables the commands' actions on a timer: let it run."""
-    for _ in range(12):
-        Gui.updateGui()
-        time.sleep(0.05)
-
-
 def button(command):
     """The toolbar button of ``command`` (a QToolButton); FreeCAD's Undo button (a drop-down
     of the undo steps) has no object name: found by its text."""

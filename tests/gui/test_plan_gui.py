@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The Plan measurement command in the real FreeCAD GUI (under Xvfb): active on a selected
-face, its task panel planning the example face (grid, then adaptive chosen with the keys),
+face, its task panel planning the example face (grid, the points a small max tilt drops
+named by the field's label, then adaptive chosen with the keys),
 the points drawn in the 3D view, a tip too large for the face refused in the panel, OK as one
 undo step, Cancel leaving nothing."""
 
@@ -47,6 +48,26 @@ def test_points_drawn_in_the_view(session):
     red = (img[..., 0] > 0.6) & (img[..., 1] < 0.3) & (img[..., 2] < 0.3)
     # 60 red points of 6 pixels: at least a few hundred red pixels
     assert red.sum() > 200
+
+
+def test_dropped_points_name_the_field_in_the_panel(session):
+    text, prop, kept, placed, tilt = session["tilt"]
+    # the example face's default 10 x 10 grid: 79 points lean more than 15 degrees
+    assert (placed, tilt, kept) == (100, 15.0, 21)
+    (reason,) = [r for r in prop if "normal leans more than" in r]
+    n = int(reason.split(" ")[0])
+    assert n == placed - kept                      # only the tilt drops points here
+    # the property names the property; the panel the field, as its row is labelled
+    assert reason == "%d normal leans more than MaxTilt from +Z" % n
+    assert text.endswith("\nDropped: %d normal leans more than Max tilt from +Z" % n)
+    assert "MaxTilt" not in text and "max_tilt" not in text
+    assert session["bad_labels"][3] == "Max tilt (deg)"
+    # the whole message shows in the panel, without scrolling, and not in red (no error)
+    assert session["tilt_scroll"] == 0
+    img = read_image(session["tilt_png"])
+    red = ((abs(img[..., :3] - [197 / 255, 48 / 255, 48 / 255]).sum(axis=2)) < 0.15).sum()
+    assert red == 0
+    assert session["tilt_back"] == [100, 60.0]
 
 
 def test_tip_too_large_stays_in_the_panel(session):

@@ -58,3 +58,27 @@ def test_low_coverage_refused_naming_the_face(session):
     errors, added, visible = session["bad"]
     assert len(errors) == 1 and "Face2: the points cover" in errors[0][1]
     assert added == 0 and visible is True
+
+
+def test_next_round_from_the_selected_region_object(session):
+    """The region object and the next measurement picked in the tree: its round 2, Base the
+    picked one, the same faces and options; the corrections add up (30 % of the error left
+    after round 1 gives 1.3 times round 1's volume change)."""
+    assert session["round_pick_region"][1] is True
+    errors, added = session["round_ambiguous"]
+    assert added == 0 and len(errors) == 1 and "2 measurement objects to choose" in errors[0][1]
+    errors, added = session["round_used_refused"]
+    assert added == 0 and len(errors) == 1 and "already took part in a round" in errors[0][1]
+    assert session["round_errors"] == []
+    r = session["round2"]
+    assert set(session["round_pick"]) == {r["first"], "Round2"}
+    assert r["base"] == r["first"] and r["round"] == 2 and r["label"].endswith("round 2")
+    assert r["faces"] == ["Face1", "Face2"] and r["measurement"] == "Round2"
+    assert r["options"][0] == r["options"][1]
+    assert r["valid"] and 0.0 <= r["max_gap"] <= 0.1
+    assert r["vol_first"] == pytest.approx(-0.64, abs=0.02)
+    assert r["vol"] == pytest.approx(1.3 * r["vol_first"], rel=0.02)
+    assert r["visible"] == [False, True] and r["undo"] == 1
+    assert "round 2" in r["status"]
+    img = read_image(session["round_shot"])
+    assert (img.sum(axis=2) < 2.7).mean() > 0.05

@@ -54,11 +54,12 @@ import numpy as np
 from scipy import stats
 
 from ...errors import ComputationError, InputError
+from ..choices import AXIS_MODELS
 from .axes import AXES, as_points, axis_index
 from .machine import SimulatedMachine  # noqa: F401 (its home before core/axis/machine.py)
 
 #: fit choices of :func:`fit_axis_errors`
-MODEL_CHOICES = ("linear", "quadratic", "auto")
+MODEL_CHOICES = AXIS_MODELS
 #: significance level of the F-test of ``model='auto'``
 F_TEST_ALPHA = 0.05
 #: a component whose straight-line fit has an RMS residual below this (mm) stays linear

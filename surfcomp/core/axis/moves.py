@@ -17,15 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
+from .. import limits
 from ..progress import report
 from .arcs import arc_points, arc_step_counts, arc_steps
 
-#: shortest accepted segment length (mm): 1 um, finer than any machine's resolution matters
-MIN_SEGMENT_LENGTH = 1e-3
-#: most points :func:`plan_moves` may sample. Measured on the 2-core development machine
-#: (23 GB): about 0.8 kB of memory per output segment from planning to the written text,
-#: so 10 million segments take about 8 GB (bench/bench_memory.py).
-MAX_SEGMENTS = 10_000_000
+#: shortest accepted segment length (mm) and most points :func:`plan_moves` may sample
+#: (:mod:`surfcomp.core.limits`)
+MIN_SEGMENT_LENGTH = limits.MIN_SEGMENT_LENGTH
+MAX_SEGMENTS = limits.MAX_SEGMENTS
 
 
 @dataclass

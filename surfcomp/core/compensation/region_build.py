@@ -49,6 +49,11 @@ HALVED_SPANS = 128
 MIN_SPANS = 8
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
+#: a boundary curve missing the displacement by more than this (mm) halfway between two
+#: fit samples gets that knot span halved (within the pole budget)
+EDGE_TOL = 2e-5
+#: rounds of that refinement
+REFINE_ROUNDS = 4
 
 
 def _unit(a):
@@ -74,8 +79,13 @@ def miters(n_a, n_b, inward_a, inward_b):
     m = (n_a + n_b) / np.where(clamped, 1.0, 1.0 + c)[:, None]
     s = n_a + n_b
     # the bisector; at a knife edge (s near 0) the in-face directions give it, with no
-    # switch from one to the other along an edge whose angle varies
-    b = _unit(s - KNIFE_SHARE * (inward_a + inward_b))
+    # switch from one to the other along an edge whose angle varies. Where a face folds
+    # back over the other (the normals' sum points into the faces, as where the BladeX
+    # pressure side curls over its tip cap) the two terms cancel where the angle passes
+    # about 175 degrees: there the vector shrinks through zero instead of turning round
+    # from one sample to the next (a step of twice the correction no fit follows)
+    b = s - KNIFE_SHARE * (inward_a + inward_b)
+    b = b / np.maximum(np.linalg.norm(b, axis=-1, keepdims=True), 2.0 * KNIFE_SHARE)
     m[clamped] = limit * b[clamped]
     angle = np.degrees(np.arccos(np.clip(c, -1.0, 1.0)))
     exact = 1.0 - smoothstep((angle - EXACT_ANGLE) / (MITER_ANGLE - EXACT_ANGLE))
@@ -181,6 +191,11 @@ class Built:
 def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=4.0):
     """The corrected surface of one face of a region.
 
+    The nominal's knots refined to ``knot_step`` within the pole budget; then, for up to
+    :data:`REFINE_ROUNDS` rounds while the budget holds, the knot spans along a boundary
+    where the boundary curve misses the displacement by more than :data:`EDGE_TOL`
+    halfway between two fit samples are halved and the face fitted again.
+
     Parameters
     ----------
     surf : Surface
@@ -217,24 +232,89 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
         step *= 1.25
     ref = insert_knots(surf, nu, nv)
     surf = original     # the zero correction returns it
-    us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
-    vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
-    P, Su, Sv = evaluate_grid(ref, us, vs, order=1)
-    n = outward * _unit(np.cross(Su, Sv))
-    x = P.reshape(-1, 3)
-    delta = field(x)
-    D = displacement(x, n.reshape(-1, 3), delta, sharp).reshape(P.shape)
-    if not np.any(D):       # zero correction: the nominal itself, not a refined copy
+    grid = _Grid(ref, outward, field, sharp)
+    poles = grid.fit()
+    if poles is None:       # zero correction: the nominal itself, not a refined copy
         return Built(surf, nominal, nominal, step)
-    # the boundary curves fitted on their own: an edge on both faces' boundaries takes
-    # each face's accuracy along it (region_fit)
-    if ref.weights is None:
-        poles = ref.poles + fit_ends_held(us, vs, D, ref.knots_u, ref.knots_v, ref.degree_u,
-                                          ref.degree_v)
-    else:       # rational: the moved points, the weights kept
-        poles = fit_ends_held(us, vs, P + D, ref.knots_u, ref.knots_v, ref.degree_u,
-                              ref.degree_v, weights=ref.weights)
+    # spans along a boundary where the boundary curve misses the displacement get halved
+    # while the budget holds: two faces meet along a shared edge as closely as both follow
+    # it, and the displacement varies fastest along an edge (a fold's vector)
+    for _ in range(REFINE_ROUNDS):
+        nu, nv = grid.misfit_spans(poles)
+        if not (len(nu) or len(nv)) or (grid.ref.poles.shape[0] + len(nu)) * (
+                grid.ref.poles.shape[1] + len(nv)) > budget:
+            break
+        grid.refine(nu, nv)
+        poles = grid.fit()
+    ref = grid.ref
     out = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v, ref.weights,
                   surf.u_range, surf.v_range)
     return Built(out, poles.shape[:2], nominal, step)
 
+
+class _Grid:
+    """The fit samples of a refined surface and the displacement at them (kept for the
+    rows and columns a refinement leaves in place)."""
+
+    def __init__(self, ref, outward, field, sharp):
+        self.ref, self.outward, self.field, self.sharp = ref, outward, field, sharp
+        self.us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
+        self.vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
+        self.P, self.D = self._moved(self.us, self.vs)
+
+    def _moved(self, us, vs):
+        P, Su, Sv = evaluate_grid(self.ref, us, vs, order=1)
+        n = self.outward * _unit(np.cross(Su, Sv))
+        x = P.reshape(-1, 3)
+        D = displacement(x, n.reshape(-1, 3), self.field(x), self.sharp).reshape(P.shape)
+        return P, D
+
+    def fit(self):
+        """Poles of the nominal plus the displacement (None where it is nil)."""
+        ref = self.ref
+        if not np.any(self.D):
+            return None
+        # the boundary curves fitted on their own: an edge on both faces' boundaries takes
+        # each face's accuracy along it (region_fit)
+        if ref.weights is None:
+            return ref.poles + fit_ends_held(self.us, self.vs, self.D, ref.knots_u,
+                                             ref.knots_v, ref.degree_u, ref.degree_v)
+        # rational: the moved points, the weights kept
+        return fit_ends_held(self.us, self.vs, self.P + self.D, ref.knots_u, ref.knots_v,
+                             ref.degree_u, ref.degree_v, weights=ref.weights)
+
+    def misfit_spans(self, poles):
+        """Midpoints of the knot spans along each boundary where the fitted surface misses
+        the displacement by more than :data:`EDGE_TOL` halfway between two samples."""
+        ref = self.ref
+        fitted = Surface(poles, ref.knots_u, ref.knots_v, ref.degree_u, ref.degree_v,
+                         ref.weights, ref.u_range, ref.v_range)
+        out = []
+        for along, ends, knots, degree in ((self.us, self.vs[[0, -1]], ref.knots_u,
+                                            ref.degree_u),
+                                           (self.vs, self.us[[0, -1]], ref.knots_v,
+                                            ref.degree_v)):
+            mid = 0.5 * (along[1:] + along[:-1])
+            grid = (mid, ends) if along is self.us else (ends, mid)
+            P, D = self._moved(*grid)
+            miss = np.linalg.norm(evaluate_grid(fitted, *grid) - P - D, axis=2)
+            bad = mid[np.max(miss, axis=1 if along is self.us else 0) > EDGE_TOL]
+            br = np.unique(knots[degree:len(knots) - degree])
+            k = np.unique(np.clip(np.searchsorted(br, bad) - 1, 0, len(br) - 2))
+            out.append(0.5 * (br[k] + br[k + 1]))
+        return out
+
+    def refine(self, nu, nv):
+        """Insert the knots; the displacement is evaluated again at new samples only."""
+        self.ref = insert_knots(self.ref, nu, nv)
+        us = _samples(self.ref.knots_u, self.ref.degree_u, PER_SPAN)
+        vs = _samples(self.ref.knots_v, self.ref.degree_v, PER_SPAN)
+        P, D = (np.empty((len(us), len(vs), 3)) for _ in range(2))
+        ou, ov = np.isin(us, self.us), np.isin(vs, self.vs)
+        iu, iv = np.searchsorted(self.us, us[ou]), np.searchsorted(self.vs, vs[ov])
+        P[np.ix_(ou, ov)] = self.P[np.ix_(iu, iv)]
+        D[np.ix_(ou, ov)] = self.D[np.ix_(iu, iv)]
+        for rows, cols in ((~ou, np.ones(len(vs), bool)), (ou, ~ov)):
+            if rows.any() and cols.any():
+                P[np.ix_(rows, cols)], D[np.ix_(rows, cols)] = self._moved(us[rows], vs[cols])
+        self.us, self.vs, self.P, self.D = us, vs, P, D

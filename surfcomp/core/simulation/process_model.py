@@ -77,6 +77,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...errors import InputError
+from ..command_options import SIMULATE
 from ..option_tables import MODEL
 from ..surface import bspline
 
@@ -84,8 +85,9 @@ from ..surface import bspline
 MAX_SLOPE = 10.0
 #: random-field lattice nodes per direction at most
 MAX_LATTICE = 1024
-#: default stock (mm) the semi-finishing pass leaves (Werner 2022: 0.3 mm)
-DEFAULT_STOCK = 0.3
+#: default stock (mm) the semi-finishing pass leaves (Werner 2022: 0.3 mm; ``simulate
+#: --stock``, :data:`surfcomp.core.command_options.SIMULATE`)
+DEFAULT_STOCK = SIMULATE["stock"].default
 #: what the model contains and what it leaves out, in words (reports; docs/method.md)
 SUMMARY = {
     "contains": "Every part is cut in two passes from the surface given to CAM: "

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ...errors import InputError
+from .. import limits
 from ..compensation.deviations import statistics
 from ..compensation.methods import METHODS
 from ..compensation.pipeline import Options, compensate, prepare
@@ -62,14 +63,9 @@ from .sim_tables import (  # noqa: F401
 SIM_METHODS = ("none",) + METHODS
 #: schema name of :meth:`SimulationResult.as_dict`
 SCHEMA = "surfcomp-simulation/1"
-#: largest measurement grid per direction: 800 x 800 with the default ``between`` = 2 is
-#: estimated at 3.7 GB (:mod:`surfcomp.core.budget`; measured 1.6 GB); the
-#: former 4000 x 4000 ran out of memory at 6.5 GB (it needs about 80 GB) and would have run
-#: for days
-MAX_GRID = 800
-#: most replicas (parts machined per method; the mirror paper machines 4); each takes
-#: seconds to minutes
-MAX_REPLICAS = 1000
+#: largest measurement grid per direction and most replicas (:mod:`surfcomp.core.limits`)
+MAX_GRID = limits.MAX_GRID
+MAX_REPLICAS = limits.MAX_REPLICAS
 #: largest evaluation grid per direction (the largest grid with the default between = 2)
 MAX_EVAL_GRID = 2 * (MAX_GRID - 1) + 1
 

@@ -15,16 +15,18 @@ and goes through the line-by-line writer. The output is the same, byte for byte
 
 A plain line: an optional ``G0``/``G1`` (``G00``/``G01``), then ``X``, ``Y``, ``Z`` and
 ``F`` words in this order (each optional, at least one axis), upper case, a letter
-directly before its number, nothing or one blank between words, blanks at the end.
+directly before its number, nothing or one blank between words, blanks at the end. Which
+lines of a block are plain, and their numbers, is found in array operations
+(:mod:`.plain_scan`).
 """
 
 import re
-from itertools import repeat
 
 import numpy as np
 
 from .interpreter import MAX_POSITION, LineInfo
 from .lexer import Word, tokenize
+from .plain_scan import scan_block
 
 _NUM = r"([+-]?(?:\d+(?:\.\d*)?|\.\d+))"
 #: groups: 1 motion code, 3 X, 5 Y, 7 Z, 9 F, the others blanks (the line is their
@@ -33,16 +35,6 @@ PLAIN = re.compile(r"(?:G(0?[01]))?( ?)(?:X%s)?( ?)(?:Y%s)?( ?)(?:Z%s)?( ?)(?:F%
                    % ((_NUM,) * 4))
 #: group of each axis number
 AXIS_GROUPS = (3, 5, 7)
-#: every line of a block with its ``"\n"`` in one pass (:func:`_candidates`): a plain line
-#: (the groups of :data:`PLAIN`, then ``"\n"``, then ``""``), or any other line (``""``
-#: eleven times, then ``"\n"``); a group of :data:`PLAIN` that took no part is ``""`` (no
-#: number or motion code is empty). Its digits are matched possessively (nothing after a
-#: number's digits can match a digit, so the lines matched are the same)
-_SCAN = re.compile(r"(?:%s(\n)|[^\n]*(\n))"
-                   % PLAIN.pattern.replace(r"(?:\d+(?:\.\d*)?|\.\d+)",
-                                           r"(?:\d++(?:\.\d*+)?|\.\d++)"))
-#: the motion code of a plain line's G word (-1: none)
-_MOTION = {"": -1, "0": 0, "1": 1, "00": 0, "01": 1}
 #: shortest run read as arrays (shorter ones cost more to set up than they save)
 MIN_RUN = 8
 #: the switch tests use to compare both paths (False: every line one at a time)
@@ -62,41 +54,41 @@ PLAIN_LINE = PlainLine()
 class PlainRun:
     """Lines ``start`` to ``stop`` (exclusive, indices in the block) read as arrays.
 
-    ``cols``: the :data:`PLAIN` groups of the lines, column by column (tuples; ``""`` for
-    an absent word); ``first_move``: the block's index of the
+    ``g_word`` (n,) bool: the line has a G word; ``first_move``: the block's index of the
     first line's move (line ``k`` of the run has move ``first_move + k``); ``motion``
     (n,): 0 or 1 per line; ``present`` (n, 3) bool, ``value`` (n, 3) (mm), ``decimals``
     (n, 3) int, ``size`` (n, 3) int (the number's length): the axis words.
     """
 
-    __slots__ = ("start", "stop", "cols", "first_move", "motion", "present", "value",
+    __slots__ = ("start", "stop", "g_word", "first_move", "motion", "present", "value",
                  "decimals", "size")
 
-    def __init__(self, start, stop, cols, first_move, motion, present, value, decimals,
+    def __init__(self, start, stop, g_word, first_move, motion, present, value, decimals,
                  size):
-        self.start, self.stop, self.cols = start, stop, cols
+        self.start, self.stop, self.g_word = start, stop, g_word
         self.first_move, self.motion, self.present, self.value = (first_move, motion,
                                                                    present, value)
         self.decimals, self.size = decimals, size
 
 
 def _candidates(lines):
-    """``(start, stop, cols)`` of the runs of at least :data:`MIN_RUN` plain lines (``cols``
-    as :class:`PlainRun` has them), found by one :data:`_SCAN` of the block's text."""
+    """``(start, stop, scan)`` of the runs of at least :data:`MIN_RUN` plain lines, with
+    the block's :class:`surfcomp.io.gcode.plain_scan.BlockScan` (``scan``, the same for
+    every run)."""
     if not lines:
         return []
-    cols = tuple(zip(*_SCAN.findall("\n".join([c for c, _e in lines]) + "\n")))
-    n = len(lines)
-    flag = np.zeros(n + 2, dtype=np.int8)
-    axes = sum(np.fromiter(map(len, cols[g - 1]), dtype=np.int64, count=n)
-               for g in AXIS_GROUPS)
-    flag[1:-1] = (np.array(cols[10]) == "\n") & (axes > 0)
+    scan = scan_block([c for c, _e in lines])
+    flag = np.zeros(len(lines) + 2, dtype=np.int8)
+    flag[1:-1] = scan.plain
     edge = np.flatnonzero(np.diff(flag))
-    out = []
-    for s, e in zip(edge[0::2].tolist(), edge[1::2].tolist()):
-        if e - s >= MIN_RUN:
-            out.append((s, e, tuple(c[s:e] for c in cols[:10])))
-    return out
+    return [(s, e, scan) for s, e in zip(edge[0::2].tolist(), edge[1::2].tolist())
+            if e - s >= MIN_RUN]
+
+
+def plain_groups(content):
+    """The ten :data:`PLAIN` groups of a plain line's ``content`` (``""`` for a group that
+    took no part)."""
+    return tuple(g or "" for g in PLAIN.fullmatch(content).groups())
 
 
 def read_block(interp, lines, base, source):
@@ -117,11 +109,11 @@ def read_block(interp, lines, base, source):
     infos = []
     done = []
     pos = 0
-    for s, e, cols in runs:
+    for s, e, scan in runs:
         infos.extend(interp.lines(toks[pos:s], base + pos))
         pos = s
         while pos < e:
-            run = _read_run(interp, cols, s, base, pos, e)
+            run = _read_run(interp, scan, base, pos, e)
             if isinstance(run, PlainRun):
                 done.append(run)
                 infos.extend([PLAIN_LINE] * (e - pos))
@@ -137,35 +129,27 @@ def read_block(interp, lines, base, source):
     return infos, done
 
 
-def _read_run(interp, cols, first, base, start, stop):
-    """The :class:`PlainRun` of lines ``start`` to ``stop`` (their groups from row
-    ``start - first`` of ``cols`` on), its moves added to the interpreter; or where the
-    line-by-line interpreter could do otherwise: ``"line"`` when it should read the first
-    line (after which a run may start), ``"rest"`` when it should read them all."""
+def _read_run(interp, scan, base, start, stop):
+    """The :class:`PlainRun` of lines ``start`` to ``stop`` of the block (their words in
+    ``scan``, :class:`surfcomp.io.gcode.plain_scan.BlockScan`), its moves added to the
+    interpreter; or where the line-by-line interpreter could do otherwise: ``"line"`` when
+    it should read the first line (after which a run may start), ``"rest"`` when it should
+    read them all."""
     if not interp.absolute or interp.factor != 1.0 or interp.path:
         return "rest"
     if not (interp.moved and all(interp.known)):
         return "line"
-    cols = tuple(c[start - first:] for c in cols)
-    if cols[0][0] == "" and interp.motion not in (0, 1):
+    given = scan.motion[start:stop]
+    if given[0] < 0 and interp.motion not in (0, 1):
         return "line"
-    n = len(cols[0])
-    motion = np.fromiter(map(_MOTION.__getitem__, cols[0]), dtype=int, count=n)
+    n = stop - start
+    motion = given.copy()
     if motion[0] < 0:
         motion[0] = interp.motion
-    value = np.empty((n, 3))
-    decimals = np.zeros((n, 3), dtype=np.int64)
-    sizes = np.zeros((n, 3), dtype=np.int64)
-    for a, g in enumerate(AXIS_GROUPS):
-        col = cols[g - 1]
-        value[:, a] = list(map(float, [t or "nan" for t in col]))
-        sizes[:, a] = size = np.fromiter(map(len, col), dtype=np.int64, count=n)
-        dot = np.fromiter(map(str.find, col, repeat(".")), dtype=np.int64, count=n)
-        decimals[:, a] = np.where(dot >= 0, size - dot - 1, 0)
-    present = sizes > 0
-    feeds = [float(t) for t in cols[8] if t]
+    value = scan.value[start:stop]
+    present = scan.present[start:stop]
     if not (np.abs(value[present]) <= MAX_POSITION).all() or \
-            not np.isfinite(np.array(feeds, dtype=float)).all():
+            not scan.feed_ok[start:stop].all():
         return "rest"       # the interpreter names the line and the word
     motion = motion[np.maximum.accumulate(np.where(motion >= 0, np.arange(n), 0))]
     end = _ffill(value, present, np.array(interp.pos, dtype=float))
@@ -180,7 +164,8 @@ def _read_run(interp, cols, first, base, start, stop):
         "factor": np.ones(n), "absolute": ones})
     interp.pos = end[-1].tolist()
     interp.motion = int(motion[-1])
-    return PlainRun(start, stop, cols, first, motion, present, value, decimals, sizes)
+    return PlainRun(start, stop, given >= 0, first, motion, present, value,
+                    scan.decimals[start:stop], scan.size[start:stop])
 
 
 def _ffill(value, present, initial):

@@ -64,8 +64,8 @@ def _gather(buf, start, length):
     return buf[idx].tobytes()
 
 
-def stretch_text(contents, sizes, units, d, change, rows, other):
-    """The output text of a stretch of plain lines.
+def stretch_text(contents, sizes, units, d, change, rows, other, bounds=None):
+    """The output text of a stretch of plain lines (or of consecutive stretches).
 
     Parameters
     ----------
@@ -83,10 +83,13 @@ def stretch_text(contents, sizes, units, d, change, rows, other):
     other : dict
         ``{line: text}`` of the lines with a change built by the caller (endings
         included).
+    bounds : ndarray (s,) int, optional
+        The line after each of s stretches (the last one ``n``): their texts are returned
+        one by one.
 
     Returns
     -------
-    str
+    str, or list of s str with ``bounds``
     """
     n = len(contents)
     text = "".join([c + e for c, e in contents])
@@ -141,9 +144,16 @@ def stretch_text(contents, sizes, units, d, change, rows, other):
         seg_len[keys, 0] = lens
         parts.append(np.frombuffer(extra, dtype=np.uint8))
     if len(parts) == 1:
-        return text
+        return text if bounds is None else _split(text, llen, bounds)
     out = _gather(np.concatenate(parts), seg_start.ravel(), seg_len.ravel())
-    return out.decode("latin-1")
+    text = out.decode("latin-1")
+    return text if bounds is None else _split(text, seg_len.sum(axis=1), bounds)
+
+
+def _split(text, line_len, bounds):
+    """``text`` cut after the lines ``bounds`` (``line_len`` the length of each)."""
+    ends = np.cumsum(line_len)[np.asarray(bounds) - 1].tolist()
+    return [text[a:b] for a, b in zip([0] + ends[:-1], ends)]
 
 
 def _line_lengths(contents):

@@ -14,7 +14,7 @@ through the line-by-line writer (their ``LineInfo`` built by
 import numpy as np
 
 from .emitter import _fmt
-from .plain import line_info
+from .plain import line_info, plain_groups
 from .plain_bytes import stretch_text
 
 #: numbers of at most this many units of their last decimal get their digits from
@@ -39,16 +39,24 @@ def _round_units(x, d):
 def write_block(w, lines, base, runs):
     """The output text of a block of ``(content, ending)`` lines written by the
     :class:`~surfcomp.io.gcode.emitter._TextWriter` ``w`` (its ``block`` set), runs
-    (:class:`surfcomp.io.gcode.plain.PlainRun`) as arrays."""
+    (:class:`surfcomp.io.gcode.plain.PlainRun`) as arrays.
+
+    The writer's decisions are taken stretch by stretch in order (the line-by-line writer
+    in between changes what the machine holds); the text of every stretch written as
+    arrays is built once for the whole block (:func:`_block_text`), which costs a fixed
+    number of array operations instead of that number per stretch."""
     out = []
+    pending = []            # (index in out, what _text takes) of the stretches
     pos = 0
     w.few = 10 * (len(lines) - sum(r.stop - r.start for r in runs)) < len(lines)
     for run in runs:
         out.extend([w.line(base + k, c, e) for k, (c, e) in enumerate(lines[pos:run.start],
                                                                         pos)])
-        _write_run(w, run, lines, base, out)
+        _write_run(w, run, lines, base, out, pending)
         pos = run.stop
     out.extend([w.line(base + k, c, e) for k, (c, e) in enumerate(lines[pos:], pos)])
+    for k, text in zip([k for k, _a in pending], _block_text([a for _k, a in pending])):
+        out[k] = text
     return "".join(out)
 
 
@@ -60,7 +68,7 @@ def _one(w, run, k, lines, base, out):
     out.append(w.line(base + i, c, e))
 
 
-def _write_run(w, run, lines, base, out):
+def _write_run(w, run, lines, base, out, pending):
     n = run.stop - run.start
     held = w.state.held
     if w.factor_prev != 1.0 or any(h is None for h in held):
@@ -72,18 +80,19 @@ def _write_run(w, run, lines, base, out):
     special = plan.split[moves] | plan.keep[moves] | (plan.offsets[moves + 1]
                                                       - plan.offsets[moves] != 1)
     k = 0
-    if run.cols[0][0] == "" and w.out_motion != int(run.motion[0]):
+    if not run.g_word[0] and w.out_motion != int(run.motion[0]):
         special[0] = True
     for s in np.flatnonzero(special).tolist() + [n]:
         if s > k:
-            _write_plain(w, run, k, s, lines, base, out)
+            _write_plain(w, run, k, s, lines, base, out, pending)
         if s < n:
             _one(w, run, s, lines, base, out)
         k = s + 1
 
 
-def _write_plain(w, run, k0, k1, lines, base, out):
-    """Lines ``k0`` to ``k1`` of a run, none of them split, as arrays."""
+def _write_plain(w, run, k0, k1, lines, base, out, pending):
+    """Lines ``k0`` to ``k1`` of a run, none of them split, as arrays (their text a
+    place in ``out`` and what :func:`_text` takes in ``pending``)."""
     plan = w.plan
     st = w.state
     n = k1 - k0
@@ -133,8 +142,9 @@ def _write_plain(w, run, k0, k1, lines, base, out):
     edited = change.any(axis=1)
     st.changed += int(edited.sum())
     i0 = run.start + k0
-    out.append(_text(run, k0, k1, lines[i0:i0 + n], comp, d, keep, change, ncomp,
-                     w.file_sep))
+    pending.append((len(out), (run, k0, k1, lines[i0:i0 + n], comp, d, keep, change, ncomp,
+                               w.file_sep)))
+    out.append(None)
 
 
 def _ffill_nan(event, initial):
@@ -148,14 +158,12 @@ def _ffill_nan(event, initial):
 
 
 def _text(run, k0, k1, contents, comp, d, keep, change, units, file_sep):
-    """The output text of lines ``k0`` to ``k1`` of a run (``contents`` their
-    ``(content, ending)``): unchanged lines as they were; changed lines with all three
-    axis words and their new numbers' decimals not trimmed (and below :data:`_EXACT`
-    units), as bytes (:func:`.plain_bytes.stretch_text`); the other changed lines one at
-    a time (:func:`_assemble`, :func:`surfcomp.io.gcode.emitter._fmt`)."""
+    """What :func:`.plain_bytes.stretch_text` takes for lines ``k0`` to ``k1`` of a run
+    (``contents`` their ``(content, ending)``): unchanged lines stay as they were; changed
+    lines with all three axis words and their new numbers' decimals not trimmed (and below
+    :data:`_EXACT` units) are built as bytes (``rows``); the other changed lines one at a
+    time (``other``: :func:`_assemble`, :func:`surfcomp.io.gcode.emitter._fmt`)."""
     edited = change.any(axis=1)
-    if not edited.any():
-        return "".join([c + e for c, e in contents])
     present = run.present[k0:k1]
     plain = (present.all(axis=1)
              & ((d >= 1) & (d == keep) & (np.abs(units) < _EXACT) | ~change).all(axis=1)
@@ -163,11 +171,32 @@ def _text(run, k0, k1, contents, comp, d, keep, change, units, file_sep):
     rows = np.flatnonzero(edited & plain)
     other = {}
     for k in np.flatnonzero(edited & ~plain).tolist():
-        t = tuple(c[k0 + k] for c in run.cols)
+        t = plain_groups(contents[k][0])
         nums = [_fmt(float(comp[k, a]), int(d[k, a]), int(keep[k, a])) if change[k, a]
                 else None for a in (0, 1, 2)]
         other[k] = _assemble(t, nums, file_sep) + contents[k][1]
-    return stretch_text(contents, run.size[k0:k1], units, d, change, rows, other)
+    return contents, run.size[k0:k1], units, d, change, rows, other
+
+
+def _block_text(stretches):
+    """The output texts of stretches (the arguments of :func:`_text` of each), built by
+    one :func:`.plain_bytes.stretch_text` of all their lines."""
+    if not stretches:
+        return []
+    parts = [_text(*a) for a in stretches]
+    if len(parts) == 1:
+        return [stretch_text(*parts[0])]
+    contents = []
+    other = {}
+    rows = []
+    for p in parts:
+        off = len(contents)
+        rows.append(p[5] + off)
+        other.update((k + off, t) for k, t in p[6].items())
+        contents.extend(p[0])
+    bounds = np.cumsum([len(p[0]) for p in parts])
+    cat = [np.concatenate([p[i] for p in parts]) for i in (1, 2, 3, 4)]
+    return stretch_text(contents, *cat, np.concatenate(rows), other, bounds=bounds)
 
 
 def _blank(s):
