@@ -207,7 +207,8 @@ def prefetch_normals(faces, sets):
     (``(face index, points (K, 3))``) with one projection per face: the projection of a
     point does not depend on the others projected with it, and one call of a few thousand
     edge points costs about what one of two hundred does (the edge points need the
-    engine's search for other minima, set up per call)."""
+    engine's search for other minima, set up per call); each set then gets its own pass
+    along its points (:func:`_project_along`), as :func:`normals_at` gives it."""
     todo = {}
     for i, pts in sets:
         pts = np.ascontiguousarray(pts, dtype=float)
@@ -218,11 +219,11 @@ def prefetch_normals(faces, sets):
         f = faces[i]
         allp = np.concatenate(list(parts.values()))
         p = f.project(allp)
-        n = normals(f.surface, p.u, p.v)
         start = 0
-        for key, pts in parts.items():
+        for key, pts in parts.items():      # each set's own pass along its points
             sl = slice(start, start + len(pts))
-            f.normals_cache[key] = (n[sl], p.u[sl], p.v[sl])
+            u, v = _project_along(f, pts, (p.u[sl], p.v[sl]))
+            f.normals_cache[key] = (normals(f.surface, u, v), u, v)
             start += len(pts)
 
 
@@ -239,15 +240,18 @@ def normals_at(f, pts):
     return n * f.outward, u, v
 
 
-def _project_along(f, pts):
+def _project_along(f, pts, found=None):
     """Parameters of the points nearest ``pts`` (K, 3), points in order along a curve (an
     edge's samples). Each point is tried again by Newton from its neighbours' feet, the
     closest foot kept: next to a blade side's boundary the projection stopped
     1 um off the face once in 200 samples, and where the pressure side
     curls back on itself (0.08 mm radius) it found a foot 0.06 um away with its normal
-    115 degrees off the edge's own; either turned the sharp edge's vector there."""
-    p = f.project(pts)
-    u, v = p.u.copy(), p.v.copy()
+    115 degrees off the edge's own; either turned the sharp edge's vector there.
+    ``found``: the projection's ``(u, v)`` of ``pts``, when already made."""
+    if found is None:
+        p = f.project(pts)
+        found = (p.u, p.v)
+    u, v = found[0].copy(), found[1].copy()
     ok = np.isfinite(u) & np.isfinite(v)
     if len(pts) < 2 or not ok.any():
         return u, v
