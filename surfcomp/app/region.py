@@ -219,12 +219,12 @@ def prefetch_normals(faces, sets):
         f = faces[i]
         allp = np.concatenate(list(parts.values()))
         p = f.project(allp)
-        start = 0
-        for key, pts in parts.items():      # each set's own pass along its points
-            sl = slice(start, start + len(pts))
-            u, v = _project_along(f, pts, (p.u[sl], p.v[sl]))
+        ends = np.cumsum([len(pts) for pts in parts.values()])
+        found = [(p.u[e - len(pts):e], p.v[e - len(pts):e])
+                 for e, pts in zip(ends, parts.values())]
+        # each set's own pass along its points, all sets in the same Newton runs
+        for key, (u, v) in zip(parts, _along(f, list(parts.values()), found)):
             f.normals_cache[key] = (normals(f.surface, u, v), u, v)
-            start += len(pts)
 
 
 def normals_at(f, pts):
@@ -251,25 +251,44 @@ def _project_along(f, pts, found=None):
     if found is None:
         p = f.project(pts)
         found = (p.u, p.v)
-    u, v = found[0].copy(), found[1].copy()
-    ok = np.isfinite(u) & np.isfinite(v)
-    if len(pts) < 2 or not ok.any():
-        return u, v
+    return _along(f, [pts], [found])[0]
+
+
+def _along(f, sets, found):
+    """:func:`_project_along` of several point sets at once (one Newton run per pass and
+    direction for all of them: a run's set-up costs more than two hundred points'
+    iterations); each point's neighbours are those of its own set."""
+    u = [x[0].copy() for x in found]
+    v = [x[1].copy() for x in found]
+    take_sets = [k for k, pts in enumerate(sets) if len(pts) >= 2
+                 and np.any(np.isfinite(u[k]) & np.isfinite(v[k]))]
+    if not take_sets:
+        return list(zip(u, v))
+    pts = np.concatenate([sets[k] for k in take_sets])
+    U, V = np.concatenate([u[k] for k in take_sets]), np.concatenate([v[k] for k in take_sets])
+    starts = np.cumsum([0] + [len(sets[k]) for k in take_sets])
     P = np.ascontiguousarray(pts.T)
+    ok = np.isfinite(U) & np.isfinite(V)
     best = np.full(len(pts), np.inf)
-    best[ok] = np.linalg.norm(evaluate(f.surface, u[ok], v[ok]) - pts[ok], axis=1)
+    best[ok] = np.linalg.norm(evaluate(f.surface, U[ok], V[ok]) - pts[ok], axis=1)
+    # each point's neighbour before it and after it in its set (the ends take the other)
+    before = np.concatenate([s + np.r_[1, np.arange(e - s - 1)]
+                             for s, e in zip(starts[:-1], starts[1:])])
+    after = np.concatenate([s + np.r_[np.arange(1, e - s), e - s - 2]
+                            for s, e in zip(starts[:-1], starts[1:])])
     for _ in range(2):      # a wrong foot's neighbours may have been wrong too
-        for seed in (np.r_[1, np.arange(len(pts) - 1)], np.r_[np.arange(1, len(pts)),
-                                                                  len(pts) - 2]):
+        for seed in (before, after):
             ok = np.isfinite(best[seed])
-            u2, v2, D, _conv = f.projector.newton.run(P[:, ok], u[seed[ok]], v[seed[ok]])
+            u2, v2, D, _conv = f.projector.newton.run(P[:, ok], U[seed[ok]], V[seed[ok]])
             # the closer point on the face wins, converged or not (Newton stops short of
             # a foot on the face's boundary at times; it is still a point of the face)
             d = np.linalg.norm(D[0] - P[:, ok], axis=0)
             k = np.flatnonzero(ok)
             take = d < best[k] - 1e-12
-            best[k[take]], u[k[take]], v[k[take]] = d[take], u2[take], v2[take]
-    return u, v
+            best[k[take]], U[k[take]], V[k[take]] = d[take], u2[take], v2[take]
+    for j, k in enumerate(take_sets):
+        u[k], v[k] = U[starts[j]:starts[j + 1]], V[starts[j]:starts[j + 1]]
+    return list(zip(u, v))
 
 
 def _vec(p):
