@@ -2,7 +2,8 @@
 """Region compensation of the 4-face BladeX blade (issue 30), whole process, beside
 FreeCAD's floor of reading and writing the same STEP file.
 
-    /usr/bin/python3 bench/bench_region.py [--points 200000] [--keep DIR]
+    /usr/bin/python3 bench/bench_region.py [--points 200000] [--keep DIR [--reuse]]
+        [--tree DIR] [--repeat 1]
 
 * the blade (tests/data/real/cad/BladeX: upper, lower, tip, root; a compound of faces, as
   OpenCASCADE does not sew its knife edges) written as STEP, with N points spread over its
@@ -16,13 +17,17 @@ FreeCAD's floor of reading and writing the same STEP file.
 
 Prints both times, their ratio, and the continuity figures (largest gap and normal angle
 per shared edge) from the JSON report. Absolute seconds depend on the machine and its
-load; the ratio is the figure to compare.
+load; the ratio is the figure to compare. ``--tree DIR`` also runs another checkout's
+command (e.g. the code before a change) on the same files, alternated with this one's
+(A B A B, ``--repeat`` times each), and prints the medians and the load average before
+and after.
 """
 
 import argparse
 import json
 import os
 import resource
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -64,36 +69,85 @@ def make_inputs(folder, points):
     return step, csv, len(pts)
 
 
-def timed(cmd):
+def timed(cmd, cwd=ROOT):
     """Wall seconds, the result, and the child's CPU seconds (user + system, all its
     threads): on a shared machine the wall time follows the load, the CPU time less so."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    r = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
     wall = time.perf_counter() - t
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     r.cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     return wall, r
 
 
+def alternate(folder, step, csv, tree, repeat):
+    """Median wall and CPU seconds of this checkout's run and ``tree``'s, alternated;
+    the first result of each (exit status, output)."""
+    runs = {ROOT: []} if tree is None else {ROOT: [], os.path.abspath(tree): []}
+    first = {}
+    for _ in range(repeat):
+        for i, t in enumerate(runs):
+            out = os.path.join(folder, "out%d.step" % i)
+            rep = os.path.join(folder, "out%d.json" % i)
+            wall, r = timed([sys.executable, "-m", "surfcomp", "compensate", step, csv,
+                             "--faces", "auto", "-o", out, "--report", rep, "--quiet"], t)
+            if r.returncode:
+                print("%s: exit %d\n%s" % (t, r.returncode, r.stdout + r.stderr))
+                raise SystemExit(r.returncode)
+            runs[t].append((wall, r.cpu))
+            first.setdefault(t, (r, rep))
+    return {t: (statistics.median(w for w, _ in v), statistics.median(c for _, c in v))
+            for t, v in runs.items()}, first
+
+
+def largest_difference(a, b):
+    """Largest relative difference between the numbers of two reports of the same shape
+    (inf where their texts or shapes differ; the input paths are not compared)."""
+    if isinstance(a, dict) and isinstance(b, dict) and a.keys() == b.keys():
+        return max([largest_difference(a[k], b[k]) for k in a if k != "inputs"], default=0.0)
+    if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
+        return max([largest_difference(x, y) for x, y in zip(a, b)], default=0.0)
+    if isinstance(a, float) and isinstance(b, (int, float)):
+        return abs(a - b) / max(abs(a), abs(b), 1e-300) if a != b else 0.0
+    return 0.0 if a == b else float("inf")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--points", type=int, default=200000)
     ap.add_argument("--keep", metavar="DIR")
+    ap.add_argument("--tree", metavar="DIR", help="also run the command of this checkout")
+    ap.add_argument("--repeat", type=int, default=1, help="runs of each, alternated")
+    ap.add_argument("--reuse", action="store_true",
+                    help="take blade.step and points.csv of --keep DIR as they are")
     a = ap.parse_args(argv)
+    if a.reuse and not a.keep:
+        ap.error("--reuse takes the files of --keep DIR")
     folder = a.keep or tempfile.mkdtemp(prefix="bench-region-")
     os.makedirs(folder, exist_ok=True)
-    step, csv, n = make_inputs(folder, a.points)
-    out, rep = os.path.join(folder, "out.step"), os.path.join(folder, "out.json")
-    t_region, r = timed([sys.executable, "-m", "surfcomp", "compensate", step, csv,
-                         "--faces", "auto", "-o", out, "--report", rep, "--quiet"])
-    if r.returncode:
-        print(r.stdout + r.stderr)
-        return r.returncode
+    if a.reuse:
+        step, csv = os.path.join(folder, "blade.step"), os.path.join(folder, "points.csv")
+        n = sum(1 for _ in open(csv)) - 1
+    else:
+        step, csv, n = make_inputs(folder, a.points)
+    load = os.getloadavg()
+    medians, first = alternate(folder, step, csv, a.tree, max(1, a.repeat))
+    (t_region, cpu), (r, rep) = medians[ROOT], first[ROOT]
+    r.cpu = cpu
     t_floor, f = timed([sys.executable, "-c", FLOOR, step, os.path.join(folder, "copy.step")])
     if f.returncode:
         print(f.stderr)
         return f.returncode
+    if a.tree:
+        print("load average before %.2f %.2f %.2f, after %.2f %.2f %.2f"
+              % (load + os.getloadavg()))
+        for t, (wall, c) in medians.items():
+            print("%s: %.2f s wall, %.2f s CPU (median of %d)" % (t, wall, c, a.repeat))
+        other = [t for t in medians if t != ROOT][0]
+        diff = largest_difference(json.load(open(first[other][1])), json.load(open(rep)))
+        print("the two reports: %s" % ("identical" if diff == 0.0 else
+                                       "largest relative difference of a figure %.1e" % diff))
     data = json.load(open(rep))
     print("blade, 4 faces, %d points" % n)
     print("surfcomp compensate --faces auto: %.2f s wall, %.2f s CPU (target 15 s)"

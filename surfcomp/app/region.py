@@ -61,9 +61,13 @@ class RegionFace:
         """Closest points on the face's nominal; one projection engine per face (its seed
         grid and tables cost about a second on a blade side, and a run projects onto each
         face a dozen times)."""
+        return self.engine(len(points)).project(np.asarray(points, dtype=float), max_distance)
+
+    def engine(self, count):
+        """The face's projection engine, made for ``count`` points on first use."""
         if self.projector is None:      # seeds as dense as project() takes for a cloud
-            self.projector = Projector(self.surface, min_samples=len(points) // 16)
-        return self.projector.project(np.asarray(points, dtype=float), max_distance)
+            self.projector = Projector(self.surface, min_samples=count // 16)
+        return self.projector
 
 
 @dataclass
@@ -130,32 +134,28 @@ def locate(faces, base, max_offset, found=None):
 
 
 def project_all(faces, base, max_offset):
-    """Each face's distance from every point in its widened bounding box, inside its trim
-    (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face."""
-    dist = np.full((len(faces), len(base)), np.inf)
-    res = []
-    may = _sample_distances(faces, base, max_offset)
-    for i, f in enumerate(faces):
-        idx = np.flatnonzero(may[i])
-        p = f.project(base[idx], max_distance=max_offset) if len(idx) else None
-        res.append((idx, p))
-        if p is None:
-            continue
-        ok = p.converged.copy()
-        ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
-        dist[i, idx[ok]] = np.abs(p.distance[ok])
-    return dist, res
+    """Each face's distance from every point that may have it as its nearest face, inside
+    its trim (F, N; inf elsewhere), and the projections ``(indices, Projection)`` per face.
+
+    In two rounds (:mod:`surfcomp.app.region_project`): each point first on the face of
+    its nearest sample, then on the other faces only where a lower bound of their distance
+    does not exceed the distance found (a blade side's box holds the other side's points,
+    which lie off the face and cost twice a point on it)."""
+    from .region_project import two_rounds
+
+    return two_rounds(faces, base, max_offset, _sample_distances(faces, base, max_offset))
 
 
 def _sample_distances(faces, base, max_offset, n=200):
     """Per face, which points may have it as their nearest face, from an n x n grid of
     samples on each: a face's distance from a point is at least its nearest sample's less
     the grid's covering radius, and at most the nearest sample's on any face. (A blade
-    side's box holds the other side's points too; projecting them would double the work.)"""
+    side's box holds the other side's points too; projecting them would double the work.)
+    Returns that (F, N) mask and, per point, the face of its nearest sample (-1: none)."""
     from ..core.surface.bspline import evaluate_grid
 
     low = np.full((len(faces), len(base)), np.inf)
-    high = np.full(len(base), np.inf)
+    near = np.full((len(faces), len(base)), np.inf)
     for i, f in enumerate(faces):
         bb = f.face.BoundBox
         idx = np.flatnonzero(np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset)
@@ -165,15 +165,24 @@ def _sample_distances(faces, base, max_offset, n=200):
             continue
         u0, u1, v0, v1 = f.bface.ParameterRange
         g = evaluate_grid(f.surface, np.linspace(u0, u1, n), np.linspace(v0, v1, n))
-        r = 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
-                            np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
+        r = covering_radius(g)
         # a point farther than max_offset + r from every sample is not near the face: the
         # bound ends its search early (most of a small cap's box is the sides' points)
         d, _ = cKDTree(g.reshape(-1, 3)).query(base[idx], k=1,
-                                               distance_upper_bound=max_offset + r)
+                                               distance_upper_bound=max_offset + r,
+                                               workers=-1)
         low[i, idx] = d - r
-        high[idx] = np.minimum(high[idx], d)
-    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9)
+        near[i, idx] = d
+    high = np.min(near, axis=0)
+    first = np.where(np.isfinite(high), np.argmin(near, axis=0), -1)
+    return (low <= np.minimum(high, max_offset)[None, :] + 1e-9), first
+
+
+def covering_radius(g):
+    """Half the longest cell diagonal of a grid of points ``g`` (nu, nv, 3): every point
+    of the surface lies within it of a sample."""
+    return 0.5 * float(max(np.max(np.linalg.norm(g[1:, 1:] - g[:-1, :-1], axis=2)),
+                           np.max(np.linalg.norm(g[1:, :-1] - g[:-1, 1:], axis=2))))
 
 
 def face_samples(f, n=60):
@@ -193,6 +202,31 @@ def _edge_points(edge, n=EDGE_SAMPLES):
     return np.array([tuple(edge.valueAt(float(t))) for t in ts])
 
 
+def prefetch_normals(faces, sets):
+    """Fill the faces' normal caches (:func:`normals_at`) for the point sets ``sets``
+    (``(face index, points (K, 3))``) with one projection per face: the projection of a
+    point does not depend on the others projected with it, and one call of a few thousand
+    edge points costs about what one of two hundred does (the edge points need the
+    engine's search for other minima, set up per call); each set then gets its own pass
+    along its points (:func:`_project_along`), as :func:`normals_at` gives it."""
+    todo = {}
+    for i, pts in sets:
+        pts = np.ascontiguousarray(pts, dtype=float)
+        key = pts.tobytes()
+        if len(pts) and key not in faces[i].normals_cache:
+            todo.setdefault(i, {})[key] = pts
+    for i, parts in todo.items():
+        f = faces[i]
+        allp = np.concatenate(list(parts.values()))
+        p = f.project(allp)
+        ends = np.cumsum([len(pts) for pts in parts.values()])
+        found = [(p.u[e - len(pts):e], p.v[e - len(pts):e])
+                 for e, pts in zip(ends, parts.values())]
+        # each set's own pass along its points, all sets in the same Newton runs
+        for key, (u, v) in zip(parts, _along(f, list(parts.values()), found)):
+            f.normals_cache[key] = (normals(f.surface, u, v), u, v)
+
+
 def normals_at(f, pts):
     """Outward unit normals of face ``f``'s nominal at its points nearest ``pts`` (K, 3),
     and their parameters. Kept per face and point set: the sharp edges, the neighbour check
@@ -206,33 +240,55 @@ def normals_at(f, pts):
     return n * f.outward, u, v
 
 
-def _project_along(f, pts):
+def _project_along(f, pts, found=None):
     """Parameters of the points nearest ``pts`` (K, 3), points in order along a curve (an
     edge's samples). Each point is tried again by Newton from its neighbours' feet, the
     closest foot kept: next to a blade side's boundary the projection stopped
     1 um off the face once in 200 samples, and where the pressure side
     curls back on itself (0.08 mm radius) it found a foot 0.06 um away with its normal
-    115 degrees off the edge's own; either turned the sharp edge's vector there."""
-    p = f.project(pts)
-    u, v = p.u.copy(), p.v.copy()
-    ok = np.isfinite(u) & np.isfinite(v)
-    if len(pts) < 2 or not ok.any():
-        return u, v
+    115 degrees off the edge's own; either turned the sharp edge's vector there.
+    ``found``: the projection's ``(u, v)`` of ``pts``, when already made."""
+    if found is None:
+        p = f.project(pts)
+        found = (p.u, p.v)
+    return _along(f, [pts], [found])[0]
+
+
+def _along(f, sets, found):
+    """:func:`_project_along` of several point sets at once (one Newton run per pass and
+    direction for all of them: a run's set-up costs more than two hundred points'
+    iterations); each point's neighbours are those of its own set."""
+    u = [x[0].copy() for x in found]
+    v = [x[1].copy() for x in found]
+    take_sets = [k for k, pts in enumerate(sets) if len(pts) >= 2
+                 and np.any(np.isfinite(u[k]) & np.isfinite(v[k]))]
+    if not take_sets:
+        return list(zip(u, v))
+    pts = np.concatenate([sets[k] for k in take_sets])
+    U, V = np.concatenate([u[k] for k in take_sets]), np.concatenate([v[k] for k in take_sets])
+    starts = np.cumsum([0] + [len(sets[k]) for k in take_sets])
     P = np.ascontiguousarray(pts.T)
+    ok = np.isfinite(U) & np.isfinite(V)
     best = np.full(len(pts), np.inf)
-    best[ok] = np.linalg.norm(evaluate(f.surface, u[ok], v[ok]) - pts[ok], axis=1)
+    best[ok] = np.linalg.norm(evaluate(f.surface, U[ok], V[ok]) - pts[ok], axis=1)
+    # each point's neighbour before it and after it in its set (the ends take the other)
+    before = np.concatenate([s + np.r_[1, np.arange(e - s - 1)]
+                             for s, e in zip(starts[:-1], starts[1:])])
+    after = np.concatenate([s + np.r_[np.arange(1, e - s), e - s - 2]
+                            for s, e in zip(starts[:-1], starts[1:])])
     for _ in range(2):      # a wrong foot's neighbours may have been wrong too
-        for seed in (np.r_[1, np.arange(len(pts) - 1)], np.r_[np.arange(1, len(pts)),
-                                                                  len(pts) - 2]):
+        for seed in (before, after):
             ok = np.isfinite(best[seed])
-            u2, v2, D, _conv = f.projector.newton.run(P[:, ok], u[seed[ok]], v[seed[ok]])
+            u2, v2, D, _conv = f.projector.newton.run(P[:, ok], U[seed[ok]], V[seed[ok]])
             # the closer point on the face wins, converged or not (Newton stops short of
             # a foot on the face's boundary at times; it is still a point of the face)
             d = np.linalg.norm(D[0] - P[:, ok], axis=0)
             k = np.flatnonzero(ok)
             take = d < best[k] - 1e-12
-            best[k[take]], u[k[take]], v[k[take]] = d[take], u2[take], v2[take]
-    return u, v
+            best[k[take]], U[k[take]], V[k[take]] = d[take], u2[take], v2[take]
+    for j, k in enumerate(take_sets):
+        u[k], v[k] = U[starts[j]:starts[j + 1]], V[starts[j]:starts[j + 1]]
+    return list(zip(u, v))
 
 
 def _vec(p):
@@ -267,30 +323,62 @@ def shared_edges(shape, faces, all_faces=False, angles=True):
         return polys[(k, j)]
 
     region = {f.index: i for i, f in enumerate(faces)}
+    shape_faces = shape.Faces
+    boxes, edges = {}, {}
+
+    def of(k):      # a face's box and (edge, degenerated, length), read from OCC once
+        if k not in edges:
+            g = shape_faces[k]
+            boxes[k] = g.BoundBox
+            edges[k] = [(e, e.Degenerated, e.Length) for e in g.Edges]
+        return boxes[k], edges[k]
+
     for i, f in enumerate(faces):
-        others = range(len(shape.Faces)) if all_faces else [g.index for g in faces[i + 1:]]
+        others = range(len(shape_faces)) if all_faces else [g.index for g in faces[i + 1:]]
+        box_a, edges_a = of(f.index)
         for k in others:
             if k == f.index or (all_faces and k in region):
                 continue
-            g = shape.Faces[k]
-            if not f.face.BoundBox.intersect(g.BoundBox):
+            box_b, edges_b = of(k)
+            if not box_a.intersect(box_b):
                 continue
-            for ja, ea in enumerate(f.face.Edges):
-                if ea.Degenerated or ea.Length < 1e-6:
-                    continue
-                pa = poly(f.index, ja, ea)
-                for jb, eb in enumerate(g.Edges):
-                    if eb.Degenerated or abs(eb.Length - ea.Length) > 0.01 * ea.Length + \
-                            SHARE_TOL:
-                        continue
-                    if _near_polyline(pa[::8], poly(k, jb, eb)) > SHARE_TOL:
-                        continue
-                    pts = _edge_points(ea)
-                    b = region[k] if not all_faces else -1 - k
-                    ang = _nominal_angle(f, faces[region[k]] if k in region else g,
-                                         pts) if angles else float("nan")
-                    out.append(SharedEdge(i, b, ja, jb, pts, ang))
+            for ja, jb, ea in _matches(edges_a, edges_b, lambda j, e, k=f.index: poly(k, j, e),
+                                       lambda j, e, k=k: poly(k, j, e)):
+                b = region[k] if not all_faces else -1 - k
+                out.append(SharedEdge(i, b, ja, jb, _edge_points(ea), float("nan")))
+    if angles:
+        # every normal the run asks for along the edges, one projection per face
+        prefetch_normals(faces, [(j, p) for e in out for j in (e.a, e.b) if j >= 0
+                                 for p in edge_point_sets(e.samples)])
+        for e in out:
+            g = faces[e.b] if e.b >= 0 else shape.Faces[-1 - e.b]
+            e.nominal_angle = _nominal_angle(faces[e.a], g, e.samples)
     return out
+
+
+def edge_point_sets(samples):
+    """The point sets along an edge whose normals the run takes: the samples (sharp
+    edges, continuity), every tenth (the nominal angle) and the midpoints (continuity)."""
+    return samples, samples[::10], midpoints(samples)
+
+
+def midpoints(samples):
+    return 0.5 * (samples[1:] + samples[:-1])
+
+
+def _matches(edges_a, edges_b, poly_a, poly_b):
+    """``(ja, jb, edge a)`` of the edges of two faces (``(edge, degenerated, length)``)
+    that are one edge: lengths within 1 %, and every eighth point of a's polyline
+    (``poly_a(j, edge)``) within SHARE_TOL of b's."""
+    for ja, (ea, degenerated_a, length_a) in enumerate(edges_a):
+        if degenerated_a or length_a < 1e-6:
+            continue
+        pa = poly_a(ja, ea)
+        for jb, (eb, degenerated_b, length_b) in enumerate(edges_b):
+            if degenerated_b or abs(length_b - length_a) > 0.01 * length_a + SHARE_TOL:
+                continue
+            if _near_polyline(pa[::8], poly_b(jb, eb)) <= SHARE_TOL:
+                yield ja, jb, ea
 
 
 def _nominal_angle(f, g, pts):
@@ -374,7 +462,7 @@ def continuity(faces, edges):
     them); fills ``edge.figures``."""
     for e in edges:
         fa, fb = faces[e.a], faces[e.b]
-        mids = 0.5 * (e.samples[1:] + e.samples[:-1])
+        mids = midpoints(e.samples)
         ma, ua, va = (np.concatenate(x) for x in zip(normals_at(fa, e.samples),
                                                       normals_at(fa, mids)))
         mb, ub, vb = (np.concatenate(x) for x in zip(normals_at(fb, e.samples),

@@ -17,6 +17,7 @@ from ..io.readers import read_any
 from . import fcenv, region, region_retrim
 from .file_route import cad_format
 from .region_orient import orient
+from .region_project import per_face
 from .retrim import PRECISION
 
 #: faces with fewer points than this are not taken by --faces auto
@@ -144,14 +145,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     closed = _closed(shape)
     if not closed:      # a compound of faces: nothing to re-trim its neighbours in
         _check_neighbours(shape, faces, fld, sharp)
-    for i, f in enumerate(faces):
-        f.built = region_build.corrected_surface(f.surface, f.outward, fld,
-                                                 sharp and sharp.for_face(i),
-                                                 knot_step=field_radius / 5.0,
-                                                 max_factor=max_factor)
-        from .convert import surface_to_part
-
-        f.part_surface = surface_to_part(f.built.surface)
+    _build(faces, fld, sharp, field_radius, max_factor)
     figures = region.continuity(faces, edges)
     fidelity = _fidelity(faces, owner, u, v, fld, base, normal, sharp)
     rep = _report(nominal, measurements, faces, counts, int(np.sum(~on)), figures, fidelity,
@@ -202,25 +196,40 @@ def _check_neighbours(shape, faces, fld, sharp):
                 % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
+def _build(faces, fld, sharp, field_radius, max_factor):
+    """Every face's corrected surface (``f.built``, ``f.part_surface``)."""
+    from .convert import surface_to_part
+
+    def one(i):
+        return region_build.corrected_surface(faces[i].surface, faces[i].outward, fld,
+                                              sharp and sharp.for_face(i),
+                                              knot_step=field_radius / 5.0,
+                                              max_factor=max_factor)
+
+    for f, built in zip(faces, per_face(faces, one)):
+        f.built = built
+        f.part_surface = surface_to_part(built.surface)
+
+
 def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
     """Per face: the largest |realised - intended| at its points (um), and the same beyond
     the zones where a knife edge or a vertex is moved by one vector (there the design
     itself falls short of the correction: those points' count and largest shortfall)."""
-    out = {}
-    for i, f in enumerate(faces):
+    def one(i):
         k = np.flatnonzero(owner == i)
         if not len(k):
-            continue
+            return None
         intended = fld(base[k])
-        miss = np.abs(realised(f, u[k], v[k], intended) - intended) * 1e3
+        miss = np.abs(realised(faces[i], u[k], v[k], intended) - intended) * 1e3
         share = region_build.designed_share(base[k], normal[k], sharp)
         zone = np.abs(share - 1.0) > 1e-9
-        out[f.name] = {"all": float(np.max(miss)),
-                       "beyond": float(np.max(miss[~zone])) if np.any(~zone) else None,
-                       "zone_points": int(np.sum(zone)),
-                       "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
-                       * 1e3 if np.any(zone) else 0.0}
-    return out
+        return {"all": float(np.max(miss)),
+                "beyond": float(np.max(miss[~zone])) if np.any(~zone) else None,
+                "zone_points": int(np.sum(zone)),
+                "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
+                * 1e3 if np.any(zone) else 0.0}
+
+    return {f.name: fid for f, fid in zip(faces, per_face(faces, one)) if fid is not None}
 
 
 def realised(f, u, v, guess):

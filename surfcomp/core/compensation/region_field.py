@@ -38,6 +38,10 @@ FALLBACK = ((4.0, 1e-3), (16.0, 1e-6))
 MEAN_WEIGHT = 1e-12
 #: cell size of the field's kernel centres, as a share of R
 CELL = 1.0 / 3.0
+#: block size of the field's kernel sums, as a share of the kernel's radius
+BLOCK = 0.5
+#: kernel values of one dense block of the field's sums at most (memory: 8 bytes each)
+BLOCK_VALUES = 1 << 20
 
 
 def wendland(s):
@@ -46,12 +50,20 @@ def wendland(s):
     return (1.0 - s) ** 4 * (4.0 * s + 1.0)
 
 
+def wendland_unclipped(s):
+    """:func:`wendland` of ``s`` already in ``[0, 1]`` (no copy, fewer passes)."""
+    t = 1.0 - s
+    t *= t
+    t *= t
+    return t * (4.0 * s + 1.0)
+
+
 def spacing(points):
     """Median distance (mm) of each point to its nearest neighbour."""
     points = np.asarray(points, dtype=float)
     if len(points) < 2:
         raise InputError("a region needs at least two measured points")
-    d, _ = cKDTree(points).query(points, k=2)
+    d, _ = cKDTree(points).query(points, k=2, workers=-1)
     return float(np.median(d[:, 1]))
 
 
@@ -120,6 +132,22 @@ def mask_filter_3d(points, d, mask_size=WERNER_MASK_SIZE, kind="box", sigma=None
     return num / den
 
 
+def _cells(key):
+    """``np.unique(key, axis=0, return_inverse=True, return_counts=True)[1:]`` for integer
+    rows (M, 3): the cells in the same (lexicographic) order, from one integer per row
+    (several times faster than sorting the rows)."""
+    if not len(key):
+        return np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp)
+    k = key - key.min(axis=0)
+    ext = k.max(axis=0) + 1
+    if float(ext[0]) * float(ext[1]) * float(ext[2]) >= 2.0 ** 62:
+        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        return inv.ravel(), count
+    _, inv, count = np.unique((k[:, 0] * ext[1] + k[:, 1]) * ext[2] + k[:, 2],
+                              return_inverse=True, return_counts=True)
+    return inv, count
+
+
 class RegionField:
     """The correction field ``delta(x)`` of a region (mm, positive: into the material).
 
@@ -138,9 +166,7 @@ class RegionField:
         values = np.asarray(values, dtype=float)
         self.radius = float(radius)
         cell = CELL * self.radius
-        key = np.floor(points / cell).astype(np.int64)
-        _, inv, count = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-        inv = inv.ravel()
+        inv, count = _cells(np.floor(points / cell).astype(np.int64))
         self.centres = np.stack([np.bincount(inv, weights=points[:, k]) / count
                                  for k in range(3)], axis=1)
         self.values = np.bincount(inv, weights=values) / count
@@ -149,19 +175,42 @@ class RegionField:
         self._tree = cKDTree(self.centres)
 
     def _sums(self, x, radius):
-        num = np.zeros(len(x))
-        den = np.zeros(len(x))
-        for start in range(0, len(x), 20000):
-            xs = x[start:start + 20000]
-            other = cKDTree(xs)
-            m = other.sparse_distance_matrix(self._tree, radius, output_type="ndarray")
-            if len(m) == 0:
+        """``sum_j phi_j w_j c_j`` and ``sum_j phi_j w_j`` at the points ``x`` (M, 3).
+
+        The points are taken in blocks of :data:`BLOCK` x ``radius`` (sorted by block);
+        each block's candidate centres are those within ``radius`` plus the block's half
+        diagonal of its middle (one ball query for all blocks), and the block's kernel
+        values are one dense matrix against them, summed by a matrix product (candidates
+        beyond ``radius`` get ``phi = 0``). About twice as fast as the pairs of a sparse
+        distance matrix, and the same sums up to rounding."""
+        out = np.zeros((len(x), 2))
+        if not len(x):
+            return out[:, 0], out[:, 1]
+        key = np.floor(x / (BLOCK * radius)).astype(np.int64)
+        order = np.lexsort(key.T[::-1])
+        xs, key = x[order], key[order]
+        starts = np.r_[0, np.flatnonzero(np.any(np.diff(key, axis=0) != 0, axis=1)) + 1]
+        ends = np.r_[starts[1:], len(x)]
+        lo, hi = np.minimum.reduceat(xs, starts), np.maximum.reduceat(xs, starts)
+        mid = 0.5 * (lo + hi)
+        half = 0.5 * np.linalg.norm(hi - lo, axis=1)
+        candidates = self._tree.query_ball_point(mid, radius + half)
+        wv = np.stack([self.weights * self.values, self.weights], axis=1)
+        sums = np.zeros((len(x), 2))
+        for a, b, c, m in zip(starts, ends, candidates, mid):
+            if not c:
                 continue
-            w = wendland(m["v"] / radius) * self.weights[m["j"]]
-            num[start:start + len(xs)] += np.bincount(m["i"], weights=w * self.values[m["j"]],
-                                                      minlength=len(xs))
-            den[start:start + len(xs)] += np.bincount(m["i"], weights=w, minlength=len(xs))
-        return num, den
+            c = np.asarray(c)
+            q = self.centres[c] - m         # about the block's middle: no cancellation
+            qq = np.einsum("ij,ij->i", q, q)
+            rows = max(1, BLOCK_VALUES // len(c))
+            for s in range(a, b, rows):
+                p = xs[s:min(s + rows, b)] - m
+                d2 = np.einsum("ij,ij->i", p, p)[:, None] + qq[None, :] - 2.0 * (p @ q.T)
+                t = np.sqrt(np.maximum(d2, 0.0)) / radius
+                sums[s:s + len(p)] = wendland_unclipped(np.minimum(t, 1.0)) @ wv[c]
+        out[order] = sums
+        return out[:, 0], out[:, 1]
 
     def __call__(self, x):
         """``delta`` at points ``x`` (shape (M, 3)), mm."""
