@@ -31,6 +31,7 @@ from surfcomp.io.gcode import (
     compensate_stream,
     parse_gcode,
     read_gcode,
+    stream,
 )
 from tests.conftest import REALDATA, ROOT
 
@@ -112,10 +113,10 @@ def test_too_many_segments_are_refused_before_planning(tmp_path, capsys, monkeyp
     """bear.nc has 14 806 mm of cutting moves: 1 um pieces would be 14.8 million points
     (the bound is 10 million); the estimate is exact and refused without sampling.
 
-    The command line's refusal is checked with the limit lowered to 200 000 points (0.05 mm
-    pieces, 304 000 points): the program is read in blocks, and the blocks below the limit
-    are compensated before the total is known, so at the real limit the run would first
-    plan 10 million points for nothing but time."""
+    The command line reads the program in blocks; a first pass adds up the blocks'
+    estimates before any block is planned, so the refusal at the real limit comes at once
+    (it used to plan the blocks below the limit first: some 37 s). No block is planned:
+    the planning function is counted."""
     prog, _ = parse_gcode(read_gcode(BEAR))
     est = estimate_segments(prog, 0.001, 0.001)
     assert est.total > MAX_SEGMENTS
@@ -129,7 +130,23 @@ def test_too_many_segments_are_refused_before_planning(tmp_path, capsys, monkeyp
     assert "expected a --segment-length of at least 0.00149 mm" in err
     # the suggested length is enough
     assert estimate_segments(prog, 0.00149, 0.001).total <= MAX_SEGMENTS
-    # the command line: the same refusal, exit 2, nothing written
+    # the command line at the real limit: the same refusal, exit 2, nothing written, and
+    # not one block planned
+    planned = []
+
+    def counted(*args, **kwargs):
+        planned.append(args[0].n_moves)
+        return plan_moves(*args, **kwargs)
+
+    monkeypatch.setattr(stream, "plan_moves", counted)
+    err = _refused(tmp_path, capsys, BEAR, "--segment-length", "0.001")
+    assert "%s: --segment-length 0.001 mm" % BEAR in err
+    assert "about 1.48e+07 segments, more than the 10000000" in err
+    assert "expected a --segment-length of at least 0.00149 mm" in err
+    assert planned == []
+    # ... and with a lower limit the refusal names that limit and what meets it (0.05 mm
+    # pieces: 304 000 points; the first block of 10 000 lines alone needs 173 000, which
+    # a run without the first pass planned before it refused)
     limit = 200000
     assert estimate_segments(prog, 0.05, 0.001).total > limit
     monkeypatch.setattr(gcode_cli, "compensate_stream",
@@ -139,6 +156,11 @@ def test_too_many_segments_are_refused_before_planning(tmp_path, capsys, monkeyp
     assert "about 3.04e+05 segments, more than the 200000" in err
     assert "expected a --segment-length of at least 0.0801 mm" in err
     assert estimate_segments(prog, 0.0801, 0.001).total <= limit
+    assert planned == []
+    # the counter counts: an accepted run plans every block
+    rc, stderr, _out = _run(tmp_path, capsys, BEAR, "--segment-length", "0.0801")
+    assert rc == 0, stderr
+    assert sum(planned) == prog.n_moves == 15159
 
 
 def test_tiny_arc_tolerance_names_its_option(tmp_path, capsys):

@@ -108,8 +108,9 @@ AXIS_CSV = "axis,position,ex,ey,ez\nX,0,0,0,0\nX,100,0.01,0.002,0\nY,0,0,0,0\nY,
     ("G1 X90000", ":%d: the error model predicts an error of"),
 ])
 def test_a_refusal_on_the_last_line_writes_nothing(last, says, tmp_path, capsys, monkeypatch):
-    """The earlier blocks are written to the staged output before the last one is read
-    (the first look at the file for its word separator stops after 200 lines)."""
+    """A point out of bounds on the last line: the earlier blocks are written to the
+    staged output before the last one is compensated (a read error there is refused by
+    the first pass, :mod:`surfcomp.io.gcode.prescan`, before any block is written)."""
     monkeypatch.setattr(stream, "BLOCK_LINES", 3)
     body = "G21 G90\nG0 X0 Y0 Z5\nG1 Z0 F300\n" + "".join(
         "G1 X%d Y%d\n" % (k % 90, (3 * k) % 90) for k in range(300))

@@ -77,6 +77,11 @@ class SegmentEstimate:
     by_angle: float
     length: float
 
+    def __add__(self, other):
+        """The estimate of two parts of a program together."""
+        return SegmentEstimate(self.total + other.total, self.by_angle + other.by_angle,
+                               self.length + other.length)
+
 
 def estimate_segments(prog, segment_length, arc_tolerance):
     """Count the points :func:`plan_moves` would sample, without sampling them.

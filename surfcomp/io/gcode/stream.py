@@ -11,9 +11,12 @@ byte for byte, whatever the block size.
 
 What the whole program decides is added up as the blocks go (:class:`Compensator`): the
 statistics, the segment count, the bounds check and the warnings; the separator style
-and the line ending new lines use come from a first look at the file's start. A refusal
-found in a late block is raised before anything is committed (the caller writes into a
-staged file, :class:`surfcomp.io.atomic.Transaction`).
+and the line ending new lines use come from a first look at the file's start. The segment
+count is also known before the first block is planned: a first pass reads the program's
+blocks and adds up their estimates without planning (:mod:`.prescan`), so a program that
+needs too many is refused at once. Any other refusal found in a late block is raised
+before anything is committed (the caller writes into a staged file,
+:class:`surfcomp.io.atomic.Transaction`).
 """
 
 import io
@@ -39,6 +42,7 @@ from .interpreter import _Interpreter, parse_gcode
 from .lexer import BOM, decode, tokenize
 from .plain import read_block
 from .plain_write import write_block
+from .prescan import check_program_segments
 from .result import GCodeResult
 from .totals import BoundsCheck, PointTotals
 
@@ -166,6 +170,7 @@ class Compensator:
         self.max_segments = max_segments
         self.dmin_mm = DEFAULT_DECIMALS["mm"] if decimals is None else int(decimals)
         self.dmin_in = DEFAULT_DECIMALS["in"] if decimals is None else int(decimals)
+        self.start = start
         self.interp = _Interpreter(source, start, False)
         self.writer = _TextWriter(sep, eol, None if start is None
                                   else np.array(start, dtype=float).reshape(3),
@@ -186,6 +191,14 @@ class Compensator:
         return self.program(self.interp.take_moves(infos, self.interp.warnings), lines, base,
                             runs)
 
+    def prescan(self, blocks):
+        """Refuse the program whose lines come in ``blocks`` (all of them, read before
+        :meth:`lines` reads any) when it needs more than ``max_segments`` segments: the
+        refusal :meth:`finish` would raise, without planning anything
+        (:func:`.prescan.check_program_segments`)."""
+        check_program_segments(blocks, self.lengths[0], self.lengths[2], self.max_segments,
+                               self.names, self.start, self.source)
+
     def program(self, prog, lines, base, runs=()):
         """Compensate the interpreted block ``prog`` of ``lines`` (from line index ``base``
         on; ``runs`` of plain lines read as arrays, :func:`.plain.read_block`); its output
@@ -194,9 +207,7 @@ class Compensator:
         self.words = self.words or not prog.is_empty()
         self.n_moves += prog.n_moves
         seg, tol, arc_tol = self.lengths
-        est = estimate_segments(prog, seg, arc_tol)
-        self.est = SegmentEstimate(self.est.total + est.total, self.est.by_angle + est.by_angle,
-                                   self.est.length + est.length)
+        self.est = self.est + estimate_segments(prog, seg, arc_tol)
         if self.est.total > self.max_segments:
             return ""
         if self.visit is not None:
@@ -270,9 +281,14 @@ def compensate_stream(program, write, model, block_lines=None, **settings):
         Finished (:meth:`Compensator.finish` raised nothing); its ``words`` tell whether
         the program had any word, :meth:`Compensator.stats` and ``totals`` what was done.
     """
-    comp = stream_program(program, write,
-                          lambda sep, eol: Compensator(model, sep=sep, eol=eol, **settings),
-                          block_lines, settings.get("source"))
+    def make(sep, eol):
+        comp = Compensator(model, sep=sep, eol=eol, **settings)
+        # the whole program's segment count first (no planning): a program that needs
+        # too many is refused before any block is compensated or anything written
+        comp.prescan(program_blocks(program, block_lines))
+        return comp
+
+    comp = stream_program(program, write, make, block_lines, settings.get("source"))
     comp.finish()
     return comp
 
