@@ -2,7 +2,8 @@
 """The fast paths of the region route (issue 30, the 200k-point blade bench) against the
 plain computation they replace, on the BladeX blade: the field's kernel sums in dense
 blocks against the pairs of a sparse distance matrix, the edge normals projected in one
-call per face against one call per point set."""
+call per face against one call per point set, the sharp edges' bounded nearest-sample
+search against the unbounded one."""
 
 import os
 
@@ -12,7 +13,7 @@ from scipy.spatial import cKDTree
 
 from surfcomp.app import region
 from surfcomp.app.region_orient import orient
-from surfcomp.core.compensation import region_field
+from surfcomp.core.compensation import region_build, region_edges, region_field
 from tests.app import region_parts as rp
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
@@ -147,3 +148,81 @@ def test_field_cells_in_the_order_of_unique_rows(blade):
         np.testing.assert_array_equal(inv2, inv.ravel())
         np.testing.assert_array_equal(count2, count)
     assert np.min(key) < 0
+
+
+def _segment_blend(sharp, x, idx):
+    """One edge's distance, miter, excess and exactness at every point of ``x`` as the
+    code before the bounded search gave them (nearest sample from an unbounded query, both
+    segments at it, the nearer one's Catmull-Rom values)."""
+    pts, ex = sharp.points[idx], sharp.exact[idx]
+    mit = np.concatenate([sharp.miter[idx], sharp.excess[idx]], axis=1)
+    last = len(idx) - 1
+    _, j = cKDTree(pts).query(x, k=1)
+    best_d, best_m, best_e = np.full(len(x), np.inf), np.zeros((len(x), 6)), np.zeros(len(x))
+    for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
+        ab = pts[k1] - pts[k0]
+        t = np.clip(np.einsum("ij,ij->i", x - pts[k0], ab)
+                    / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+        d = np.linalg.norm(x - (pts[k0] + t[:, None] * ab), axis=1)
+        b = d < best_d
+        best_d[b] = d[b]
+        ks = (np.maximum(k0 - 1, 0)[b], k0[b], k1[b], np.minimum(k1 + 1, last)[b])
+        best_m[b] = region_edges._catmull_rom(mit, ks, t[b, None])
+        best_e[b] = region_edges._catmull_rom(ex[:, None], ks, t[b, None])[:, 0]
+    return best_d, best_m, best_e
+
+
+def _plain_nearest(sharp, x):
+    """``SharpEdges.nearest`` as it was: every point within the band plus the samples'
+    spacing of any sample weighs every edge whose widened box holds it."""
+    reach = sharp.band + sharp._reach
+    near = np.flatnonzero(np.isfinite(cKDTree(sharp.points).query(
+        x, k=1, distance_upper_bound=reach)[0]))
+    dmin, wsum = np.full(len(x), np.inf), np.zeros(len(x))
+    m, e = np.zeros((len(x), 6)), np.zeros(len(x))
+    for idx in sharp._edges:
+        lo, hi = sharp.points[idx].min(axis=0) - sharp.band, sharp.points[idx].max(axis=0) \
+            + sharp.band
+        k = near[np.all((x[near] >= lo) & (x[near] <= hi), axis=1)]
+        d, mk, ek = _segment_blend(sharp, x[k], idx)
+        w = (1.0 - region_edges.smoothstep(d / sharp.band)) / (d * d + (1e-9 * sharp.band) ** 2)
+        dmin[k] = np.minimum(dmin[k], d)
+        wsum[k] += w
+        m[k] += w[:, None] * mk
+        e[k] += w * ek
+    far = wsum <= 0
+    wsum[far], e[far] = 1.0, 1.0
+    return dmin, m[:, :3] / wsum[:, None], e / wsum, m[:, 3:] / wsum[:, None]
+
+
+def test_sharp_edges_bounded_search_equals_the_plain_one(blade):
+    """The blade's six sharp edges with the bench's band (5 % of the diagonal): at the
+    blade's points and at points 3 mm off them, as every face sees the edges, the miter,
+    exactness and excess equal bit for bit those of searching every edge's nearest sample
+    without a bound; the distance equals within the band and is at least the band beyond
+    it (where nothing turns), and the displacement's direction is the same bit for bit."""
+    shape, pts, _dev = blade
+    faces = _faces(shape)
+    edges = region.shared_edges(shape, faces)
+    band = region.FIELD_SHARE * shape.BoundBox.DiagonalLength
+    sharp = region.sharp_edges(faces, edges, band=band)
+    assert len(sharp._edges) == 6 and band == pytest.approx(7.886, abs=1e-3)
+    rng = np.random.default_rng(3)
+    off = pts + 3.0 * rng.normal(size=pts.shape)
+    normal = rng.normal(size=pts.shape)
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    for s in [sharp] + [sharp.for_face(i) for i in range(4)]:
+        for x in (pts, off):
+            new, old = s.nearest(x), _plain_nearest(s, x)
+            inside = old[0] < band
+            assert 0.3 * len(x) < np.sum(inside) < len(x)     # both kinds of points
+            assert np.sum(old[2] < 1.0) > 0.05 * len(x)       # knife edges in reach
+            np.testing.assert_array_equal(new[0][inside], old[0][inside])
+            assert np.all(new[0][~inside] >= band)
+            for a, b in zip(new[1:], old[1:]):
+                np.testing.assert_array_equal(a, b)
+            turned = region_build.direction(x, normal, s)
+            assert np.max(np.linalg.norm(turned - normal, axis=1)) > 0.1
+            with pytest.MonkeyPatch.context() as mp:
+                mp.setattr(s, "nearest", lambda y, s=s: _plain_nearest(s, y))
+                np.testing.assert_array_equal(turned, region_build.direction(x, normal, s))

@@ -163,7 +163,6 @@ class SharpEdges:
         self.excess = self.miter
         self._edges = [np.flatnonzero(self.edge == k) for k in np.unique(self.edge)]
         self._trees = [cKDTree(self.points[idx]) for idx in self._edges]
-        self._tree = cKDTree(self.points)
         # a point within the band of a segment is within this much more of a sample
         self._reach = float(np.max(np.linalg.norm(np.diff(self.points, axis=0), axis=1)[
             np.diff(self.edge) == 0], initial=0.0))
@@ -185,55 +184,54 @@ class SharpEdges:
         return out
 
     def _one(self, x, idx, tree):
-        """Distance to one edge polyline, the miter, exactness and excess there."""
-        pts, ex = self.points[idx], self.exact[idx]
-        mit = np.concatenate([self.miter[idx], self.excess[idx]], axis=1)
+        """The points of ``x`` within ``band`` plus the samples' spacing of a sample of one
+        edge polyline (the others are beyond its band: nothing turns towards it there),
+        their distance to the polyline, and the miter, exactness and excess there."""
+        pts = self.points[idx]
+        mit = np.concatenate([self.miter[idx], self.excess[idx], self.exact[idx, None]],
+                             axis=1)
         last = len(idx) - 1
-        _, j = tree.query(x, k=1)
-        best_d = np.full(len(x), np.inf)
-        best_m = np.zeros((len(x), 6))
-        best_e = np.zeros(len(x))
+        _, j = tree.query(x, k=1, distance_upper_bound=self.band + self._reach)
+        k = np.flatnonzero(j <= last)
+        x, j = x[k], j[k]
+        # the two segments at the nearest sample; the second where strictly nearer
+        ends, feet = [], []
         for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
             a, b = pts[k0], pts[k1]
             ab = b - a
             t = np.einsum("ij,ij->i", x - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab),
                                                               1e-300)
             t = np.clip(t, 0.0, 1.0)
-            d = np.linalg.norm(x - (a + t[:, None] * ab), axis=1)
-            better = d < best_d
-            tt = t[better, None]
-            best_d[better] = d[better]
-            # Catmull-Rom between the samples: the displacement's slope does not jump
-            # where the foot passes a sample (a linear blend kinks it there, and the fit
-            # of a face along the edge follows no kink)
-            ks = (np.maximum(k0 - 1, 0)[better], k0[better], k1[better],
-                  np.minimum(k1 + 1, last)[better])
-            best_m[better] = _catmull_rom(mit, ks, tt)
-            best_e[better] = _catmull_rom(ex[:, None], ks, tt)[:, 0]
-        return best_d, best_m, best_e
+            ends.append((k0, k1))
+            feet.append((t, np.linalg.norm(x - (a + t[:, None] * ab), axis=1)))
+        second = feet[1][1] < feet[0][1]
+        k0 = np.where(second, ends[1][0], ends[0][0])
+        k1 = np.where(second, ends[1][1], ends[0][1])
+        tt = np.where(second, feet[1][0], feet[0][0])[:, None]
+        d = np.where(second, feet[1][1], feet[0][1])
+        # Catmull-Rom between the samples: the displacement's slope does not jump where
+        # the foot passes a sample (a linear blend kinks it there, and the fit of a face
+        # along the edge follows no kink)
+        ks = (np.maximum(k0 - 1, 0), k0, k1, np.minimum(k1 + 1, last))
+        mk = _catmull_rom(mit, ks, tt)
+        return k, d, mk[:, :6], mk[:, 6]
 
     def nearest(self, x):
         """Distance to the nearest edge, and the blended miter, exactness and excess (the
-        turn along the face: :meth:`for_face`) at ``x``."""
+        turn along the face: :meth:`for_face`) at ``x``. The distance is exact within the
+        band; beyond it, where nothing turns, it is at least the band (or inf)."""
         x = np.asarray(x, dtype=float)
         dmin = np.full(len(x), np.inf)
         wsum = np.zeros(len(x))
         m = np.zeros((len(x), 6))
         e = np.zeros(len(x))
         eps2 = (1e-9 * self.band) ** 2
-        # beyond the band of every edge nothing turns (their distance is not needed)
-        near = np.flatnonzero(np.isfinite(self._tree.query(
-            x, k=1, distance_upper_bound=self.band + self._reach)[0]))
-        if not len(near):
-            return dmin, m[:, :3], np.ones(len(x)), m[:, 3:]
-        full = (dmin, wsum, m, e)
-        x = x[near]
-        dmin, wsum, m, e = (a[near] for a in full)
         for idx, tree in zip(self._edges, self._trees):
             # only the points in the edge's box widened by the band weigh it
             lo, hi = self.points[idx].min(axis=0), self.points[idx].max(axis=0)
             k = np.flatnonzero(np.all((x >= lo - self.band) & (x <= hi + self.band), axis=1))
-            d, mk, ek = self._one(x[k], idx, tree)
+            sub, d, mk, ek = self._one(x[k], idx, tree)
+            k = k[sub]
             w = (1.0 - smoothstep(d / self.band)) / (d * d + eps2)
             dmin[k] = np.minimum(dmin[k], d)
             wsum[k] += w
@@ -242,10 +240,7 @@ class SharpEdges:
         far = wsum <= 0
         wsum[far] = 1.0
         e[far] = 1.0
-        out_d, _, out_m, out_e = full
-        out_e[:] = 1.0
-        out_d[near], out_m[near], out_e[near] = dmin, m / wsum[:, None], e / wsum
-        return out_d, out_m[:, :3], out_e, out_m[:, 3:]
+        return dmin, (m / wsum[:, None])[:, :3], e / wsum, (m / wsum[:, None])[:, 3:]
 
 
 def knife_limit(angle):
