@@ -110,6 +110,17 @@ def run_gui(body, tmp_path, home=None, timeout=240, env=None):
     return results, output
 
 
+def build_document(tmp, make, shop, csv):
+    """Run the script text ``make`` in ``freecadcmd`` (in ``tmp``), with SURFCOMP_ROOT,
+    SURFCOMP_DOC=``shop`` and SURFCOMP_CSV=``csv`` set: how the GUI tests build their
+    documents headless, so the session opens them from disk."""
+    env = dict(os.environ, SURFCOMP_ROOT=ROOT, SURFCOMP_DOC=shop, SURFCOMP_CSV=csv)
+    script = tmp / "make.py"
+    script.write_text(make)
+    return subprocess.run(["freecadcmd", str(script)], env=env, capture_output=True,
+                          text=True, timeout=300, cwd=str(tmp))
+
+
 def read_image(path):
     """An RGB image as floats in [0, 1], shape (H, W, 3)."""
     import matplotlib.image as mpimg

@@ -13,7 +13,7 @@ import sys
 import pytest
 
 from tests.conftest import ROOT
-from tests.gui.harness import read_image, run_session
+from tests.gui.harness import build_document, read_image, run_session
 
 MAKE = r'''
 import os, sys
@@ -41,11 +41,7 @@ with open(os.environ["SURFCOMP_CSV"] + ".volume", "w") as fh:
 def session(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("gui_region_replace")
     shop, csv = str(tmp / "shop.FCStd"), str(tmp / "g1.csv")
-    env = dict(os.environ, SURFCOMP_ROOT=ROOT, SURFCOMP_DOC=shop, SURFCOMP_CSV=csv)
-    script = tmp / "make.py"
-    script.write_text(MAKE)
-    p = subprocess.run(["freecadcmd", str(script)], env=env, capture_output=True, text=True,
-                       timeout=300, cwd=str(tmp))
+    p = build_document(tmp, MAKE, shop, csv)
     assert os.path.isfile(shop) and os.path.isfile(csv + ".volume"), p.stdout + p.stderr
     with open(csv + ".volume") as fh:
         volume = float(fh.read())

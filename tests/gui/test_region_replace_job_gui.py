@@ -19,7 +19,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from tests.conftest import ROOT
-from tests.gui.harness import run_session
+from tests.gui.harness import build_document, run_session
 
 MAKE = r'''
 import os, sys
@@ -50,11 +50,7 @@ rp.write_csv(os.environ["SURFCOMP_CSV"], pts, nrm, dev)
 def session(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("gui_region_job")
     shop, csv = str(tmp / "shop.FCStd"), str(tmp / "ridge.csv")
-    env = dict(os.environ, SURFCOMP_ROOT=ROOT, SURFCOMP_DOC=shop, SURFCOMP_CSV=csv)
-    script = tmp / "make.py"
-    script.write_text(MAKE)
-    p = subprocess.run(["freecadcmd", str(script)], env=env, capture_output=True, text=True,
-                       timeout=300, cwd=str(tmp))
+    p = build_document(tmp, MAKE, shop, csv)
     assert os.path.isfile(shop) and os.path.isfile(csv), p.stdout + p.stderr
     out = str(tmp / "region.FCStd")
     r = subprocess.run([sys.executable, "-m", "surfcomp", "compensate", shop, csv, "--object",
