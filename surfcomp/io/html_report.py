@@ -33,19 +33,18 @@ Maps use the colour scheme of :mod:`surfcomp.core.colormap` (the GUI's, default 
 and, when given, the GUI map's range, values beyond it in the out-of-range colours.
 """
 
-import base64
 import html
-import io
 
 import numpy as np
 
-from ..core import colormap
 from ..core.compensation.deviations import statistics
 from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
+from .html_figures import DEFAULT_STYLE, bar_chart, hist_figure, png, simulation_maps_figure
+from .html_figures import map_figure as _map
 
-#: the maps' colours: scheme name and range (mm) or None for each map's symmetric range
-DEFAULT_STYLE = {"scheme": colormap.DEFAULT_SCHEME, "range": None}
+__all__ = ["DEFAULT_STYLE", "SECTIONS", "grid_arrays", "render_html", "simulation_maps",
+           "simulation_maps_figure", "write_html_report"]
 
 #: section ids in document order
 SECTIONS = ("inputs", "method", "alignment", "maps", "histograms", "statistics", "checks",
@@ -77,24 +76,9 @@ def _e(x):
     return text
 
 
-def _png(fig):
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-
-    FigureCanvasAgg(fig)
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=90)
-    return base64.b64encode(buf.getvalue()).decode("ascii")
-
-
 def _img(fig, alt, caption):
     return ('<figure><img alt="%s" src="data:image/png;base64,%s"><figcaption>%s</figcaption>'
-            "</figure>" % (_e(alt), _png(fig), _e(caption)))
-
-
-def _figure(size=(5.2, 4.2)):
-    from matplotlib.figure import Figure
-
-    return Figure(figsize=size, layout="constrained")
+            "</figure>" % (_e(alt), png(fig), _e(caption)))
 
 
 def _kv_table(rows):
@@ -137,66 +121,6 @@ def grid_arrays(report):
     out["residual"] = predicted_residual(out["determined"], out["correction"], meth.get("name"),
                                          meth.get("stock_mm"))
     return out
-
-
-def _cmap(scheme):
-    from matplotlib.colors import LinearSegmentedColormap
-
-    cmap = LinearSegmentedColormap.from_list(scheme, colormap.scheme(scheme))
-    cmap.set_under(colormap.OUT_OF_RANGE_COLORS["below"])
-    cmap.set_over(colormap.OUT_OF_RANGE_COLORS["above"])
-    cmap.set_bad(colormap.NAN_COLOR)
-    return cmap
-
-
-def _map(x, y, values_um, title, symmetric=True, fig=None, ax=None, style=None):
-    if ax is None:
-        fig = _figure()
-        ax = fig.add_subplot()
-    style = style or DEFAULT_STYLE
-    finite = values_um[np.isfinite(values_um)]
-    lim = float(np.max(np.abs(finite))) if finite.size else 1.0
-    lim = lim or 1.0
-    extend = "neither"
-    if style.get("range") is not None:
-        lo, hi = (1e3 * float(r) for r in style["range"])
-        extend = "both"
-    else:
-        lo, hi = -lim, lim
-    kw = dict(vmin=lo, vmax=hi, cmap=_cmap(style["scheme"])) if symmetric \
-        else dict(cmap="viridis")
-    if x.ndim == 1:  # scattered points: Delaunay triangles of the nominal x, y
-        mesh = ax.tripcolor(x, y, values_um, shading="gouraud", **kw)
-        ax.plot(x, y, ".", color="k", markersize=1.5)
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
-        ax.set_aspect("equal", adjustable="box")
-    elif np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and min(x.shape) > 1:
-        mesh = ax.pcolormesh(x, y, np.ma.masked_invalid(values_um), shading="gouraud", **kw)
-        ax.set_xlabel("x [mm]")
-        ax.set_ylabel("y [mm]")
-        ax.set_aspect("equal", adjustable="box")
-    else:
-        mesh = ax.imshow(values_um.T, origin="lower", **kw)
-        ax.set_xlabel("grid row")
-        ax.set_ylabel("grid column")
-    cb = fig.colorbar(mesh, ax=ax, shrink=0.85, extend=extend if symmetric else "neither")
-    cb.set_label("µm (along the outward normal)")
-    ax.set_title(title, fontsize=11)
-    return fig
-
-
-def _hist(values_um, title, color):
-    fig = _figure((5.0, 3.4))
-    ax = fig.add_subplot()
-    v = values_um[np.isfinite(values_um)]
-    ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color=color, edgecolor="white")
-    ax.set_xlabel("µm")
-    ax.set_ylabel("points")
-    ax.set_title("%s (mean %.2f µm, std %.2f µm)"
-                 % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
-                 fontsize=10)
-    return fig
 
 
 def _stat_table(columns):
@@ -317,7 +241,7 @@ def _range_note(style):
 
 
 def _section_histograms(arrays):
-    figs = [_img(_hist(arrays[k] * 1e3, t, c), "histogram of " + k, t)
+    figs = [_img(hist_figure(arrays[k] * 1e3, t, c), "histogram of " + k, t)
             for k, t, c in (("deviation", "Raw deviation", "#4477aa"),
                             ("random", "Random component", "#cc6677"),
                             ("residual", "Predicted residual", "#228833"))]
@@ -381,24 +305,6 @@ def _section_checks(report):
             rows.append(("Written file size", '<span class="num">%d bytes</span>' % size))
         body = _kv_table(rows)
     return '<section id="checks"><h2>Corrected face checks</h2>%s</section>' % body
-
-
-def _bar_chart(sim):
-    cols = [("Before", sim["before"])] + [(m["label"], m) for m in sim["methods"]]
-    fig = _figure((7.5, 3.6))
-    axes = fig.subplots(1, 2)
-    x = np.arange(len(cols))
-    for ax, key, title in zip(axes, ("std", "profile"),
-                              ("Standard deviation", "Profile error ISO 1101")):
-        vals = np.array([[r["all"][key] for r in c["replicas"]] for _, c in cols], dtype=object)
-        mean = np.array([np.mean(v) for v in vals]) * 1e3
-        lo = mean - np.array([np.min(v) for v in vals]) * 1e3
-        hi = np.array([np.max(v) for v in vals]) * 1e3 - mean
-        ax.bar(x, mean, yerr=[lo, hi], capsize=4, color="#88aacc")
-        ax.set_xticks(x, [h for h, _ in cols], rotation=30, ha="right", fontsize=8)
-        ax.set_ylabel("µm")
-        ax.set_title(title + " (bars: min..max over replicas)", fontsize=9)
-    return fig
 
 
 def simulation_maps(result):
@@ -481,25 +387,6 @@ def _preset_html(sim):
     return "".join(out)
 
 
-def simulation_maps_figure(maps, columns=4, title=None):
-    """All :func:`simulation_maps` in one matplotlib Figure (``columns`` maps per row), e.g.
-    for the README; each map on its own symmetric scale in um."""
-    from matplotlib.figure import Figure
-
-    rows = -(-len(maps) // columns)
-    fig = Figure(figsize=(4.6 * columns, 3.7 * rows), layout="constrained")
-    axes = np.atleast_1d(fig.subplots(rows, columns)).ravel()
-    for ax, m in zip(axes, maps):
-        v = np.asarray(m["values"]) * 1e3
-        _map(np.asarray(m["x"]), np.asarray(m["y"]), v,
-             "%s (std %.2f µm)" % (m["title"], np.std(v, ddof=1)), fig=fig, ax=ax)
-    for ax in axes[len(maps):]:
-        ax.set_axis_off()
-    if title:
-        fig.suptitle(title)
-    return fig
-
-
 def _simulated_maps_html(maps):
     if not maps:
         return ""
@@ -544,7 +431,7 @@ def _section_simulation(sim):
             % (sim.get("replicas", 0), _e(sim.get("seed")),
                _e("x".join(map(str, sim.get("grid", [])))),
                _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
-               _img(_bar_chart(sim), "before and after bar chart", "Spread per method"),
+               _img(bar_chart(sim), "before and after bar chart", "Spread per method"),
                _preset_html(sim), _simulated_maps_html(sim.get("maps")), params))
 
 

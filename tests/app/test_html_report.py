@@ -202,8 +202,13 @@ def test_preset_simulation_shows_the_papers_table_and_the_parts_maps():
         img = Image.open(io.BytesIO(base64.b64decode(src)))
         img.load()
         assert img.format == "PNG" and img.size[0] > 300
-    # without maps (the JSON alone) the section has the tables but no map block
-    assert 'id="simulated-maps"' not in render_html(_report(), res.as_dict())
+    # without maps (the JSON alone) the section has the tables but no map block (the
+    # section alone: the rest of the page is the same as above, its figures drawn once)
+    from surfcomp.io import html_report
+
+    bare = html_report._section_simulation(res.as_dict())
+    assert bare.startswith('<section id="simulation">') and 'id="side-by-side"' in bare
+    assert 'id="simulated-maps"' not in bare
 
 
 def test_checks_state_the_poles_and_the_written_file_size(rendered):
