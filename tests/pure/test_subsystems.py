@@ -46,7 +46,7 @@ def test_every_core_module_is_in_a_subsystem_or_shared():
     assert subsystems == set(ALLOWED)
     shared = sorted(f for f in os.listdir(CORE) if f.endswith(".py"))
     assert shared == ["__init__.py", "budget.py", "choices.py", "chunks.py", "colormap.py",
-                      "limits.py", "measurement_set.py", "memory.py", "option_tables.py",
+                      "command_options.py", "limits.py", "measurement_set.py", "memory.py", "option_tables.py",
                       "options.py", "progress.py"], shared
 
 
