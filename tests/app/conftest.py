@@ -24,9 +24,9 @@ def fresh_doc():
 @pytest.fixture(scope="session")
 def cam_example(tmp_path_factory):
     """The example's finishing Job before and after the compensation replaces the nominal
-    (tests/app/cam_example.py), built once for the modules that check it. A test that
-    changes its document (test_path_regen.py's restore) runs last in its module and the
-    others read only what the build recorded."""
+    (tests/app/cam_example.py), built once for the modules that check it; they read only
+    what the build recorded (test_path_regen.py's restore, which changes its document, has
+    a build of its own)."""
     import FreeCAD
 
     from tests.app import cam_example as example

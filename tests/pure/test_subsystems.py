@@ -46,8 +46,8 @@ def test_every_core_module_is_in_a_subsystem_or_shared():
     assert subsystems == set(ALLOWED)
     shared = sorted(f for f in os.listdir(CORE) if f.endswith(".py"))
     assert shared == ["__init__.py", "budget.py", "choices.py", "chunks.py", "colormap.py",
-                      "command_options.py", "limits.py", "measurement_set.py", "memory.py", "option_tables.py",
-                      "options.py", "progress.py"], shared
+                      "command_options.py", "limits.py", "measurement_set.py", "memory.py",
+                      "option_tables.py", "options.py", "progress.py"], shared
 
 
 def test_subsystems_import_only_what_the_architecture_allows():
