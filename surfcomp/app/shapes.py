@@ -19,6 +19,7 @@ import FreeCAD  # noqa: F401  (Part needs FreeCAD imported first)
 import numpy as np
 import Part
 
+from ..core.limits import NIL_INTEGRAL
 from ..core.surface.bspline import clamped
 from ..errors import GeometryError
 from . import retrim
@@ -55,8 +56,6 @@ class Output:
     def volume_mismatch(self):
         """``volume_change / -correction_volume - 1`` (None without a volume change, or for
         a nil correction)."""
-        from ..core.limits import NIL_INTEGRAL
-
         if self.volume_change is None or not abs(self.correction_volume) >= NIL_INTEGRAL:
             return None
         return self.volume_change / -self.correction_volume - 1.0
