@@ -29,6 +29,9 @@ if __name__ == "__main__":
     import gc
 
     from surfcomp.cli import main
+    from surfcomp.core.memory import one_command_process
+
+    one_command_process()
 
     code = main()
     # the process ends here: the interpreter's exit need not search the objects still alive
