@@ -51,3 +51,15 @@ def test_printed_text_and_exit_code_survive(tmp_path):
             lines = out.read_text().splitlines()
             assert lines[0].startswith("Nominal:") and lines[-1] == "wrote %s" % face
             assert len(lines) > 20 and face.read_text().rstrip().endswith("END-ISO-10303-21;")
+
+
+def test_a_program_that_runs_the_module_goes_on_after_it(tmp_path):
+    """Run through ``runpy`` from another program's process, the command returns to it
+    (SystemExit with the command's code), which then goes on."""
+    code = ("import runpy, sys\nsys.argv = ['surfcomp'] + sys.argv[1:]\ntry:\n"
+            "    runpy.run_module('surfcomp', run_name='__main__', alter_sys=True)\n"
+            "except SystemExit as exc:\n    print('went on after', exc.code)\n")
+    res = subprocess.run([sys.executable, "-c", code, "compensate", "examples/nominal.step",
+                          str(tmp_path / "missing.csv"), "-o", str(tmp_path / "x.step")],
+                         cwd=ROOT, capture_output=True, text=True)
+    assert res.returncode == 0 and res.stdout.strip() == "went on after 2", res.stderr
