@@ -66,6 +66,6 @@ if __name__ == "__main__":
     if not owned or _busy_threads():
         sys.exit(code)
     # every output is committed and closed and nothing else runs: the modules' teardown at
-    # the interpreter's exit (numpy's, scipy's, FreeCAD's: 0.02 s) would only free memory
+    # the interpreter's exit (numpy's, scipy's, FreeCAD's) would only free memory
     # that the system takes back anyway
     os._exit(code)

@@ -279,7 +279,7 @@ def _one_side(piece, u_range, v_range, tol=1e-9):
 def outside_trim(nominal, prepared):
     """The measured points that lie on the nominal surface but outside the trimmed face:
     ``(indices, distances)`` in file order, distances (mm) from the face (its boundary).
-    None (empty arrays) on a face bounded by its surface's whole domain
+    Nothing (empty arrays) on a face bounded by its surface's whole domain
     (:func:`bounds_whole_domain`): every point on the surface is on the face."""
     import FreeCAD
     import Part
