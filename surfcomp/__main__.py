@@ -2,6 +2,7 @@
 """``python3 -m surfcomp``: the batch command line."""
 
 import importlib.util
+import os
 import sys
 
 
@@ -19,6 +20,25 @@ def _missing():
     return out
 
 
+def _owns_the_process():
+    """True when Python was started to run this command (``python3 -m surfcomp``, as the
+    ``surfcomp`` launcher does), False when another program runs this module in its own
+    process (``runpy``) and goes on after it."""
+    argv = getattr(sys, "orig_argv", None) or []
+    return any(a == "-m" and b == "surfcomp" for a, b in zip(argv, argv[1:]))
+
+
+def _busy_threads():
+    """Threads the interpreter's exit would wait for: any but the main thread, the daemons
+    and the idle workers of the chunk pools (:mod:`surfcomp.core.chunks`, whose calls
+    return only once all their chunks are done)."""
+    import threading
+
+    return [t for t in threading.enumerate()
+            if t is not threading.main_thread() and not t.daemon
+            and not t.name.startswith("surfcomp-chunk")]
+
+
 if __name__ == "__main__":
     lacking = _missing()
     if lacking:
@@ -29,9 +49,23 @@ if __name__ == "__main__":
     import gc
 
     from surfcomp.cli import main
+    from surfcomp.core.memory import one_command_process
 
+    owned = _owns_the_process()
+    if owned:
+        one_command_process()
     code = main()
     # the process ends here: the interpreter's exit need not search the objects still alive
     # (numpy's, scipy's, FreeCAD's) for reference cycles, which took 0.04 s of CPU
     gc.freeze()
-    sys.exit(code)
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):   # the interpreter's own exit says so, as it always did
+        sys.exit(code)
+    if not owned or _busy_threads():
+        sys.exit(code)
+    # every output is committed and closed and nothing else runs: the modules' teardown at
+    # the interpreter's exit (numpy's, scipy's, FreeCAD's) would only free memory
+    # that the system takes back anyway
+    os._exit(code)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.surface.surface_checks import MAX_DEGREE, check_nominal
-from ..core.surface.trimmed import inside
+from ..core.surface.trimmed import inside, whole_domain
 from ..errors import GeometryError
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
@@ -243,13 +243,50 @@ def boundary_polylines(face, points=EDGE_POINTS):
     return out
 
 
+def bounds_whole_domain(face, u_range, v_range):
+    """True when every edge of ``face`` is a straight line in (u, v) along one side of the
+    rectangle ``u_range x v_range`` and together they go once around it: the answer
+    :func:`surfcomp.core.surface.trimmed.whole_domain` gives on the
+    :func:`boundary_polylines`, from the ends of each edge alone (the points between the
+    ends of a line lie on the same side), without sampling 400 points of every pcurve.
+    False for anything else (then sample them)."""
+    import Part
+
+    ends = []
+    for e in (e for w in face.Wires for e in w.childShapes()):
+        c2d, a, b = face.curveOnSurface(e)[:3]
+        if not isinstance(c2d, (Part.Geom2d.Line2d, Part.Geom2d.Line2dSegment)):
+            return False
+        p, q = c2d.value(a), c2d.value(b)
+        if e.Orientation == "Reversed":
+            p, q = q, p
+        ends.append(np.array([(p.x, p.y), (q.x, q.y)], dtype=float))
+    if not ends or not all(_one_side(piece, u_range, v_range) for piece in ends):
+        return False
+    return whole_domain(ends, u_range, v_range)
+
+
+def _one_side(piece, u_range, v_range, tol=1e-9):
+    """Both ends of a line on the same side of the rectangle (as ``whole_domain`` tells a
+    side: within ``tol`` of its extent), so that every point between them is too."""
+    (u0, u1), (v0, v1) = u_range, v_range
+    du, dv = tol * (u1 - u0), tol * (v1 - v0)
+    u, v = piece[:, 0], piece[:, 1]
+    return any(bool(np.all(near)) for near in (np.abs(u - u0) <= du, np.abs(u - u1) <= du,
+                                               np.abs(v - v0) <= dv, np.abs(v - v1) <= dv))
+
+
 def outside_trim(nominal, prepared):
     """The measured points that lie on the nominal surface but outside the trimmed face:
-    ``(indices, distances)`` in file order, distances (mm) from the face (its boundary)."""
+    ``(indices, distances)`` in file order, distances (mm) from the face (its boundary).
+    Nothing (empty arrays) on a face bounded by its surface's whole domain
+    (:func:`bounds_whole_domain`): every point on the surface is on the face."""
     import FreeCAD
     import Part
 
     face = nominal.bspline_face
+    if bounds_whole_domain(face, nominal.surface.u_range, nominal.surface.v_range):
+        return np.zeros(0, dtype=np.int64), np.zeros(0)
     candidates = np.nonzero(~inside(boundary_polylines(face, 200), prepared.u,
                                     prepared.v))[0]
     dist = np.array([face.distToShape(Part.Vertex(FreeCAD.Vector(*prepared.nominal[k])))[0]

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.surface import bspline
 from ..core.surface.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
-from .nominal import boundary_polylines
+from .nominal import boundary_polylines, bounds_whole_domain
 from .retrim import KEPT
 
 #: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
@@ -33,8 +33,13 @@ def correction_volume(nominal, corrected):
     """The integral of the correction over the (trimmed) nominal face (mm^3, positive =
     material removed): :func:`surfcomp.core.surface.trimmed.correction_integral` inside the face's
     boundary in (u, v)."""
-    return correction_integral(nominal.surface, corrected, nominal.outward,
-                               boundary_polylines(nominal.bspline_face))
+    surface = nominal.surface
+    if bounds_whole_domain(nominal.bspline_face, surface.u_range, surface.v_range):
+        (u0, u1), (v0, v1) = surface.u_range, surface.v_range   # the tensor rule's case
+        lines = [np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1], [u0, v0]])]
+    else:
+        lines = boundary_polylines(nominal.bspline_face)
+    return correction_integral(surface, corrected, nominal.outward, lines)
 
 
 def _flux(s, su, sv, outward, centre):

@@ -3,12 +3,14 @@
 program by the correction (:mod:`surfcomp.app.program_route`) instead of writing the face."""
 
 import math
+import sys
 
 from ..core.command_options import PROGRAM_MOVE
 from ..core.memory import collector_paused
 from ..errors import InputError
 from . import registry
 from .common import ProgressLine, job_from_args, wrote
+from .option_flags import shown
 from .options import add_arguments
 
 
@@ -73,6 +75,8 @@ def run_program(args):
                                    max_memory=args.max_memory)
     finally:
         cadread.discard()
+    for w in comp.prepared.warnings:    # the measurements' and the corrected face's, as -o
+        print("warning: " + shown(w), file=sys.stderr)
     for line in summary_lines(comp, po, pj):
         print(line)
     print(wrote(args.output))

@@ -15,6 +15,7 @@ import gc
 import sys
 
 _TRIM = []      # [malloc_trim] or [None], looked up once
+_ONE_COMMAND = []   # [True] once :func:`one_command_process` was called
 
 
 def _trim():
@@ -51,5 +52,19 @@ def collector_paused():
     try:
         yield
     finally:
+        if _ONE_COMMAND:
+            gc.freeze()
         if was:
             gc.enable()
+
+
+def one_command_process():
+    """Mark this process as one that runs a single command and then ends (``python3 -m
+    surfcomp``). From then on :func:`collector_paused` also freezes (``gc.freeze``) every
+    object alive when it resumes the collector: the imported modules' objects, which live as
+    long as the process anyway, so that the collections of the command's own work (reading
+    a program's lines makes tens of thousands of containers) no longer walk them again.
+    Frozen objects are still freed when their last reference goes; only a reference cycle
+    among them would never be: so not in a process that runs on (FreeCAD, a test session)."""
+    if not _ONE_COMMAND:
+        _ONE_COMMAND.append(True)
