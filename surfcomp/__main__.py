@@ -2,7 +2,6 @@
 """``python3 -m surfcomp``: the batch command line."""
 
 import importlib.util
-import os
 import sys
 
 
@@ -28,17 +27,6 @@ def _owns_the_process():
     return any(a == "-m" and b == "surfcomp" for a, b in zip(argv, argv[1:]))
 
 
-def _busy_threads():
-    """Threads the interpreter's exit would wait for: any but the main thread, the daemons
-    and the idle workers of the chunk pools (:mod:`surfcomp.core.chunks`, whose calls
-    return only once all their chunks are done)."""
-    import threading
-
-    return [t for t in threading.enumerate()
-            if t is not threading.main_thread() and not t.daemon
-            and not t.name.startswith("surfcomp-chunk")]
-
-
 if __name__ == "__main__":
     lacking = _missing()
     if lacking:
@@ -58,14 +46,4 @@ if __name__ == "__main__":
     # the process ends here: the interpreter's exit need not search the objects still alive
     # (numpy's, scipy's, FreeCAD's) for reference cycles, which took 0.04 s of CPU
     gc.freeze()
-    try:
-        sys.stdout.flush()
-        sys.stderr.flush()
-    except (OSError, ValueError):   # the interpreter's own exit says so, as it always did
-        sys.exit(code)
-    if not owned or _busy_threads():
-        sys.exit(code)
-    # every output is committed and closed and nothing else runs: the modules' teardown at
-    # the interpreter's exit (numpy's, scipy's, FreeCAD's) would only free memory
-    # that the system takes back anyway
-    os._exit(code)
+    sys.exit(code)
