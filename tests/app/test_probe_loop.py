@@ -108,10 +108,17 @@ def sphere_touch(surf, a, b):
         c = FreeCAD.Vector(*(a + s * u))
         return (c - surf.value(*surf.parameter(c))).Length - R
 
-    steps = np.arange(0.0, np.linalg.norm(b - a) + 1e-9, 0.05)
-    values = [gap(s) for s in steps]
-    k = next(k for k in range(1, len(steps)) if values[k] <= 0.0)
-    return a + brentq(gap, steps[k - 1], steps[k], xtol=1e-12) * u
+    # the gap is a distance minus R, so it shrinks by at most the step: a step of the gap
+    # itself cannot pass the first touch (sphere tracing); closer than 0.05 mm, steps of
+    # 0.05 mm bracket it
+    length = np.linalg.norm(b - a)
+    s, g = 0.0, gap(0.0)
+    assert g > 0.0, "the ball starts in the face"
+    while g > 0.0:
+        assert s < length, "the ball does not touch the face between a and b"
+        s, t = min(s + max(g, 0.05), length), s
+        g = gap(s)
+    return a + brentq(gap, t, s, xtol=1e-12) * u
 
 
 def write_log(path, centres):
