@@ -22,7 +22,7 @@ from scipy.optimize import brentq
 
 from surfcomp.io.plan_join import read_plan
 from surfcomp.io.probe_program import ProbeSettings, write_probe_program
-from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt
+from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt, run_in_process
 from tests.probe_checks import check_probe_moves, rs274_moves
 
 R = 1.0
@@ -50,8 +50,9 @@ def loop(tmp_path_factory):
     face = next("Face%d" % (k + 1) for k, f in enumerate(faces)
                 if f.Surface.TypeId == "Part::GeomBSplineSurface")
     plan, prog = tmp / "plan.csv", tmp / "probe.ngc"
-    out = run_cli("plan", part, "--face", face, "-o", plan, "--count", "8x9", "--tip-radius",
-                  R, "--clearance", CLEARANCE, "--stand-off", 2, "--program", prog, "--quiet")
+    out = run_in_process("plan", part, "--face", face, "-o", plan, "--count", "8x9",
+                         "--tip-radius", R, "--clearance", CLEARANCE, "--stand-off", 2,
+                         "--program", prog, "--quiet")
     assert out.returncode == 0, out.stderr
     assert "paths checked against the part's other faces" in out.stdout
     p = read_plan(str(plan))
@@ -147,13 +148,15 @@ def test_round_trip_recovers_the_correction(loop, probed):
     cmm.write_text("id,x_nom,y_nom,z_nom,i,j,k,dev\n" + "".join(
         "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % ((i,) + tuple(p) + tuple(n) + (d,))
         for i, p, n, d in zip(loop["ids"], loop["P"], loop["N"], truth)))
-    out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
-                  "--report", tmp / "probe.json", "--html", tmp / "probe.html", "--quiet")
+    out = run_in_process("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"],
+                         "--tip-radius", R, "--report", tmp / "probe.json", "--html",
+                         tmp / "probe.html", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "<b>%s</b>" % loop["plan"] in (tmp / "probe.html").read_text()
     assert "Plan:         %s" % loop["plan"] in out.stdout and "8 x 9" in out.stdout.replace(
         "9 x 8", "8 x 9")
-    ref = run_cli("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json", "--quiet")
+    ref = run_in_process("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json",
+                         "--quiet")
     assert ref.returncode == 0, ref.stderr
     got, want = (json.loads((tmp / n).read_text()) for n in ("probe.json", "truth.json"))
     assert got["inputs"]["plan"]["sha256"] == hashlib.sha256(
@@ -236,8 +239,8 @@ def test_second_touch_round_trip(loop, probed):
         centres += [first, sphere_touch(probed["surf"], first + 1.0 * loop["N"][k], b)]
     log = tmp / "probe2.log"
     write_log(log, centres)
-    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
-                  "--touches", 2, "--report", tmp / "probe2.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius",
+                         R, "--touches", 2, "--report", tmp / "probe2.json", "--quiet")
     assert out.returncode == 0, out.stderr
     dev = np.array(json.loads((tmp / "probe2.json").read_text())["points"]["deviation"])
     assert_allclose(dev, probed["truth"], atol=1e-4, rtol=0)
