@@ -59,3 +59,20 @@ def realised_by_occt(face, P, N, reach=0.5):
 
 def face_nominal(face, name="Face1"):
     return nominal_from_face(face, source="<test>", face_name=name)
+
+
+def run_in_process(*args):
+    """``python3 -m surfcomp ARGS`` run as ``surfcomp.cli.main`` in this process, as a
+    ``CompletedProcess`` (exit code, standard output, standard error with the numeric
+    warnings a real run prints there); the working directory, the signal handlers and the
+    open FreeCAD documents are as they were afterwards (tests/fuzz/harness.py). For the
+    runs whose results a test checks: it saves the interpreter's start and imports. The
+    runs that check the program as a process (the exit code and message of refused input,
+    signals) stay subprocesses."""
+    import subprocess
+
+    from tests.fuzz.harness import run_cli
+
+    res = run_cli(args, ROOT)
+    err = res.err + "".join("%s\n" % w for w in res.numeric_warnings)
+    return subprocess.CompletedProcess(["surfcomp", *map(str, args)], res.rc, res.out, err)

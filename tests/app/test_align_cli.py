@@ -11,7 +11,7 @@ from scipy.spatial.transform import Rotation
 
 from surfcomp.core.measurement import align
 from surfcomp.io.readers import read_any
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT
+from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, run_in_process
 
 #: the move of the measured points into the measuring frame (10 deg, 80 mm)
 MOVE = align.rigid(Rotation.from_euler("xyz", [4.0, -3.0, 10.0], degrees=True)
@@ -33,11 +33,11 @@ def _points(tmp_path, move):
 
 def test_transform_gives_the_deviations_of_unmoved_points(tmp_path):
     (tmp_path / "t.json").write_text(json.dumps({"matrix": np.linalg.inv(MOVE).tolist()}))
-    out = run_cli("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--transform",
-                  tmp_path / "t.json", "--report", tmp_path / "a.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--transform",
+                         tmp_path / "t.json", "--report", tmp_path / "a.json", "--quiet")
     assert out.returncode == 0, out.stderr
-    out = run_cli("inspect", EXAMPLE_STEP, _points(tmp_path, np.eye(4)), "--report",
-                  tmp_path / "b.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, _points(tmp_path, np.eye(4)), "--report",
+                         tmp_path / "b.json", "--quiet")
     assert out.returncode == 0, out.stderr
     a = json.loads((tmp_path / "a.json").read_text())
     b = json.loads((tmp_path / "b.json").read_text())
@@ -50,9 +50,9 @@ def test_bestfit_on_the_compensated_face_reports_what_it_absorbed(tmp_path):
     """Brought near by the known transform, the fit on the face itself takes out the
     machining error's mean and tilt: the deviations change by what it reports."""
     (tmp_path / "t.json").write_text(json.dumps({"matrix": np.linalg.inv(MOVE).tolist()}))
-    out = run_cli("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--align", "bestfit",
-                  "--transform", tmp_path / "t.json", "--report", tmp_path / "r.json",
-                  "--html", tmp_path / "r.html", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--align",
+                         "bestfit", "--transform", tmp_path / "t.json", "--report",
+                         tmp_path / "r.json", "--html", tmp_path / "r.html", "--quiet")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     a = rep["alignment"]
@@ -67,8 +67,8 @@ def test_bestfit_on_the_compensated_face_reports_what_it_absorbed(tmp_path):
     page = (tmp_path / "r.html").read_text()
     assert '<section id="alignment">' in page and "Absorbed on the compensated face" in page
     # from the measuring frame itself: the absorbed part cannot be told apart from the move
-    out = run_cli("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--align", "bestfit",
-                  "--report", tmp_path / "f.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--align",
+                         "bestfit", "--report", tmp_path / "f.json", "--quiet")
     assert out.returncode == 0 and "cannot be told apart" in out.stderr
     far = json.loads((tmp_path / "f.json").read_text())
     assert_allclose(far["points"]["deviation"], rep["points"]["deviation"], atol=1e-4)
@@ -128,9 +128,9 @@ def test_datum_faces_of_a_solid_leave_the_deviations_unchanged(tmp_path):
     datums puts the top's points back; their deviations are those never moved (0.1 um) and
     nothing is absorbed; the datum points serve the alignment only."""
     top_name, names, dev, _faces, _pts = block_points(tmp_path)
-    out = run_cli("inspect", tmp_path / "box.step", tmp_path / "p.xyz", "--face", top_name,
-                  "--align", "bestfit", "--align-faces", ",".join(names),
-                  "--report", tmp_path / "r.json", "--quiet")
+    out = run_in_process("inspect", tmp_path / "box.step", tmp_path / "p.xyz", "--face",
+                         top_name, "--align", "bestfit", "--align-faces", ",".join(names),
+                         "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     a = rep["alignment"]
@@ -152,7 +152,7 @@ def test_face_column_assigns_the_points(tmp_path):
     (tmp_path / "f.csv").write_text("\n".join(rows) + "\n")
     args = ("inspect", tmp_path / "box.step", tmp_path / "f.csv", "--face", top_name,
             "--align", "bestfit", "--align-faces", ",".join(names), "--quiet")
-    out = run_cli(*args, "--report", tmp_path / "r.json")
+    out = run_in_process(*args, "--report", tmp_path / "r.json")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     assert_allclose(rep["points"]["deviation"], dev, atol=1e-4)

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """The batch CLI: exit codes, messages, atomic outputs (subprocesses of
-/usr/bin/python3 -m surfcomp)."""
+/usr/bin/python3 -m surfcomp; the runs whose outputs a test checks run the command line in
+this process, tests/app/helpers.py run_in_process)."""
 
 import json
 import os
@@ -11,7 +12,14 @@ import numpy as np
 import pytest
 
 from surfcomp.app.nominal import load_nominal
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
+from tests.app.helpers import (
+    EXAMPLE_CSV,
+    EXAMPLE_STEP,
+    ROOT,
+    grid_on_face,
+    run_in_process,
+    write_cmm_csv,
+)
 from tests.conftest import REALDATA, default_signals
 
 
@@ -25,7 +33,7 @@ def example_run(tmp_path_factory):
     """One compensation of the example that writes every output (face, JSON report, points,
     curve net and HTML report); the tests below assert on its outputs."""
     folder = tmp_path_factory.mktemp("example")
-    out = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "-o", folder / "c.step",
+    out = run_in_process("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "-o", folder / "c.step",
                   "--report", folder / "r.json", "--points", folder / "p.csv",
                   "--curves", folder / "net.step", "--html", folder / "r.html", "--quiet")
     return out, folder
@@ -50,8 +58,8 @@ def test_compensate_example_writes_step_and_report(example_run):
 
 
 def test_inspect_prints_statistics_only(tmp_path):
-    out = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--report", tmp_path / "r.json",
-                  "--html", tmp_path / "r.html", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--report", tmp_path / "r.json",
+                         "--html", tmp_path / "r.html", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "Standard deviation (ddof=1)" in out.stdout
     assert "Corrected face" not in out.stdout
@@ -94,8 +102,8 @@ def test_normals_on_the_other_side(tmp_path):
     write_cmm_csv(meas, P, -N, np.full((5, 5), 0.01))
     err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas)
     assert "flip.csv:2:" in err and "--flip-normals" in err
-    ok = run_cli("compensate", EXAMPLE_STEP, meas, "--flip-normals", "--method", "raw",
-                 "--report", tmp_path / "ok.json", "--quiet")
+    ok = run_in_process("compensate", EXAMPLE_STEP, meas, "--flip-normals", "--method", "raw",
+                        "--report", tmp_path / "ok.json", "--quiet")
     assert ok.returncode == 0, ok.stderr
     rep = json.loads((tmp_path / "ok.json").read_text())
     np.testing.assert_allclose(rep["points"]["deviation"], -0.01, atol=1e-12)
@@ -111,7 +119,7 @@ def test_incomplete_grid_is_refused_with_what_is_missing(tmp_path):
     err = _bad(tmp_path, "compensate", EXAMPLE_STEP, meas, "--layout", "grid")
     assert "do not form a complete n x m grid" in err and "has 5 points (missing near u=" in err
     # by default such a set is used as a scattered layout, with the same reason as a warning
-    out = run_cli("inspect", EXAMPLE_STEP, meas, "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, meas, "--quiet")
     assert out.returncode == 0, out.stderr
     assert "has 5 points (missing near u=" in out.stderr and "scattered layout" in out.stderr
     assert "29 scattered points" in out.stdout
@@ -175,8 +183,8 @@ def test_nominal_from_an_fcstd_document(tmp_path):
     finally:
         FreeCAD.closeDocument(doc.Name)
     before = path.read_bytes()
-    out = run_cli("compensate", path, EXAMPLE_CSV, "--object", "Nominal", "--face", "Face1",
-                  "--report", tmp_path / "r.json", "--quiet")
+    out = run_in_process("compensate", path, EXAMPLE_CSV, "--object", "Nominal", "--face",
+                         "Face1", "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     assert rep["inputs"]["nominal"]["object"] == "Nominal"
@@ -218,7 +226,8 @@ def test_point_only_files_through_the_pipeline(tmp_path, kind):
         rows = ["%.6f %.6f %.6f 0 0 0 0 0 0" % tuple(p) for p in pts]
         extra = ["--format", "probe"]
     path.write_text("\n".join(rows) + "\n")
-    out = run_cli("inspect", EXAMPLE_STEP, path, "--report", tmp_path / "r.json", "--quiet", *extra)
+    out = run_in_process("inspect", EXAMPLE_STEP, path, "--report", tmp_path / "r.json",
+                         "--quiet", *extra)
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     got = np.array(rep["points"]["deviation"])
@@ -253,12 +262,12 @@ def test_probe_log_tip_radius_compensation(tmp_path):
     path = tmp_path / "probe.txt"
     path.write_text("\n".join("%.6f %.6f %.6f 0 0 0 0 0 0" % tuple(c) for c in centres) + "\n")
     # R is above the default --max-offset: the check applies to the contact points
-    out = run_cli("inspect", EXAMPLE_STEP, path, "--tip-radius", R, "--report",
-                  tmp_path / "r.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, path, "--tip-radius", R, "--report",
+                         tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     got = np.array(json.loads((tmp_path / "r.json").read_text())["points"]["deviation"])
     np.testing.assert_allclose(np.sort(got), np.sort(d.ravel()), atol=2e-6)
-    out = run_cli("inspect", EXAMPLE_STEP, path, "--max-offset", 2, "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, path, "--max-offset", 2, "--quiet")
     assert out.returncode == 0 and "tip centres (probe log); without --tip-radius" in out.stderr
     assert "1541.5" in out.stdout or "Max. positive" in out.stdout
     bad = run_cli("inspect", EXAMPLE_STEP, EXAMPLE_CSV, "--tip-radius", 1, "--quiet")
@@ -295,9 +304,9 @@ def test_scattered_adaptive_layout_end_to_end(tmp_path):
         "%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % (tuple(p) + tuple(n) + (x,))
         for p, n, x in zip(P, N, d)))
     for method in ("filtered", "raw"):
-        out = run_cli("compensate", EXAMPLE_STEP, meas, "--method", method, "-o",
-                      tmp_path / "c.step", "--report", tmp_path / "r.json", "--html",
-                      tmp_path / "r.html", "--quiet")
+        out = run_in_process("compensate", EXAMPLE_STEP, meas, "--method", method, "-o",
+                             tmp_path / "c.step", "--report", tmp_path / "r.json", "--html",
+                             tmp_path / "r.html", "--quiet")
         assert out.returncode == 0, out.stderr
         assert "70 scattered points" in out.stdout and "do not form" in out.stderr
         rep = json.loads((tmp_path / "r.json").read_text())

@@ -12,7 +12,7 @@ import Part
 from numpy.testing import assert_allclose
 
 from surfcomp.io.readers import read_any
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT
+from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, run_in_process
 
 
 def run_cli(*args):
@@ -35,8 +35,8 @@ def test_file_route_reads_the_deviations_in_um(tmp_path):
     um = _um_file(tmp_path)
     out = run_cli("inspect", EXAMPLE_STEP, um, "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 2 and "are the deviations in um?" in out.stderr
-    out = run_cli("inspect", EXAMPLE_STEP, um, "--deviation-units", "um",
-                  "--report", tmp_path / "r.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, um, "--deviation-units", "um",
+                         "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     rep = json.loads((tmp_path / "r.json").read_text())
     assert rep["inputs"]["measurements"]["units"] == "mm, deviation um"

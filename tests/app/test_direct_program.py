@@ -34,7 +34,14 @@ import pytest
 from surfcomp.app import cam, cam_job, features, replace, reports
 from surfcomp.app.nominal import load_nominal
 from tests.app.cam_example import POST_ARGS, R, with_dressup
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
+from tests.app.helpers import (
+    EXAMPLE_CSV,
+    EXAMPLE_STEP,
+    ROOT,
+    grid_on_face,
+    run_in_process,
+    write_cmm_csv,
+)
 from tests.program_compare import feed_points, surface_distance
 from tests.pure.test_gcode_rs274 import rs274
 
@@ -115,8 +122,8 @@ def agreement(tmp, step, csv, finish, regen, corrected):
     """Distances (mm) of the directly moved program from the regenerated one, and of the
     nominal program from it; the command's standard output."""
     out = tmp / "DIRECT.ngc"
-    run = run_cli("compensate", step, csv, "--refine", "1", "--program", str(finish),
-                  "--tool", "ball:%g" % R, "-o", str(out), "--quiet")
+    run = run_in_process("compensate", step, csv, "--refine", "1", "--program", str(finish),
+                         "--tool", "ball:%g" % R, "-o", str(out), "--quiet")
     assert run.returncode == 0, run.stderr
     assert "wrote %s" % out in run.stdout
     nominal = load_nominal(step)
@@ -179,8 +186,8 @@ def test_zero_correction_gives_the_same_moves(programs, tmp_path):
     zero.write_text("\n".join([head] + [",".join(r.split(",")[:-1] + ["0.0"])
                                         for r in body]) + "\n")
     out = tmp_path / "same.ngc"
-    run = run_cli("compensate", EXAMPLE_STEP, str(zero), "--program", str(finish), "--tool",
-                  "ball:3", "-o", str(out), "--quiet")
+    run = run_in_process("compensate", EXAMPLE_STEP, str(zero), "--program", str(finish),
+                         "--tool", "ball:3", "-o", str(out), "--quiet")
     assert run.returncode == 0, run.stderr
     assert out.read_bytes() == finish.read_bytes()
     assert rs274(out, tmp_path)[1] == rs274(finish, tmp_path)[1]

@@ -17,7 +17,14 @@ from numpy.testing import assert_allclose
 from surfcomp.app import features
 from surfcomp.app.nominal import load_nominal
 from surfcomp.errors import InputError
-from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP, ROOT, grid_on_face, write_cmm_csv
+from tests.app.helpers import (
+    EXAMPLE_CSV,
+    EXAMPLE_STEP,
+    ROOT,
+    grid_on_face,
+    run_in_process,
+    write_cmm_csv,
+)
 
 
 def run_cli(*args):
@@ -45,8 +52,8 @@ def test_cli_refuses_the_default_stock_on_a_finished_part(tmp_path):
 
 
 def test_cli_confirmed_stock_runs_and_says_what_it_assumed(tmp_path):
-    out = run_cli("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "--method", "mirror",
-                  "--stock", "0.1", "--accept-stock", *_outputs(tmp_path))
+    out = run_in_process("compensate", EXAMPLE_STEP, EXAMPLE_CSV, "--method", "mirror",
+                         "--stock", "0.1", "--accept-stock", *_outputs(tmp_path))
     assert out.returncode == 0, out.stderr
     assert "INCONSISTENT, used by --accept-stock" in out.stdout
     assert "predicted residual assumes the measured part carries the stock 0.1 mm" in out.stdout
@@ -71,8 +78,8 @@ def test_cli_a_stock_that_fits_needs_no_confirmation(tmp_path):
     e = 0.01 * np.sin(np.linspace(0, 3, 9))[:, None] * np.ones(9)
     meas = tmp_path / "semi.csv"
     write_cmm_csv(meas, P, N, 0.2 + e)
-    out = run_cli("compensate", EXAMPLE_STEP, meas, "--method", "mirror", "--stock", "0.2",
-                  "-o", tmp_path / "c.step", "--quiet")
+    out = run_in_process("compensate", EXAMPLE_STEP, meas, "--method", "mirror", "--stock",
+                         "0.2", "-o", tmp_path / "c.step", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "a part measured with the stock 0.2 mm should have a mean of 0.2 mm +- 100.0 um " \
            "(the larger of stock/2 and 3 x the spread): consistent" in out.stdout

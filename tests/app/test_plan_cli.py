@@ -15,7 +15,7 @@ from surfcomp.app.nominal import load_nominal
 from surfcomp.errors import MeasurementFileError
 from surfcomp.io.measurements import read_measurements
 from surfcomp.io.pointfiles import read_point_file
-from tests.app.helpers import EXAMPLE_STEP, ROOT
+from tests.app.helpers import EXAMPLE_STEP, ROOT, run_in_process
 
 
 def run_plan(*args):
@@ -25,9 +25,15 @@ def run_plan(*args):
                           env=env)
 
 
+def plan_in_process(*args):
+    """``plan ARGS --quiet`` in this process (tests/app/helpers.py), for the runs whose
+    plan a test checks."""
+    return run_in_process("plan", *args, "--quiet")
+
+
 def test_plan_round_trip_through_the_measurement_reader(tmp_path):
-    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--layout", "grid",
-                   "--count", "9x7", "--tip-radius", "1.5", "--edge-margin", "1")
+    out = plan_in_process(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--layout", "grid",
+                          "--count", "9x7", "--tip-radius", "1.5", "--edge-margin", "1")
     assert out.returncode == 0, out.stderr
     # a plan is no measurement: the reader accepts its nominal points without deviations
     # only when told it reads a plan
@@ -63,13 +69,13 @@ def test_plan_round_trip_through_the_measurement_reader(tmp_path):
 
 
 def test_plan_xyzijk_read_as_pcdmis(tmp_path):
-    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.xyz", "--format", "xyzijk",
-                   "--layout", "adaptive", "--points", "50")
+    out = plan_in_process(EXAMPLE_STEP, "-o", tmp_path / "plan.xyz", "--format", "xyzijk",
+                          "--layout", "adaptive", "--points", "50")
     assert out.returncode == 0, out.stderr
     assert (tmp_path / "plan.xyz").read_text().startswith("XYZIJK    METRIC\n")
     pts = read_point_file(tmp_path / "plan.xyz", fmt="auto")
-    csv = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--layout", "adaptive",
-                   "--points", "50")
+    csv = plan_in_process(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--layout", "adaptive",
+                          "--points", "50")
     assert csv.returncode == 0, csv.stderr
     ms = read_measurements(tmp_path / "plan.csv", plan=True)
     assert len(pts.measured) == 50
@@ -131,9 +137,9 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     radius is kept; the plan's top Z is the roof's top."""
     step = tmp_path / "roofed.step"
     face = _roofed_solid(step, roof_bottom)
-    out = run_plan(step, "--face", face, "-o", tmp_path / "plan.csv", "--count", "41x9",
-                   "--dropped", tmp_path / "dropped.csv", "--tip-radius", "1",
-                   "--edge-margin", "0.5", "--stand-off", "2")
+    out = plan_in_process(step, "--face", face, "-o", tmp_path / "plan.csv", "--count",
+                          "41x9", "--dropped", tmp_path / "dropped.csv", "--tip-radius", "1",
+                          "--edge-margin", "0.5", "--stand-off", "2")
     assert out.returncode == 0, out.stderr
     assert "paths checked against the part's other faces" in out.stdout
     assert "Safe Z:    %.4f mm (part top %.4f" % (roof_bottom + 11, roof_bottom + 5) in out.stdout
@@ -163,10 +169,11 @@ def test_simulate_at_a_written_plan(tmp_path):
     import json
 
     plan = tmp_path / "plan.csv"
-    assert run_plan(EXAMPLE_STEP, "-o", plan, "--layout", "adaptive",
-                    "--points", "120").returncode == 0
-    out = run_simulate(EXAMPLE_STEP, "--plan", plan, "--grid", "15x15", "--replicas", "1",
-                       "--methods", "none,filtered", "--json", tmp_path / "s.json")
+    assert plan_in_process(EXAMPLE_STEP, "-o", plan, "--layout", "adaptive",
+                           "--points", "120").returncode == 0
+    out = run_in_process("simulate", EXAMPLE_STEP, "--plan", plan, "--grid", "15x15",
+                         "--replicas", "1", "--methods", "none,filtered", "--json",
+                         tmp_path / "s.json", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "Measured:  120 points of %s" % plan in out.stdout
     d = json.loads((tmp_path / "s.json").read_text())
@@ -184,7 +191,7 @@ def test_simulate_at_a_written_plan(tmp_path):
 
 def test_simulate_refuses_a_plan_of_another_face(tmp_path):
     plan = tmp_path / "plan.csv"
-    assert run_plan(EXAMPLE_STEP, "-o", plan, "--count", "4x4").returncode == 0
+    assert plan_in_process(EXAMPLE_STEP, "-o", plan, "--count", "4x4").returncode == 0
     lines = plan.read_text().splitlines()
     k = next(i for i, t in enumerate(lines) if t.startswith("P3,"))
     f = lines[k].split(",")
@@ -225,8 +232,8 @@ def test_plate_with_a_hole_keeps_the_margin(tmp_path):
     back = Part.read(str(step))
     k = next(i for i, f in enumerate(back.Faces)
              if abs(f.BoundBox.ZMin - 5) < 1e-9 and abs(f.BoundBox.ZMax - 5) < 1e-9)
-    out = run_plan(step, "--face", "Face%d" % (k + 1), "-o", tmp_path / "plan.csv",
-                   "--count", "30x22", "--tip-radius", "1", "--edge-margin", "0.5")
+    out = plan_in_process(step, "--face", "Face%d" % (k + 1), "-o", tmp_path / "plan.csv",
+                          "--count", "30x22", "--tip-radius", "1", "--edge-margin", "0.5")
     assert out.returncode == 0, out.stderr
     ms = read_measurements(tmp_path / "plan.csv", plan=True)
     top = back.Faces[k]

@@ -22,7 +22,7 @@ from scipy.optimize import brentq
 
 from surfcomp.io.plan_join import read_plan
 from surfcomp.io.probe_program import ProbeSettings, write_probe_program
-from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt
+from tests.app.helpers import EXAMPLE_STEP, ROOT, realised_by_occt, run_in_process
 from tests.probe_checks import check_probe_moves, rs274_moves
 
 R = 1.0
@@ -50,8 +50,9 @@ def loop(tmp_path_factory):
     face = next("Face%d" % (k + 1) for k, f in enumerate(faces)
                 if f.Surface.TypeId == "Part::GeomBSplineSurface")
     plan, prog = tmp / "plan.csv", tmp / "probe.ngc"
-    out = run_cli("plan", part, "--face", face, "-o", plan, "--count", "8x9", "--tip-radius",
-                  R, "--clearance", CLEARANCE, "--stand-off", 2, "--program", prog, "--quiet")
+    out = run_in_process("plan", part, "--face", face, "-o", plan, "--count", "8x9",
+                         "--tip-radius", R, "--clearance", CLEARANCE, "--stand-off", 2,
+                         "--program", prog, "--quiet")
     assert out.returncode == 0, out.stderr
     assert "paths checked against the part's other faces" in out.stdout
     p = read_plan(str(plan))
@@ -108,10 +109,17 @@ def sphere_touch(surf, a, b):
         c = FreeCAD.Vector(*(a + s * u))
         return (c - surf.value(*surf.parameter(c))).Length - R
 
-    steps = np.arange(0.0, np.linalg.norm(b - a) + 1e-9, 0.05)
-    values = [gap(s) for s in steps]
-    k = next(k for k in range(1, len(steps)) if values[k] <= 0.0)
-    return a + brentq(gap, steps[k - 1], steps[k], xtol=1e-12) * u
+    # the gap is a distance minus R, so it shrinks by at most the step: a step of the gap
+    # itself cannot pass the first touch (sphere tracing); closer than 0.05 mm, steps of
+    # 0.05 mm bracket it
+    length = np.linalg.norm(b - a)
+    s, g = 0.0, gap(0.0)
+    assert g > 0.0, "the ball starts in the face"
+    while g > 0.0:
+        assert s < length, "the ball does not touch the face between a and b"
+        s, t = min(s + max(g, 0.05), length), s
+        g = gap(s)
+    return a + brentq(gap, t, s, xtol=1e-12) * u
 
 
 def write_log(path, centres):
@@ -140,13 +148,15 @@ def test_round_trip_recovers_the_correction(loop, probed):
     cmm.write_text("id,x_nom,y_nom,z_nom,i,j,k,dev\n" + "".join(
         "%s,%.9f,%.9f,%.9f,%.12f,%.12f,%.12f,%.9f\n" % ((i,) + tuple(p) + tuple(n) + (d,))
         for i, p, n, d in zip(loop["ids"], loop["P"], loop["N"], truth)))
-    out = run_cli("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
-                  "--report", tmp / "probe.json", "--html", tmp / "probe.html", "--quiet")
+    out = run_in_process("compensate", EXAMPLE_STEP, log, "--plan", loop["plan"],
+                         "--tip-radius", R, "--report", tmp / "probe.json", "--html",
+                         tmp / "probe.html", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "<b>%s</b>" % loop["plan"] in (tmp / "probe.html").read_text()
     assert "Plan:         %s" % loop["plan"] in out.stdout and "8 x 9" in out.stdout.replace(
         "9 x 8", "8 x 9")
-    ref = run_cli("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json", "--quiet")
+    ref = run_in_process("compensate", EXAMPLE_STEP, cmm, "--report", tmp / "truth.json",
+                         "--quiet")
     assert ref.returncode == 0, ref.stderr
     got, want = (json.loads((tmp / n).read_text()) for n in ("probe.json", "truth.json"))
     assert got["inputs"]["plan"]["sha256"] == hashlib.sha256(
@@ -229,8 +239,8 @@ def test_second_touch_round_trip(loop, probed):
         centres += [first, sphere_touch(probed["surf"], first + 1.0 * loop["N"][k], b)]
     log = tmp / "probe2.log"
     write_log(log, centres)
-    out = run_cli("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius", R,
-                  "--touches", 2, "--report", tmp / "probe2.json", "--quiet")
+    out = run_in_process("inspect", EXAMPLE_STEP, log, "--plan", loop["plan"], "--tip-radius",
+                         R, "--touches", 2, "--report", tmp / "probe2.json", "--quiet")
     assert out.returncode == 0, out.stderr
     dev = np.array(json.loads((tmp / "probe2.json").read_text())["points"]["deviation"])
     assert_allclose(dev, probed["truth"], atol=1e-4, rtol=0)

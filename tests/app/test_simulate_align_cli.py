@@ -8,7 +8,7 @@ import numpy as np
 from numpy.testing import assert_allclose
 
 from surfcomp.core.measurement import align
-from tests.app.helpers import EXAMPLE_STEP
+from tests.app.helpers import EXAMPLE_STEP, run_in_process
 from tests.app.test_align_cli import run_cli
 
 LOOP = ("--grid", "11x11", "--replicas", "2", "--methods", "offset,filtered", "--sigma", "0",
@@ -18,11 +18,12 @@ LOOP = ("--grid", "11x11", "--replicas", "2", "--methods", "offset,filtered", "-
 def test_simulate_reports_what_the_best_fit_absorbed(tmp_path):
     T = align.work_offset([30.0, 10.0, -4.0], -8.0)
     (tmp_path / "t.json").write_text(json.dumps({"matrix": T.tolist()}))
-    plain = run_cli("simulate", EXAMPLE_STEP, *LOOP, "--json", tmp_path / "p.json", "--quiet")
+    plain = run_in_process("simulate", EXAMPLE_STEP, *LOOP, "--json", tmp_path / "p.json",
+                           "--quiet")
     assert plain.returncode == 0, plain.stderr
-    out = run_cli("simulate", EXAMPLE_STEP, *LOOP, "--align", "bestfit", "--align-dof",
-                  "z,rx,ry", "--transform", tmp_path / "t.json", "--json", tmp_path / "s.json",
-                  "--html", tmp_path / "s.html", "--quiet")
+    out = run_in_process("simulate", EXAMPLE_STEP, *LOOP, "--align", "bestfit", "--align-dof",
+                         "z,rx,ry", "--transform", tmp_path / "t.json", "--json",
+                         tmp_path / "s.json", "--html", tmp_path / "s.html", "--quiet")
     assert out.returncode == 0, out.stderr
     p = json.loads((tmp_path / "p.json").read_text())
     s = json.loads((tmp_path / "s.json").read_text())

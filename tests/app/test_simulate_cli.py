@@ -16,7 +16,7 @@ from surfcomp.app.nominal import load_nominal
 from surfcomp.core.compensation.corrected import MATCH_TOL
 from surfcomp.core.simulation import presets
 from surfcomp.core.simulation import simulate as sm
-from tests.app.helpers import EXAMPLE_STEP, ROOT
+from tests.app.helpers import EXAMPLE_STEP, ROOT, run_in_process
 
 #: until the command is listed in surfcomp.cli.COMMANDS the tests register it for the child
 #: process only; afterwards they run the real ``python3 -m surfcomp``
@@ -30,9 +30,16 @@ def run_cli(*args):
                           capture_output=True, text=True, timeout=300)
 
 
+def simulate_in_process(*args):
+    """``simulate ARGS`` in this process (tests/app/helpers.py), for the runs whose results
+    a test checks."""
+    return run_in_process("simulate", *args)
+
+
 def test_simulate_example_writes_json_with_every_replica(tmp_path):
-    out = run_cli(EXAMPLE_STEP, "--grid", "15x15", "--replicas", "2", "--seed", "4",
-                  "--json", tmp_path / "s.json", "--html", tmp_path / "s.html", "--quiet")
+    out = simulate_in_process(EXAMPLE_STEP, "--grid", "15x15", "--replicas", "2", "--seed", "4",
+                              "--json", tmp_path / "s.json", "--html", tmp_path / "s.html",
+                              "--quiet")
     assert out.returncode == 0, out.stderr
     assert "Profile error ISO 1101" in out.stdout and "per replica" in out.stdout
     d = json.loads((tmp_path / "s.json").read_text())
@@ -64,10 +71,11 @@ def test_simulate_example_writes_json_with_every_replica(tmp_path):
 def test_model_options_reach_the_model(tmp_path):
     """Only a constant 10 um error, no noise: before mean 10 um, offset removes it to the
     construction's precision."""
-    out = run_cli(EXAMPLE_STEP, "--grid", "7x7", "--replicas", "1", "--methods", "none,offset,raw",
-                  "--offset", "0.01", "--slope-gain", "0", "--abs-slope-gain", "0", "--tilt", "0,0",
-                  "--bow", "0,0", "--sigma", "0", "--probe-sigma", "0",
-                  "--json", tmp_path / "s.json", "--quiet")
+    out = simulate_in_process(EXAMPLE_STEP, "--grid", "7x7", "--replicas", "1", "--methods",
+                              "none,offset,raw", "--offset", "0.01", "--slope-gain", "0",
+                              "--abs-slope-gain", "0", "--tilt", "0,0", "--bow", "0,0",
+                              "--sigma", "0", "--probe-sigma", "0",
+                              "--json", tmp_path / "s.json", "--quiet")
     assert out.returncode == 0, out.stderr
     d = json.loads((tmp_path / "s.json").read_text())
     assert d["model"]["offset"] == 0.01 and d["model"]["sigma"] == 0.0
@@ -133,10 +141,9 @@ def test_out_of_range_and_non_finite_options_name_the_option(tmp_path, capsys):
 def test_preset_prints_the_papers_table_beside_the_simulated_one(tmp_path):
     """No NOMINAL: the preset's own surface (mirror paper Fig. 2), its 70 points, 4 replicas;
     the paper's Tab. 3-4 figures in the rows of the simulated ones, JSON and HTML."""
-    out = subprocess.run([sys.executable, "-m", "surfcomp", "simulate", "--preset",
-                          "mirror2019-s1", "--json", str(tmp_path / "s.json"), "--html",
-                          str(tmp_path / "s.html"), "--report-method", "mirror", "--quiet"],
-                         cwd=ROOT, capture_output=True, text=True, timeout=300)
+    out = simulate_in_process("--preset", "mirror2019-s1", "--json", tmp_path / "s.json",
+                              "--html", tmp_path / "s.html", "--report-method", "mirror",
+                              "--quiet")
     assert out.returncode == 0, out.stderr
     text = out.stdout.split("Paper vs simulated: preset mirror2019-s1")[1]
     rows = {ln.split("|")[0].strip(): ln.split("|") for ln in text.splitlines() if "|" in ln}
@@ -167,9 +174,10 @@ def test_preset_prints_the_papers_table_beside_the_simulated_one(tmp_path):
 def test_preset_on_a_nominal_file_is_the_same_process_on_that_face(tmp_path):
     """The bundled example face is the werner2022 preset's surface: the preset run on the
     STEP file gives the preset's own numbers (no random part: exactly)."""
-    out = run_cli(EXAMPLE_STEP, "--preset", "werner2022", "--grid", "9x9", "--replicas", "1",
-                  "--methods", "none,raw,mirror", "--sigma", "0", "--probe-sigma", "0",
-                  "--json", tmp_path / "s.json", "--quiet")
+    out = simulate_in_process(EXAMPLE_STEP, "--preset", "werner2022", "--grid", "9x9",
+                              "--replicas", "1", "--methods", "none,raw,mirror", "--sigma",
+                              "0", "--probe-sigma", "0", "--json", tmp_path / "s.json",
+                              "--quiet")
     assert out.returncode == 0, out.stderr
     assert "surface replaced by NOMINAL" in out.stdout and "Paper vs simulated" in out.stdout
     d = json.loads((tmp_path / "s.json").read_text())

@@ -23,7 +23,7 @@ from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.app.shapes import corrected_shape
 from surfcomp.core.compensation.pipeline import Options
-from tests.app.helpers import ROOT
+from tests.app.helpers import ROOT, run_in_process
 from tests.app.trim_cases import (
     HOLE,
     INSIDE,
@@ -39,7 +39,6 @@ from tests.app.trim_cases import (
     other_faces_untouched,
     raw_deviation,
     realised_ok,
-    run_cli,
     z_field,
 )
 
@@ -55,8 +54,8 @@ def test_trimmed_face_keeps_its_boundary(tmp_path):
     nominal = nominal_from_face(Part.read(str(src)).Faces[0])
     P, N, U, V, d = measure(tmp_path / "meas.csv", nominal, 12, lambda P, U, V:
                             raw_deviation(P), box=INSIDE)
-    out = run_cli("compensate", src, tmp_path / "meas.csv", "-o", tmp_path / "out.step",
-                  "--method", "raw", "--report", tmp_path / "r.json", "--quiet")
+    out = run_in_process("compensate", src, tmp_path / "meas.csv", "-o", tmp_path / "out.step",
+                         "--method", "raw", "--report", tmp_path / "r.json", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "outside its trimmed boundary" not in out.stderr      # measured inside
     assert "the corrected face alone" in out.stdout
@@ -205,9 +204,9 @@ def _check_replaced_solid(case, out, volume_change, correction):
 def test_face_of_a_solid_on_the_command_line(circle_solid):
     case = circle_solid
     tmp, top = case["tmp"], case["top"]
-    out = run_cli("compensate", case["src"], tmp / "meas.csv", "--face", "Face%d" % (top + 1),
-                  "-o", tmp / "out.step", "--report", tmp / "r.json", "--method", "raw",
-                  "--quiet")
+    out = run_in_process("compensate", case["src"], tmp / "meas.csv", "--face",
+                         "Face%d" % (top + 1), "-o", tmp / "out.step", "--report",
+                         tmp / "r.json", "--method", "raw", "--quiet")
     assert out.returncode == 0, out.stderr
     assert "the nominal's shape with the face replaced (3 faces, 1 solids" in out.stdout
     assert "volume change" in out.stdout
@@ -223,8 +222,9 @@ def test_face_of_a_solid_on_the_command_line(circle_solid):
                        "integral": -rep["correction_integral_mm3"], "exact": exact,
                        "mesh": mesh}
     # --face-only writes the corrected face alone
-    out = run_cli("compensate", case["src"], tmp / "meas.csv", "--face", "Face%d" % (top + 1),
-                  "-o", tmp / "face.step", "--method", "raw", "--face-only", "--quiet")
+    out = run_in_process("compensate", case["src"], tmp / "meas.csv", "--face",
+                         "Face%d" % (top + 1), "-o", tmp / "face.step", "--method", "raw",
+                         "--face-only", "--quiet")
     assert out.returncode == 0, out.stderr
     alone = Part.read(str(tmp / "face.step"))
     assert len(alone.Faces) == 1 and not alone.Solids and len(alone.Faces[0].Edges) == 1

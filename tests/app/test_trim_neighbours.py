@@ -14,6 +14,7 @@ from surfcomp.app.file_route import Job, run_job
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.compensation.pipeline import Options
 from surfcomp.errors import GeometryError
+from tests.app.helpers import run_in_process
 from tests.app.trim_cases import (
     BOXED_SPHERE,
     UM,
@@ -162,7 +163,7 @@ def test_pipe_quarter_with_a_constant_correction_is_refused(pipe, tmp_path):
     assert "between Face2 and Face" in out.stderr and "14.00 um off" in out.stderr
     assert not os.path.exists(tmp_path / "out.brep")
     # the face alone is fine
-    out = run_cli("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
-                  tmp_path / "face.brep", "--method", "raw", "--face-only", "--quiet")
+    out = run_in_process("compensate", src, tmp_path / "m.csv", "--face", "Face2", "-o",
+                         tmp_path / "face.brep", "--method", "raw", "--face-only", "--quiet")
     assert out.returncode == 0, out.stderr
     assert len(Part.read(str(tmp_path / "face.brep")).Faces) == 1
