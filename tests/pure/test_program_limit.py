@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from surfcomp.core import budget
 from surfcomp.core.compensation.program_offset import BallOffset
 from surfcomp.core.limits import MAX_SEGMENTS
 from surfcomp.core.simulation.presets import werner_surface
@@ -48,7 +49,7 @@ def nil(u, v):
     return np.zeros(np.shape(u))
 
 
-def moved(path, seg, limit, block_lines=None, calls=None):
+def moved(path, seg, limit, block_lines=None, calls=None, max_memory=None):
     off = BallOffset(SURF, 1, R, nil, 1.0)
     if calls is not None:
         displace = off.displace
@@ -59,7 +60,8 @@ def moved(path, seg, limit, block_lines=None, calls=None):
         off.displace = counted
     out = []
     po = offset_stream(ProgramFile(str(path)), out.append, off, block_lines=block_lines,
-                       segment_length=seg, source="p.ngc", max_segments=limit)
+                       segment_length=seg, source="p.ngc", max_segments=limit,
+                       max_memory=max_memory)
     return po, "".join(out)
 
 
@@ -121,3 +123,25 @@ def test_the_refused_block_is_not_sampled(tmp_path):
     assert sum(max(1, math.ceil(c[1] / least)) for c in cuts) <= MAX_SEGMENTS
     # (rounded up to three digits)
     assert 0 <= least - length / (MAX_SEGMENTS - len(cuts)) <= 1e-5
+
+
+def test_a_block_beyond_the_memory_is_refused_before_it_is_sampled(tmp_path):
+    """Within the piece limit, but one block's pieces would need more than ``max_memory``
+    (:data:`surfcomp.core.budget.PROGRAM_PER_PIECE` a piece): refused on that block, its
+    pieces never made; the blocks before it pass."""
+    text, cuts = passes(6)
+    path = tmp_path / "p.ngc"
+    path.write_text(text)
+    n, _total = expected(cuts, 0.5)
+    # blocks of 4 lines: the first (lines 1-4) has no cutting move, the second (lines 5-8)
+    # the plunge and three passes, more than the memory of the first two of them
+    limit = budget.BASE + (n[0] + n[1]) * budget.PROGRAM_PER_PIECE
+    calls = []
+    with pytest.raises(GCodeError) as exc:
+        moved(path, 0.5, MAX_SEGMENTS, 4, calls, max_memory=limit)
+    err = exc.value
+    assert "need about" in str(err) and "more than max_memory" in str(err)
+    assert err.line == 8 and err.options == ("segment_length", "max_memory")
+    assert calls[-1] == 4                   # the refused block's move ends, nothing after
+    _po, out = moved(path, 0.5, MAX_SEGMENTS, 4)
+    assert out == text

@@ -49,13 +49,13 @@ class ProgramOffset:
         File name for messages.
     sep, eol : str
         The file's word separator and first line ending.
-    max_segments : int, optional
-        Most pieces the moves near the face are planned at in all
-        (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
+    max_segments, max_memory : int, optional
+        Most pieces the moves near the face are planned at in all, most bytes one
+        block's pieces may take (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
     """
 
     def __init__(self, offset, tolerance=5e-4, segment_length=2.0, decimals=None, source=None,
-                 sep=" ", eol="\n", max_segments=MAX_SEGMENTS):
+                 sep=" ", eol="\n", max_segments=MAX_SEGMENTS, max_memory=None):
         self.offset = offset
         self.tolerance = tolerance
         self.segment_length = segment_length
@@ -70,7 +70,7 @@ class ProgramOffset:
         self.start_move = None
         self.closest = (np.inf, 0)          # smallest clearance of a cutting point, line
         self.contact = []                    # (gap, tilt, interior, line) per block
-        self.count = PieceCount(segment_length, max_segments, source)
+        self.count = PieceCount(segment_length, max_segments, source, max_memory)
 
     def lines(self, lines):
         """Read, interpret, move and write the next block of ``(content, ending)`` lines;
@@ -264,7 +264,7 @@ def offset_stream(program, write, offset, block_lines=None, **settings):
         Lines at a time (default :data:`surfcomp.io.gcode.stream.BLOCK_LINES`).
     **settings
         Of :class:`ProgramOffset` (``tolerance``, ``segment_length``, ``decimals``,
-        ``source``, ``max_segments``).
+        ``source``, ``max_segments``, ``max_memory``).
 
     Returns
     -------
