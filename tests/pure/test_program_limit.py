@@ -4,7 +4,8 @@ more pieces than the limit, before the block that passes it is sampled
 (:class:`surfcomp.core.compensation.program_limit.PieceCount`): the pieces counted are
 those the plan makes (every cutting move near the face in ``ceil(length /
 segment_length)``), the line named is the one where the count passes the limit, and no
-point of the refused block but its move ends is displaced."""
+point of the refused block but its move ends is displaced; a block beyond the memory
+allowed is refused the same way; the document's dressup counts alike."""
 
 import math
 
@@ -17,7 +18,7 @@ from surfcomp.core.limits import MAX_SEGMENTS
 from surfcomp.core.simulation.presets import werner_surface
 from surfcomp.errors import GCodeError
 from surfcomp.io.gcode import ProgramFile
-from surfcomp.io.gcode.offset_stream import offset_stream
+from surfcomp.io.gcode.offset_stream import offset_commands, offset_stream
 from tests.toolpath_checks import drop_cutter
 
 R = 3.0
@@ -145,3 +146,23 @@ def test_a_block_beyond_the_memory_is_refused_before_it_is_sampled(tmp_path):
     assert calls[-1] == 4                   # the refused block's move ends, nothing after
     _po, out = moved(path, 0.5, MAX_SEGMENTS, 4)
     assert out == text
+
+
+def test_the_path_dressup_refuses_the_same_way():
+    """The document's dressup (:func:`offset_commands`, Path's command list) counts its
+    pieces the same way: 300 passes at 1 um refused at the command passing the limit."""
+    text, cuts = passes(300)
+    commands = []
+    for line in text.splitlines():
+        words = line.split()
+        if words[0] in ("G0", "G1"):
+            commands.append((words[0], {w[0]: float(w[1:]) for w in words[1:]}))
+    # the text's lines before the first move (G21 G90 G17, M3 S10000) are not commands
+    first = next(k for k, line in enumerate(text.splitlines()) if line.startswith("G0"))
+    _n, total = expected(cuts, 1e-3)
+    k = int(np.searchsorted(total, MAX_SEGMENTS, side="right"))
+    with pytest.raises(GCodeError) as exc:
+        offset_commands(commands, BallOffset(SURF, 1, R, nil, 1.0), segment_length=1e-3,
+                        source="Surface correction")
+    assert exc.value.line == cuts[k][0] - first
+    assert "more than %d pieces" % MAX_SEGMENTS in str(exc.value)
