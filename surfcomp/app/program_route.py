@@ -77,7 +77,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
                 done.append(offset_stream(
                     program, lambda text: fh.write(text.encode("latin-1")), offset,
                     tolerance=pj.tolerance, segment_length=pj.segment_length,
-                    decimals=pj.decimals, source=pj.program))
+                    decimals=pj.decimals, source=pj.program, max_memory=max_memory))
 
         tr.write(pj.output, put)
         tr.commit()

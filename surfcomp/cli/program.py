@@ -6,6 +6,7 @@ import math
 import sys
 
 from ..core.command_options import PROGRAM_MOVE
+from ..core.limits import MIN_SEGMENT_LENGTH
 from ..core.memory import collector_paused
 from ..errors import InputError
 from . import registry
@@ -51,7 +52,9 @@ def run_program(args):
         raise InputError("--program needs --tool ball:R, the ball end mill's radius in mm")
     _positive(args.tolerance, "--tolerance")
     _positive(args.blend, "--blend")
-    _positive(args.segment_length, "--segment-length", 1e-3)
+    if not (math.isfinite(args.segment_length) and args.segment_length >= MIN_SEGMENT_LENGTH):
+        raise InputError("--segment-length %r: expected a length of at least %g mm (1 um)"
+                         % (args.segment_length, MIN_SEGMENT_LENGTH))
     if args.decimals is not None and not 3 <= args.decimals <= 9:
         raise InputError("--decimals %d: expected 3 to 9" % args.decimals)
     from ..app import cadread

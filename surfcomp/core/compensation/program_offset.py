@@ -268,7 +268,7 @@ def _seg_dist(p, a, b):
     return np.linalg.norm(p - (a + s[:, None] * ab), axis=1)
 
 
-def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None):
+def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None, count=None):
     """Moved points of every move of a block (:class:`OffsetPlan`).
 
     Parameters
@@ -289,6 +289,9 @@ def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None)
         a move moved nowhere by more is kept as programmed (arcs stay arcs).
     start_move : ndarray (3,), optional
         Displacement of the block's first start point (the previous block's last end).
+    count : surfcomp.core.compensation.program_limit.PieceCount, optional
+        The pieces of the program's blocks so far: a block that would take the program
+        past its limit is refused before its pieces are made.
 
     Returns
     -------
@@ -322,6 +325,8 @@ def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None)
         idx = np.fromiter(arcs.row, dtype=int)
         bound[idx] = 2.0 * np.maximum(arcs.r0, arcs.r1)
     near = (kind >= 1) & known & (reach - bound < offset.blend)
+    if count is not None:
+        count.admit(prog, near, nseg, length)
     # pieces: owner move, fractions fa < fb, displacements at both ends
     owner = np.repeat(np.flatnonzero(near), nseg[near])
     step = np.arange(owner.size) - np.repeat(np.cumsum(nseg[near]) - nseg[near], nseg[near])
@@ -338,8 +343,11 @@ def plan_offset(prog, offset, tolerance, segment_length, still, start_move=None)
     first = fa == 0.0
     da[first] = start_d[owner[first]]
     da[~first] = db[np.flatnonzero(~first) - 1]
+    sampled = owner.size
     owner, fa, fb, da, db, n_new = _refine(prog, arcs, offset, owner, fa, fb, da, db,
                                            tolerance)
+    if count is not None:
+        count.refined(owner.size - sampled)
     return _assemble(prog, owner, fb, db, end_d, start_d, still, checked + n_new, arcs)
 
 

@@ -11,7 +11,10 @@ is committed: the caller writes into a staged file.
 Refused besides what the interpreter refuses (G41/G42 among it, anywhere): moves in inch
 mode (G20) or incremental mode (G91); a program no cutting move of which comes near the
 face; cutting points that cut into the nominal (a larger ball than the program's) or sit
-off its ball offset (another radius, stock, or another face): see :meth:`ProgramOffset.finish`.
+off its ball offset (another radius, stock, or another face): see :meth:`ProgramOffset.finish`;
+a program whose moves near the face would be planned at more pieces than
+:data:`surfcomp.core.limits.MAX_SEGMENTS` in all, before the block that passes it is
+sampled (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
 """
 
 from concurrent.futures import ThreadPoolExecutor
@@ -19,7 +22,9 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ...core.chunks import threads
+from ...core.compensation.program_limit import PieceCount
 from ...core.compensation.program_offset import CONTACT_TOL, fit_contact, plan_offset
+from ...core.limits import MAX_SEGMENTS
 from ...errors import GCodeError
 from .commands import _CommandWriter, command_words
 from .emitter import DEFAULT_DECIMALS, _TextWriter
@@ -44,10 +49,13 @@ class ProgramOffset:
         File name for messages.
     sep, eol : str
         The file's word separator and first line ending.
+    max_segments, max_memory : int, optional
+        Most pieces the moves near the face are planned at in all, most bytes one
+        block's pieces may take (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
     """
 
     def __init__(self, offset, tolerance=5e-4, segment_length=2.0, decimals=None, source=None,
-                 sep=" ", eol="\n"):
+                 sep=" ", eol="\n", max_segments=MAX_SEGMENTS, max_memory=None):
         self.offset = offset
         self.tolerance = tolerance
         self.segment_length = segment_length
@@ -62,6 +70,7 @@ class ProgramOffset:
         self.start_move = None
         self.closest = (np.inf, 0)          # smallest clearance of a cutting point, line
         self.contact = []                    # (gap, tilt, interior, line) per block
+        self.count = PieceCount(segment_length, max_segments, source, max_memory)
 
     def lines(self, lines):
         """Read, interpret, move and write the next block of ``(content, ending)`` lines;
@@ -109,7 +118,7 @@ class ProgramOffset:
     def plan(self, prog):
         """The :func:`plan_offset` of a block read by :meth:`read` (blocks in order)."""
         op = plan_offset(prog, self.offset, self.tolerance, self.segment_length, self.still,
-                         self.start_move)
+                         self.start_move, self.count)
         if prog.n_moves:
             self.start_move = op.plan.compensated[-1] - op.plan.nominal[-1]
         return op
@@ -255,7 +264,7 @@ def offset_stream(program, write, offset, block_lines=None, **settings):
         Lines at a time (default :data:`surfcomp.io.gcode.stream.BLOCK_LINES`).
     **settings
         Of :class:`ProgramOffset` (``tolerance``, ``segment_length``, ``decimals``,
-        ``source``).
+        ``source``, ``max_segments``, ``max_memory``).
 
     Returns
     -------
@@ -294,7 +303,9 @@ def offset_commands(commands, offset, tolerance=5e-4, segment_length=2.0, source
     Raises
     ------
     GCodeError
-        What :func:`check_contact` and the interpreter refuse; a move in incremental mode.
+        What :func:`check_contact` and the interpreter refuse; a move in incremental mode;
+        more pieces than :data:`surfcomp.core.limits.MAX_SEGMENTS`
+        (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
     """
     line_words = [(command_words(n, p, source, k + 1), False)
                   for k, (n, p) in enumerate(commands)]
@@ -303,7 +314,8 @@ def offset_commands(commands, offset, tolerance=5e-4, segment_length=2.0, source
         if not prog.lines[int(prog.line[j])].absolute:
             raise GCodeError("move in incremental mode (G91): expected absolute positions",
                              file=source, line=int(prog.line[j]) + 1)
-    op = plan_offset(prog, offset, tolerance, segment_length, 0.5e-6)
+    op = plan_offset(prog, offset, tolerance, segment_length, 0.5e-6,
+                     count=PieceCount(segment_length, source=source))
     got = contact_points(prog, op)
     closest, points = got if got is not None else ((np.inf, 0), None)
     fit = check_contact(offset, closest, [points] if points is not None else [], source)
