@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 # GUI session of test_align_fit_gui.py: the Align measurements panel opened as a user opens
-# it (the example loaded through the commands and compensated, the compensation picked in the tree, the
-# menu command), a best fit applied so the result box holds the alignment report; then,
-# with the main window at 1600x1200 and at 1280x800, where the result box lies in the task
-# view's visible part (the view not scrolled), and a screenshot of each.
+# it (the example's nominal and re-clamped points loaded through the commands, the
+# compensation picked in the tree, the menu command), a best fit applied so the result box
+# holds the alignment report; then, with the main window at 1600x1200 and at 1280x800,
+# where Apply and the result box lie in the task view's visible part (the view not
+# scrolled), with a screenshot of the window and of the panel for each.
 from surfcomp.app import features  # noqa: E402
-from surfcomp.gui import align_panel  # noqa: E402
-
 from surfcomp.core.measurement import align  # noqa: E402
+from surfcomp.gui import align_panel  # noqa: E402
 from surfcomp.io.readers import read_any  # noqa: E402
 
 # the example's measured points after re-clamping (0.3 deg about Z, 50 um): a best fit has
