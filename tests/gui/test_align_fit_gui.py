@@ -35,9 +35,16 @@ def test_result_box_is_visible_without_scrolling(session, size):
     # task view has nothing to scroll to
     assert s["form"][1] >= s["form_least"], s
     assert s["view_scroll"] == 0, s
-    # the options are all shown when there is room, else they scroll in their own area
+    # the options are all shown when there is room (at 1600x1200 everywhere; at 1280x800 on
+    # FreeCAD 1.0, whose task view is 626 px there), else they scroll in their own area,
+    # which takes the room there is (0.20: 405 px beside the report view; 1.1: 385 px)
     shown, needed = s["options"]
-    assert shown == needed if size == "1600x1200" else 100 <= shown < needed
+    assert 100 <= shown <= needed
+    if size == "1600x1200":
+        assert shown == needed
+    if shown < needed:
+        x, y, w, h, view_w, view_h = s["result"]
+        assert y + h >= view_h - 40, s
     # the result box shows several lines of the report (not squeezed to nothing)
     assert s["result"][3] >= 100
     # the screenshot is the window (in device pixels: FreeCAD may scale the interface)
