@@ -25,7 +25,10 @@ version string, so a build between the releases takes the branch its modules sup
 - topological naming: 1.x shapes carry an element map (the history of their faces', edges'
   and vertices' names); a shape built from several shapes can come out with names that
   change at every recompute, which breaks the links of CAM operations to its faces
-  (:func:`plain_shape` gives it the plain ``FaceN`` names instead); 0.20 has no such map.
+  (:func:`plain_shape` gives it the plain ``FaceN`` names instead); 0.20 has no such map;
+- labels: 1.1 counts the labels in use to make new ones unique, and a count can outlive the
+  label (a CAM Job's model clone renamed in the GUI): :func:`set_label` puts back a label
+  no other object carries without the ``001`` suffix 1.1 would add.
 
 No FreeCADGui: everything here works in ``freecadcmd`` and in a plain ``python3`` once
 :func:`setup_workbench` has run.
@@ -280,6 +283,35 @@ def plain_shape(shape):
     out = Part.Shape()
     out.importBrepFromString(shape.exportBrepToString())
     return out
+
+
+def set_label(obj, label):
+    """Give ``obj`` the label ``label`` exactly when no other object of its document carries
+    it; when one does, FreeCAD makes it unique as usual (a number suffix).
+
+    FreeCAD 1.1 keeps a count of the labels in use; in the GUI a CAM Job's model clone
+    renamed once left its old label counted after the rename, so giving the old label back
+    (Restore nominal) produced "Model-Block001" although no object was called "Model-Block".
+    The label checked free here is set with the duplicate check off for this assignment
+    (FreeCAD's ``DuplicateLabels`` preference, put back at once); 0.20 and 1.0 set it the
+    same either way.
+    """
+    if any(o.Name != obj.Name and o.Label == label for o in obj.Document.Objects):
+        obj.Label = label
+        return
+    import FreeCAD
+
+    prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Document")
+    had = "DuplicateLabels" in prefs.GetBools()
+    kept = prefs.GetBool("DuplicateLabels", False)
+    prefs.SetBool("DuplicateLabels", True)
+    try:
+        obj.Label = label
+    finally:
+        if had:
+            prefs.SetBool("DuplicateLabels", kept)
+        else:
+            prefs.RemBool("DuplicateLabels")
 
 
 # --------------------------------------------------------------------------- post-processing

@@ -19,7 +19,7 @@ objects that were not touched before are not touched after.
 import json
 
 from ..errors import GeometryError, InputError
-from . import features
+from . import cam, features
 from .undo import UndoStep
 
 #: properties never rebound: group membership and the compensation's own inputs
@@ -214,6 +214,14 @@ def _snapshot(doc, objs):
     return {o.Name: ("Touched" in o.State) for o in objs}
 
 
+def _assign(o, prop, value):
+    """Set a property; a label exactly as given when it is free (:func:`cam.set_label`)."""
+    if prop == "Label":
+        cam.set_label(o, value)
+    else:
+        setattr(o, prop, value)
+
+
 class _Undo:
     """Puts back what a failed replace/restore changed (with or without undo support)."""
 
@@ -224,7 +232,7 @@ class _Undo:
 
     def set(self, o, prop, value):
         self.steps.append((o, prop, getattr(o, prop)))
-        setattr(o, prop, value)
+        _assign(o, prop, value)
 
     def set_record(self, o, prop, value):
         """Set a property that records what was done (``ReplacedLinks``), not an input of
@@ -236,7 +244,7 @@ class _Undo:
 
     def rollback(self):
         for o, prop, value in reversed(self.steps):
-            setattr(o, prop, value)
+            _assign(o, prop, value)
         for o in self.doc.Objects:
             if o.Name in self.touched and not self.touched[o.Name] and "Touched" in o.State:
                 o.purgeTouched()

@@ -24,7 +24,7 @@ from ..app.undo import UndoStep
 from ..core.measurement.align import DOF_NAMES, parse_dof
 from ..core.option_tables import ALIGN
 from ..errors import SurfcompError
-from . import dialogs, option_labels
+from . import dialogs, fit_view, option_labels
 from .commands import Command, selected
 from .result_box import result_box, show_message
 from .task_panel import UndoTaskPanel
@@ -37,6 +37,9 @@ TEXTS = (QT_TRANSLATE_NOOP(ID, "Align measurements"),
                                "transform, with what the alignment absorbed"))
 TRANSFORM_FILTER = "Transform (*.json *.txt *.csv);;All files (*)"
 RPS_FILTER = "3-2-1 set (*.json);;All files (*)"
+#: lines of the result box (it scrolls), and the least height of the options (pixels) when
+#: the task view is short (:mod:`surfcomp.gui.fit_view`)
+RESULT_LINES, OPTIONS_LEAST = 9, 100
 
 
 def compensation_of_selection(doc):
@@ -75,7 +78,9 @@ class AlignPanel(UndoTaskPanel):
         self.matrix = list(meas.AlignTransform or [])
         self.form = QtGui.QWidget()
         self.form.setWindowTitle(translate("SurfComp", "Align measurements"))
-        lay = QtGui.QVBoxLayout(self.form)
+        options = QtGui.QWidget()
+        lay = QtGui.QVBoxLayout(options)
+        lay.setContentsMargins(0, 0, 0, 0)
         methods = list(ALIGN["align"].choices)
         self.method = QtGui.QComboBox()
         self.method.addItems(methods)
@@ -102,7 +107,7 @@ class AlignPanel(UndoTaskPanel):
         self.clear_button = QtGui.QPushButton(translate("SurfComp", "No transform"))
         self.apply_button = QtGui.QPushButton(translate("SurfComp", "Apply"))
         # the transform, the RMS and what the fit absorbed: a label would widen the panel
-        self.result = result_box(18)
+        self.result = result_box(RESULT_LINES)
         # labels above their fields (the task view is narrow); labels and tooltips are the
         # option registry's, as messages name the options
         for name, field in (("align", self.method),
@@ -119,8 +124,14 @@ class AlignPanel(UndoTaskPanel):
                 field.setToolTip(option_labels.tip(name, "align"))
                 lay.addWidget(field)
         lay.addWidget(_row(self.transform_button, self.clear_button))
-        lay.addWidget(self.apply_button)
-        lay.addWidget(self.result)
+        lay.addStretch(1)
+        # the options scroll when the task view is short; Apply and the result stay in sight
+        self.options = fit_view.options_area(options)
+        self.fit = fit_view.FitInView(self.form, self.options, OPTIONS_LEAST)
+        outer = QtGui.QVBoxLayout(self.form)
+        outer.addWidget(self.options)
+        outer.addWidget(self.apply_button)
+        outer.addWidget(self.result)
         self.method.currentIndexChanged.connect(self._enable)
         self.faces_button.clicked.connect(self.faces_from_selection)
         self.rps_button.clicked.connect(self.rps_from_file)

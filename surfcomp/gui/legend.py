@@ -25,6 +25,26 @@ MIN_WIDTH = 290
 LISTED = 12
 
 
+def _text_layout(font, text, width):
+    """``text`` laid out in lines ``width`` pixels wide: broken between words, and inside a
+    word only where the word is wider than the line (a long point id); with its height."""
+    layout = QtGui.QTextLayout(text, font)
+    option = QtGui.QTextOption()
+    option.setWrapMode(QtGui.QTextOption.WrapAtWordBoundaryOrAnywhere)
+    layout.setTextOption(option)
+    layout.beginLayout()
+    y = 0.0
+    while True:
+        line = layout.createLine()
+        if not line.isValid():
+            break
+        line.setLineWidth(width)
+        line.setPosition(QtCore.QPointF(0.0, y))
+        y += line.height()
+    layout.endLayout()
+    return layout, y
+
+
 class LegendEntry(QtGui.QWidget):
     """The legend of one map: its object's name and quantity, the note, the colour bar with
     its labels and percentages, and the points outside the trimmed face."""
@@ -39,9 +59,20 @@ class LegendEntry(QtGui.QWidget):
 
     def set_legend(self, key, name, data, outside=()):
         self.key, self.name, self.data, self.outside = key, name, data, list(outside)
-        self.setMinimumHeight(self._height())
-        self.updateGeometry()
+        self._fit_height()
         self.update()
+
+    def _fit_height(self):
+        """The height the entry needs at its width (its texts wrap): a taller entry makes
+        the panel scroll."""
+        h = self._height()
+        if h != self.minimumHeight():
+            self.setMinimumHeight(h)
+            self.updateGeometry()
+
+    def resizeEvent(self, event):
+        super().resizeEvent(event)
+        self._fit_height()
 
     def _lines(self):
         d = self.data
@@ -50,9 +81,38 @@ class LegendEntry(QtGui.QWidget):
     def _line_height(self):
         return self.fontMetrics().height()
 
+    def _bold(self):
+        font = QtGui.QFont(self.font())
+        font.setBold(True)
+        return font
+
+    def _wrapped(self, font, text, top):
+        """The rectangle ``text`` takes wrapped to the entry's width, from row ``top``."""
+        width = max(self.width(), self.minimumWidth()) - 16
+        _layout, height = _text_layout(font, text, width)
+        return QtCore.QRect(8, top, width, max(int(height + 0.999), self._line_height()))
+
+    def text_blocks(self):
+        """``[(text, font, QRect)]``: the name, quantity and note above the bar and the list
+        of the points outside the trimmed face below it, each wrapped to the entry's width
+        (also for tests)."""
+        if self.data is None:
+            return []
+        out, y = [], TOP
+        for k, line in enumerate(self._lines()):
+            font = self._bold() if k == 0 else self.font()
+            out.append((line, font, self._wrapped(font, line, y)))
+            y = out[-1][2].bottom() + 1
+        if self.outside:
+            top = y + 14 + BAR_HEIGHT + 10 + self._line_height()
+            out.append((self.outside_text(), self.font(),
+                        self._wrapped(self.font(), self.outside_text(), top)))
+        return out
+
     def bar_rect(self):
         """The colour bar in widget pixels (a QRect), also for tests."""
-        top = TOP + len(self._lines()) * self._line_height() + 14
+        head = self.text_blocks()[:len(self._lines())] if self.data is not None else []
+        top = (head[-1][2].bottom() + 1 if head else TOP) + 14
         return QtCore.QRect(LEFT, top, BAR_WIDTH, BAR_HEIGHT)
 
     def y_of(self, fraction):
@@ -74,10 +134,10 @@ class LegendEntry(QtGui.QWidget):
     def _height(self):
         if self.data is None:
             return 40
-        h = self.bar_rect().bottom() + 14 + self._line_height()
+        blocks = self.text_blocks()
         if self.outside:
-            h += self._line_height() * (2 + len(self.outside_text()) // 40)
-        return h
+            return blocks[-1][2].bottom() + 1 + self._line_height()
+        return self.bar_rect().bottom() + 14 + self._line_height()
 
     def sizeHint(self):
         return QtCore.QSize(280, self._height())
@@ -101,15 +161,14 @@ class LegendEntry(QtGui.QWidget):
             return
         d = self.data
         lh = self._line_height()
-        y = TOP + lh
-        bold = QtGui.QFont(p.font())
-        bold.setBold(True)
-        for k, line in enumerate(self._lines()):
-            p.setFont(bold if k == 0 else self.font())
-            p.setPen(QtGui.QColor(0, 0, 0))
-            p.drawText(8, y, line)
-            y += lh
+        outside = self.outside_text()
+        for text, font, r in self.text_blocks():
+            p.setFont(font)
+            p.setPen(QtGui.QColor(150, 0, 0) if self.outside and text == outside
+                     else QtGui.QColor(0, 0, 0))
+            _text_layout(font, text, r.width())[0].draw(p, QtCore.QPointF(r.topLeft()))
         p.setFont(self.font())
+        p.setPen(QtGui.QColor(0, 0, 0))
         bar = self.bar_rect()
         self._paint_bar(p, bar, d)
         for f, text in d["labels"]:
@@ -117,11 +176,6 @@ class LegendEntry(QtGui.QWidget):
         for f, text in d["side"]:
             w = p.fontMetrics().boundingRect(text).width()
             p.drawText(bar.left() - 8 - w, int(self.y_of(f) + lh / 3), text)
-        if self.outside:
-            p.setPen(QtGui.QColor(150, 0, 0))
-            r = QtCore.QRect(8, bar.bottom() + 10 + lh, self.width() - 16,
-                             self.height() - bar.bottom() - 10 - lh)
-            p.drawText(r, QtCore.Qt.TextWordWrap, self.outside_text())
         p.end()
 
     def _paint_bar(self, p, bar, d):

@@ -247,3 +247,30 @@ def test_clones_named_after_the_nominal_are_renamed_and_named_back(setup):
     assert s["renamed"] == [("Model-Block", "Model-Compensation")] and s["jobs"] == []
     replace.restore(doc, comp)
     assert clone.Label == "Model-Block"
+
+
+def test_set_label_gives_a_free_label_exactly_and_leaves_the_preference(fresh_doc):
+    """cam.set_label: a label no other object carries is set as given (FreeCAD 1.1 in the
+    GUI added "001" to a label its count still held, tests/gui/test_region_replace_job_gui.py);
+    a label another object carries still gets FreeCAD's suffix; the DuplicateLabels
+    preference is as before, absent or set."""
+    prefs = FreeCAD.ParamGet("User parameter:BaseApp/Preferences/Document")
+    had = "DuplicateLabels" in prefs.GetBools()
+    kept = prefs.GetBool("DuplicateLabels", False)
+    a = fresh_doc.addObject("Part::Feature", "A")
+    b = fresh_doc.addObject("Part::Feature", "B")
+    try:
+        prefs.RemBool("DuplicateLabels")
+        cam.set_label(a, "Model-Block")
+        assert a.Label == "Model-Block" and "DuplicateLabels" not in prefs.GetBools()
+        cam.set_label(b, "Model-Block")
+        assert b.Label == "Model-Block001"
+        prefs.SetBool("DuplicateLabels", False)
+        cam.set_label(a, "Model-Other")
+        assert a.Label == "Model-Other"
+        assert prefs.GetBool("DuplicateLabels", True) is False
+    finally:
+        if had:
+            prefs.SetBool("DuplicateLabels", kept)
+        else:
+            prefs.RemBool("DuplicateLabels")

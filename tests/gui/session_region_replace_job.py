@@ -21,6 +21,7 @@ def state():
             "invalid": ["%s: %s" % (o.Name, o.getStatusString()) for o in doc.Objects
                         if "Invalid" in o.State or "Error" in o.State],
             "touched": [o.Name for o in doc.Objects if "Touched" in o.State],
+            "labels": {o.Name: o.Label for o in doc.Objects},
             "tips": cam_job.cutter_locations(op).tolist()}
 
 

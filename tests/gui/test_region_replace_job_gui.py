@@ -127,3 +127,18 @@ def test_undo_restore_and_replace_again_keep_the_job_valid(session):
 def test_report_view_has_no_traceback(session):
     text = session["report_view_end"] + session["output"]
     assert "Traceback" not in text and "Unknown C++ exception" not in text
+
+
+def test_labels_stay_as_the_first_replace_left_them(session):
+    """Replace, Undo, Replace, Restore, Replace: every object keeps the label the first
+    Replace gave it (the Job's model clone is named after the region object), and Restore
+    and Undo give back the labels of the opened document; no label gets a number suffix."""
+    opened = session["opened"][2]["labels"]
+    replaced = session["replace"][3]["labels"]
+    assert replaced["Clone"] != opened["Clone"]
+    assert {n: v for n, v in replaced.items() if opened.get(n) != v} == {
+        "Clone": opened["Clone"].replace(opened["Block"], opened["RegionCompensation"])}
+    assert session["after_undo"]["labels"] == opened
+    assert session["replace_again"][3]["labels"] == replaced
+    assert session["restore"][3]["labels"] == opened
+    assert session["replace_third"][3]["labels"] == replaced
