@@ -27,12 +27,18 @@ DPI = 90
 
 
 def png(fig):
-    """``fig`` as a base64 PNG (str) at :data:`DPI`."""
+    """``fig`` as a base64 PNG (str) at :data:`DPI`: RGB (the figures are opaque), zlib
+    level 4, which encodes in half the time of PIL's default 6 for a few % more bytes."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
 
-    FigureCanvasAgg(fig)
+    canvas = FigureCanvasAgg(fig)
+    fig.set_dpi(DPI)
+    canvas.draw()
+    img = Image.frombuffer("RGBA", canvas.get_width_height(), canvas.buffer_rgba(),
+                           "raw", "RGBA", 0, 1).convert("RGB")
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=DPI)
+    img.save(buf, format="png", compress_level=4)
     return base64.b64encode(buf.getvalue()).decode("ascii")
 
 
