@@ -197,18 +197,36 @@ def map_figure(x, y, values_um, title, symmetric=True, fig=None, ax=None, style=
     return fig
 
 
+class HistPainter:
+    """:func:`hist_figure` drawn one histogram after the other into one reused figure (its
+    axes, ticks and labels made once); each as a figure of its own would look."""
+
+    def __init__(self):
+        self._fig = self._ax = self._bars = None
+
+    def figure(self, values_um, title, color):
+        """The histogram in the (reused) figure, ready to encode; valid until the next call."""
+        if self._fig is None:
+            self._fig = _figure((5.0, 3.4))
+            self._ax = _axes(self._fig, 0.7, 0.5, 0.15, 0.3)
+            self._ax.set_xlabel("µm")
+            self._ax.set_ylabel("points")
+        else:
+            self._bars.remove()
+            self._ax.ignore_existing_data_limits = True  # the limits of the new bars alone
+        ax = self._ax
+        v = values_um[np.isfinite(values_um)]
+        self._bars = ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color=color,
+                             edgecolor="white")[2]
+        ax.set_title("%s (mean %.2f µm, std %.2f µm)"
+                     % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
+                     fontsize=10, y=1.0)
+        return self._fig
+
+
 def hist_figure(values_um, title, color):
     """The distribution of the finite ``values_um`` with their mean and std in the title."""
-    fig = _figure((5.0, 3.4))
-    ax = _axes(fig, 0.7, 0.5, 0.15, 0.3)
-    v = values_um[np.isfinite(values_um)]
-    ax.hist(v, bins=min(60, max(10, int(np.sqrt(v.size)))), color=color, edgecolor="white")
-    ax.set_xlabel("µm")
-    ax.set_ylabel("points")
-    ax.set_title("%s (mean %.2f µm, std %.2f µm)"
-                 % (title, v.mean(), v.std(ddof=1) if v.size > 1 else 0.0),
-                 fontsize=10, y=1.0)
-    return fig
+    return HistPainter().figure(values_um, title, color)
 
 
 def bar_chart(sim):

@@ -42,9 +42,9 @@ from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
 from .html_figures import (
     DEFAULT_STYLE,
+    HistPainter,
     MapPainter,
     bar_chart,
-    hist_figure,
     png,
     simulation_maps_figure,
 )
@@ -249,7 +249,8 @@ def _range_note(style):
 
 
 def _section_histograms(arrays):
-    figs = [_img(hist_figure(arrays[k] * 1e3, t, c), "histogram of " + k, t)
+    painter = HistPainter()
+    figs = [_img(painter.figure(arrays[k] * 1e3, t, c), "histogram of " + k, t)
             for k, t, c in (("deviation", "Raw deviation", "#4477aa"),
                             ("random", "Random component", "#cc6677"),
                             ("residual", "Predicted residual", "#228833"))]

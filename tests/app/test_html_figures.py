@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""The HTML report's map figures (surfcomp.io.html_figures): one MapPainter reusing its
-figures over maps of every kind draws each map pixel for pixel as a figure of its own."""
+"""The HTML report's figures (surfcomp.io.html_figures): one MapPainter reusing its figures
+over maps of every kind, and one HistPainter over histograms of different ranges and sizes,
+draw each figure pixel for pixel as a figure of its own."""
 
 import base64
 import io
@@ -8,7 +9,7 @@ import io
 import numpy as np
 from PIL import Image
 
-from surfcomp.io.html_figures import DPI, MapPainter
+from surfcomp.io.html_figures import DPI, HistPainter, MapPainter, png
 
 
 def _pixels(b64):
@@ -50,3 +51,16 @@ def test_a_reused_figure_draws_each_map_as_a_fresh_one():
         assert np.array_equal(reused, fresh), "map %d differs from a fresh figure's" % i
     # one figure per kind and colorbar: grid, points, index, grid with the GUI's range
     assert len(painter._figures) == 4
+
+
+def test_a_reused_histogram_figure_draws_each_as_a_fresh_one():
+    rng = np.random.default_rng(5)
+    values = [rng.normal(0, 20, 121), rng.normal(300, 1, 4000), np.array([0.5, 0.7, np.nan]),
+              rng.uniform(-1200, -1100, 50), np.full(30, 2.0)]
+    painter = HistPainter()
+    for i, v in enumerate(values):
+        mode, reused = _pixels(png(painter.figure(v, "hist %d" % i, "#4477aa")))
+        _, fresh = _pixels(png(HistPainter().figure(v, "hist %d" % i, "#4477aa")))
+        assert mode == "RGB"
+        assert reused.shape == (round(3.4 * DPI), round(5.0 * DPI), 3)
+        assert np.array_equal(reused, fresh), "histogram %d differs from a fresh figure's" % i
