@@ -40,8 +40,14 @@ import numpy as np
 from ..core.compensation.deviations import statistics
 from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
-from .html_figures import DEFAULT_STYLE, bar_chart, hist_figure, png, simulation_maps_figure
-from .html_figures import map_figure as _map
+from .html_figures import (
+    DEFAULT_STYLE,
+    HistPainter,
+    MapPainter,
+    bar_chart,
+    png,
+    simulation_maps_figure,
+)
 
 __all__ = ["DEFAULT_STYLE", "SECTIONS", "grid_arrays", "render_html", "simulation_maps",
            "simulation_maps_figure", "write_html_report"]
@@ -77,8 +83,9 @@ def _e(x):
 
 
 def _img(fig, alt, caption):
+    """``fig`` (a Figure or its base64 PNG) as a figure element."""
     return ('<figure><img alt="%s" src="data:image/png;base64,%s"><figcaption>%s</figcaption>'
-            "</figure>" % (_e(alt), png(fig), _e(caption)))
+            "</figure>" % (_e(alt), fig if isinstance(fig, str) else png(fig), _e(caption)))
 
 
 def _kv_table(rows):
@@ -217,14 +224,15 @@ def _section_alignment(report):
     return '<section id="alignment"><h2>Alignment</h2>%s</section>' % _kv_table(rows)
 
 
-def _section_maps(arrays, style=None):
+def _section_maps(arrays, style=None, painter=None):
+    painter = painter or MapPainter()
     figs = []
     for key, title in (("deviation", "Raw deviation d"),
                        ("determined", "Determined (filtered) d_f"),
                        ("random", "Random d - d_f"), ("correction", "Correction applied delta"),
                        ("residual", "Predicted residual")):
-        figs.append(_img(_map(arrays["x"], arrays["y"], arrays[key] * 1e3, title + " [µm]",
-                              style=style), "map of " + key, title))
+        figs.append(_img(painter.png(arrays["x"], arrays["y"], arrays[key] * 1e3,
+                                     title + " [µm]", style=style), "map of " + key, title))
     return ('<section id="maps"><h2>Maps</h2><p>Values along the outward normal in µm; '
             'positive = material left; correction positive = material removed (the face moves '
             'inwards by it). Predicted residual = d_f - stock - delta: what the correction '
@@ -241,7 +249,8 @@ def _range_note(style):
 
 
 def _section_histograms(arrays):
-    figs = [_img(hist_figure(arrays[k] * 1e3, t, c), "histogram of " + k, t)
+    painter = HistPainter()
+    figs = [_img(painter.figure(arrays[k] * 1e3, t, c), "histogram of " + k, t)
             for k, t, c in (("deviation", "Raw deviation", "#4477aa"),
                             ("random", "Random component", "#cc6677"),
                             ("residual", "Predicted residual", "#228833"))]
@@ -387,11 +396,13 @@ def _preset_html(sim):
     return "".join(out)
 
 
-def _simulated_maps_html(maps):
+def _simulated_maps_html(maps, painter=None):
     if not maps:
         return ""
-    figs = [_img(_map(np.asarray(m["x"]), np.asarray(m["y"]), np.asarray(m["values"]) * 1e3,
-                      "%s [µm]" % m["title"]), "simulated map of " + m["key"],
+    painter = painter or MapPainter()
+    figs = [_img(painter.png(np.asarray(m["x"]), np.asarray(m["y"]),
+                             np.asarray(m["values"]) * 1e3, "%s [µm]" % m["title"]),
+                 "simulated map of " + m["key"],
                  "%s (std %.2f µm)" % (m["title"], np.std(np.asarray(m["values"]) * 1e3, ddof=1)))
             for m in maps]
     return ('<div id="simulated-maps"><h3>Simulated parts, replica 1</h3><p>Deviation from the '
@@ -399,7 +410,7 @@ def _simulated_maps_html(maps):
             '<div class="figs">%s</div></div>' % "".join(figs))
 
 
-def _section_simulation(sim):
+def _section_simulation(sim, painter=None):
     if not sim:
         return ""
     cols = [("Before", sim["before"])] + [(m["label"], m) for m in sim["methods"]]
@@ -432,7 +443,7 @@ def _section_simulation(sim):
                _e("x".join(map(str, sim.get("grid", [])))),
                _e("x".join(map(str, sim.get("evaluation_grid", [])))), table, "".join(rep),
                _img(bar_chart(sim), "before and after bar chart", "Spread per method"),
-               _preset_html(sim), _simulated_maps_html(sim.get("maps")), params))
+               _preset_html(sim), _simulated_maps_html(sim.get("maps"), painter), params))
 
 
 def render_html(report, simulation=None, style=None):
@@ -450,6 +461,7 @@ def render_html(report, simulation=None, style=None):
         :data:`DEFAULT_STYLE`): the GUI passes its map's so both show the same colours.
     """
     arrays = grid_arrays(report)
+    painter = MapPainter()  # one figure for all the maps of a kind
     warn = report.get("warnings") or []
     warn_html = (("<ul>%s</ul>" % "".join("<li>%s</li>" % _e(w) for w in warn)) if warn
                  else "<p>None.</p>")
@@ -459,9 +471,9 @@ def render_html(report, simulation=None, style=None):
              "<title>%s</title><style>%s</style></head><body>" % (_e(title), _CSS),
              "<h1>%s</h1>" % _e(title),
              _section_inputs(report), _section_method(report), _section_alignment(report),
-             _section_maps(arrays, style),
+             _section_maps(arrays, style, painter),
              _section_histograms(arrays), _section_statistics(report, arrays),
-             _section_checks(report), _section_simulation(simulation),
+             _section_checks(report), _section_simulation(simulation, painter),
              '<section id="warnings"><h2>Warnings</h2>%s</section>' % warn_html,
              "</body></html>\n"]
     return "\n".join(parts)

@@ -156,12 +156,12 @@ def test_predicted_residual_by_method():
 def test_maps_use_the_gui_scheme_and_range():
     """The report's maps use the GUI's rainbow (red at the top of the range) and, when the
     GUI passes its range, grey beyond it (colorbar arrows)."""
-    from surfcomp.io import html_report
+    from surfcomp.io import html_figures, html_report
 
     rep = _report("filtered", n=7, build=False)
     arr = grid_arrays(rep)
-    fig = html_report._map(arr["x"], arr["y"], arr["deviation"] * 1e3, "d",
-                           style={"scheme": "rainbow", "range": (-1e-4, 1e-4)})
+    fig = html_figures.map_figure(arr["x"], arr["y"], arr["deviation"] * 1e3, "d",
+                                  style={"scheme": "rainbow", "range": (-1e-4, 1e-4)})
     mesh = fig.axes[0].collections[0]
     assert_allclose(mesh.cmap(1.0)[:3], (1, 0, 0))
     assert_allclose(mesh.cmap(0.5)[:3], (0, 1, 0), atol=0.01)
