@@ -145,7 +145,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
         fld = stack(fld)
-    sharp = region.sharp_edges(faces, edges, band=field_radius)
+    sharp = region.sharp_edges(faces, edges, band=field_radius, field=fld)
     closed = _closed(shape)
     if not closed:      # a compound of faces: nothing to re-trim its neighbours in
         _check_neighbours(shape, faces, fld, sharp)
@@ -225,11 +225,14 @@ def _build(faces, fld, sharp, field_radius, max_factor):
     """Every face's corrected surface (``f.built``, ``f.part_surface``)."""
     from .convert import surface_to_part
 
+    plans = region_build.knot_plans([f.surface for f in faces], field_radius / 5.0,
+                                    max_factor)
+
     def one(i):
         return region_build.corrected_surface(faces[i].surface, faces[i].outward, fld,
                                               sharp and sharp.for_face(i),
                                               knot_step=field_radius / 5.0,
-                                              max_factor=max_factor)
+                                              max_factor=max_factor, plan=plans[i])
 
     for f, built in zip(faces, per_face(faces, one)):
         f.built = built
