@@ -314,8 +314,8 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     curves were fitted on their own, the tip cap's by 4.4 um before the faces were oriented
     and 36 um with a cap's collapsed end moved by more than one vector). Beyond the zones
     where the design shortens the correction, the root cap meets it within 0.02 um; the
-    sides miss by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
-    (see docs/regions.md)."""
+    sides missed by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
+    (see docs/regions.md); 0.31 and 0.23 um with the slide's second-order term."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
@@ -336,7 +336,7 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert len(sides) == 2
     # oriented, the sides meet at 0 to 22 deg (leading edge) and 10 to 143 deg (trailing)
     assert sorted(round(e["nominal_angle_deg"]) for e in sides) == [22, 143]
-    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.023 um, the
+    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.029 um, the
     # rounded edge 0.0000, the suction side - tip cap 0.0003, the pressure side - tip cap
     # 0.046 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.3 um
     # (trailing edge), 8.9, 12.3 (suction side - tip cap), 11.7, 10.7 and 10.8 um apart
@@ -352,10 +352,12 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert trailing["nominal_gap_um"] == pytest.approx(3.27, abs=0.03)
     faces_rep = {f["face"]: f for f in data["faces"]}
     assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
-    # measured: 0.449, 0.426 and 0.0059 um (1.8 and 3.5 um on the sides before the edges'
-    # exactness was eased along them: the trailing edge turns from 143 to 95 deg within
-    # 3.5 mm near the tip, and the displacement turned as fast, over 3 mm spanwise spans)
-    for name, within in (("Face1", 0.6), ("Face2", 0.6), ("Face4", 0.02)):
+    # measured: 0.311, 0.227 and 0.0031 um (0.449, 0.426 and 0.0059 before the second-order
+    # term of the slide along a face curling next to the trailing edge; 1.8 and 3.5 um on
+    # the sides before the edges' exactness was eased along them: the trailing edge turns
+    # from 143 to 95 deg within 3.5 mm near the tip, and the displacement turned as fast,
+    # over 3 mm spanwise spans). What is left on the sides is their spanwise fit (42 poles)
+    for name, within in (("Face1", 0.36), ("Face2", 0.27), ("Face4", 0.01)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within
