@@ -118,7 +118,7 @@ def displacement_second(x, derivs, n, field, sharp=None):
         return -delta[:, None] * np.asarray(n, dtype=float)
     turned, w, lam, second = _turn(x, n, sharp)
     D = -delta[:, None] * turned
-    q = normal_term(x, *derivs, n, D, field)
+    q = normal_term(x, *derivs, n, D, field, here=delta)
     along = second - np.einsum("ij,ij->i", second, n)[:, None] * n
     return D + lam[:, None] * (q[:, None] * n + w[:, None] * along)
 

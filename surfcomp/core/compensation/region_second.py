@@ -37,11 +37,11 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
-def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field):
+def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field, here=None):
     """``q`` (M,) at points ``S`` (M, 3) of a face with derivatives ``Su``... (M, 3) and
     outward unit normals ``n`` moved by ``D`` (M, 3): ``S + D + q n`` lies on the offset
     surface to second order in ``D``'s part along the face (module docstring). ``field``:
-    ``field(x)`` -> corrections (mm) at points (K, 3)."""
+    ``field(x)`` -> corrections (mm) at points (K, 3); ``here``: ``field(S)``, when known."""
     D = np.asarray(D, dtype=float)
     q = np.zeros(len(D))
     dn = _dot(D, n)
@@ -77,7 +77,7 @@ def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field):
     dv = np.where(ok, (g11 * r2 - g12 * r1) / det, 0.0)
     curve = 0.5 * (L * du * du + 2.0 * M * du * dv + Nn * dv * dv)
     # the correction read at the foot the point slid to, in the share the normal keeps
-    here = field(S)
+    here = field(S) if here is None else np.asarray(here, dtype=float)[slid]
     there = field(S + du[:, None] * Su + dv[:, None] * Sv)
     share = np.where(np.abs(here) > 1e-15, delta / np.where(here == 0, 1.0, here), 0.0)
     q[slid] = np.where(ok, np.clip(curve - share * (there - here), -SHORT * slide,
