@@ -47,7 +47,7 @@ def _deviation(ms, normal, signed):
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
                sample=None, deviation_units=None, method="filtered", mask_size=WERNER_MASK_SIZE,
                mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
-               max_factor=4.0, log=print):
+               max_factor=region_build.POLE_FACTOR, log=print):
     """Run a region compensation; returns the report dict. Nothing is written on error."""
     outputs = [("output", output)] + ([("report", report)] if report else [])
     inputs = [("nominal", nominal), ("measurements", measurements)]
@@ -81,7 +81,8 @@ def check_method(method):
 
 def compute_region(shape, ms, faces_text, sources, method="filtered",
                    mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
-                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print, stack=None):
+                   min_coverage=0.5, smoothing=None, max_factor=region_build.POLE_FACTOR,
+                   log=print, stack=None):
     """The region of ``shape`` (faces ``faces_text``: ``'Face1,Face2'`` or ``'auto'``)
     corrected by the measurement set ``ms``; ``sources``: the nominal's and the
     measurements' names for the report and the errors; ``stack``: a function given this

@@ -48,6 +48,11 @@ PER_SPAN = 3
 HALVED_SPANS = 128
 #: the fewest knot spans of a corrected face in each direction
 MIN_SPANS = 8
+#: the pole budget of a corrected face: at most this many times the nominal's poles (CAM's
+#: 3D Surface operation on the BladeX blade's corrected suction side, 568 x 80 poles, took
+#: 1.12 times its time on the nominal's 526 x 13: bench/bench_region_cam.py; with 4 times,
+#: 42 spanwise poles, the sides' fit missed the correction by up to 0.31 um)
+POLE_FACTOR = 8.0
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
 #: a boundary curve missing the displacement by more than this (mm) halfway between two
@@ -167,7 +172,7 @@ def _inserted(knots, degree, splits):
     return np.concatenate(new) if new else np.array([])
 
 
-def knot_plans(surfaces, knot_step, max_factor=4.0):
+def knot_plans(surfaces, knot_step, max_factor=POLE_FACTOR):
     """How :func:`corrected_surface` refines each of ``surfaces``: per surface
     ``(splits_u, splits_v, step)``, the parts each knot span is split into and the knot
     step (mm) that holds the pole budget. Surfaces with the same degrees and numbers of
@@ -251,7 +256,7 @@ class Built:
     knot_step: float
 
 
-def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=4.0,
+def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=POLE_FACTOR,
                       plan=None):
     """The corrected surface of one face of a region.
 
