@@ -112,18 +112,20 @@ def direction(x, n, sharp=None):
     return _turn(x, n, sharp)[0]
 
 
-def displacement_second(x, derivs, n, field, sharp=None):
+def displacement_second(x, derivs, n, field, sharp=None, delta=None, slope=None):
     """:func:`displacement` of points ``x`` of one face (``derivs``: ``(Su, Sv, Suu, Suv,
     Svv)`` there) with its second-order term where it slides the face along itself
     (:mod:`surfcomp.core.compensation.region_second`): ``q n`` plus, within the band, the
     part of the edges' second-order vector along the face, both in the share ``lam`` that
-    keeps the normal component, so that on an edge both faces add the edge's vector."""
-    delta = field(x)
+    keeps the normal component, so that on an edge both faces add the edge's vector.
+    ``delta``: ``field(x)`` when known; ``slope``: see
+    :func:`~surfcomp.core.compensation.region_second.normal_term`."""
+    delta = field(x) if delta is None else delta
     if sharp is None or len(sharp.points) == 0:
         return -delta[:, None] * np.asarray(n, dtype=float)
     turned, w, lam, second = _turn(x, n, sharp)
     D = -delta[:, None] * turned
-    q = normal_term(x, *derivs, n, D, field, here=delta)
+    q = normal_term(x, *derivs, n, D, field, here=delta, slope=slope)
     along = second - np.einsum("ij,ij->i", second, n)[:, None] * n
     return D + lam[:, None] * (q[:, None] * n + w[:, None] * along)
 
@@ -324,14 +326,22 @@ class _Grid:
         self.ref, self.outward, self.field, self.sharp = ref, outward, field, sharp
         self.us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
         self.vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
-        self.P, self.D = self._moved(self.us, self.vs)
+        self.P, self.D = self._moved(self.us, self.vs, dense=True)
 
-    def _moved(self, us, vs):
+    def _moved(self, us, vs, dense=False):
+        """The points and their displacement on the grid ``us x vs``; ``dense``: the fit's
+        whole grid, where the correction's change along a slide is taken from its
+        differences between the samples (the field evaluated once per sample)."""
         P, *derivs = evaluate_grid(self.ref, us, vs, order=2)
         n = self.outward * _unit(np.cross(derivs[0], derivs[1]))
         flat = [a.reshape(-1, 3) for a in derivs]
-        D = displacement_second(P.reshape(-1, 3), flat, n.reshape(-1, 3), self.field,
-                                self.sharp).reshape(P.shape)
+        x = P.reshape(-1, 3)
+        delta = self.field(x)
+        slope = None
+        if dense and len(us) > 2 and len(vs) > 2:
+            slope = [g.ravel() for g in np.gradient(delta.reshape(len(us), len(vs)), us, vs)]
+        D = displacement_second(x, flat, n.reshape(-1, 3), self.field, self.sharp,
+                                delta=delta, slope=slope).reshape(P.shape)
         return P, D
 
     def fit(self):

@@ -37,11 +37,13 @@ def _dot(a, b):
     return np.einsum("ij,ij->i", a, b)
 
 
-def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field, here=None):
+def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field, here=None, slope=None):
     """``q`` (M,) at points ``S`` (M, 3) of a face with derivatives ``Su``... (M, 3) and
     outward unit normals ``n`` moved by ``D`` (M, 3): ``S + D + q n`` lies on the offset
     surface to second order in ``D``'s part along the face (module docstring). ``field``:
-    ``field(x)`` -> corrections (mm) at points (K, 3); ``here``: ``field(S)``, when known."""
+    ``field(x)`` -> corrections (mm) at points (K, 3); ``here``: ``field(S)``, when known;
+    ``slope``: the correction's derivatives in u and v (M,) each, when known (a dense grid's
+    differences: the field is then not evaluated where the points land)."""
     D = np.asarray(D, dtype=float)
     q = np.zeros(len(D))
     dn = _dot(D, n)
@@ -78,7 +80,10 @@ def normal_term(S, Su, Sv, Suu, Suv, Svv, n, D, field, here=None):
     curve = 0.5 * (L * du * du + 2.0 * M * du * dv + Nn * dv * dv)
     # the correction read at the foot the point slid to, in the share the normal keeps
     here = field(S) if here is None else np.asarray(here, dtype=float)[slid]
-    there = field(S + du[:, None] * Su + dv[:, None] * Sv)
+    if slope is None:
+        there = field(S + du[:, None] * Su + dv[:, None] * Sv)
+    else:
+        there = here + slope[0][slid] * du + slope[1][slid] * dv
     share = np.where(np.abs(here) > 1e-15, delta / np.where(here == 0, 1.0, here), 0.0)
     q[slid] = np.where(ok, np.clip(curve - share * (there - here), -SHORT * slide,
                                    SHORT * slide), 0.0)
