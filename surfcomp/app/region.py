@@ -399,11 +399,13 @@ def _angle(a, b):
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
 
 
-def sharp_edges(faces, edges, band):
+def sharp_edges(faces, edges, band, field=None):
     """The :class:`~surfcomp.core.compensation.region_edges.SharpEdges` of the region's edges that
     are not G1, with the normals and in-face directions at their samples, each edge's vector
     turned to its vertices' near them
-    (:func:`~surfcomp.core.compensation.region_edges.at_vertices`)."""
+    (:func:`~surfcomp.core.compensation.region_edges.at_vertices`); with ``field`` (the
+    correction), each edge's second-order vector
+    (:mod:`~surfcomp.core.compensation.region_second`), nil at vertices."""
     pts, mit, cl, eid, nrm, ids = [], [], [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:
@@ -421,11 +423,36 @@ def sharp_edges(faces, edges, band):
     if not pts:
         return None
     pts, eid, nrm = np.concatenate(pts), np.concatenate(eid), np.concatenate(nrm)
-    mit, exact = region_edges.at_vertices(
+    mit, exact, away = region_edges.at_vertices(
         pts, np.concatenate(mit), np.concatenate(cl), eid, nrm, 0.5 * band,
-        region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces))
+        region_edges.knife_limit(region_build.MITER_ANGLE), SHARE_TOL, _collapsed(faces),
+        away=True)
     exact = region_edges.eased(exact, eid, pts, EASE_SHARE * band)
-    return region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, np.concatenate(ids))
+    ids = np.concatenate(ids)
+    out = region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, ids)
+    if field is not None:
+        out.second = away[:, None] * _second(faces, edges, pts, mit, eid, nrm, field)
+    return out
+
+
+def _second(faces, edges, pts, mit, eid, nrm, field):
+    """Each sharp edge sample's second-order vector: both faces' second-order normal terms
+    for the slide the edge's vector ``-delta m`` gives them, combined into one vector."""
+    from ..core.compensation.region_second import edge_vector, normal_term
+
+    out = np.zeros_like(mit)
+    delta = field(pts)
+    for k in np.unique(eid):
+        idx = np.flatnonzero(eid == k)
+        e = edges[k]
+        q = []
+        for side, i in enumerate((e.a, e.b)):
+            _n, u, v = normals_at(faces[i], e.samples)
+            S, *derivs = derivatives(faces[i].surface, u, v, order=2)
+            n = nrm[idx, side]
+            q.append(normal_term(S, *derivs, n, -delta[idx, None] * mit[idx], field))
+        out[idx] = edge_vector(nrm[idx, 0], nrm[idx, 1], *q)
+    return out
 
 
 def _collapsed(faces):

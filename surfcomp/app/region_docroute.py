@@ -152,7 +152,7 @@ def run_region_document(document, measurements, object_name, faces, save, replac
 
 def summary_lines(result):
     """The printed lines of a :class:`RegionDocumentResult`."""
-    from .region_route import output_line, summary
+    from .region_route import dropped_text, output_line, summary
 
     rep = result.report
     lines = ["region compensation %s (measurement %s) added to the document: faces %s"
@@ -164,7 +164,8 @@ def summary_lines(result):
     lines.append("options: " + ", ".join("%s %s" % kv for kv in result.options.items()))
     lines.append("points per face: " + ", ".join("%s %d" % (f["face"], f["points"])
                                                  for f in rep["faces"])
-                 + "; on no face: %d" % rep["points_on_no_face"])
+                 + "; on no face: %d" % rep["points_on_no_face"]
+                 + dropped_text(rep.get("points_on_dropped_faces", {})))
     lines += [a for a in result.alignment if a not in result.alignment_warnings]
     lines += summary(rep)
     lines.append(output_line(rep["output"]))

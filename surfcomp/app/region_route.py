@@ -47,7 +47,7 @@ def _deviation(ms, normal, signed):
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
                sample=None, deviation_units=None, method="filtered", mask_size=WERNER_MASK_SIZE,
                mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
-               max_factor=4.0, log=print):
+               max_factor=region_build.POLE_FACTOR, log=print):
     """Run a region compensation; returns the report dict. Nothing is written on error."""
     outputs = [("output", output)] + ([("report", report)] if report else [])
     inputs = [("nominal", nominal), ("measurements", measurements)]
@@ -81,7 +81,8 @@ def check_method(method):
 
 def compute_region(shape, ms, faces_text, sources, method="filtered",
                    mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
-                   min_coverage=0.5, smoothing=None, max_factor=4.0, log=print, stack=None):
+                   min_coverage=0.5, smoothing=None, max_factor=region_build.POLE_FACTOR,
+                   log=print, stack=None):
     """The region of ``shape`` (faces ``faces_text``: ``'Face1,Face2'`` or ``'auto'``)
     corrected by the measurement set ``ms``; ``sources``: the nominal's and the
     measurements' names for the report and the errors; ``stack``: a function given this
@@ -99,20 +100,24 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
             "neighbours'): " + ", ".join(turned))
     dist, res = region.project_all(faces, base, max_offset)
     owner, u, v, normal, signed = region.locate(faces, base, max_offset, (dist, res))
+    dropped = {}
     if chosen is None:
         keep = [i for i in range(len(faces)) if np.sum(owner == i) >= AUTO_MIN_POINTS]
         if not keep:
             raise MeasurementFileError("faces auto: no face of the shape has %d points within "
                                        "max_offset %g mm" % (AUTO_MIN_POINTS, max_offset),
                                        file=measurements, options=("faces", "max_offset"))
-        faces = [faces[i] for i in keep]      # the points go to their nearest kept face
+        first = owner
+        faces_all, faces = faces, [faces[i] for i in keep]  # points go to the nearest kept face
         owner, u, v, normal, signed = region.locate(faces, base, max_offset,
                                                     (dist[keep], [res[i] for i in keep]))
+        dropped = _dropped(faces_all, keep, first, owner)
     names = [f.name for f in faces]
     on = owner >= 0
     counts = {f.name: int(np.sum(owner == i)) for i, f in enumerate(faces)}
+    none = int(np.sum(~on)) - sum(dropped.values())
     log("points per face: " + ", ".join("%s %d" % kv for kv in counts.items())
-        + "; on no face: %d" % int(np.sum(~on)))
+        + "; on no face: %d" % none + dropped_text(dropped))
     d = _deviation(ms, normal, signed)
     lines = np.asarray(ms.lines) if ms.lines is not None else np.arange(2, len(base) + 2)
     pts, dev, lines = base[on], d[on], lines[on]
@@ -141,15 +146,16 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
         fld = stack(fld)
-    sharp = region.sharp_edges(faces, edges, band=field_radius)
+    sharp = region.sharp_edges(faces, edges, band=field_radius, field=fld)
     closed = _closed(shape)
     if not closed:      # a compound of faces: nothing to re-trim its neighbours in
         _check_neighbours(shape, faces, fld, sharp)
     _build(faces, fld, sharp, field_radius, max_factor)
     figures = region.continuity(faces, edges)
     fidelity = _fidelity(faces, owner, u, v, fld, base, normal, sharp)
-    rep = _report(nominal, measurements, faces, counts, int(np.sum(~on)), figures, fidelity,
+    rep = _report(nominal, measurements, faces, counts, none, figures, fidelity,
                   field_radius, step, method, mask_size)
+    rep["points_on_dropped_faces"] = dropped
     for line in summary(rep):
         log(line)
     out_shape, kind, volume = _assemble(shape, faces, fld, closed)
@@ -157,6 +163,26 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     for line in neighbour_lines(rep["output"]) + [output_line(rep["output"])]:
         log(line)
     return out_shape, rep
+
+
+def _dropped(faces, keep, first, owner):
+    """Per face left out by ``--faces auto`` (fewer than AUTO_MIN_POINTS points), the
+    points nearest to it that lie on no kept face: they are on a face, not on none."""
+    out = {}
+    for i, f in enumerate(faces):
+        if i not in keep:
+            k = int(np.sum((first == i) & (owner < 0)))
+            if k:
+                out[f.name] = k
+    return out
+
+
+def dropped_text(dropped):
+    """``'; on faces left out (fewer than 10 points): Face3 4'`` or ``''``."""
+    if not dropped:
+        return ""
+    return "; on faces left out (fewer than %d points): %s" % (
+        AUTO_MIN_POINTS, ", ".join("%s %d" % kv for kv in dropped.items()))
 
 
 def _near(face, base, max_offset):
@@ -200,11 +226,14 @@ def _build(faces, fld, sharp, field_radius, max_factor):
     """Every face's corrected surface (``f.built``, ``f.part_surface``)."""
     from .convert import surface_to_part
 
+    plans = region_build.knot_plans([f.surface for f in faces], field_radius / 5.0,
+                                    max_factor)
+
     def one(i):
         return region_build.corrected_surface(faces[i].surface, faces[i].outward, fld,
                                               sharp and sharp.for_face(i),
                                               knot_step=field_radius / 5.0,
-                                              max_factor=max_factor)
+                                              max_factor=max_factor, plan=plans[i])
 
     for f, built in zip(faces, per_face(faces, one)):
         f.built = built

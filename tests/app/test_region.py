@@ -178,7 +178,7 @@ def test_boxed_sphere_corner_blends_and_their_fillets(tmp_path):
     for name in ("Face1", "Face2", "Face3", "Face4"):
         assert fid[name] <= 0.01
     for f in data["faces"]:
-        assert f["poles"][0] * f["poles"][1] <= max(4 * f["nominal_poles"][0] *
+        assert f["poles"][0] * f["poles"][1] <= max(8 * f["nominal_poles"][0] *
                                                     f["nominal_poles"][1], 64 * 64)
     assert data["output"]["kind"] == "faces"
     assert len(Part.read(out).Faces) == 4
@@ -314,8 +314,9 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     curves were fitted on their own, the tip cap's by 4.4 um before the faces were oriented
     and 36 um with a cap's collapsed end moved by more than one vector). Beyond the zones
     where the design shortens the correction, the root cap meets it within 0.02 um; the
-    sides miss by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
-    (see docs/regions.md)."""
+    sides missed by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
+    (see docs/regions.md); with the slide's second-order term and 8 times the nominal's
+    poles, within 0.1 um."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
@@ -336,14 +337,14 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert len(sides) == 2
     # oriented, the sides meet at 0 to 22 deg (leading edge) and 10 to 143 deg (trailing)
     assert sorted(round(e["nominal_angle_deg"]) for e in sides) == [22, 143]
-    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.023 um, the
-    # rounded edge 0.0000, the suction side - tip cap 0.0003, the pressure side - tip cap
-    # 0.046 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.3 um
+    # measured (FreeCAD 0.20): beyond the nominal's gap, the trailing edge 0.0095 um, the
+    # rounded edge 0.0000, the suction side - tip cap 0.0002, the pressure side - tip cap
+    # 0.042 (its fold), the root cap's 0.0028 and 0.0072; the nominal faces lie 3.3 um
     # (trailing edge), 8.9, 12.3 (suction side - tip cap), 11.7, 10.7 and 10.8 um apart
     # (a wrong foot of one edge sample read 40 um before)
-    bounds = {("Face1", "Face2", 143): 0.04, ("Face1", "Face2", 22): 0.001,
+    bounds = {("Face1", "Face2", 143): 0.02, ("Face1", "Face2", 22): 0.001,
               ("Face1", "Face3", 14): 0.005, ("Face1", "Face4", 97): 0.01,
-              ("Face2", "Face3", 179): 0.07, ("Face2", "Face4", 95): 0.015}
+              ("Face2", "Face3", 179): 0.06, ("Face2", "Face4", 95): 0.015}
     for e in edges:
         key = (*e["faces"], round(e["nominal_angle_deg"]))
         assert e["max_gap_beyond_nominal_um"] <= bounds[key], e
@@ -352,10 +353,12 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     assert trailing["nominal_gap_um"] == pytest.approx(3.27, abs=0.03)
     faces_rep = {f["face"]: f for f in data["faces"]}
     assert faces_rep["Face3"]["edge_zone_points"] >= 190      # the tip cap: in the zone
-    # measured: 0.449, 0.426 and 0.0059 um (1.8 and 3.5 um on the sides before the edges'
-    # exactness was eased along them: the trailing edge turns from 143 to 95 deg within
-    # 3.5 mm near the tip, and the displacement turned as fast, over 3 mm spanwise spans)
-    for name, within in (("Face1", 0.6), ("Face2", 0.6), ("Face4", 0.02)):
+    # measured: 0.041, 0.053 and 0.0031 um (with 4 times the nominal's poles, 42 spanwise
+    # poles on the sides, 0.311 and 0.227 um; before the second-order term of the slide
+    # along a face curling next to the trailing edge 0.449 and 0.426; 1.8 and 3.5 um before
+    # the edges' exactness was eased along them: the trailing edge turns from 143 to 95 deg
+    # within 3.5 mm near the tip, and the displacement turned as fast)
+    for name, within in (("Face1", 0.07), ("Face2", 0.08), ("Face4", 0.01)):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within

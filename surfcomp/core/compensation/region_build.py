@@ -33,6 +33,7 @@ import numpy as np
 from ..surface.bspline import Surface, evaluate_grid, fit_grid_lsq, insert_knots
 from .region_edges import SharpEdges, knife_limit, smoothstep  # noqa: F401 (SharpEdges: API)
 from .region_fit import fit_ends_held
+from .region_second import normal_term
 
 #: largest angle (degrees) between the two normals of an edge that gets its full miter
 MITER_ANGLE = 120.0
@@ -47,6 +48,11 @@ PER_SPAN = 3
 HALVED_SPANS = 128
 #: the fewest knot spans of a corrected face in each direction
 MIN_SPANS = 8
+#: the pole budget of a corrected face: at most this many times the nominal's poles (CAM's
+#: 3D Surface operation on the BladeX blade's corrected suction side, 568 x 80 poles, took
+#: 1.12 times its time on the nominal's 526 x 13: bench/bench_region_cam.py; with 4 times,
+#: 42 spanwise poles, the sides' fit missed the correction by up to 0.31 um)
+POLE_FACTOR = 8.0
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
 #: a boundary curve missing the displacement by more than this (mm) halfway between two
@@ -103,7 +109,31 @@ def direction(x, n, sharp=None):
     vectors within their band (see the module docstring)."""
     if sharp is None or len(sharp.points) == 0:
         return np.array(n, dtype=float)
-    d, m, exact, excess = sharp.nearest(x)
+    return _turn(x, n, sharp)[0]
+
+
+def displacement_second(x, derivs, n, field, sharp=None, delta=None, slope=None):
+    """:func:`displacement` of points ``x`` of one face (``derivs``: ``(Su, Sv, Suu, Suv,
+    Svv)`` there) with its second-order term where it slides the face along itself
+    (:mod:`surfcomp.core.compensation.region_second`): ``q n`` plus, within the band, the
+    part of the edges' second-order vector along the face, both in the share ``lam`` that
+    keeps the normal component, so that on an edge both faces add the edge's vector.
+    ``delta``: ``field(x)`` when known; ``slope``: see
+    :func:`~surfcomp.core.compensation.region_second.normal_term`."""
+    delta = field(x) if delta is None else delta
+    if sharp is None or len(sharp.points) == 0:
+        return -delta[:, None] * np.asarray(n, dtype=float)
+    turned, w, lam, second = _turn(x, n, sharp)
+    D = -delta[:, None] * turned
+    q = normal_term(x, *derivs, n, D, field, here=delta, slope=slope)
+    along = second - np.einsum("ij,ij->i", second, n)[:, None] * n
+    return D + lam[:, None] * (q[:, None] * n + w[:, None] * along)
+
+
+def _turn(x, n, sharp):
+    """:func:`direction`, the band's weight ``w``, the share ``lam`` that keeps the normal
+    component and the blended second-order edge vector at ``x``."""
+    d, m, exact, excess, second = sharp.blend(x)
     s = d / sharp.band
     w = 1.0 - smoothstep((s - 0.1) / 0.9)
     lam = exact + (1.0 - exact) * smoothstep(s / 0.5)
@@ -112,7 +142,7 @@ def direction(x, n, sharp=None):
     # the edge the face's normal is its own there and this is m; lam = 0: m alone
     along = (excess - m) - np.einsum("ij,ij->i", excess - m, n)[:, None] * n
     turned = m + lam[:, None] * ((1.0 - mn)[:, None] * n + along)
-    return (1.0 - w)[:, None] * n + w[:, None] * turned
+    return (1.0 - w)[:, None] * n + w[:, None] * turned, w, lam, second
 
 
 def designed_share(x, n, sharp=None):
@@ -121,23 +151,63 @@ def designed_share(x, n, sharp=None):
     return np.einsum("ij,ij->i", direction(x, n, sharp), n)
 
 
-def _refined(knots, degree, lo, hi, step):
-    """Knots to insert so no span of ``knots`` in ``(lo, hi)`` is wider than ``step`` and
-    every span is split at least once."""
+def _splits(knots, degree, step):
+    """Parts each knot span of ``knots`` is split into so no span is wider than ``step``
+    and every span is split at least once."""
     br = np.unique(knots[degree:len(knots) - degree])
-    new = []
     # a narrow face (a blade's tip cap, a few mm across) still gets MIN_SPANS spans: the
     # displacement turns from one edge's vector to the other's across it
     step = min(step, (br[-1] - br[0]) / MIN_SPANS)
-    for a, b in zip(br[:-1], br[1:]):
-        # every span at least halved (the nominal's own spans leave no room for the field)
-        # unless there are many, already finer than a quarter step: a blade side's 523
-        # chordwise spans would take the budget its few spanwise ones need
-        fine = len(br) > HALVED_SPANS and b - a <= 0.25 * step
-        k = max(1 if fine else 2, int(math.ceil((b - a) / step - 1e-9)))
-        if k > 1:
-            new.extend(a + (b - a) * np.arange(1, k) / k)
-    return np.array(new)
+    fine = len(br) > HALVED_SPANS
+    # every span at least halved (the nominal's own spans leave no room for the field)
+    # unless there are many, already finer than a quarter step: a blade side's 523
+    # chordwise spans would take the budget its few spanwise ones need
+    return np.array([max(1 if fine and b - a <= 0.25 * step else 2,
+                         int(math.ceil((b - a) / step - 1e-9)))
+                     for a, b in zip(br[:-1], br[1:])], dtype=int)
+
+
+def _inserted(knots, degree, splits):
+    """The knots splitting each span of ``knots`` into ``splits`` equal parts."""
+    br = np.unique(knots[degree:len(knots) - degree])
+    new = [a + (b - a) * np.arange(1, k) / k for a, b, k in zip(br[:-1], br[1:], splits)]
+    return np.concatenate(new) if new else np.array([])
+
+
+def knot_plans(surfaces, knot_step, max_factor=POLE_FACTOR):
+    """How :func:`corrected_surface` refines each of ``surfaces``: per surface
+    ``(splits_u, splits_v, step)``, the parts each knot span is split into and the knot
+    step (mm) that holds the pole budget. Surfaces with the same degrees and numbers of
+    knot spans (a blade's two sides, made alike) split each span into as many parts (the
+    most any of them needs, the step growing until every budget holds): their knots then
+    correspond, and along an edge they share their fits miss its displacement alike
+    (split by their own lengths, at 8 times the nominal's poles, the sides took 79 and 80
+    spanwise poles and the trailing edge opened by 0.29 um)."""
+    ups = [elevated(s) for s in surfaces]
+
+    def key(s):
+        return (s.degree_u, s.degree_v, len(np.unique(s.knots_u)), len(np.unique(s.knots_v)))
+
+    out = [None] * len(ups)
+    for k in {key(s) for s in ups}:
+        group = [i for i, s in enumerate(ups) if key(s) == k]
+        sizes = [_lengths(ups[i]) for i in group]
+        budgets = [max(max_factor * np.prod(surfaces[i].poles.shape[:2]), MIN_BUDGET)
+                   for i in group]
+        step = float(knot_step)
+        while True:
+            su = np.max([_splits(ups[i].knots_u, ups[i].degree_u, step / max(lu, 1e-12))
+                         for i, (lu, _) in zip(group, sizes)], axis=0)
+            sv = np.max([_splits(ups[i].knots_v, ups[i].degree_v, step / max(lv, 1e-12))
+                         for i, (_, lv) in zip(group, sizes)], axis=0)
+            if all((ups[i].poles.shape[0] + np.sum(su - 1)) * (ups[i].poles.shape[1]
+                                                              + np.sum(sv - 1)) <= b
+                   for i, b in zip(group, budgets)):
+                break
+            step *= 1.25
+        for i in group:
+            out[i] = (su, sv, step)
+    return out
 
 
 def _lengths(surf):
@@ -188,7 +258,8 @@ class Built:
     knot_step: float
 
 
-def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=4.0):
+def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_factor=POLE_FACTOR,
+                      plan=None):
     """The corrected surface of one face of a region.
 
     The nominal's knots refined to ``knot_step`` within the pole budget; then, for up to
@@ -211,6 +282,8 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     max_factor : float
         Pole budget: at most this many times the nominal's poles (at least MIN_BUDGET);
         the knot step grows until the budget holds.
+    plan : tuple, optional
+        The surface's :func:`knot_plans` (default its own alone).
 
     Returns
     -------
@@ -219,18 +292,11 @@ def corrected_surface(surf, outward, field, sharp=None, knot_step=1.0, max_facto
     nominal = surf.poles.shape[:2]
     original = surf
     surf = elevated(surf)       # degree 1 (a ruled cap) to 2; the sides keep theirs
-    lu, lv = _lengths(surf)
     budget = max(max_factor * nominal[0] * nominal[1], MIN_BUDGET)
-    lo_u, hi_u = surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1]
-    lo_v, hi_v = surf.knots_v[surf.degree_v], surf.knots_v[-surf.degree_v - 1]
-    step = float(knot_step)
-    while True:
-        nu = _refined(surf.knots_u, surf.degree_u, lo_u, hi_u, step / max(lu, 1e-12))
-        nv = _refined(surf.knots_v, surf.degree_v, lo_v, hi_v, step / max(lv, 1e-12))
-        if (surf.poles.shape[0] + len(nu)) * (surf.poles.shape[1] + len(nv)) <= budget:
-            break
-        step *= 1.25
-    ref = insert_knots(surf, nu, nv)
+    su, sv, step = plan if plan is not None else knot_plans([original], knot_step,
+                                                           max_factor)[0]
+    ref = insert_knots(surf, _inserted(surf.knots_u, surf.degree_u, su),
+                       _inserted(surf.knots_v, surf.degree_v, sv))
     surf = original     # the zero correction returns it
     grid = _Grid(ref, outward, field, sharp)
     poles = grid.fit()
@@ -260,13 +326,22 @@ class _Grid:
         self.ref, self.outward, self.field, self.sharp = ref, outward, field, sharp
         self.us = _samples(ref.knots_u, ref.degree_u, PER_SPAN)
         self.vs = _samples(ref.knots_v, ref.degree_v, PER_SPAN)
-        self.P, self.D = self._moved(self.us, self.vs)
+        self.P, self.D = self._moved(self.us, self.vs, dense=True)
 
-    def _moved(self, us, vs):
-        P, Su, Sv = evaluate_grid(self.ref, us, vs, order=1)
-        n = self.outward * _unit(np.cross(Su, Sv))
+    def _moved(self, us, vs, dense=False):
+        """The points and their displacement on the grid ``us x vs``; ``dense``: the fit's
+        whole grid, where the correction's change along a slide is taken from its
+        differences between the samples (the field evaluated once per sample)."""
+        P, *derivs = evaluate_grid(self.ref, us, vs, order=2)
+        n = self.outward * _unit(np.cross(derivs[0], derivs[1]))
+        flat = [a.reshape(-1, 3) for a in derivs]
         x = P.reshape(-1, 3)
-        D = displacement(x, n.reshape(-1, 3), self.field(x), self.sharp).reshape(P.shape)
+        delta = self.field(x)
+        slope = None
+        if dense and len(us) > 2 and len(vs) > 2:
+            slope = [g.ravel() for g in np.gradient(delta.reshape(len(us), len(vs)), us, vs)]
+        D = displacement_second(x, flat, n.reshape(-1, 3), self.field, self.sharp,
+                                delta=delta, slope=slope).reshape(P.shape)
         return P, D
 
     def fit(self):

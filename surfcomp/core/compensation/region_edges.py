@@ -50,14 +50,17 @@ def vertex_miter(normals, limit):
     return m * (limit / size) if size > limit else m
 
 
-def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=None):
+def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=None,
+                away=False):
     """Turn each edge's miters to its vertex's vector near the vertex (see the module
     docstring). ``normals``: (K, 2, 3), both faces' normals at each sample; ``zone``: the
     arc length (mm) over which an edge's miter turns; ``tol``: ends closer than this meet;
     ``singular``: (S, 3) points where a face collapses (a cap's end: its normal takes every
     direction of a fan there, so no vector but the vertex's own moves it as one point).
-    Returns new ``miter`` and ``exact`` arrays."""
+    Returns new ``miter`` and ``exact`` arrays (and with ``away`` a third: 0 at a vertex
+    where two edges meet, rising to 1 over ``zone``)."""
     miter, exact = miter.copy(), exact.astype(float).copy()
+    far = np.ones(len(miter))
     ends = []
     for k in np.unique(edge):
         idx = np.flatnonzero(edge == k)
@@ -82,9 +85,10 @@ def at_vertices(points, miter, exact, edge, normals, zone, limit, tol, singular=
             arc = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points[idx], axis=0), axis=1))]
             t = smoothstep(arc / zone)[:, None]
             miter[idx] = t * miter[idx] + (1.0 - t) * mv
+            far[idx] *= t[:, 0]
             if shorten:
                 exact[idx] *= smoothstep(arc / zone - 1.0)
-    return miter, exact
+    return (miter, exact, far) if away else (miter, exact)
 
 
 def eased(exact, edge, points, length):
@@ -161,6 +165,8 @@ class SharpEdges:
         # what the displacement turns by along the face, per sample: the miter itself
         # (seen from no face in particular), or the miter less the face's own normal
         self.excess = self.miter
+        # the second-order edge vector (mm, region_second.edge_vector; zero unless set)
+        self.second = np.zeros_like(self.miter)
         self._edges = [np.flatnonzero(self.edge == k) for k in np.unique(self.edge)]
         self._trees = [cKDTree(self.points[idx]) for idx in self._edges]
         # a point within the band of a segment is within this much more of a sample
@@ -188,8 +194,8 @@ class SharpEdges:
         edge polyline (the others are beyond its band: nothing turns towards it there),
         their distance to the polyline, and the miter, exactness and excess there."""
         pts = self.points[idx]
-        mit = np.concatenate([self.miter[idx], self.excess[idx], self.exact[idx, None]],
-                             axis=1)
+        mit = np.concatenate([self.miter[idx], self.excess[idx], self.second[idx],
+                              self.exact[idx, None]], axis=1)
         last = len(idx) - 1
         _, j = tree.query(x, k=1, distance_upper_bound=self.band + self._reach)
         k = np.flatnonzero(j <= last)
@@ -214,16 +220,20 @@ class SharpEdges:
         # along the edge follows no kink)
         ks = (np.maximum(k0 - 1, 0), k0, k1, np.minimum(k1 + 1, last))
         mk = _catmull_rom(mit, ks, tt)
-        return k, d, mk[:, :6], mk[:, 6]
+        return k, d, mk[:, :9], mk[:, 9]
 
     def nearest(self, x):
         """Distance to the nearest edge, and the blended miter, exactness and excess (the
         turn along the face: :meth:`for_face`) at ``x``. The distance is exact within the
         band; beyond it, where nothing turns, it is at least the band (or inf)."""
+        return self.blend(x)[:4]
+
+    def blend(self, x):
+        """:meth:`nearest` and the blended second-order edge vector at ``x``."""
         x = np.asarray(x, dtype=float)
         dmin = np.full(len(x), np.inf)
         wsum = np.zeros(len(x))
-        m = np.zeros((len(x), 6))
+        m = np.zeros((len(x), 9))
         e = np.zeros(len(x))
         eps2 = (1e-9 * self.band) ** 2
         for idx, tree in zip(self._edges, self._trees):
@@ -240,7 +250,8 @@ class SharpEdges:
         far = wsum <= 0
         wsum[far] = 1.0
         e[far] = 1.0
-        return dmin, (m / wsum[:, None])[:, :3], e / wsum, (m / wsum[:, None])[:, 3:]
+        m /= wsum[:, None]
+        return dmin, m[:, :3], e / wsum, m[:, 3:6], m[:, 6:]
 
 
 def knife_limit(angle):
