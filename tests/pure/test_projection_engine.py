@@ -296,16 +296,22 @@ def test_span_table_matches_derivatives():
             assert_allclose(b.T, a, atol=1e-10 * np.abs(a).max())
 
 
-@pytest.mark.reference_solver
-@pytest.mark.parametrize("samples_per_span", [1, 2, None])
-def test_project_between_the_legs_of_a_hairpin(samples_per_span):
-    # points 0.85..0.97 mm from the lower leg and 1.03..1.15 mm from the upper one:
-    # with coarse samples the nearest sample is often on the wrong leg; the check
-    # for far-apart samples within reach must find the better minimum
+@pytest.fixture(scope="module")
+def hairpin_reference():
+    """Points 0.85..0.97 mm from the hairpin's lower leg and 1.03..1.15 mm from the upper
+    one, and their reference feet (solved once for every sample density)."""
     s = hairpin()
     rng = np.random.default_rng(50)
     Q = np.c_[rng.uniform(5, 15, 40), rng.uniform(1, 9, 40), rng.uniform(0.85, 0.97, 40)]
-    ru, rv, rf = reference_projection(s, Q)
+    return s, Q, reference_projection(s, Q)[2]
+
+
+@pytest.mark.reference_solver
+@pytest.mark.parametrize("samples_per_span", [1, 2, None])
+def test_project_between_the_legs_of_a_hairpin(hairpin_reference, samples_per_span):
+    # with coarse samples the nearest sample is often on the wrong leg; the check
+    # for far-apart samples within reach must find the better minimum
+    s, Q, rf = hairpin_reference
     r = pj.Projector(s, samples_per_span=samples_per_span).project(Q)
     assert r.converged.all()
     assert_allclose(np.abs(r.distance), np.linalg.norm(Q - rf, axis=1), atol=1e-12, rtol=0)
