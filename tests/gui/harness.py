@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """Run a script inside the real FreeCAD GUI (``freecad script.py``) and collect its results.
 
-Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cfg, and a
-``Mod`` folder that holds only what the test puts there (a link to this checkout, or an
-Addon-Manager-like clone). The script writes a JSON report to ``$SURFCOMP_GUI_OUT``;
-the report view's text and the process output come back too, for the "no traceback"
-checks. Without a DISPLAY, or in a worker of a parallel run, the run is wrapped in
-``xvfb-run`` (its own X server).
+Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cfg (whose one
+setting turns the splash screen off), and a ``Mod`` folder that holds only what the test puts
+there (a link to this checkout, or an Addon-Manager-like clone). The script writes a JSON
+report to ``$SURFCOMP_GUI_OUT``; the report view's text and the process output come back
+too, for the "no traceback" checks. Without a DISPLAY, or in a worker of a parallel run,
+the run is wrapped in ``xvfb-run`` (its own X server).
 """
 
 import json
@@ -55,11 +55,32 @@ _finish()
 '''
 
 
+#: a new user's settings but for the splash screen: with it FreeCAD runs the script only
+#: after the splash has waited for the main window to be exposed, which under Xvfb (no
+#: window manager) costs some 3 s a start; nothing of surfcomp shows on it
+USER_CFG = """<?xml version="1.0" encoding="UTF-8" standalone="no" ?>
+<FCParameters>
+  <FCParamGroup Name="Root">
+    <FCParamGroup Name="BaseApp">
+      <FCParamGroup Name="Preferences">
+        <FCParamGroup Name="General">
+          <FCBool Name="ShowSplasher" Value="0"/>
+        </FCParamGroup>
+      </FCParamGroup>
+    </FCParamGroup>
+  </FCParamGroup>
+</FCParameters>
+"""
+
+
 def make_home(tmp_path, link_checkout=True):
-    """A FreeCAD user home under ``tmp_path``; with ``link_checkout`` its Mod folder
-    links this checkout (as tools/install.sh does for the real user)."""
+    """A FreeCAD user home under ``tmp_path`` (:data:`USER_CFG` its settings); with
+    ``link_checkout`` its Mod folder links this checkout (as tools/install.sh does for the
+    real user)."""
     home = tmp_path / "fchome"
     (home / "Mod").mkdir(parents=True, exist_ok=True)
+    if not (home / "user.cfg").exists():
+        (home / "user.cfg").write_text(USER_CFG)
     if link_checkout:
         os.symlink(ROOT, home / "Mod" / "surfcomp")
     return home

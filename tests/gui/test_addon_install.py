@@ -16,7 +16,7 @@ import xml.etree.ElementTree as ET
 import pytest
 
 from tests.conftest import ROOT
-from tests.gui.harness import run_gui
+from tests.gui.harness import make_home, run_gui
 
 GIT = ["git", "-c", "user.name=surfcomp-test", "-c", "user.email=test@example.invalid",
        "-c", "init.defaultBranch=main", "-c", "advice.detachedHead=false"]
@@ -106,8 +106,7 @@ def installed(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("addon")
     repo = tmp / "repo"
     _repository_as_committed(repo)
-    home = tmp / "fchome"
-    (home / "Mod").mkdir(parents=True)
+    home = make_home(tmp, link_checkout=False)
     # what the Addon Manager does for a git-hosted workbench
     _git("clone", "-q", str(repo), str(home / "Mod" / "surfcomp"))
     first, out1 = run_gui(FIRST_START, tmp, home=home)

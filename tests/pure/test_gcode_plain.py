@@ -131,6 +131,11 @@ def random_program(seed, n=1500, tip=None):
     return ("\n".join(lines) + "\n").encode()
 
 
+#: seed -> the random program's output under the zero model (both paths compared once: the
+#: outcome does not depend on the parametrized block size)
+_ZERO_OUTPUT = {}
+
+
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("block_lines", [97, 1000])
 def test_axis_route_random_programs_byte_for_byte(seed, block_lines, monkeypatch):
@@ -139,7 +144,9 @@ def test_axis_route_random_programs_byte_for_byte(seed, block_lines, monkeypatch
     assert not isinstance(res, Exception), res
     # compensated, terse lines gained words, and most lines were read in runs
     assert res.data != data and res.stats["lines_changed"] > 500
-    assert _same_axis(data, AxisErrorModel.zero(), monkeypatch).data == data
+    if seed not in _ZERO_OUTPUT:
+        _ZERO_OUTPUT[seed] = _same_axis(data, AxisErrorModel.zero(), monkeypatch).data
+    assert _ZERO_OUTPUT[seed] == data
 
 
 def test_axis_route_freecad_3d_surface_program(monkeypatch):
