@@ -2,7 +2,8 @@
 """Run a script inside the real FreeCAD GUI (``freecad script.py``) and collect its results.
 
 Each run gets its own FreeCAD user home (``FREECAD_USER_HOME``): a fresh user.cfg (whose one
-setting turns the splash screen off), and a ``Mod`` folder that holds only what the test puts
+setting turns the splash screen off), its own Qt settings (``XDG_CONFIG_HOME``: the main
+window's layout), and a ``Mod`` folder that holds only what the test puts
 there (a link to this checkout, or an Addon-Manager-like clone). The script writes a JSON
 report to ``$SURFCOMP_GUI_OUT``; the report view's text and the process output come back
 too, for the "no traceback" checks. Without a DISPLAY, or in a worker of a parallel run,
@@ -111,7 +112,12 @@ def run_gui(body, tmp_path, home=None, timeout=240, env=None):
     script.write_text(PROLOGUE + indented + "\n    pass\n" + EPILOGUE)
     out = tmp_path / "gui_results.json"
     e = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
-    e.update({"FREECAD_USER_HOME": str(home), "SURFCOMP_GUI_OUT": str(out),
+    # Qt's settings (FreeCAD keeps its main window's toolbar layout and size there, in
+    # $XDG_CONFIG_HOME/FreeCAD/FreeCAD.conf, not in the user home) belong to the session's
+    # home too: a layout an earlier session on this machine left (a toolbar moved off the
+    # window) hid a toolbar button from later sessions
+    e.update({"FREECAD_USER_HOME": str(home), "XDG_CONFIG_HOME": str(home / "xdg-config"),
+              "SURFCOMP_GUI_OUT": str(out),
               "SURFCOMP_ROOT": ROOT, "SURFCOMP_TMP": str(tmp_path),
               "QTWEBENGINE_CHROMIUM_FLAGS": e.get("QTWEBENGINE_CHROMIUM_FLAGS", "--no-sandbox")})
     e.update(env or {})
