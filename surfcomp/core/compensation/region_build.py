@@ -48,10 +48,10 @@ PER_SPAN = 3
 HALVED_SPANS = 128
 #: the fewest knot spans of a corrected face in each direction
 MIN_SPANS = 8
-#: the pole budget of a corrected face: at most this many times the nominal's poles (CAM's
-#: 3D Surface operation on the BladeX blade's corrected suction side, 568 x 80 poles, took
-#: 1.12 times its time on the nominal's 526 x 13: bench/bench_region_cam.py; with 4 times,
-#: 42 spanwise poles, the sides' fit missed the correction by up to 0.31 um)
+#: the pole budget of a corrected face: at most this many times the nominal's poles (with 4
+#: times, 42 spanwise poles, the BladeX sides' fit missed the correction by up to 0.31 um;
+#: CAM's time on the corrected faces against the nominal's: bench/bench_region_cam.py and
+#: docs/regions.md)
 POLE_FACTOR = 8.0
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
