@@ -6,6 +6,7 @@ The nominal is never modified: everything here works on copies.
 
 import os
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -48,6 +49,14 @@ class Nominal:
     object_name: str = None
     converted: str = None
     shape: object = None
+
+    @cached_property
+    def untrimmed(self):
+        """True when the face is bounded by its surface's whole domain
+        (:func:`bounds_whole_domain`), told once for the trim warning, the correction's
+        volume and the direct program's trim."""
+        return bounds_whole_domain(self.bspline_face, self.surface.u_range,
+                                   self.surface.v_range)
 
 
 def read_shape(path, object_name=None):
@@ -285,7 +294,7 @@ def outside_trim(nominal, prepared):
     import Part
 
     face = nominal.bspline_face
-    if bounds_whole_domain(face, nominal.surface.u_range, nominal.surface.v_range):
+    if nominal.untrimmed:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
     candidates = np.nonzero(~inside(boundary_polylines(face, 200), prepared.u,
                                     prepared.v))[0]

@@ -18,10 +18,9 @@ from ..core.compensation.realised_feet import RealisedAt
 def offset_of(nominal, corrected, radius, blend):
     """The :class:`surfcomp.core.compensation.program_offset.BallOffset` of ``nominal``
     (:class:`surfcomp.app.nominal.Nominal`) corrected to the surface ``corrected``."""
-    from .nominal import boundary_polylines, bounds_whole_domain
+    from .nominal import boundary_polylines
 
     surface = nominal.surface
-    trim = None if bounds_whole_domain(nominal.bspline_face, surface.u_range, surface.v_range) \
-        else Trim.of(surface, boundary_polylines(nominal.bspline_face))
+    trim = None if nominal.untrimmed else Trim.of(surface, boundary_polylines(nominal.bspline_face))
     return BallOffset(nominal.surface, nominal.outward, radius,
                       RealisedAt(nominal.surface, corrected, nominal.outward), blend, trim=trim)

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..core.surface import bspline
 from ..core.surface.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
-from .nominal import boundary_polylines, bounds_whole_domain
+from .nominal import boundary_polylines
 from .retrim import KEPT
 
 #: the trapezoidal rule: ``numpy.trapezoid`` since numpy 2.0, where ``trapz`` is deprecated
@@ -34,7 +34,7 @@ def correction_volume(nominal, corrected):
     material removed): :func:`surfcomp.core.surface.trimmed.correction_integral` inside the face's
     boundary in (u, v)."""
     surface = nominal.surface
-    if bounds_whole_domain(nominal.bspline_face, surface.u_range, surface.v_range):
+    if nominal.untrimmed:
         (u0, u1), (v0, v1) = surface.u_range, surface.v_range   # the tensor rule's case
         lines = [np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1], [u0, v0]])]
     else:
