@@ -22,6 +22,14 @@ _MOVE = re.compile(r"^\s*\d+\s+N\S*\s+(STRAIGHT_TRAVERSE|STRAIGHT_FEED|STRAIGHT_
 PRINTED = 0.5e-4
 
 
+def own_tool_data(folder):
+    """The environment for one ``rs274`` run: HOME in ``folder``. LinuxCNC's interpreter
+    keeps its tool table in a memory-mapped file ``$HOME/.tool.mmap``, so two runs at once
+    (the parallel test workers) shared one table, and one run found the other's tools
+    ("Requested tool 99 not found in the tool table")."""
+    return dict(os.environ, HOME=str(folder))
+
+
 def rs274_moves(program, tmp_path, tool=99, diameter=2.0, other_tools=()):
     """The canonical moves of ``program``: list of ``(kind, start (3,), end (3,))`` in mm,
     the first start being the machine's origin. The tool table holds ``tool`` and the
@@ -34,7 +42,8 @@ def rs274_moves(program, tmp_path, tool=99, diameter=2.0, other_tools=()):
                      + "".join("T%d P%d Z0 D6 ;other\n" % (t, t) for t in other_tools))
     out = tmp_path / (os.path.basename(str(program)) + ".canon")
     run = subprocess.run([RS274, "-t", str(table), "-g", str(program), str(out)],
-                         cwd=str(tmp_path), capture_output=True, text=True, timeout=300)
+                         cwd=str(tmp_path), env=own_tool_data(tmp_path), capture_output=True,
+                         text=True, timeout=300)
     errors = [ln for ln in run.stderr.splitlines() if ln.strip() not in ("", "executing")]
     assert run.returncode == 0 and not errors, "rs274 refused %s: %s" % (program, run.stderr)
     text = out.read_text()

@@ -30,6 +30,7 @@ from surfcomp.core.axis.machine import SimulatedMachine
 from surfcomp.io.axis_csv import read_axis_errors, write_axis_errors
 from surfcomp.io.gcode import compensate_gcode, parse_gcode
 from tests.conftest import REALDATA, ROOT
+from tests.probe_checks import own_tool_data
 
 RS274 = "/usr/bin/rs274"
 WAVE = os.path.join(REALDATA, "gcode", "CAMotics_GPL", "wave.gcode")
@@ -111,7 +112,8 @@ def rs274(path, tmp_path):
         % RS274)
     out = tmp_path / (os.path.basename(str(path)) + ".canon")
     run = subprocess.run([RS274, "-g", str(path), str(out)], cwd=str(tmp_path),
-                         capture_output=True, text=True, timeout=300)
+                         env=own_tool_data(tmp_path), capture_output=True, text=True,
+                         timeout=300)
     errors = [ln for ln in run.stderr.splitlines() if ln.strip() not in ("", "executing")]
     assert run.returncode == 0 and not errors, "rs274 refused %s: %s" % (path, run.stderr)
     text = out.read_text()
