@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
-"""``python3 -m surfcomp`` gives numpy's BLAS one thread when the user set none (its
-worker thread only spun beside the commands' small linear algebra), and leaves every
-thread variable the user set, and a process that only runs the module (``runpy``), alone.
+"""``python3 -m surfcomp compensate|inspect`` gives numpy's BLAS one thread when the user
+set none (its worker thread only spun beside those commands' small linear algebra), and
+leaves every thread variable the user set, the other commands, and a process that only
+runs the module (``runpy``), alone.
 
 The process's environment is read at its exit by a ``sitecustomize`` module put first on
 ``PYTHONPATH`` (what the command itself saw, not what the test passed)."""
@@ -40,11 +41,19 @@ def run(tmp_path, env, argv):
     return out, json.loads(lines[-1][4:])
 
 
-def test_unset_gets_one_thread(tmp_path):
-    out, seen = run(tmp_path, {}, ["-m", "surfcomp", "--version"])
+@pytest.mark.parametrize("command", ["compensate", "inspect"])
+def test_unset_gets_one_thread(tmp_path, command):
+    out, seen = run(tmp_path, {}, ["-m", "surfcomp", command, "--help"])
     assert out.returncode == 0, out.stderr
     assert seen == {"OPENBLAS_NUM_THREADS": "1", "GOTO_NUM_THREADS": None,
                     "OMP_NUM_THREADS": None, "numpy": False}
+
+
+@pytest.mark.parametrize("argv", [["--version"], ["simulate", "--help"], ["gcode", "--help"]])
+def test_other_commands_keep_the_default(tmp_path, argv):
+    out, seen = run(tmp_path, {}, ["-m", "surfcomp"] + argv)
+    assert out.returncode == 0, out.stderr
+    assert {k: seen[k] for k in BLAS_THREAD_VARIABLES} == dict.fromkeys(BLAS_THREAD_VARIABLES)
 
 
 @pytest.mark.parametrize("name, value", [("OPENBLAS_NUM_THREADS", "2"),
@@ -52,7 +61,7 @@ def test_unset_gets_one_thread(tmp_path):
                                          ("GOTO_NUM_THREADS", "3"),
                                          ("OMP_NUM_THREADS", "4")])
 def test_a_users_setting_is_kept(tmp_path, name, value):
-    out, seen = run(tmp_path, {name: value}, ["-m", "surfcomp", "--version"])
+    out, seen = run(tmp_path, {name: value}, ["-m", "surfcomp", "compensate", "--help"])
     assert out.returncode == 0, out.stderr
     expected = dict.fromkeys(BLAS_THREAD_VARIABLES)
     expected[name] = value
@@ -61,7 +70,7 @@ def test_a_users_setting_is_kept(tmp_path, name, value):
 
 def test_a_process_that_only_runs_the_module_is_left_alone(tmp_path):
     """``runpy`` in another program's process (which goes on afterwards): no change."""
-    code = ("import runpy, sys\nsys.argv = ['surfcomp', '--version']\n"
+    code = ("import runpy, sys\nsys.argv = ['surfcomp', 'compensate', '--help']\n"
             "try:\n    runpy.run_module('surfcomp', run_name='__main__', alter_sys=True)\n"
             "except SystemExit:\n    pass\n")
     out, seen = run(tmp_path, {}, ["-c", code])
@@ -71,8 +80,11 @@ def test_a_process_that_only_runs_the_module_is_left_alone(tmp_path):
 
 def test_the_rule_on_a_mapping():
     env = {}
-    assert one_blas_thread(env) is True and env == {"OPENBLAS_NUM_THREADS": "1"}
-    assert one_blas_thread(env) is False and env == {"OPENBLAS_NUM_THREADS": "1"}
+    assert one_blas_thread(env, ["simulate", "--preset", "werner2022"]) is False and env == {}
+    assert one_blas_thread(env, []) is False and env == {}
+    assert one_blas_thread(env, ["compensate", "n.step", "m.csv"]) is True
+    assert env == {"OPENBLAS_NUM_THREADS": "1"}
+    assert one_blas_thread(env, ["inspect"]) is False and env == {"OPENBLAS_NUM_THREADS": "1"}
     env = {"OMP_NUM_THREADS": "8", "PATH": "/usr/bin"}
-    assert one_blas_thread(env) is False
+    assert one_blas_thread(env, ["compensate"]) is False
     assert env == {"OMP_NUM_THREADS": "8", "PATH": "/usr/bin"}
