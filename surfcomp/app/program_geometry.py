@@ -11,7 +11,6 @@ point's intersection along a path); a trimmed face's boundary
 """
 
 from ..core.compensation.program_offset import BallOffset
-from ..core.compensation.program_trim import Trim
 from ..core.compensation.realised_feet import RealisedAt
 
 
@@ -21,6 +20,10 @@ def offset_of(nominal, corrected, radius, blend):
     from .nominal import boundary_polylines
 
     surface = nominal.surface
-    trim = None if nominal.untrimmed else Trim.of(surface, boundary_polylines(nominal.bspline_face))
+    trim = None
+    if not nominal.untrimmed:   # imported here: its KD-tree needs the whole scipy.spatial
+        from ..core.compensation.program_trim import Trim
+
+        trim = Trim.of(surface, boundary_polylines(nominal.bspline_face))
     return BallOffset(nominal.surface, nominal.outward, radius,
                       RealisedAt(nominal.surface, corrected, nominal.outward), blend, trim=trim)

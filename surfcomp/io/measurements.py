@@ -86,8 +86,8 @@ import os
 import re
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from ..core.surface.kdtree import cKDTree
 from ..errors import InputError, MeasurementFileError
 from .columns import ALIASES, GROUP_TEXT, GROUPS, HINTS, LENGTH_ROLES, norm, role_of
 from .files import clip, read_bytes

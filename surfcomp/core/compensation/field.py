@@ -27,10 +27,10 @@ the border value, and clipped to the node value range like the inside.
 
 import numpy as np
 from scipy.sparse import csr_matrix
-from scipy.spatial import cKDTree
 
 from ...errors import ComputationError
 from ..chunks import for_chunks, threads
+from ..surface.kdtree import cKDTree
 
 _L = 0.5  # damping length of the outside continuation, in grid steps
 

@@ -10,7 +10,6 @@ import functools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ...errors import ComputationError, GridError, InputError, MeasurementFileError, note
 from ..choices import LAYOUTS  # noqa: F401  (re-exported: Options.layout's choices)
@@ -21,6 +20,7 @@ from ..options import OPTIONS
 from ..progress import report, sub
 from ..surface import bspline
 from ..surface.grid import Scattered, grid_from_indices, grid_from_uv
+from ..surface.kdtree import cKDTree
 from ..surface.projection import project, tangent_lengths
 from . import plausibility
 from .corrected import construct, construct_smooth, meets_limits

@@ -26,12 +26,12 @@ import threading
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ...errors import GeometryError, InputError
 from ..chunks import for_chunks
 from ..progress import report
 from . import bspline
+from .kdtree import cKDTree
 from .projection_newton import GenericEval, Newton, SpanTable, dot
 from .projection_regions import Regions, principal_curvatures
 

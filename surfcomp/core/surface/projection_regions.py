@@ -26,8 +26,8 @@ point-by-point search for other minima.
 """
 
 import numpy as np
-from scipy.spatial import cKDTree
 
+from .kdtree import cKDTree
 from .projection_newton import dot
 
 #: radii R, R/2, ... R/2^(LEVELS-1) at which the tile curvature is recorded
