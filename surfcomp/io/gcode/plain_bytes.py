@@ -12,6 +12,8 @@ numbers replaced. The text is the same, byte for byte, as the line-by-line write
 (``tests/pure/test_gcode_plain.py``).
 """
 
+from itertools import chain
+
 import numpy as np
 
 _POW10 = 10.0 ** np.arange(23)
@@ -92,9 +94,9 @@ def stretch_text(contents, sizes, units, d, change, rows, other, bounds=None):
     str, or list of s str with ``bounds``
     """
     n = len(contents)
-    text = "".join([c + e for c, e in contents])
+    text = "".join(chain.from_iterable(contents))
     buf = np.frombuffer(text.encode("latin-1"), dtype=np.uint8)
-    llen = _line_lengths(contents)
+    llen = _line_lengths(contents, buf)
     lstart = np.zeros(n, dtype=np.int64)
     np.cumsum(llen[:-1], out=lstart[1:])
     # segments per line: original up to X's number, X's number, up to Y's, Y's, up to
@@ -156,11 +158,18 @@ def _split(text, line_len, bounds):
     return [text[a:b] for a, b in zip([0] + ends[:-1], ends)]
 
 
-def _line_lengths(contents):
-    """Length of each ``(content, ending)`` line with its ending (n,) int64."""
+def _line_lengths(contents, buf):
+    """Length of each ``(content, ending)`` line with its ending (n,) int64; ``buf`` is
+    their text (uint8). A line ends at its ``"\n"`` (the ending is ``"\n"`` or
+    ``"\r\n"``, the content has none), the file's last one perhaps without one."""
     n = len(contents)
     if not n:
         return np.zeros(0, dtype=np.int64)
+    ends = np.flatnonzero(buf == ord("\n")) + 1
+    if ends.size == n - 1:
+        ends = np.append(ends, buf.size)
+    if ends.size == n and ends[-1] == buf.size:
+        return np.diff(ends, prepend=0)
     cont, ends = zip(*contents)
     return (np.fromiter(map(len, cont), dtype=np.int64, count=n)
             + np.fromiter(map(len, ends), dtype=np.int64, count=n))

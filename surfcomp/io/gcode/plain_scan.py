@@ -12,8 +12,8 @@ axis. In :data:`PLAIN` nothing after a number can continue it, so its numbers ar
 same maximal runs (``tests/pure/test_gcode_plain_scan.py`` compares both on random
 lines). An ASCII block (every block a program of those characters gives) is scanned over
 its bytes instead (:mod:`.plain_bytes_scan`: the same rules as array operations, about
-half the time); the pattern reads the others. The blanks a writer needs to rebuild a line are taken from :data:`PLAIN` for that
-line alone (:func:`surfcomp.io.gcode.plain.plain_groups`).
+half the time); the pattern reads the others. The blanks a writer needs to rebuild a line
+are taken from :data:`PLAIN` for that line alone (:func:`surfcomp.io.gcode.plain.plain_groups`).
 """
 
 import re
