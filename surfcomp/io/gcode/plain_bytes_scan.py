@@ -94,7 +94,7 @@ def scan_bytes(buf, n, out):
         bad[tab_line[tab < last_end[tab_line]]] = True
     # the numbers
     size = stop - start
-    mant, digits, dot, valid = _digits(buf, cls, start, size)
+    mant, digits, dot, valid = _digits(buf, start, size)
     g = which == 0
     motion_ok = (size <= 2) & (digits == size) & (mant <= 1) & \
         ((size == 1) | (buf[start] == ord("0")))
@@ -126,20 +126,30 @@ def scan_bytes(buf, n, out):
     return out
 
 
-def _digits(buf, cls, start, size):
+def _digits(buf, start, size):
     """Per run of ``[-+.0-9]`` (``start``, ``size``): its digits as an integer (float,
     exact up to :data:`_FAST_DIGITS` digits), how many, the index of its dot in the run
     (-1: none), and whether it is a number (a digit, at most one dot, a sign only first)."""
+    width = min(int(size.max(initial=0)), _LONG)
+    # the runs' characters, one row per place in the run (a place after its end: none)
+    inside = np.arange(width)[:, None] < size[None, :]
+    chars = buf[np.minimum(start[None, :] + np.arange(width)[:, None], buf.size - 1)]
+    kind = np.where(inside, np.take(_CLASS, chars), _OTHER)
+    is_digit = kind == _DIGIT
+    is_dot = kind == _DOT
+    digits = np.count_nonzero(is_digit, axis=0)
+    dots = np.count_nonzero(is_dot, axis=0)
+    place = np.arange(width, dtype=np.float64)[:, None]
+    dot = np.where(dots > 0, np.where(is_dot, place, 0.0).sum(axis=0), -1).astype(np.int64)
+    valid = (digits > 0) & (dots <= 1) & (np.count_nonzero(kind[1:] == _SIGN, axis=0) == 0)
+    # Horner over the places: a digit multiplies by ten and adds itself, the rest nothing
+    times = np.where(is_digit, 10.0, 1.0)
+    add = np.where(is_digit, chars - np.float64(ord("0")), 0.0)
     mant = np.zeros(start.size)
-    digits = np.zeros(start.size, dtype=np.int64)
-    dot = np.full(start.size, -1, dtype=np.int64)
-    valid = np.ones(start.size, dtype=bool)
-    if not start.size:
-        return mant, digits, dot, valid
     with np.errstate(over="ignore"):        # the digits of a long number: read by float
-        for k in range(min(int(size.max()), _LONG)):
-            _digit(buf, cls, start, size, k, mant, digits, dot, valid)
-    valid &= digits > 0
+        for k in range(width):
+            mant *= times[k]
+            mant += add[k]
     long = np.flatnonzero(size > _LONG)
     if long.size:           # character by character would take a pass per character
         text = [buf[a:a + m].tobytes().decode("ascii") for a, m in zip(start[long].tolist(),
@@ -148,19 +158,3 @@ def _digits(buf, cls, start, size):
         dot[long] = [t.find(".") for t in text]
         digits[long] = _FAST_DIGITS + 1         # read by float
     return mant, digits, dot, valid
-
-
-def _digit(buf, cls, start, size, k, mant, digits, dot, valid):
-    """Add the ``k``-th character of the runs to :func:`_digits`'s arrays."""
-    live = np.flatnonzero(size > k) if k else np.arange(start.size)
-    c = cls[start[live] + k]
-    d = c == _DIGIT
-    dl = live[d]
-    if dl.size:
-        mant[dl] = mant[dl] * 10.0 + (buf[start[dl] + k] - ord("0"))
-        digits[dl] += 1
-    dots = live[c == _DOT]
-    valid[dots[dot[dots] >= 0]] = False
-    dot[dots] = k
-    if k:
-        valid[live[c == _SIGN]] = False
