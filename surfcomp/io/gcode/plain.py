@@ -21,6 +21,7 @@ lines of a block are plain, and their numbers, is found in array operations
 """
 
 import re
+from operator import itemgetter
 
 import numpy as np
 
@@ -77,7 +78,7 @@ def _candidates(lines):
     every run)."""
     if not lines:
         return []
-    scan = scan_block([c for c, _e in lines])
+    scan = scan_block(list(map(itemgetter(0), lines)))
     flag = np.zeros(len(lines) + 2, dtype=np.int8)
     flag[1:-1] = scan.plain
     edge = np.flatnonzero(np.diff(flag))
