@@ -418,7 +418,7 @@ def _refine(prog, arcs, offset, owner, fa, fb, da, db, tolerance):
         right = np.zeros(new.size, dtype=bool)
         right[ends[split] - 1] = True
         k_mid = mid_of[new]
-        fa, fb, da, db, pa, pb = (a[new].copy() for a in (fa, fb, da, db, pa, pb))
+        fa, fb, da, db, pa, pb = (a[new] for a in (fa, fb, da, db, pa, pb))
         owner = owner[new]
         fb[left], db[left], pb[left] = fm[k_mid[left]], dm[k_mid[left]], pm[k_mid[left]]
         fa[right], da[right], pa[right] = fm[k_mid[right]], dm[k_mid[right]], pm[k_mid[right]]
