@@ -18,6 +18,9 @@ import numpy as np
 
 _POW10 = 10.0 ** np.arange(23)
 _MINUS, _DOT, _ZERO = ord("-"), ord("."), ord("0")
+#: 1, 2, 3 for the letters X, Y, Z, 0 for any other byte
+_AXIS = np.zeros(256, dtype=np.int8)
+_AXIS[[ord("X"), ord("Y"), ord("Z")]] = [1, 2, 3]
 
 
 def number_bytes(units, d):
@@ -110,13 +113,11 @@ def stretch_text(contents, sizes, units, d, change, rows, other, bounds=None):
     if rows.size:
         sz = sizes[rows]
         # the numbers' starts: after their letter (a plain line has each letter once)
-        starts = np.empty((rows.size, 3), dtype=np.int64)
-        for a, letter in enumerate(b"XYZ"):
-            pos = np.flatnonzero(buf == letter)
-            prow = np.searchsorted(lstart, pos, side="right") - 1
-            at = np.zeros(n, dtype=np.int64)
-            at[prow] = pos + 1
-            starts[:, a] = at[rows]
+        axis = np.take(_AXIS, buf)
+        pos = np.flatnonzero(axis)
+        at = np.zeros((n, 3), dtype=np.int64)
+        at[np.searchsorted(lstart, pos, side="right") - 1, axis[pos] - 1] = pos + 1
+        starts = at[rows]
         ch = change[rows]
         nb, nsize = number_bytes(units[rows][ch], d[rows][ch])
         noff = np.zeros(nsize.size, dtype=np.int64)

@@ -114,10 +114,10 @@ def scan_bytes(buf, n, out):
     out.size = np.zeros((n, 3), dtype=np.int64)
     out.decimals = np.zeros((n, 3), dtype=np.int64)
     axis = (which >= 1) & (which <= 3)
-    at = (line[axis], which[axis] - 1)
-    out.value[at] = value[axis]
-    out.size[at] = size[axis]
-    out.decimals[at] = decimals[axis]
+    at = 3 * line[axis] + which[axis] - 1           # flat index in the (n, 3) arrays
+    out.value.ravel()[at] = value[axis]
+    out.size.ravel()[at] = size[axis]
+    out.decimals.ravel()[at] = decimals[axis]
     out.present = out.size > 0
     out.feed_ok = np.ones(n, dtype=bool)
     feed = which == 4
