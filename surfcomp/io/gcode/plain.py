@@ -4,14 +4,14 @@
 Most lines of a finishing program are plain moves: ``G1 X.. Y.. Z.. F..``, nothing else.
 Reading them one :class:`surfcomp.io.gcode.lexer.Word` and one
 :class:`surfcomp.io.gcode.interpreter.LineInfo` at a time costs tens of microseconds a
-line; here a run of such lines is matched by one pattern per line and interpreted as
-arrays, and :mod:`.plain_write` writes it back as arrays. It is part of the one reader
-and writer, not a second one: a run is taken only where the line-by-line interpreter
-would do exactly the same (absolute mm positions, every axis known, a G0/G1 motion,
-nothing to warn about), anything else goes through the line-by-line path, and a line of
-a run the writer cannot write as arrays gets its ``LineInfo`` built (:func:`line_info`)
-and goes through the line-by-line writer. The output is the same, byte for byte
-(``tests/pure/test_gcode_plain.py`` compares both paths).
+line; here a run of such lines is found by one scan of the block (:mod:`.plain_scan`) and
+interpreted as arrays, and :mod:`.plain_write` writes it back as arrays. It is part of the
+one reader and writer, not a second one: a run is taken only where the line-by-line
+interpreter would do exactly the same (absolute mm positions, every axis known, a G0/G1
+motion, nothing to warn about), anything else goes through the line-by-line path, and a
+line of a run the writer cannot write as arrays gets its ``LineInfo`` built
+(:func:`line_info`) and goes through the line-by-line writer. The output is the same, byte
+for byte (``tests/pure/test_gcode_plain.py`` compares both paths).
 
 A plain line: an optional ``G0``/``G1`` (``G00``/``G01``), then ``X``, ``Y``, ``Z`` and
 ``F`` words in this order (each optional, at least one axis), upper case, a letter
@@ -21,6 +21,7 @@ lines of a block are plain, and their numbers, is found in array operations
 """
 
 import re
+from operator import itemgetter
 
 import numpy as np
 
@@ -77,7 +78,7 @@ def _candidates(lines):
     every run)."""
     if not lines:
         return []
-    scan = scan_block([c for c, _e in lines])
+    scan = scan_block(list(map(itemgetter(0), lines)))
     flag = np.zeros(len(lines) + 2, dtype=np.int8)
     flag[1:-1] = scan.plain
     edge = np.flatnonzero(np.diff(flag))

@@ -12,10 +12,15 @@ numbers replaced. The text is the same, byte for byte, as the line-by-line write
 (``tests/pure/test_gcode_plain.py``).
 """
 
+from itertools import chain
+
 import numpy as np
 
 _POW10 = 10.0 ** np.arange(23)
 _MINUS, _DOT, _ZERO = ord("-"), ord("."), ord("0")
+#: 1, 2, 3 for the letters X, Y, Z, 0 for any other byte
+_AXIS = np.zeros(256, dtype=np.int8)
+_AXIS[[ord("X"), ord("Y"), ord("Z")]] = [1, 2, 3]
 
 
 def number_bytes(units, d):
@@ -92,9 +97,9 @@ def stretch_text(contents, sizes, units, d, change, rows, other, bounds=None):
     str, or list of s str with ``bounds``
     """
     n = len(contents)
-    text = "".join([c + e for c, e in contents])
+    text = "".join(chain.from_iterable(contents))
     buf = np.frombuffer(text.encode("latin-1"), dtype=np.uint8)
-    llen = _line_lengths(contents)
+    llen = _line_lengths(contents, buf)
     lstart = np.zeros(n, dtype=np.int64)
     np.cumsum(llen[:-1], out=lstart[1:])
     # segments per line: original up to X's number, X's number, up to Y's, Y's, up to
@@ -108,13 +113,11 @@ def stretch_text(contents, sizes, units, d, change, rows, other, bounds=None):
     if rows.size:
         sz = sizes[rows]
         # the numbers' starts: after their letter (a plain line has each letter once)
-        starts = np.empty((rows.size, 3), dtype=np.int64)
-        for a, letter in enumerate(b"XYZ"):
-            pos = np.flatnonzero(buf == letter)
-            prow = np.searchsorted(lstart, pos, side="right") - 1
-            at = np.zeros(n, dtype=np.int64)
-            at[prow] = pos + 1
-            starts[:, a] = at[rows]
+        axis = np.take(_AXIS, buf)
+        pos = np.flatnonzero(axis)
+        at = np.zeros((n, 3), dtype=np.int64)
+        at[np.searchsorted(lstart, pos, side="right") - 1, axis[pos] - 1] = pos + 1
+        starts = at[rows]
         ch = change[rows]
         nb, nsize = number_bytes(units[rows][ch], d[rows][ch])
         noff = np.zeros(nsize.size, dtype=np.int64)
@@ -156,11 +159,18 @@ def _split(text, line_len, bounds):
     return [text[a:b] for a, b in zip([0] + ends[:-1], ends)]
 
 
-def _line_lengths(contents):
-    """Length of each ``(content, ending)`` line with its ending (n,) int64."""
+def _line_lengths(contents, buf):
+    """Length of each ``(content, ending)`` line with its ending (n,) int64; ``buf`` is
+    their text (uint8). A line ends at its ``"\n"`` (the ending is ``"\n"`` or
+    ``"\r\n"``, the content has none), the file's last one perhaps without one."""
     n = len(contents)
     if not n:
         return np.zeros(0, dtype=np.int64)
+    ends = np.flatnonzero(buf == ord("\n")) + 1
+    if ends.size == n - 1:
+        ends = np.append(ends, buf.size)
+    if ends.size == n and ends[-1] == buf.size:
+        return np.diff(ends, prepend=0)
     cont, ends = zip(*contents)
     return (np.fromiter(map(len, cont), dtype=np.int64, count=n)
             + np.fromiter(map(len, ends), dtype=np.int64, count=n))

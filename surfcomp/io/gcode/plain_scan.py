@@ -10,14 +10,18 @@ that shape; a line is plain exactly when it has that shape, every number is one
 in front, the grammar of :data:`surfcomp.io.gcode.plain.PLAIN`'s numbers) and it names an
 axis. In :data:`PLAIN` nothing after a number can continue it, so its numbers are these
 same maximal runs (``tests/pure/test_gcode_plain_scan.py`` compares both on random
-lines). The blanks a writer needs to rebuild a line are taken from :data:`PLAIN` for that
-line alone (:func:`surfcomp.io.gcode.plain.plain_groups`).
+lines). An ASCII block (every block a program of those characters gives) is scanned over
+its bytes instead (:mod:`.plain_bytes_scan`: the same rules as array operations, about
+half the time); the pattern reads the others. The blanks a writer needs to rebuild a line
+are taken from :data:`PLAIN` for that line alone (:func:`surfcomp.io.gcode.plain.plain_groups`).
 """
 
 import re
 from itertools import repeat
 
 import numpy as np
+
+from .plain_bytes_scan import scan_bytes
 
 #: a plain line's shape, numbers taken loosely (see the module's text); groups: the motion
 #: code, the X, Y, Z and F numbers, ``"\n"``; ``""`` for a group that took no part, and
@@ -46,8 +50,17 @@ class BlockScan:
 def scan_block(contents):
     """The :class:`BlockScan` of the line contents ``contents`` (list of str, no line
     endings)."""
-    n = len(contents)
-    found = _LOOSE.findall("\n".join(contents) + "\n")
+    text = "\n".join(contents) + "\n"
+    if text.isascii():
+        return scan_bytes(np.frombuffer(text.encode("ascii"), dtype=np.uint8),
+                          len(contents), BlockScan())
+    return _scan_pattern(text, len(contents))     # other digits than 0-9 may match \d
+
+
+def _scan_pattern(text, n):
+    """:func:`scan_block` of the block's ``text`` (its ``n`` lines each ending in ``"\n"``)
+    with :data:`_LOOSE`."""
+    found = _LOOSE.findall(text)
     cols = tuple(zip(*found)) if found else ((),) * 6
     out = BlockScan()
     ok = np.array(cols[5]) == "\n"
