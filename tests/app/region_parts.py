@@ -17,6 +17,14 @@ def compensate(*args, timeout=900):
                           cwd=ROOT, capture_output=True, text=True, timeout=timeout)
 
 
+def run(*args):
+    """``compensate ARGS`` run in this process (``run_in_process``, tests/app/helpers.py): for
+    the runs whose results a test checks; a refused run stays a process (:func:`compensate`)."""
+    from tests.app.helpers import run_in_process
+
+    return run_in_process("compensate", *args)
+
+
 def sha256(path):
     with open(path, "rb") as fh:
         return hashlib.sha256(fh.read()).hexdigest()

@@ -52,8 +52,9 @@ def test_document_route_reads_the_deviations_in_um(tmp_path, fresh_doc):
     nom.Shape = Part.read(EXAMPLE_STEP)
     doc.recompute()
     doc.saveAs(str(tmp_path / "d.FCStd"))
-    out = run_cli("compensate", tmp_path / "d.FCStd", _um_file(tmp_path), "--object", "Nominal",
-                  "--save", tmp_path / "out.FCStd", "--deviation-units", "um", "--quiet")
+    out = run_in_process("compensate", tmp_path / "d.FCStd", _um_file(tmp_path), "--object",
+                         "Nominal", "--save", tmp_path / "out.FCStd", "--deviation-units", "um",
+                         "--quiet")
     assert out.returncode == 0, out.stderr
     import FreeCAD
 

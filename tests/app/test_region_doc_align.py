@@ -49,8 +49,8 @@ def shop(tmp_path_factory):
         files[name] = str(path_xyz)
     back = tmp / "back.json"
     back.write_text(json.dumps({"matrix": np.linalg.inv(MOVE).tolist()}))
-    ref = rp.compensate(path, nominal_csv, "--object", "Block", "--faces", "Face1,Face2", "--save",
-                        tmp / "ref.FCStd")
+    ref = rp.run(path, nominal_csv, "--object", "Block", "--faces", "Face1,Face2", "--save",
+                 tmp / "ref.FCStd")
     assert ref.returncode == 0, ref.stderr
     return {"tmp": tmp, "doc": path, "files": files, "back": str(back), "csv": nominal_csv,
             "reference": _volume(ref.stdout), "datum_points": len(datum)}
@@ -75,9 +75,9 @@ def test_bestfit_on_datum_faces_brings_the_points_back(shop):
     tmp = shop["tmp"]
     sha = rp.sha256(shop["doc"])
     out = tmp / "datum.FCStd"
-    r = rp.compensate(shop["doc"], shop["files"]["all"], "--object", "Block",
-                      "--faces", "Face1,Face2",
-                      "--align", "bestfit", "--align-faces", DATUM, "--save", out)
+    r = rp.run(shop["doc"], shop["files"]["all"], "--object", "Block",
+               "--faces", "Face1,Face2",
+               "--align", "bestfit", "--align-faces", DATUM, "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
     assert rp.sha256(shop["doc"]) == sha
     assert "Alignment:    bestfit: translation" in r.stdout
@@ -103,8 +103,8 @@ def test_bestfit_on_datum_faces_brings_the_points_back(shop):
 
 def test_known_transform_alone_works_with_faces_auto(shop):
     out = shop["tmp"] / "known.FCStd"
-    r = rp.compensate(shop["doc"], shop["files"]["tops"], "--object", "Block", "--faces", "auto",
-                      "--transform", shop["back"], "--save", out)
+    r = rp.run(shop["doc"], shop["files"]["tops"], "--object", "Block", "--faces", "auto",
+               "--transform", shop["back"], "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "points per face: Face1 2000, Face2 2000; on no face: 0" in r.stdout
     assert _volume(r.stdout) == pytest.approx(shop["reference"], rel=0.005)
@@ -115,10 +115,10 @@ def test_known_transform_alone_works_with_faces_auto(shop):
 
 def test_bestfit_on_the_region_itself_says_what_it_absorbed(shop):
     out = shop["tmp"] / "self.FCStd"
-    r = rp.compensate(shop["doc"], shop["files"]["tops"], "--object", "Block",
-                      "--faces", "Face1,Face2",
-                      "--align", "bestfit", "--align-dof", "z,rx,ry", "--transform", shop["back"],
-                      "--save", out)
+    r = rp.run(shop["doc"], shop["files"]["tops"], "--object", "Block",
+               "--faces", "Face1,Face2",
+               "--align", "bestfit", "--align-dof", "z,rx,ry", "--transform", shop["back"],
+               "--save", out)
     assert r.returncode == 0, r.stdout + r.stderr
     assert "warning: the best fit used the region's faces themselves: it absorbed a mean " \
            "offset of" in r.stderr

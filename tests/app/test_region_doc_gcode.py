@@ -61,9 +61,9 @@ def posted(shop):
     tmp, path, csv, _solid, _nominal = shop
     sha = rp.sha256(path)
     out, ngc = str(tmp / "out.FCStd"), str(tmp / "out.ngc")
-    r = rp.compensate(path, csv, "--object", "Block",
-                      "--faces", "Face1,Face2", "--replace", "--save",
-                      out, "--gcode", ngc, "--post", "linuxcnc", "--post-args", POST_ARGS)
+    r = rp.run(path, csv, "--object", "Block",
+               "--faces", "Face1,Face2", "--replace", "--save",
+               out, "--gcode", ngc, "--post", "linuxcnc", "--post-args", POST_ARGS)
     assert rp.sha256(path) == sha                 # the input document is untouched
     assert r.returncode == 0, r.stdout + r.stderr
     return out, ngc, r.stdout

@@ -29,12 +29,12 @@ def rounds(tmp_path_factory):
     rp.write_csv(first, pts, nrm, dev)
     rp.write_csv(second, pts, nrm, LEFT * dev)
     out1, out2 = str(tmp / "round1.FCStd"), str(tmp / "round2.FCStd")
-    r1 = rp.compensate(path, first, "--object", "Block", "--faces", "Face1,Face2", "--replace",
-                       "--save", out1)
+    r1 = rp.run(path, first, "--object", "Block", "--faces", "Face1,Face2", "--replace",
+                "--save", out1)
     assert r1.returncode == 0, r1.stdout + r1.stderr
     sha = rp.sha256(out1)
-    r2 = rp.compensate(out1, second, "--object", "RegionCompensation", "--faces", "Face1,Face2",
-                       "--replace", "--save", out2)
+    r2 = rp.run(out1, second, "--object", "RegionCompensation", "--faces", "Face1,Face2",
+                "--replace", "--save", out2)
     assert r2.returncode == 0, r2.stdout + r2.stderr
     assert rp.sha256(out1) == sha                     # the first round's document is untouched
     return {"tmp": tmp, "solid": solid, "pts": pts, "nrm": nrm, "dev": dev, "out1": out1,

@@ -68,8 +68,8 @@ def replaced(shop):
     tmp, path, csv, solid, *_ = shop
     sha = rp.sha256(path)
     out = str(tmp / "out.FCStd")
-    r = rp.compensate(path, csv, "--object", "Block", "--faces", "auto", "--replace", "--save", out,
-                      "--min-coverage", "0.6")
+    r = rp.run(path, csv, "--object", "Block", "--faces", "auto", "--replace", "--save", out,
+               "--min-coverage", "0.6")
     assert r.returncode == 0, r.stderr
     assert rp.sha256(path) == sha          # the input document is untouched
     return out, r.stdout, solid
@@ -138,7 +138,7 @@ def test_reopened_in_a_fresh_freecadcmd_recomputes_the_same(replaced, tmp_path):
 def test_save_without_replace_keeps_the_links(shop):
     tmp, path, csv, *_ = shop
     out = str(tmp / "plain.FCStd")
-    r = rp.compensate(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out)
+    r = rp.run(path, csv, "--object", "Block", "--faces", "Face1,Face2", "--save", out)
     assert r.returncode == 0, r.stderr
     assert "replaced the nominal" not in r.stdout
     assert "faces Face1, Face2" in r.stdout and "Faces Face1,Face2" in r.stdout

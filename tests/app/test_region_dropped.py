@@ -3,15 +3,10 @@
 on a face, so the run reports them by the face's name, apart from the points on no face."""
 
 import json
-import os
-import subprocess
-import sys
 
 import numpy as np
 
 from tests.app import region_parts as rp
-
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def test_points_of_a_face_left_out_are_not_on_no_face(tmp_path):
@@ -34,9 +29,7 @@ def test_points_of_a_face_left_out_are_not_on_no_face(tmp_path):
     rp.write_csv(csv, np.concatenate([pts, extra]), np.concatenate([nrm, normals]),
                  np.concatenate([dev, np.zeros(len(extra))]))
     rep = str(tmp_path / "out.json")
-    r = subprocess.run([sys.executable, "-m", "surfcomp", "compensate", step, csv, "--faces",
-                        "auto", "-o", str(tmp_path / "out.step"), "--report", rep],
-                       cwd=ROOT, capture_output=True, text=True, timeout=600)
+    r = rp.run(step, csv, "--faces", "auto", "-o", str(tmp_path / "out.step"), "--report", rep)
     assert r.returncode == 0, r.stderr
     name = "Face%d" % (wall + 1)
     top = ", ".join("Face%d 3000" % (k + 1) for k in tops)

@@ -15,14 +15,21 @@ import numpy as np
 import pytest
 
 from tests.app import region_parts as rp
+from tests.app.helpers import run_in_process
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 UM = 1e-3
 
 
 def _cli(*args):
+    """A refused run, as a process: its exit code and message."""
     return subprocess.run([sys.executable, "-m", "surfcomp", "compensate", *map(str, args)],
                           cwd=ROOT, capture_output=True, text=True, timeout=600)
+
+
+def _run(*args):
+    """A run whose results the test checks, in this process (tests/app/helpers.py)."""
+    return run_in_process("compensate", *args)
 
 
 def _edges(report):
@@ -48,7 +55,7 @@ def test_block_walls_retrimmed_to_a_constant_correction(block):
     tmp, step, solid, tops, pts, nrm = block
     csv, out, rep = tmp / "flat.csv", tmp / "flat.step", tmp / "flat.json"
     rp.write_csv(str(csv), pts, nrm, np.full(len(pts), 0.01))
-    r = _cli(step, csv, "--faces", "auto", "-o", out, "--report", rep)
+    r = _run(step, csv, "--faces", "auto", "-o", out, "--report", rep)
     assert r.returncode == 0, r.stderr
     assert "re-trimmed neighbours: Face3, Face4, Face5, Face6" in r.stdout
     assert "edge Face1-Face5 (Edge1, outside the region): re-trimmed, moved by 10.0000 um" \
@@ -137,7 +144,7 @@ def test_pipe_quarters_retrim_the_disks(pipe):
     tmp, brep, solid, pts, nrm, dev = pipe
     csv, out, rep = tmp / "m.csv", tmp / "out.brep", tmp / "out.json"
     rp.write_csv(str(csv), pts, nrm, dev)
-    r = _cli(brep, csv, "--faces", "Face2,Face6", "-o", out, "--report", rep, "--method",
+    r = _run(brep, csv, "--faces", "Face2,Face6", "-o", out, "--report", rep, "--method",
              "raw", "--smoothing", "150")
     assert r.returncode == 0, r.stderr
     assert "re-trimmed neighbours: Face1, Face3" in r.stdout
@@ -228,7 +235,7 @@ def test_boxed_sphere_blends_inside_the_solid(tmp_path):
     csv, out, rep = tmp_path / "bump.csv", tmp_path / "out.brep", tmp_path / "out.json"
     rp.write_csv(str(csv), pts, nrm, dev)
     region = "Face8,Face12,Face24,Face20"
-    r = _cli(brep, csv, "--faces", region, "-o", out, "--report", rep, "--method", "raw",
+    r = _run(brep, csv, "--faces", region, "-o", out, "--report", rep, "--method", "raw",
              "--smoothing", "0.06")
     assert r.returncode == 0, r.stderr
     assert "re-trimmed neighbours: none" in r.stdout
@@ -247,7 +254,7 @@ def test_boxed_sphere_blends_inside_the_solid(tmp_path):
     assert -0.0016 < o["integral_mm3"] < -0.0014
     # the zero correction: the trims' share of the volume change, no relative figure
     rp.write_csv(str(csv), pts, nrm, np.zeros(len(pts)))
-    r = _cli(brep, csv, "--faces", region, "-o", tmp_path / "zero.brep", "--report", rep,
+    r = _run(brep, csv, "--faces", region, "-o", tmp_path / "zero.brep", "--report", rep,
              "--method", "raw", "--smoothing", "0.06")
     assert r.returncode == 0, r.stderr
     zero = json.load(open(rep))["output"]
