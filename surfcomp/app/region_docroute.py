@@ -122,7 +122,12 @@ def run_region_document(document, measurements, object_name, faces, save, replac
         region_doc.write_results(comp, run)
         comp.Placement = run.shape.Placement
         comp.Shape = run.shape
-        comp.purgeTouched()      # computed: the document's recompute need not do it again
+        # computed: the document's recompute need not do it again. The new measurement
+        # object's own recompute is only the check of its stored lists, which the
+        # computation just made (features.measurement_set); left touched, it would have
+        # the recompute compute the region, which uses it, a second time
+        comp.purgeTouched()
+        meas.purgeTouched()
         result = RegionDocumentResult(document=os.path.abspath(document),
                                       compensation=comp.Name, measurement=meas.Name,
                                       options=region_doc.options_record(comp),
