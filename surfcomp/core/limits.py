@@ -25,6 +25,10 @@ MATCH_ITERATIONS = 8
 #: a scattered layout's corrected face is built from its smoothing fit's spline when the
 #: intended corrections are the fit's values at the points within this
 SMOOTH_MATCH = 1e-9
+#: a corrected face whose normal turns more than this many degrees from the nominal's folds
+#: over itself (reported): the correction's slopes tilt it by well under a degree, a loop
+#: (a correction beyond the radius of a curl) by 90 to 180
+FOLD_ANGLE_DEG = 90.0
 
 # ------------------------------------------------------------------ the measured points
 #: a given normal more than this many degrees off the face normal is reported

@@ -155,14 +155,20 @@ class CheckFigures:
     max_intended: float
     dense_shape: tuple
     poles_shape: tuple
+    #: where the corrected surface's normal turns most from the nominal's
+    #: (:class:`surfcomp.core.compensation.folds.Fold`), once the surface is chosen
+    fold: object = None
 
     def as_dict(self):
-        return {"max_error_at_points_mm": self.max_error_at_points,
-                "max_deviation_from_nominal_with_zero_correction_mm": self.max_zero_deviation,
-                "max_abs_realised_correction_on_face_mm": self.max_realised,
-                "max_abs_intended_correction_mm": self.max_intended,
-                "dense_check_grid": list(self.dense_shape),
-                "poles": list(self.poles_shape)}
+        out = {"max_error_at_points_mm": self.max_error_at_points,
+               "max_deviation_from_nominal_with_zero_correction_mm": self.max_zero_deviation,
+               "max_abs_realised_correction_on_face_mm": self.max_realised,
+               "max_abs_intended_correction_mm": self.max_intended,
+               "dense_check_grid": list(self.dense_shape),
+               "poles": list(self.poles_shape)}
+        if self.fold is not None:
+            out["normal_turn"] = self.fold.as_dict()
+        return out
 
 
 #: the dense check grid is ``density`` times denser than the measurement grid, with the

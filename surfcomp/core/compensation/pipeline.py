@@ -26,6 +26,7 @@ from . import plausibility
 from .corrected import construct, construct_smooth, meets_limits
 from .deviations import deviation_components, statistics
 from .filters import make_mask
+from .folds import find_fold, fold_warning
 from .grid_check import as_scattered, unlocatable
 from .methods import compute_correction
 from .spline_field import ConstantField
@@ -513,6 +514,10 @@ def build_surface(result, surface, outward, delta, progress=None):
             "intended correction (more than %.1f um; usually beyond the measured region, "
             "where noisy raw data are continued): the filtered method or a larger "
             % (prepared.source, over * 1e3, OVERSHOOT_TOL * 1e3), refine, " helps"))
+    built.checks.fold = find_fold(surface, built.corrected, outward)
+    folded = fold_warning(prepared.source, built.checks.fold)
+    if folded:
+        prepared.warnings.append(folded)
     return result
 
 
