@@ -11,6 +11,7 @@ import numpy as np
 
 from ..core.compensation import region_build, region_field
 from ..core.compensation.filters import WERNER_MASK_SIZE
+from ..core.compensation.folds import find_fold, fold_warning
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
@@ -303,10 +304,18 @@ def _report(nominal, measurements, faces, counts, none, figures, fidelity, radiu
         "faces": [{"face": f.name, "points": counts[f.name], "coverage": f.coverage,
                    "poles": list(f.built.poles), "nominal_poles": list(f.built.nominal_poles),
                    "knot_step_mm": f.built.knot_step,
-                   **_fidelity_keys(fidelity.get(f.name))} for f in faces],
+                   **_fidelity_keys(fidelity.get(f.name)), **_fold_keys(f)} for f in faces],
         "points_on_no_face": none,
         "edges": figures,
     }
+
+
+def _fold_keys(f):
+    """The corrected face's largest turn of the normal from the nominal's, and the warning
+    when it folds over itself (:mod:`surfcomp.core.compensation.folds`)."""
+    fold = find_fold(f.surface, f.built.surface, f.outward)
+    text = fold_warning(f.name, fold)
+    return {"normal_turn": fold.as_dict(), "warnings": [text] if text else []}
 
 
 def _fidelity_keys(fid):
@@ -334,6 +343,7 @@ def summary(rep):
                          % (f["face"], f["edge_zone_points"],
                             f["edge_zone_max_designed_shortfall_um"],
                             "-" if beyond is None else "%.4f um" % beyond))
+        lines.extend("warning: " + text for text in f.get("warnings", ()))
     for e in rep["edges"]:
         lines.append("edge %s-%s (%s): largest gap %.4f um (nominal %.4f um, %.4f um more "
                      "than the nominal's at most), largest normal angle %.4f deg (nominal "
