@@ -9,10 +9,17 @@ nominal's poles); a Path Job over the nominal blade and one over each corrected 
 3D Surface operation (6 mm ball end mill, line pattern, 1 mm sample interval, 50 um mesh
 deflection) on the suction side (Face1), turned to face the tool. Printed per face and
 budget: the poles, the operation's time (its first recompute, or the best of ``--repeat``
-- 1 recomputes) and its ratio to the nominal's (target <= 1.5), and the cutter locations.
+- 1 recomputes; wall and the process's CPU time) and its ratio to the nominal's (target
+<= 1.5), and the cutter locations; ``--rounds N`` runs the shapes in turn N times (A B A B)
+and prints the load average before and after.
+
+Where the time goes: the operation meshes the Job's whole model (``Shape.tessellate`` with
+its ``LinearDeflection``; FreeCAD's tessellation turns the normal by at most 0.1 rad per
+triangle) for OpenCamLib, not only the faces it cuts, so the table of every face's
+triangles and meshing CPU time (each face alone, a fresh copy) follows the operation's.
 
     /usr/bin/python3 bench/bench_region_cam.py [--factors 4,8] [--repeat 1] [--points 20000]
-        [--sample 1] [--deflection 0.05]
+        [--sample 1] [--deflection 0.05] [--rounds 1]
 """
 
 import argparse
@@ -33,23 +40,41 @@ def operation_time(FreeCAD, shape, face, repeat, sample, deflection):
 
     doc = FreeCAD.newDocument("benchregioncam")
     obj = doc.addObject("Part::Feature", "Blade")
-    obj.Shape = shape
+    # a copy without the triangulation an earlier run left on the shape's faces (the
+    # operation meshes them only where they hold none fine enough)
+    obj.Shape = shape.copy()
     doc.recompute()
     job = cam_job.create_job(doc, [obj])
     tc = cam_job.ball_end_tool_controller(job, 6.0)
     op = cam_job.surface_operation(job, obj, [face], tc, sample_interval=sample,
                                    linear_deflection=deflection)
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     doc.recompute()         # the first recompute: the Job, its model and the operation
-    t = time.perf_counter() - t0
+    t, cpu = time.perf_counter() - t0, time.process_time() - c0
     if repeat > 1:
         cam_job.model_clone(job, obj).touch()   # settle the stock box (test_path_regen)
         doc.recompute()
+        c0 = time.process_time()
         t = best_recompute(doc, op, repeat - 1)
+        cpu = (time.process_time() - c0) / (repeat - 1)
     cl = len(cam_job.cutter_locations(op))
     s = shape.Faces[int(face[4:]) - 1].Surface
     FreeCAD.closeDocument(doc.Name)
-    return t, cl, "%d x %d" % (s.NbUPoles, s.NbVPoles)
+    return t, cpu, cl, "%d x %d" % (s.NbUPoles, s.NbVPoles)
+
+
+def meshing(shape, deflection):
+    """Per face of ``shape``: its poles, the triangles of FreeCAD's tessellation with
+    ``deflection`` (what the 3D Surface operation hands OpenCamLib) and its CPU seconds
+    (a fresh copy of the face, so no earlier triangulation is reused)."""
+    out = []
+    for f in shape.Faces:
+        c = f.copy()
+        c0 = time.process_time()
+        _v, tri = c.tessellate(deflection)
+        out.append(("%d x %d" % (f.Surface.NbUPoles, f.Surface.NbVPoles), len(tri),
+                    time.process_time() - c0))
+    return out
 
 
 def facing_up(FreeCAD, nominal, shape):
@@ -74,6 +99,8 @@ def main(argv=None):
     ap.add_argument("--sample", type=float, default=1.0, help="sample interval (mm)")
     ap.add_argument("--deflection", type=float, default=0.05,
                     help="mesh deflection (mm; 1 um takes over 6 GB on the whole blade)")
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="run the shapes in turn this many times (A B A B)")
     a = ap.parse_args(argv)
 
     from bench.bench_region import make_inputs
@@ -96,15 +123,25 @@ def main(argv=None):
     print("3D Surface operation, BladeX blade, ball end mill 6 mm, sample interval %g mm, "
           "mesh deflection %g mm, %s" % (a.sample, a.deflection, "first recompute"
                                         if a.repeat <= 1 else "best of %d" % (a.repeat - 1)))
-    print("%-6s %-14s %10s %9s %7s %10s" % ("face", "shape", "poles", "seconds", "ratio",
-                                             "CL points"))
-    for face in ("Face1",):
+    print("load average before: %.2f %.2f %.2f" % os.getloadavg())
+    print("%-6s %-14s %10s %9s %7s %9s %7s %10s" % ("face", "shape", "poles", "wall s", "ratio",
+                                                   "CPU s", "ratio", "CL points"))
+    for _ in range(a.rounds):
         ref = None
         for name, shape in shapes:
-            t, cl, poles = operation_time(FreeCAD, shape, face, a.repeat, a.sample,
-                                          a.deflection)
-            ref = ref or t
-            print("%-6s %-14s %10s %9.2f %7.2f %10d" % (face, name, poles, t, t / ref, cl))
+            t, cpu, cl, poles = operation_time(FreeCAD, shape, "Face1", a.repeat, a.sample,
+                                               a.deflection)
+            ref = ref or (t, cpu)
+            print("%-6s %-14s %10s %9.2f %7.2f %9.2f %7.2f %10d"
+                  % ("Face1", name, poles, t, t / ref[0], cpu, cpu / ref[1], cl), flush=True)
+    print("load average after: %.2f %.2f %.2f" % os.getloadavg())
+    print("FreeCAD's tessellation of each face with deflection %g mm (what the operation "
+          "meshes: the whole model)" % a.deflection)
+    print("%-14s %s" % ("shape", "  ".join("Face%d poles / triangles / CPU s" % (i + 1)
+                                          for i in range(len(shapes[0][1].Faces)))))
+    for name, shape in shapes:
+        print("%-14s %s" % (name, "  ".join("%s / %d / %.2f" % m
+                                           for m in meshing(shape, a.deflection))))
 
 
 if __name__ == "__main__":

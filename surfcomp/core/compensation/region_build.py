@@ -51,7 +51,8 @@ MIN_SPANS = 8
 #: the pole budget of a corrected face: at most this many times the nominal's poles (with 4
 #: times, 42 spanwise poles, the BladeX sides' fit missed the correction by up to 0.31 um;
 #: CAM's time on the corrected faces against the nominal's: bench/bench_region_cam.py and
-#: docs/regions.md)
+#: docs/regions.md: the 3D Surface operation's time follows the triangles of its mesh of the
+#: whole model, which the poles add little to; a smaller budget does not meet its bound)
 POLE_FACTOR = 8.0
 #: the smallest pole budget of a corrected face (64 x 64)
 MIN_BUDGET = 64 * 64
