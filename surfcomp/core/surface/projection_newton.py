@@ -79,8 +79,12 @@ class SpanTable:
         return Ku * Kv * (surf.degree_u + 1) * (surf.degree_v + 1) * dim
 
     def locate(self, u, v):
-        iu = np.clip(np.searchsorted(self.bu, u, side="right") - 1, 0, self.hu.size - 1)
-        iv = np.clip(np.searchsorted(self.bv, v, side="right") - 1, 0, self.hv.size - 1)
+        # np.minimum / np.maximum: np.clip's argument checks cost more than the work at
+        # a few points
+        iu = np.minimum(np.maximum(np.searchsorted(self.bu, u, side="right") - 1, 0),
+                        self.hu.size - 1)
+        iv = np.minimum(np.maximum(np.searchsorted(self.bv, v, side="right") - 1, 0),
+                        self.hv.size - 1)
         hu, hv = self.hu[iu], self.hv[iv]
         return iu * self.Kv + iv, (u - self.bu[iu]) / hu, (v - self.bv[iv]) / hv, hu, hv
 
@@ -103,51 +107,74 @@ class SpanTable:
         n = u.size
         pu, pv, dim = self.pu, self.pv, self.dim
         G = self._table[:, key].reshape(pv + 1, (pu + 1) * dim, n)
-        W = _horner(G, t, order)  # W[kv]: d^kv/dt^kv, (A*C, n)
+        # along v: the value and derivatives of every u coefficient, in one buffer laid
+        # out (kv, a, c, n); then along u on all kv at once: derivative k of the u
+        # polynomial of the kv-th v derivative, for k + kv <= order
+        Wt = np.empty((order + 1, (pu + 1) * dim, n))
+        _horner_into(G, t, list(Wt))
+        Gs = Wt.reshape(order + 1, pu + 1, dim, n).transpose(1, 0, 2, 3)
+        Ws = [np.empty((order + 1 - k, dim, n)) for k in range(order + 1)]
+        _horner_into(Gs, s, Ws)
+        # the accumulators hold d^k/ds^k / k! (k <= 2): the 2 of the second derivatives
+        # joins the span scale (a power of two: the same rounding)
+        inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
+        fu = (None, inv_hu, 2.0 * inv_hu ** 2)
+        fv = (None, inv_hv, 2.0 * inv_hv ** 2)
         keys = bspline._ORDER_KEYS[order]
         A = {}
-        inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
-        for kv in range(order + 1):
-            Ws = W[kv].reshape(pu + 1, dim, n)
-            D = _horner(Ws, s, order - kv)
-            for k in range(order - kv + 1):
-                if (k, kv) in keys:
-                    val = D[k]
-                    if k:
-                        val = val * inv_hu ** k
-                    if kv:
-                        val = val * inv_hv ** kv
-                    A[(k, kv)] = val
+        for (k, kv) in keys:
+            val = Ws[k][kv]
+            if k:
+                val = val * fu[k]
+            if kv:
+                val = val * fv[kv]
+            A[(k, kv)] = val
         if not self.rational:
             return [A[key_] for key_ in keys]
         return _quotient_soa(A, order)
 
 
-def _horner(G, x, order):
-    """Value and derivatives up to ``order`` (<= 2) of ``sum_b G[b] x^b`` (leading axis b).
+def _horner_into(G, x, outs):
+    """Horner's scheme for ``sum_b G[b] x^b`` (leading axis b) and its derivatives.
 
-    ``G`` has shape (deg + 1, m, n), ``x`` shape (n,); returns a list of (m, n)
-    arrays: the value, first and second derivative w.r.t. x.
+    ``G`` has shape (deg + 1, m, ...), ``x`` shape (n,) (the last axis); ``outs[k]``
+    (k <= 2), of shape (m_k, ...) with m_k <= m, receives ``d^k/dx^k / k!`` of the
+    polynomials ``G[:, :m_k]`` (so the second derivative is ``2 * outs[2]``). The
+    arithmetic is that of the textbook loop from zero derivative accumulators; the
+    first steps, whose accumulators are still zero, are taken on ``0 * x`` alone.
     """
     deg = G.shape[0] - 1
-    p = G[deg].copy()
-    d1 = np.zeros_like(p) if order >= 1 else None
-    d2 = np.zeros_like(p) if order >= 2 else None
-    for b in range(deg - 1, -1, -1):
-        if d2 is not None:
-            d2 *= x
-            d2 += d1
-        if d1 is not None:
-            d1 *= x
-            d1 += p
-        p *= x
-        p += G[b]
-    out = [p]
-    if order >= 1:
-        out.append(d1)
+    order = len(outs) - 1
+    p = outs[0]
+    m = [o.shape[0] for o in outs]
+    if deg == 0:
+        p[...] = G[0, :m[0]]
+        for o in outs[1:]:
+            o[...] = 0.0
+        return
+    z = x * 0.0                                  # 0 * x: the zero accumulator times x
     if order >= 2:
-        out.append(2.0 * d2)
-    return out
+        d2 = z + 0.0                             # (0 * x + 0)
+    if order >= 1:
+        d1 = outs[1]
+        np.add(G[deg, :m[1]], z, out=d1)         # 0 * x + G[deg]
+    np.multiply(G[deg, :m[0]], x, out=p)
+    p += G[deg - 1, :m[0]]
+    if order >= 2:
+        if deg >= 2:
+            np.add(d2 * x, d1[:m[2]], out=outs[2])
+        else:
+            outs[2][...] = d2
+        d2 = outs[2]
+    for b in range(deg - 2, -1, -1):
+        if order >= 2 and b < deg - 2:
+            d2 *= x
+            d2 += d1[:m[2]]
+        if order >= 1:
+            d1 *= x
+            d1 += p[:m[1]]
+        p *= x
+        p += G[b, :m[0]]
 
 
 def _quotient_soa(A, order):
