@@ -21,9 +21,11 @@ STEP_TOL = 1e-6
 #: the same for other steps and near curvature centres (linear convergence)
 STEP_TOL_SLOW = 1e-10
 #: points evaluated at once by :meth:`SpanTable.evaluate`: the Horner temporaries then
-#: stay in the processor's cache (about 3 times faster per point than 65536 at once,
-#: bench/bench_align.py)
-EVAL_BLOCK = 8192
+#: stay in the processor's cache (a bicubic face's gathered coefficients are 0.8 MB for
+#: 2048 points; 2048 took 0.54-0.60 us a point against 0.83-0.97 us for 8192 and 0.63-0.76
+#: for 4096, 65536 points, 4 alternations; 8192 was about 3 times faster per point than
+#: 65536 at once, bench/bench_align.py)
+EVAL_BLOCK = 2048
 
 
 # --------------------------------------------------------------------------- power-basis table
@@ -243,9 +245,11 @@ class Newton:
         # sigma I (sigma = 1.5 |lambda_min|, so its smallest eigenvalue becomes
         # |lambda_min| / 2, plus a little Gauss-Newton scale); with one variable
         # held at a bound only its own curvature matters (else Gauss-Newton)
-        mu = 1e-9 * (a + c)
-        h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
-        h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
+        fixed = bool((fix_u | fix_v).any())
+        if fixed:
+            mu = 1e-9 * (a + c)
+            h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
+            h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
         if pd.all():
             H_uu, H_uv, H_vv, det2 = Huu, Huv, Hvv, det
         else:
@@ -254,10 +258,17 @@ class Newton:
             H_uu, H_uv, H_vv = Huu + sigma, Huv, Hvv + sigma
             det2 = H_uu * H_vv - H_uv * H_uv
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            du = np.where(fix_v, -gu / h_u, (H_uv * gv - H_vv * gu) / det2)
-            dv = np.where(fix_u, -gv / h_v, (H_uv * gu - H_uu * gv) / det2)
-        du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
-        dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
+            du = (H_uv * gv - H_vv * gu) / det2
+            dv = (H_uv * gu - H_uu * gv) / det2
+            if fixed:   # (none at a bound: the same values without these selections)
+                du = np.where(fix_v, -gu / h_u, du)
+                dv = np.where(fix_u, -gv / h_v, dv)
+        if fixed:
+            du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
+            dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
+        else:
+            du = np.where(np.isfinite(du), du, 0.0)
+            dv = np.where(np.isfinite(dv), dv, 0.0)
         # trust region: at most half the work area per step
         lim = np.maximum(np.abs(du) * (2.0 / (self.u1 - self.u0)),
                          np.abs(dv) * (2.0 / (self.v1 - self.v0)))
@@ -265,9 +276,10 @@ class Newton:
         un = np.minimum(np.maximum(u + du * scale, self.u0), self.u1)
         vn = np.minimum(np.maximum(v + dv * scale, self.v0), self.v1)
         # fast = a true Newton step away from a curvature centre (quadratic convergence)
-        fast = np.where(fix_u | fix_v,
-                        np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a),
-                        pd & (det > 0.5 * gn_det))
+        fast = pd & (det > 0.5 * gn_det)
+        if fixed:
+            fast = np.where(fix_u | fix_v,
+                            np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a), fast)
         return un - u, vn - v, fast
 
     def quick(self, P, u, v, seed_derivs, evaluations=2, extra=1):
