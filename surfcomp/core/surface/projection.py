@@ -523,18 +523,20 @@ class Projector:
             out[at] = (dot(rt, rt) > 1e-16) & (((ua <= u0) & (tu < 0)) | ((ua >= u1) & (tu > 0))
                                                | ((va <= v0) & (tv < 0)) | ((va >= v1) & (tv > 0)))
             d[out] = np.copysign(np.sqrt(dot(r[:, out], r[:, out])), d[out])
-        keep = slice(None)
         if max_distance is not None:
             keep = np.abs(d) <= float(max_distance)
-        idx = idx[keep]
-        res["u"][idx], res["v"][idx] = u[keep], v[keep]
-        res["foot"][idx], res["normal"][idx] = S[:, keep].T, n[:, keep].T
-        res["distance"][idx] = d[keep]
-        res["outside"][idx] = out[keep]
-        res["converged"][idx] = conv[keep]
+            if not keep.all():       # (all kept: no copies)
+                idx, u, v, S, n, d, out, conv = (
+                    a[..., keep] for a in (idx, u, v, S, n, d, out, conv))
+                D = [d_[:, keep] for d_ in D]
+        res["u"][idx], res["v"][idx] = u, v
+        res["foot"][idx], res["normal"][idx] = S.T, n.T
+        res["distance"][idx] = d
+        res["outside"][idx] = out
+        res["converged"][idx] = conv
         if "derivatives" in res:
             for k, d_ in enumerate(D):
-                res["derivatives"][k][:, idx] = d_[:, keep]
+                res["derivatives"][k][:, idx] = d_
 
 
 def tangent_lengths(surf, u, v, chunk=CHUNK):

@@ -136,7 +136,7 @@ def _warm(pj, P, idx, base, res, max_distance):
     where the answer is certified and returns that mask."""
     Pt = np.ascontiguousarray(P[idx].T)
     u0, v0 = res["u"][base], res["v"][base]
-    D0 = [d[:, base] for d in res["derivatives"]]
+    D0 = list(res["derivatives"][:, :, base])
     du, dv, ok = _step(D0[0] - Pt, *D0[1:])
     D = _taylor(D0, du, dv)
     du2, dv2, fast = _step(D[0] - Pt, *D[1:])
@@ -168,6 +168,9 @@ def _warm(pj, P, idx, base, res, max_distance):
     if check.size:
         ok[check] = pj._certified(u[check], v[check], r[:, check],
                                   [d[:, check] for d in D[1:3]], ok[check])
+    if ok.all():                 # (all answered: no copies)
+        pj._finish(P[idx], idx, u, v, D, ok, res, max_distance)
+        return ok
     keep = np.flatnonzero(ok)
     pj._finish(P[idx[keep]], idx[keep], u[keep], v[keep], [d[:, keep] for d in D],
                np.ones(keep.size, dtype=bool), res, max_distance)

@@ -21,9 +21,11 @@ STEP_TOL = 1e-6
 #: the same for other steps and near curvature centres (linear convergence)
 STEP_TOL_SLOW = 1e-10
 #: points evaluated at once by :meth:`SpanTable.evaluate`: the Horner temporaries then
-#: stay in the processor's cache (about 3 times faster per point than 65536 at once,
-#: bench/bench_align.py)
-EVAL_BLOCK = 8192
+#: stay in the processor's cache (a bicubic face's gathered coefficients are 0.8 MB for
+#: 2048 points; 2048 took 0.54-0.60 us a point against 0.83-0.97 us for 8192 and 0.63-0.76
+#: for 4096, 65536 points, 4 alternations; 8192 was about 3 times faster per point than
+#: 65536 at once, bench/bench_align.py)
+EVAL_BLOCK = 2048
 
 
 # --------------------------------------------------------------------------- power-basis table
@@ -79,8 +81,12 @@ class SpanTable:
         return Ku * Kv * (surf.degree_u + 1) * (surf.degree_v + 1) * dim
 
     def locate(self, u, v):
-        iu = np.clip(np.searchsorted(self.bu, u, side="right") - 1, 0, self.hu.size - 1)
-        iv = np.clip(np.searchsorted(self.bv, v, side="right") - 1, 0, self.hv.size - 1)
+        # np.minimum / np.maximum: np.clip's argument checks cost more than the work at
+        # a few points
+        iu = np.minimum(np.maximum(np.searchsorted(self.bu, u, side="right") - 1, 0),
+                        self.hu.size - 1)
+        iv = np.minimum(np.maximum(np.searchsorted(self.bv, v, side="right") - 1, 0),
+                        self.hv.size - 1)
         hu, hv = self.hu[iu], self.hv[iv]
         return iu * self.Kv + iv, (u - self.bu[iu]) / hu, (v - self.bv[iv]) / hv, hu, hv
 
@@ -103,51 +109,74 @@ class SpanTable:
         n = u.size
         pu, pv, dim = self.pu, self.pv, self.dim
         G = self._table[:, key].reshape(pv + 1, (pu + 1) * dim, n)
-        W = _horner(G, t, order)  # W[kv]: d^kv/dt^kv, (A*C, n)
+        # along v: the value and derivatives of every u coefficient, in one buffer laid
+        # out (kv, a, c, n); then along u on all kv at once: derivative k of the u
+        # polynomial of the kv-th v derivative, for k + kv <= order
+        Wt = np.empty((order + 1, (pu + 1) * dim, n))
+        _horner_into(G, t, list(Wt))
+        Gs = Wt.reshape(order + 1, pu + 1, dim, n).transpose(1, 0, 2, 3)
+        Ws = [np.empty((order + 1 - k, dim, n)) for k in range(order + 1)]
+        _horner_into(Gs, s, Ws)
+        # the accumulators hold d^k/ds^k / k! (k <= 2): the 2 of the second derivatives
+        # joins the span scale (a power of two: the same rounding)
+        inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
+        fu = (None, inv_hu, 2.0 * inv_hu ** 2)
+        fv = (None, inv_hv, 2.0 * inv_hv ** 2)
         keys = bspline._ORDER_KEYS[order]
         A = {}
-        inv_hu, inv_hv = 1.0 / hu, 1.0 / hv
-        for kv in range(order + 1):
-            Ws = W[kv].reshape(pu + 1, dim, n)
-            D = _horner(Ws, s, order - kv)
-            for k in range(order - kv + 1):
-                if (k, kv) in keys:
-                    val = D[k]
-                    if k:
-                        val = val * inv_hu ** k
-                    if kv:
-                        val = val * inv_hv ** kv
-                    A[(k, kv)] = val
+        for (k, kv) in keys:
+            val = Ws[k][kv]
+            if k:
+                val = val * fu[k]
+            if kv:
+                val = val * fv[kv]
+            A[(k, kv)] = val
         if not self.rational:
             return [A[key_] for key_ in keys]
         return _quotient_soa(A, order)
 
 
-def _horner(G, x, order):
-    """Value and derivatives up to ``order`` (<= 2) of ``sum_b G[b] x^b`` (leading axis b).
+def _horner_into(G, x, outs):
+    """Horner's scheme for ``sum_b G[b] x^b`` (leading axis b) and its derivatives.
 
-    ``G`` has shape (deg + 1, m, n), ``x`` shape (n,); returns a list of (m, n)
-    arrays: the value, first and second derivative w.r.t. x.
+    ``G`` has shape (deg + 1, m, ...), ``x`` shape (n,) (the last axis); ``outs[k]``
+    (k <= 2), of shape (m_k, ...) with m_k <= m, receives ``d^k/dx^k / k!`` of the
+    polynomials ``G[:, :m_k]`` (so the second derivative is ``2 * outs[2]``). The
+    arithmetic is that of the textbook loop from zero derivative accumulators; the
+    first steps, whose accumulators are still zero, are taken on ``0 * x`` alone.
     """
     deg = G.shape[0] - 1
-    p = G[deg].copy()
-    d1 = np.zeros_like(p) if order >= 1 else None
-    d2 = np.zeros_like(p) if order >= 2 else None
-    for b in range(deg - 1, -1, -1):
-        if d2 is not None:
-            d2 *= x
-            d2 += d1
-        if d1 is not None:
-            d1 *= x
-            d1 += p
-        p *= x
-        p += G[b]
-    out = [p]
-    if order >= 1:
-        out.append(d1)
+    order = len(outs) - 1
+    p = outs[0]
+    m = [o.shape[0] for o in outs]
+    if deg == 0:
+        p[...] = G[0, :m[0]]
+        for o in outs[1:]:
+            o[...] = 0.0
+        return
+    z = x * 0.0                                  # 0 * x: the zero accumulator times x
     if order >= 2:
-        out.append(2.0 * d2)
-    return out
+        d2 = z + 0.0                             # (0 * x + 0)
+    if order >= 1:
+        d1 = outs[1]
+        np.add(G[deg, :m[1]], z, out=d1)         # 0 * x + G[deg]
+    np.multiply(G[deg, :m[0]], x, out=p)
+    p += G[deg - 1, :m[0]]
+    if order >= 2:
+        if deg >= 2:
+            np.add(d2 * x, d1[:m[2]], out=outs[2])
+        else:
+            outs[2][...] = d2
+        d2 = outs[2]
+    for b in range(deg - 2, -1, -1):
+        if order >= 2 and b < deg - 2:
+            d2 *= x
+            d2 += d1[:m[2]]
+        if order >= 1:
+            d1 *= x
+            d1 += p[:m[1]]
+        p *= x
+        p += G[b, :m[0]]
 
 
 def _quotient_soa(A, order):
@@ -216,9 +245,11 @@ class Newton:
         # sigma I (sigma = 1.5 |lambda_min|, so its smallest eigenvalue becomes
         # |lambda_min| / 2, plus a little Gauss-Newton scale); with one variable
         # held at a bound only its own curvature matters (else Gauss-Newton)
-        mu = 1e-9 * (a + c)
-        h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
-        h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
+        fixed = bool((fix_u | fix_v).any())
+        if fixed:
+            mu = 1e-9 * (a + c)
+            h_u = np.where(Huu > 1e-10 * a, Huu, a + mu)
+            h_v = np.where(Hvv > 1e-10 * c, Hvv, c + mu)
         if pd.all():
             H_uu, H_uv, H_vv, det2 = Huu, Huv, Hvv, det
         else:
@@ -227,10 +258,17 @@ class Newton:
             H_uu, H_uv, H_vv = Huu + sigma, Huv, Hvv + sigma
             det2 = H_uu * H_vv - H_uv * H_uv
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            du = np.where(fix_v, -gu / h_u, (H_uv * gv - H_vv * gu) / det2)
-            dv = np.where(fix_u, -gv / h_v, (H_uv * gu - H_uu * gv) / det2)
-        du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
-        dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
+            du = (H_uv * gv - H_vv * gu) / det2
+            dv = (H_uv * gu - H_uu * gv) / det2
+            if fixed:   # (none at a bound: the same values without these selections)
+                du = np.where(fix_v, -gu / h_u, du)
+                dv = np.where(fix_u, -gv / h_v, dv)
+        if fixed:
+            du = np.where(fix_u | ~np.isfinite(du), 0.0, du)
+            dv = np.where(fix_v | ~np.isfinite(dv), 0.0, dv)
+        else:
+            du = np.where(np.isfinite(du), du, 0.0)
+            dv = np.where(np.isfinite(dv), dv, 0.0)
         # trust region: at most half the work area per step
         lim = np.maximum(np.abs(du) * (2.0 / (self.u1 - self.u0)),
                          np.abs(dv) * (2.0 / (self.v1 - self.v0)))
@@ -238,9 +276,10 @@ class Newton:
         un = np.minimum(np.maximum(u + du * scale, self.u0), self.u1)
         vn = np.minimum(np.maximum(v + dv * scale, self.v0), self.v1)
         # fast = a true Newton step away from a curvature centre (quadratic convergence)
-        fast = np.where(fix_u | fix_v,
-                        np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a),
-                        pd & (det > 0.5 * gn_det))
+        fast = pd & (det > 0.5 * gn_det)
+        if fixed:
+            fast = np.where(fix_u | fix_v,
+                            np.where(fix_u, fix_v | (Hvv > 0.5 * c), Huu > 0.5 * a), fast)
         return un - u, vn - v, fast
 
     def quick(self, P, u, v, seed_derivs, evaluations=2, extra=1):

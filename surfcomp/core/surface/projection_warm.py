@@ -145,5 +145,30 @@ def _taylor(D, du, dv):
     """``S, Su, Sv, Suu, Suv, Svv`` of the second-order Taylor model of the face at the
     derivatives ``D``, a parameter step ``(du, dv)`` away."""
     S, Su, Sv, Suu, Suv, Svv = D
-    return [S + Su * du + Sv * dv + 0.5 * (Suu * du * du + 2.0 * Suv * du * dv + Svv * dv * dv),
-            Su + Suu * du + Suv * dv, Sv + Suv * du + Svv * dv, Suu, Suv, Svv]
+    # S + Su du + Sv dv + (Suu du du + 2 Suv du dv + Svv dv dv) / 2, Su + Suu du + Suv dv,
+    # Sv + Suv du + Svv dv: the same operations in the same order, in place (fewer
+    # temporaries of the size of the path)
+    q = Suu * du
+    q *= du
+    w = 2.0 * Suv
+    w *= du
+    w *= dv
+    q += w
+    np.multiply(Svv, dv, out=w)
+    w *= dv
+    q += w
+    q *= 0.5
+    s = Su * du
+    s += S
+    np.multiply(Sv, dv, out=w)
+    s += w
+    s += q
+    su = Suu * du
+    su += Su
+    np.multiply(Suv, dv, out=w)
+    su += w
+    sv = Suv * du
+    sv += Sv
+    np.multiply(Svv, dv, out=w)
+    sv += w
+    return [s, su, sv, Suu, Suv, Svv]
