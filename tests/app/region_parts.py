@@ -52,6 +52,20 @@ def block_document(path, solid, mirror=True, build=None):
         FreeCAD.closeDocument(doc.Name)
 
 
+def g1_shop(folder, count, seed):
+    """The G1 block saved as ``folder/shop.FCStd`` (Block and its Mirror) and ``count``
+    points on each of its two top faces carrying :func:`ridge_field`, in ``folder/g1.csv``:
+    ``(document, csv, solid, pts, nrm, dev)``."""
+    solid, tops = g1_top_solid()
+    path = os.path.join(str(folder), "shop.FCStd")
+    block_document(path, solid)
+    pts, nrm, dev = sample_faces([solid.Faces[k] for k in tops], count, ridge_field,
+                                 seed=seed)
+    csv = os.path.join(str(folder), "g1.csv")
+    write_csv(csv, pts, nrm, dev)
+    return path, csv, solid, pts, nrm, dev
+
+
 def _h(x, y):
     return 5.0 + 0.6 * np.sin(x / 5.0) + 0.4 * np.cos(y / 4.0)
 

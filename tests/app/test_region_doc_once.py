@@ -11,13 +11,7 @@ def test_the_region_is_computed_once_and_the_saved_document_is_up_to_date(tmp_pa
                                                                            monkeypatch):
     import FreeCAD
 
-    solid, tops = rp.g1_top_solid()
-    path = str(tmp_path / "shop.FCStd")
-    rp.block_document(path, solid)
-    pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 800, rp.ridge_field,
-                                    seed=3)
-    csv = str(tmp_path / "g1.csv")
-    rp.write_csv(csv, pts, nrm, dev)
+    path, csv, *_ = rp.g1_shop(tmp_path, 800, seed=3)
     calls = []
     compute = region_doc.compute
 

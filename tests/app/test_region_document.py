@@ -53,14 +53,7 @@ print("RESULT " + json.dumps(out))
 @pytest.fixture(scope="module")
 def shop(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("regiondoc")
-    solid, tops = rp.g1_top_solid()
-    path = str(tmp / "shop.FCStd")
-    rp.block_document(path, solid)
-    pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 3000, rp.ridge_field,
-                                    seed=1)
-    csv = str(tmp / "g1.csv")
-    rp.write_csv(csv, pts, nrm, dev)
-    return tmp, path, csv, solid, pts, nrm, dev
+    return (tmp, *rp.g1_shop(tmp, 3000, seed=1))
 
 
 @pytest.fixture(scope="module")
