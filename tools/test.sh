@@ -4,6 +4,12 @@
 # Arguments go to pytest (e.g. tests/pure); the lint gate runs only for a full run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# the suite starts hundreds of Python processes (the command line, freecadcmd, GUI
+# sessions): with PYTHONDONTWRITEBYTECODE set (some CI images set it) none of them finds the
+# modules compiled, and each compiles every surfcomp module it imports again (0.25 s of CPU
+# for the routes' modules alone), and every pytest worker rewrites every test module's
+# asserts again; the compiled files go to __pycache__ folders, which git ignores
+unset PYTHONDONTWRITEBYTECODE
 if [ $# -eq 0 ]; then
   echo "surfcomp tests: lint with $(ruff --version) (pyproject.toml)"
   ruff check --no-cache .
