@@ -12,6 +12,7 @@ import numpy as np
 from ..core.compensation import region_build, region_field
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..core.compensation.folds import find_fold, fold_warning
+from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
@@ -311,9 +312,11 @@ def _report(nominal, measurements, faces, counts, none, figures, fidelity, radiu
 
 
 def _fold_keys(f):
-    """The corrected face's largest turn of the normal from the nominal's, and the warning
-    when it folds over itself (:mod:`surfcomp.core.compensation.folds`)."""
-    fold = find_fold(f.surface, f.built.surface, f.outward)
+    """The corrected face's largest turn of the normal from the nominal's within the face's
+    boundary, and the warning when it folds over itself there
+    (:mod:`surfcomp.core.compensation.folds`)."""
+    fold = find_fold(f.surface, f.built.surface, f.outward,
+                     keep=lambda U, V: inside(f.polylines, U, V))
     text = fold_warning(f.name, fold)
     return {"normal_turn": fold.as_dict(), "warnings": [text] if text else []}
 

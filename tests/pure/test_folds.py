@@ -48,9 +48,9 @@ def test_a_partial_fold_is_located_where_the_correction_exceeds_the_radius():
     assert fold.folds
     assert fold.xyz[2] > 20.0
     # one span each way, 4 samples across: the rows at z = 30 and 40 mm fold, the row at
-    # z = 20 mm has shrunk to the axis (no normal, left out), z = 0 and 10 mm do not fold
-    assert fold.samples == 5 * 5
-    assert fold.folded_share == pytest.approx(2 / 5)
+    # z = 20 mm has shrunk to the axis (no normal, not counted), z = 0 and 10 mm do not
+    assert fold.samples == 5 * 4
+    assert fold.folded_share == pytest.approx(2 / 4)
 
 
 def test_the_samples_cover_every_knot_span_of_both_surfaces():
@@ -58,3 +58,14 @@ def test_the_samples_cover_every_knot_span_of_both_surfaces():
     assert t.size == 3 * 4 + 1
     assert np.allclose(t[:5], [0, 0.025, 0.05, 0.075, 0.1])
     assert t[0] == 0.0 and t[-1] == 1.0
+
+
+def test_samples_outside_the_kept_part_are_left_out():
+    nominal = quarter_cylinder(R, H)
+    moved = moved_inwards(nominal, 10.0, 40.0)
+    # the cylinder's v runs along z from 0 to 1: keeping v <= 0.45 (z <= 18 mm) leaves the
+    # fold out, as a trim that ends before it would
+    fold = folds.find_fold(nominal, moved, per_span=4, keep=lambda U, V: V <= 0.45)
+    assert not fold.folds and fold.folded_share == 0.0
+    assert fold.samples == 5 * 2        # the rows at z = 0 and 10 mm
+    assert fold.xyz[2] <= 10.0 + 1e-9

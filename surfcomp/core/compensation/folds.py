@@ -30,8 +30,8 @@ PER_SPAN = 2
 class Fold:
     """What :func:`find_fold` found: the largest angle (degrees) between the corrected
     and the nominal normal at the same parameters, where it is (``u``, ``v`` and the nominal
-    point ``xyz``, mm), the share of the samples past :data:`FOLD_ANGLE` and the sample
-    count."""
+    point ``xyz``, mm), the share of the samples past :data:`FOLD_ANGLE` and the count of
+    the samples that had a normal (and were kept)."""
 
     angle: float
     u: float
@@ -68,17 +68,18 @@ def _unit_normals(surf, us, vs, outward):
         return _S, n * (outward / np.where(degenerate, np.nan, length))
 
 
-def find_fold(nominal, corrected, outward=1, per_span=PER_SPAN):
+def find_fold(nominal, corrected, outward=1, per_span=PER_SPAN, keep=None):
     """The largest turn of the corrected surface's normal from the nominal's at the same
     (u, v) (:class:`Fold`), over the knot spans of both surfaces (the corrected surface
     spans the nominal's parameter domain, as every builder here makes it). Degenerate
-    normals (a pole) are left out."""
+    normals (a pole) are left out, and so are the samples where ``keep(U, V)`` (a bool
+    array of the grid block's shape, e.g. inside a trimmed face's boundary) is false."""
     (u0, u1), (v0, v1) = nominal.u_range, nominal.v_range
     us = np.union1d(span_parameters(nominal.knots_u, u0, u1, per_span),
                     span_parameters(corrected.knots_u, u0, u1, per_span))
     vs = np.union1d(span_parameters(nominal.knots_v, v0, v1, per_span),
                     span_parameters(corrected.knots_v, v0, v1, per_span))
-    best, where, folded = -1.0, (u0, v0, (np.nan,) * 3), 0
+    best, where, folded, count = -1.0, (u0, v0, (np.nan,) * 3), 0, 0
     step = max(1, int(1e6 // vs.size))
     for start in range(0, us.size, step):
         ub = us[start:start + step]
@@ -86,6 +87,9 @@ def find_fold(nominal, corrected, outward=1, per_span=PER_SPAN):
         _C, nc = _unit_normals(corrected, ub, vs, outward)
         cos = np.clip(np.einsum("ijk,ijk->ij", n, nc), -1.0, 1.0)
         angle = np.degrees(np.arccos(cos))
+        if keep is not None:
+            angle[~keep(*np.meshgrid(ub, vs, indexing="ij"))] = np.nan
+        count += int(np.count_nonzero(np.isfinite(angle)))
         if not np.isfinite(angle).any():
             continue
         folded += int(np.count_nonzero(angle > FOLD_ANGLE))
@@ -94,7 +98,7 @@ def find_fold(nominal, corrected, outward=1, per_span=PER_SPAN):
             best = float(angle[i, j])
             where = (float(ub[i]), float(vs[j]), tuple(float(x) for x in S[i, j]))
     return Fold(angle=max(best, 0.0), u=where[0], v=where[1], xyz=where[2],
-                folded_share=folded / float(us.size * vs.size), samples=int(us.size * vs.size))
+                folded_share=folded / float(max(count, 1)), samples=count)
 
 
 def fold_warning(name, fold):
