@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from ..core.compensation import region_build, region_field
+from ..core.compensation import curl_cap, region_build, region_field
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..core.compensation.folds import find_fold, fold_warning
 from ..core.surface.trimmed import inside
@@ -148,6 +148,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
         fld = stack(fld)
+    fld = _cap(faces, fld, pts, field_radius)
     sharp = region.sharp_edges(faces, edges, band=field_radius, field=fld)
     closed = _closed(shape)
     if not closed:      # a compound of faces: nothing to re-trim its neighbours in
@@ -224,6 +225,18 @@ def _check_neighbours(shape, faces, fld, sharp):
                 % (f.name, -e.b, move * 1e3, PRECISION * 1e3, -e.b), options=("faces",))
 
 
+def _cap(faces, fld, pts, field_radius):
+    """The field held short of turning a curl of the region inside out
+    (:mod:`surfcomp.core.compensation.curl_cap`); the field itself where no radius of
+    curvature comes near the correction."""
+    step = curl_cap.SAMPLE_STEP * field_radius / 5.0       # of the build's knot step
+    samples = [curl_cap.curvature_samples(f.surface, f.outward,
+                                          keep=lambda U, V, f=f: inside(f.polylines, U, V),
+                                          step=step) for f in faces]
+    capped = curl_cap.CappedField(fld, samples, step, curl_cap.field_largest(fld, pts))
+    return capped if capped.active else fld
+
+
 def _build(faces, fld, sharp, field_radius, max_factor):
     """Every face's corrected surface (``f.built``, ``f.part_surface``)."""
     from .convert import surface_to_part
@@ -254,11 +267,16 @@ def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
         miss = np.abs(realised(faces[i], u[k], v[k], intended) - intended) * 1e3
         share = region_build.designed_share(base[k], normal[k], sharp)
         zone = np.abs(share - 1.0) > 1e-9
+        curl, short = fld.capped(base[k]) if hasattr(fld, "capped") else (
+            np.zeros(len(k), dtype=bool), np.zeros(len(k)))
+        rest = ~zone & ~curl
         return {"all": float(np.max(miss)),
-                "beyond": float(np.max(miss[~zone])) if np.any(~zone) else None,
+                "beyond": float(np.max(miss[rest])) if np.any(rest) else None,
                 "zone_points": int(np.sum(zone)),
                 "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
-                * 1e3 if np.any(zone) else 0.0}
+                * 1e3 if np.any(zone) else 0.0,
+                "curl_points": int(np.sum(curl)),
+                "curl_shortfall": float(np.max(short[curl])) * 1e3 if np.any(curl) else 0.0}
 
     return {f.name: fid for f, fid in zip(faces, per_face(faces, one)) if fid is not None}
 
@@ -327,7 +345,9 @@ def _fidelity_keys(fid):
     return {"max_realised_minus_intended_um": fid["all"],
             "max_realised_minus_intended_beyond_edge_zones_um": fid["beyond"],
             "edge_zone_points": fid["zone_points"],
-            "edge_zone_max_designed_shortfall_um": fid["zone_shortfall"]}
+            "edge_zone_max_designed_shortfall_um": fid["zone_shortfall"],
+            "curl_points": fid["curl_points"],
+            "curl_max_shortfall_um": fid["curl_shortfall"]}
 
 
 def summary(rep):
@@ -346,6 +366,12 @@ def summary(rep):
                          % (f["face"], f["edge_zone_points"],
                             f["edge_zone_max_designed_shortfall_um"],
                             "-" if beyond is None else "%.4f um" % beyond))
+        if f.get("curl_points"):
+            lines.append("  %s: %d points where the face curls tighter than the correction "
+                         "can follow (the correction is held to %g of the radius of "
+                         "curvature): short by up to %.4f um by design"
+                         % (f["face"], f["curl_points"], curl_cap.SHARE,
+                            f["curl_max_shortfall_um"]))
         lines.extend("warning: " + text for text in f.get("warnings", ()))
     for e in rep["edges"]:
         lines.append("edge %s-%s (%s): largest gap %.4f um (nominal %.4f um, %.4f um more "

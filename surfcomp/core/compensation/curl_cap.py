@@ -1,0 +1,205 @@
+# SPDX-License-Identifier: LGPL-2.1-or-later
+"""A region's correction held short of turning a curl inside out (issue 30; no FreeCAD).
+
+A face moved along its normal by ``delta`` towards its centre of curvature has the normal
+of the nominal times ``1 - delta * kappa``: past ``delta = 1 / kappa`` (a trailing edge
+curled at a 12 um radius, corrected 30 um inwards) it folds over itself
+(:mod:`surfcomp.core.compensation.folds`). So the field is capped, before the edges, the
+build, the fidelity and the volume integral take it, by a limit that is ONE function of
+the position in space (on a shared edge both faces must still move by the same vector):
+
+* **Curvature samples** (:func:`curvature_samples`): every knot span of every region
+  face, :data:`PER_SPAN` parameters across it and at most :data:`SAMPLE_STEP` knot steps
+  apart, the principal curvatures from the first and second derivatives; the *convex*
+  curvature (centre of curvature on the inward side) limits an inward correction
+  (``delta > 0``, into the material), the *concave* one an outward correction. They are
+  thinned to the tightest of each cell of the sample step.
+* **Limit in space**: ``L(x) = 1 / kappa(x)``, ``kappa(x) = (sum_j (phi_j / (SHARE R_j +
+  SLOPE |x - x_j|))^P)^(1/P)``, a smooth maximum (at least its largest term, at most
+  ``n^(1/P)`` times it for ``n`` samples) over the samples within the reach, ``R_j`` the
+  radius at the sample, ``phi_j`` 1 within :data:`FLAT` of the reach and Wendland's C2
+  kernel down to 0 at it. The limit grows by at most :data:`SLOPE` away from a tight curl,
+  a slope the build's knot step follows; the reach is where it no longer matters.
+* **Soft cap**: with ``t = |delta| / L``, the field is left as it is for ``t <= KNEE`` and
+  becomes ``sign(delta) L g(t)``, ``g(t) = KNEE + (1 - KNEE)(1 - exp(-(t - KNEE) /
+  (1 - KNEE)))`` beyond (C1, below ``L`` always). Samples whose curvature cannot bring
+  ``t`` past the knee anywhere (``kappa_j max|delta| <= KNEE SHARE``) are dropped before the
+  tree is built: where every radius is well above the correction, the cap is the field
+  itself, to the bit.
+"""
+
+import numpy as np
+
+from ..surface import bspline
+from ..surface.kdtree import cKDTree
+from .folds import span_parameters
+from .region_build import _lengths
+from .region_field import wendland
+
+#: the cap: at most this share of the local radius of curvature
+SHARE = 0.5
+#: the field is unchanged up to this share of the cap
+KNEE = 0.5
+#: exponent of the smooth maximum of the samples' curvatures
+P = 16.0
+#: samples across each knot span, in each direction
+PER_SPAN = 3
+#: largest distance between two curvature samples (and their cell), in knot steps
+SAMPLE_STEP = 0.5
+#: points of one block of the limit's neighbour queries
+BLOCK = 4096
+#: share of the reach over which a sample's term counts in full
+FLAT = 0.8
+#: the limit grows by at most this (mm per mm) away from a tight curl
+SLOPE = 0.005
+
+
+def principal_curvatures(Su, Sv, Suu, Suv, Svv, n):
+    """The principal curvatures ``(k1, k2)`` (``k1 <= k2``, 1/mm) for the unit normal ``n``:
+    negative where the surface bends away from ``n`` (convex for an outward ``n``)."""
+    E, F, G = (np.einsum("...k,...k", a, b) for a, b in ((Su, Su), (Su, Sv), (Sv, Sv)))
+    L, M, N = (np.einsum("...k,...k", a, n) for a in (Suu, Suv, Svv))
+    det = np.maximum(E * G - F * F, 1e-300)
+    H = (E * N - 2.0 * F * M + G * L) / (2.0 * det)
+    K = (L * N - M * M) / det
+    root = np.sqrt(np.maximum(H * H - K, 0.0))
+    return H - root, H + root
+
+
+def curvature_samples(surf, outward=1, keep=None, step=None, per_span=PER_SPAN):
+    """Points of ``surf`` across every knot span, and at most ``step`` (mm) apart in each
+    direction, and their convex and concave curvature (1/mm, >= 0) for the outward normal
+    (the surface's normal times ``outward``); samples where ``keep(U, V)`` is false or the
+    normal is degenerate are left out. Returns ``(points (M, 3), convex (M,), concave
+    (M,))``."""
+    (u0, u1), (v0, v1) = surf.u_range, surf.v_range
+    us = span_parameters(surf.knots_u, u0, u1, per_span)
+    vs = span_parameters(surf.knots_v, v0, v1, per_span)
+    if step is not None:
+        lu, lv = _lengths(surf)
+        us = np.union1d(us, np.linspace(u0, u1, int(np.ceil(lu * (u1 - u0) / step)) + 1))
+        vs = np.union1d(vs, np.linspace(v0, v1, int(np.ceil(lv * (v1 - v0) / step)) + 1))
+    S, Su, Sv, Suu, Suv, Svv = bspline.evaluate_grid(surf, us, vs, order=2)
+    n = np.cross(Su, Sv)
+    length = np.linalg.norm(n, axis=-1)
+    ok = length > 1e-9 * max(float(np.max(length)), 1e-300)
+    if keep is not None:
+        U, V = np.meshgrid(us, vs, indexing="ij")
+        ok &= np.asarray(keep(U, V), dtype=bool)
+    n = n[ok] * (outward / length[ok])[:, None]
+    k1, k2 = principal_curvatures(Su[ok], Sv[ok], Suu[ok], Suv[ok], Svv[ok], n)
+    return S[ok], np.maximum(-k1, 0.0), np.maximum(k2, 0.0)
+
+
+class _Limit:
+    """``kappa(x)`` of the samples (see the module docstring); 0 where none matters. The
+    samples that can matter (for a field at most ``largest``, mm) are thinned to the
+    tightest of each ``cell`` (mm), so a query meets a bounded count of them."""
+
+    def __init__(self, points, kappa, cell, largest):
+        self.reach = largest / (KNEE * SLOPE * FLAT)
+        keep = kappa * largest > KNEE * SHARE
+        points, kappa = points[keep], kappa[keep]
+        if len(points):
+            key = np.floor(points / cell).astype(np.int64)
+            order = np.lexsort((-kappa, *key.T[::-1]))
+            key = key[order]
+            first = np.r_[True, np.any(np.diff(key, axis=0) != 0, axis=1)]
+            points, kappa = points[order][first], kappa[order][first]
+        self.points, self.kappa = points, kappa
+        self.tree = cKDTree(points) if len(points) else None
+
+    def __call__(self, x):
+        out = np.zeros(len(x))
+        if self.tree is None:
+            return out
+        for a in range(0, len(x), BLOCK):
+            xs = x[a:a + BLOCK]
+            near = self.tree.query_ball_point(xs, self.reach)
+            count = np.fromiter((len(c) for c in near), dtype=np.intp, count=len(xs))
+            if not count.any():
+                continue
+            rows = np.repeat(np.arange(len(xs)), count)
+            idx = np.concatenate([c for c in near if c]).astype(np.intp)
+            d = np.linalg.norm(self.points[idx] - xs[rows], axis=1)
+            term = flat_top(d / self.reach) / (SHARE / self.kappa[idx] + SLOPE * d)
+            out[a:a + len(xs)] = np.bincount(rows, weights=term ** P,
+                                             minlength=len(xs)) ** (1.0 / P)
+        return out
+
+
+def flat_top(s):
+    """1 for ``s <= FLAT``, then Wendland's C2 kernel down to 0 at ``s = 1``."""
+    return wendland((np.asarray(s, dtype=float) - FLAT) / (1.0 - FLAT))
+
+
+def soft_cap(delta, kappa):
+    """``delta`` (mm) capped by ``SHARE / kappa`` (1/mm) as the module docstring says."""
+    delta = np.asarray(delta, dtype=float)
+    t = np.abs(delta) * np.asarray(kappa, dtype=float)
+    over = t > KNEE
+    factor = np.ones_like(t)
+    s = t[over]
+    factor[over] = (KNEE + (1.0 - KNEE) * (1.0 - np.exp(-(s - KNEE) / (1.0 - KNEE)))) / s
+    return delta * factor
+
+
+class CappedField:
+    """``field`` capped by the region's curvature (the module docstring), a function of
+    the position; :meth:`capped` says where the cap is active and by how much it falls
+    short.
+
+    Parameters
+    ----------
+    field : callable
+        ``delta(x)`` (mm) at points ``x`` (M, 3).
+    samples : list of (points, convex, concave)
+        :func:`curvature_samples` of every region face.
+    cell : float
+        Cell (mm) the samples are thinned to (their spacing).
+    largest : float
+        The largest ``|delta|`` the field takes (mm), which sets which samples can matter.
+    """
+
+    def __init__(self, field, samples, cell, largest):
+        self.field = field
+        largest = max(float(largest), 1e-12)
+        pts = np.concatenate([s[0] for s in samples]) if samples else np.zeros((0, 3))
+        convex = np.concatenate([s[1] for s in samples]) if samples else np.zeros(0)
+        concave = np.concatenate([s[2] for s in samples]) if samples else np.zeros(0)
+        self.inward = _Limit(pts, convex, cell, largest)
+        self.outward = _Limit(pts, concave, cell, largest)
+
+    @property
+    def active(self):
+        """True where some sample is tight enough for the cap to act somewhere."""
+        return self.inward.tree is not None or self.outward.tree is not None
+
+    def both(self, x):
+        """``(field, capped field)`` at points ``x`` (M, 3), mm."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
+        raw = self.field(x)
+        if not self.active:
+            return raw, raw
+        out = raw.copy()
+        for lim, side in ((self.inward, raw > 0), (self.outward, raw < 0)):
+            k = np.flatnonzero(side)
+            if lim.tree is not None and len(k):
+                out[k] = soft_cap(raw[k], lim(x[k]))
+        return raw, out
+
+    def __call__(self, x):
+        return self.both(x)[1]
+
+    def capped(self, x):
+        """Where the cap is active at ``x`` (bool) and the shortfall ``|field - capped|``
+        (mm) there."""
+        raw, out = self.both(x)
+        short = np.abs(raw - out)
+        return short > 0.0, short
+
+
+def field_largest(field, points):
+    """The largest ``|field|`` at ``points`` (mm), with a margin of 2 for what the field
+    takes between them (the cap's sample floor)."""
+    return 2.0 * float(np.max(np.abs(field(points)))) if len(points) else 0.0
