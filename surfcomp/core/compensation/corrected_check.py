@@ -210,13 +210,8 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
     for start in range(0, us.size, step):
         ub = us[start:start + step]
         S, Su, Sv = bspline.evaluate_grid(nominal, ub, vs, order=1)
-        n = np.cross(Su, Sv)
-        length = np.linalg.norm(n, axis=-1, keepdims=True)
-        # no normal where the surface degenerates (a sphere's pole: Su x Sv is zero or
-        # rounding noise there): NaN, left out below
-        degenerate = length <= 1e-9 * max(float(np.max(length)), 1e-300)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            n *= outward / np.where(degenerate, np.nan, length)
+        # no normal where the surface degenerates: NaN, left out below
+        n = bspline.grid_unit_normals(Su, Sv, outward)
         # on the dense grid the normal line meets the corrected surface within the fit
         # error of the same (u, v), so the normal component of S - S_c(u, v) is the
         # realised correction to second order (exact Newton intersections at the points)

@@ -33,7 +33,7 @@ import numpy as np
 from ..surface import bspline
 from ..surface.kdtree import cKDTree
 from .folds import span_parameters
-from .region_build import _lengths
+from .region_build import face_lengths
 from .region_field import wendland
 
 #: the cap: at most this share of the local radius of curvature
@@ -76,18 +76,16 @@ def curvature_samples(surf, outward=1, keep=None, step=None, per_span=PER_SPAN):
     us = span_parameters(surf.knots_u, u0, u1, per_span)
     vs = span_parameters(surf.knots_v, v0, v1, per_span)
     if step is not None:
-        lu, lv = _lengths(surf)
+        lu, lv = face_lengths(surf)
         us = np.union1d(us, np.linspace(u0, u1, int(np.ceil(lu * (u1 - u0) / step)) + 1))
         vs = np.union1d(vs, np.linspace(v0, v1, int(np.ceil(lv * (v1 - v0) / step)) + 1))
     S, Su, Sv, Suu, Suv, Svv = bspline.evaluate_grid(surf, us, vs, order=2)
-    n = np.cross(Su, Sv)
-    length = np.linalg.norm(n, axis=-1)
-    ok = length > 1e-9 * max(float(np.max(length)), 1e-300)
+    n = bspline.grid_unit_normals(Su, Sv, outward)
+    ok = np.isfinite(n[..., 0])
     if keep is not None:
         U, V = np.meshgrid(us, vs, indexing="ij")
         ok &= np.asarray(keep(U, V), dtype=bool)
-    n = n[ok] * (outward / length[ok])[:, None]
-    k1, k2 = principal_curvatures(Su[ok], Sv[ok], Suu[ok], Suv[ok], Svv[ok], n)
+    k1, k2 = principal_curvatures(Su[ok], Sv[ok], Suu[ok], Suv[ok], Svv[ok], n[ok])
     return S[ok], np.maximum(-k1, 0.0), np.maximum(k2, 0.0)
 
 

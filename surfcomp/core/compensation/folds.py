@@ -60,12 +60,8 @@ def span_parameters(knots, lo, hi, per_span=PER_SPAN):
 
 
 def _unit_normals(surf, us, vs, outward):
-    _S, Su, Sv = bspline.evaluate_grid(surf, us, vs, order=1)
-    n = np.cross(Su, Sv)
-    length = np.linalg.norm(n, axis=-1, keepdims=True)
-    degenerate = length <= 1e-9 * max(float(np.max(length)), 1e-300)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return _S, n * (outward / np.where(degenerate, np.nan, length))
+    S, Su, Sv = bspline.evaluate_grid(surf, us, vs, order=1)
+    return S, bspline.grid_unit_normals(Su, Sv, outward)
 
 
 def find_fold(nominal, corrected, outward=1, per_span=PER_SPAN, keep=None):

@@ -192,7 +192,7 @@ def knot_plans(surfaces, knot_step, max_factor=POLE_FACTOR):
     out = [None] * len(ups)
     for k in {key(s) for s in ups}:
         group = [i for i, s in enumerate(ups) if key(s) == k]
-        sizes = [_lengths(ups[i]) for i in group]
+        sizes = [face_lengths(ups[i]) for i in group]
         budgets = [max(max_factor * np.prod(surfaces[i].poles.shape[:2]), MIN_BUDGET)
                    for i in group]
         step = float(knot_step)
@@ -211,7 +211,7 @@ def knot_plans(surfaces, knot_step, max_factor=POLE_FACTOR):
     return out
 
 
-def _lengths(surf):
+def face_lengths(surf):
     """Largest length (mm) of the surface per unit of u and of v."""
     us = np.linspace(surf.knots_u[surf.degree_u], surf.knots_u[-surf.degree_u - 1], 41)
     vs = np.linspace(surf.knots_v[surf.degree_v], surf.knots_v[-surf.degree_v - 1], 41)

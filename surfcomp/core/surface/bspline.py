@@ -322,6 +322,17 @@ def unit_normals(surf, u, v, Su, Sv):
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
+def grid_unit_normals(Su, Sv, outward=1):
+    """Unit normals ``outward * Su x Sv / |Su x Sv|`` of grid derivatives (..., 3), NaN where
+    the surface degenerates (a sphere's pole: ``Su x Sv`` zero or rounding noise, at most
+    1e-9 of the grid's largest)."""
+    n = np.cross(Su, Sv)
+    length = np.linalg.norm(n, axis=-1, keepdims=True)
+    degenerate = length <= 1e-9 * max(float(np.max(length, initial=0.0)), 1e-300)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return n * (outward / np.where(degenerate, np.nan, length))
+
+
 def evaluate_grid(surf, us, vs, order=0):
     """Tensor-product evaluation on the grid ``us x vs`` with sparse basis matrices.
 
