@@ -88,3 +88,27 @@ def test_a_tight_curl_caps_inward_corrections_and_the_cap_fades_with_distance():
     # an outward correction on the convex curl: nothing to fold, nothing capped
     out = curl_cap.CappedField(constant(-0.03), samples, 0.1, 0.06)
     assert np.array_equal(out(on), np.full(len(on), -0.03))
+
+
+def test_the_limit_is_taken_only_where_the_cap_can_act_and_alike_there():
+    # two tight curls (12 and 60 um) and a field that falls away from them: the bound of
+    # kappa per box is above kappa everywhere, and capping only where the bound lets the
+    # field pass the knee gives the same bits as capping everywhere
+    samples = [curl_cap.curvature_samples(quarter_cylinder(r, 40.0), 1, step=0.1)
+               for r in (0.012, 0.06)]
+    samples[1] = (samples[1][0] + [3.0, 1.0, 0.0],) + samples[1][1:]
+    capped = curl_cap.CappedField(lambda x: 0.03 - 0.0005 * np.abs(x[:, 0]), samples,
+                                  0.1, 0.06)
+    lim = capped.inward
+    rng = np.random.default_rng(5)
+    x = rng.uniform([-30.0, -30.0, -10.0], [30.0, 30.0, 50.0], (20000, 3))
+    on = np.concatenate([s[0] for s in samples])
+    x[:len(on)] = on + rng.normal(0, 0.5, on.shape)
+    kappa = lim(x)
+    bound = lim.bound(x)
+    assert np.all(bound >= kappa) and np.any(kappa > 0) and np.any(bound == 0)
+    raw, out = capped.both(x)
+    assert np.array_equal(out, curl_cap.soft_cap(raw, kappa))
+    assert np.any(out != raw) and np.any(out == raw)
+    # the boxes' bounds kept from the first call are the same in the next
+    assert np.array_equal(lim.bound(x[::-1]), bound[::-1])

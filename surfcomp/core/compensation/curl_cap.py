@@ -24,14 +24,24 @@ the position in space (on a shared edge both faces must still move by the same v
   becomes ``sign(delta) L g(t)``, ``g(t) = KNEE + (1 - KNEE)(1 - exp(-(t - KNEE) /
   (1 - KNEE)))`` beyond (C1, below ``L`` always). Samples whose curvature cannot bring
   ``t`` past the knee anywhere (``kappa_j max|delta| <= KNEE SHARE``) are dropped before the
-  tree is built: where every radius is well above the correction, the cap is the field
+  limit is built: where every radius is well above the correction, the cap is the field
   itself, to the bit.
+* **Evaluation**: ``kappa(x)`` is a sum over every sample within the reach (the terms fall
+  as slowly as ``1 / (SLOPE d)``: none can be left out at the 1e-16 level), so it is taken
+  only where the cap can act. An upper bound of ``kappa`` per box of 1/32 of the reach
+  (every sample's term at the box's nearest point) sorts out the points where ``|delta|
+  kappa`` stays below the knee for certain (on the 200 000-point blade bench, 90 % of the
+  1.08 million points the field is taken at); they keep the field as it is. The others
+  take ``kappa`` sample by sample, the terms added in the samples' order, which is the
+  order the neighbour queries of the first version added them in: the capped field is
+  the same to the bit as theirs.
 """
+
+import threading
 
 import numpy as np
 
 from ..surface import bspline
-from ..surface.kdtree import cKDTree
 from .folds import span_parameters
 from .region_build import face_lengths
 from .region_field import wendland
@@ -46,8 +56,13 @@ P = 16.0
 PER_SPAN = 3
 #: largest distance between two curvature samples (and their cell), in knot steps
 SAMPLE_STEP = 0.5
-#: points of one block of the limit's neighbour queries
+#: points of one block of the limit's evaluation
 BLOCK = 4096
+#: boxes of one block of the limit's bound
+BOX_BLOCK = 1024
+#: boxes of the limit's bound to the reach (the bound takes a sample nearer by at most the
+#: box's diagonal, 5 % of the reach)
+BOXES_PER_REACH = 32
 #: share of the reach over which a sample's term counts in full
 FLAT = 0.8
 #: the limit grows by at most this (mm per mm) away from a tight curl
@@ -92,7 +107,13 @@ def curvature_samples(surf, outward=1, keep=None, step=None, per_span=PER_SPAN):
 class _Limit:
     """``kappa(x)`` of the samples (see the module docstring); 0 where none matters. The
     samples that can matter (for a field at most ``largest``, mm) are thinned to the
-    tightest of each ``cell`` (mm), so a query meets a bounded count of them."""
+    tightest of each ``cell`` (mm), so a query meets a bounded count of them.
+
+    :meth:`cap` evaluates ``kappa`` only at the points where the cap can act: an upper
+    bound of ``kappa`` over a box of :data:`BOXES_PER_REACH` boxes to the reach (each
+    sample's term taken at the box's nearest point, see :meth:`bound`) sorts out the points
+    where ``|delta| kappa`` stays below :data:`KNEE` for certain; those keep their field to
+    the bit, the others take ``kappa`` sample by sample in the same order as before."""
 
     def __init__(self, points, kappa, cell, largest):
         self.reach = largest / (KNEE * SLOPE * FLAT)
@@ -105,24 +126,89 @@ class _Limit:
             first = np.r_[True, np.any(np.diff(key, axis=0) != 0, axis=1)]
             points, kappa = points[order][first], kappa[order][first]
         self.points, self.kappa = points, kappa
-        self.tree = cKDTree(points) if len(points) else None
+        self.radius = SHARE / kappa           # SHARE R_j, the term's floor (mm)
+        self.empty = not len(points)
+        # the bound's boxes: over the samples' reach, at most a million to a side
+        if not self.empty:
+            self.origin = points.min(axis=0) - self.reach
+            extent = points.max(axis=0) + self.reach - self.origin
+            self.box = max(self.reach / BOXES_PER_REACH, float(np.max(extent)) * 1e-6)
+            self.shape = tuple(int(n) for n in np.ceil(extent / self.box) + 1)
+        self.known, self.values = np.zeros(0, dtype=np.int64), np.zeros(0)
+        self.lock = threading.Lock()
 
     def __call__(self, x):
+        """``kappa`` at points ``x`` (M, 3), 1/mm."""
+        x = np.asarray(x, dtype=float).reshape(-1, 3)
         out = np.zeros(len(x))
-        if self.tree is None:
+        if self.empty:
             return out
         for a in range(0, len(x), BLOCK):
-            xs = x[a:a + BLOCK]
-            near = self.tree.query_ball_point(xs, self.reach)
-            count = np.fromiter((len(c) for c in near), dtype=np.intp, count=len(xs))
-            if not count.any():
-                continue
-            rows = np.repeat(np.arange(len(xs)), count)
-            idx = np.concatenate([c for c in near if c]).astype(np.intp)
-            d = np.linalg.norm(self.points[idx] - xs[rows], axis=1)
-            term = flat_top(d / self.reach) / (SHARE / self.kappa[idx] + SLOPE * d)
-            out[a:a + len(xs)] = np.bincount(rows, weights=term ** P,
-                                             minlength=len(xs)) ** (1.0 / P)
+            out[a:a + BLOCK] = self._exact(x[a:a + BLOCK])
+        return out
+
+    def _exact(self, xs):
+        """``kappa`` at ``xs`` (at most a few thousand points): the samples within the
+        reach of their bounding box, each term to the power P added in the samples' order
+        (a term beyond the reach is 0 and adds nothing)."""
+        lo, hi = xs.min(axis=0), xs.max(axis=0)
+        gap = np.linalg.norm(np.maximum(np.maximum(lo - self.points, self.points - hi), 0.0),
+                             axis=1)
+        acc = np.zeros(len(xs))
+        for j in np.flatnonzero(gap < self.reach):
+            d = np.linalg.norm(self.points[j] - xs, axis=1)
+            term = flat_top(d / self.reach) / (self.radius[j] + SLOPE * d)
+            acc += term ** P
+        return acc ** (1.0 / P)
+
+    def bound(self, x):
+        """An upper bound of ``kappa`` at points ``x`` (M, 3): per box of side
+        :attr:`box` holding a point, every sample within the reach of the box taken at
+        the box's nearest point (a term is at most ``1 / (SHARE R_j + SLOPE d)`` and falls
+        with ``d``); 0 beyond the reach of every sample. The boxes' bounds are kept for
+        the next call."""
+        key = np.floor((x - self.origin) / self.box).astype(np.int64)
+        inside = np.all((key >= 0) & (key < self.shape), axis=1)
+        out = np.zeros(len(x))
+        if not inside.any():
+            return out
+        flat = np.ravel_multi_index(tuple(key[inside].T), self.shape)
+        boxes, which = np.unique(flat, return_inverse=True)
+        with self.lock:
+            known, values = self.known, self.values
+        pos = np.minimum(np.searchsorted(known, boxes), max(len(known) - 1, 0))
+        found = known[pos] == boxes if len(known) else np.zeros(len(boxes), dtype=bool)
+        value = np.where(found, values[pos] if len(known) else 0.0, 0.0)
+        new = np.flatnonzero(~found)
+        for a in range(0, len(new), BOX_BLOCK):
+            part = new[a:a + BOX_BLOCK]
+            lo = self.origin + np.stack(np.unravel_index(boxes[part], self.shape),
+                                        axis=1)[:, None, :] * self.box
+            gap = np.maximum(np.maximum(lo - self.points, self.points - (lo + self.box)), 0.0)
+            # less a millionth of the box: a point rounded onto the box's face is inside it
+            d = np.maximum(np.linalg.norm(gap, axis=2) - 1e-6 * self.box, 0.0)
+            term = np.where(d < self.reach, 1.0 / (self.radius + SLOPE * d), 0.0)
+            value[part] = np.sum(term ** P, axis=1) ** (1.0 / P)
+        if len(new):
+            with self.lock:
+                keys = np.concatenate([self.known, boxes[new]])
+                order = np.argsort(keys, kind="stable")
+                keys, vals = keys[order], np.concatenate([self.values, value[new]])[order]
+                first = np.r_[True, keys[1:] != keys[:-1]]
+                self.known, self.values = keys[first], vals[first]
+        out[inside] = value[which.reshape(-1)]
+        return out
+
+    def cap(self, delta, x):
+        """``delta`` at points ``x`` soft-capped by ``1 / kappa(x)`` (:func:`soft_cap`),
+        ``kappa`` taken only where :meth:`bound` lets ``|delta| kappa`` pass the knee."""
+        out = np.array(delta, dtype=float)
+        if self.empty or not len(out):
+            return out
+        # a margin of a millionth covers the rounding of the bound and of kappa
+        k = np.flatnonzero(np.abs(out) * self.bound(x) > KNEE * (1.0 - 1e-6))
+        if len(k):
+            out[k] = soft_cap(out[k], self(x[k]))
         return out
 
 
@@ -171,7 +257,7 @@ class CappedField:
     @property
     def active(self):
         """True where some sample is tight enough for the cap to act somewhere."""
-        return self.inward.tree is not None or self.outward.tree is not None
+        return not (self.inward.empty and self.outward.empty)
 
     def both(self, x):
         """``(field, capped field)`` at points ``x`` (M, 3), mm."""
@@ -182,8 +268,8 @@ class CappedField:
         out = raw.copy()
         for lim, side in ((self.inward, raw > 0), (self.outward, raw < 0)):
             k = np.flatnonzero(side)
-            if lim.tree is not None and len(k):
-                out[k] = soft_cap(raw[k], lim(x[k]))
+            if not lim.empty and len(k):
+                out[k] = lim.cap(raw[k], x[k])
         return raw, out
 
     def __call__(self, x):
