@@ -90,7 +90,7 @@ def test_a_tight_curl_caps_inward_corrections_and_the_cap_fades_with_distance():
     assert np.array_equal(out(on), np.full(len(on), -0.03))
 
 
-def test_the_limit_is_taken_only_where_the_cap_can_act_and_alike_there():
+def test_the_limit_is_taken_only_where_the_cap_can_act_and_alike_there(monkeypatch):
     # two tight curls (12 and 60 um) and a field that falls away from them: the bound of
     # kappa per box is above kappa everywhere, and capping only where the bound lets the
     # field pass the knee gives the same bits as capping everywhere
@@ -112,3 +112,11 @@ def test_the_limit_is_taken_only_where_the_cap_can_act_and_alike_there():
     assert np.any(out != raw) and np.any(out == raw)
     # the boxes' bounds kept from the first call are the same in the next
     assert np.array_equal(lim.bound(x[::-1]), bound[::-1])
+    # in small blocks (of points, of boxes, of box-sample pairs) the capped field alike, to
+    # the bit
+    for name, value in (("BLOCK", 64), ("BOX_BLOCK", 5), ("PAIRS", 7)):
+        monkeypatch.setattr(curl_cap, name, value)
+    small = curl_cap.CappedField(capped.field, samples, 0.1, 0.06)
+    y = x[::4]
+    assert small.inward.bound(y) == pytest.approx(bound[::4], rel=1e-12)   # other sums
+    assert np.array_equal(small.both(y)[1], out[::4])

@@ -42,6 +42,7 @@ import threading
 import numpy as np
 
 from ..surface import bspline
+from ..surface.kdtree import cKDTree
 from .folds import span_parameters
 from .region_build import face_lengths
 from .region_field import wendland
@@ -60,6 +61,8 @@ SAMPLE_STEP = 0.5
 BLOCK = 4096
 #: boxes of one block of the limit's bound
 BOX_BLOCK = 1024
+#: box-sample pairs the bound takes at once (its arrays' size)
+PAIRS = 1 << 20
 #: boxes of the limit's bound to the reach (the bound takes a sample nearer by at most the
 #: box's diagonal, 5 % of the reach)
 BOXES_PER_REACH = 32
@@ -134,6 +137,7 @@ class _Limit:
             extent = points.max(axis=0) + self.reach - self.origin
             self.box = max(self.reach / BOXES_PER_REACH, float(np.max(extent)) * 1e-6)
             self.shape = tuple(int(n) for n in np.ceil(extent / self.box) + 1)
+        self.tree = cKDTree(points) if not self.empty else None
         self.known, self.values = np.zeros(0, dtype=np.int64), np.zeros(0)
         self.lock = threading.Lock()
 
@@ -147,67 +151,88 @@ class _Limit:
             out[a:a + BLOCK] = self._exact(x[a:a + BLOCK])
         return out
 
+    def _near(self, lo, hi):
+        """The samples within the reach of the box ``[lo, hi]`` (and some beyond it), in
+        their order."""
+        centre, half = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
+        return np.sort(np.asarray(self.tree.query_ball_point(centre, half + self.reach),
+                                  dtype=np.intp))
+
     def _exact(self, xs):
         """``kappa`` at ``xs`` (at most a few thousand points): the samples within the
         reach of their bounding box, each term to the power P added in the samples' order
         (a term beyond the reach is 0 and adds nothing)."""
-        lo, hi = xs.min(axis=0), xs.max(axis=0)
-        gap = np.linalg.norm(np.maximum(np.maximum(lo - self.points, self.points - hi), 0.0),
-                             axis=1)
         acc = np.zeros(len(xs))
-        for j in np.flatnonzero(gap < self.reach):
+        for j in self._near(xs.min(axis=0), xs.max(axis=0)):
             d = np.linalg.norm(self.points[j] - xs, axis=1)
             term = flat_top(d / self.reach) / (self.radius[j] + SLOPE * d)
             acc += term ** P
         return acc ** (1.0 / P)
 
-    def bound(self, x):
+    def _boxes(self, boxes):
+        """:meth:`bound` of the boxes ``boxes`` (flat indices, ascending)."""
+        out = np.empty(len(boxes))
+        for a in range(0, len(boxes), BOX_BLOCK):
+            lo = self.origin + np.stack(np.unravel_index(boxes[a:a + BOX_BLOCK], self.shape),
+                                        axis=1) * self.box
+            near = self._near(lo.min(axis=0), lo.max(axis=0) + self.box)
+            step = max(1, PAIRS // max(len(near), 1))
+            for c in range(0, len(lo), step):
+                low = lo[c:c + step, None, :]
+                pts = self.points[near]
+                gap = np.maximum(np.maximum(low - pts, pts - (low + self.box)), 0.0)
+                # less a millionth of the box: a point rounded onto its face is inside it
+                d = np.maximum(np.linalg.norm(gap, axis=2) - 1e-6 * self.box, 0.0)
+                term = np.where(d < self.reach, 1.0 / (self.radius[near] + SLOPE * d), 0.0)
+                out[a + c:a + c + len(low)] = np.sum(term ** P, axis=1) ** (1.0 / P)
+        return out
+
+    def bound(self, x, keys=False):
         """An upper bound of ``kappa`` at points ``x`` (M, 3): per box of side
         :attr:`box` holding a point, every sample within the reach of the box taken at
         the box's nearest point (a term is at most ``1 / (SHARE R_j + SLOPE d)`` and falls
         with ``d``); 0 beyond the reach of every sample. The boxes' bounds are kept for
-        the next call."""
+        the next call. With ``keys``, also each point's box (-1 beyond the boxes)."""
         key = np.floor((x - self.origin) / self.box).astype(np.int64)
         inside = np.all((key >= 0) & (key < self.shape), axis=1)
-        out = np.zeros(len(x))
-        if not inside.any():
-            return out
-        flat = np.ravel_multi_index(tuple(key[inside].T), self.shape)
-        boxes, which = np.unique(flat, return_inverse=True)
-        with self.lock:
-            known, values = self.known, self.values
-        pos = np.minimum(np.searchsorted(known, boxes), max(len(known) - 1, 0))
-        found = known[pos] == boxes if len(known) else np.zeros(len(boxes), dtype=bool)
-        value = np.where(found, values[pos] if len(known) else 0.0, 0.0)
-        new = np.flatnonzero(~found)
-        for a in range(0, len(new), BOX_BLOCK):
-            part = new[a:a + BOX_BLOCK]
-            lo = self.origin + np.stack(np.unravel_index(boxes[part], self.shape),
-                                        axis=1)[:, None, :] * self.box
-            gap = np.maximum(np.maximum(lo - self.points, self.points - (lo + self.box)), 0.0)
-            # less a millionth of the box: a point rounded onto the box's face is inside it
-            d = np.maximum(np.linalg.norm(gap, axis=2) - 1e-6 * self.box, 0.0)
-            term = np.where(d < self.reach, 1.0 / (self.radius + SLOPE * d), 0.0)
-            value[part] = np.sum(term ** P, axis=1) ** (1.0 / P)
-        if len(new):
+        out, flat_all = np.zeros(len(x)), np.full(len(x), -1, dtype=np.int64)
+        if inside.any():
+            flat = np.ravel_multi_index(tuple(key[inside].T), self.shape)
+            flat_all[inside] = flat
+            boxes, which = np.unique(flat, return_inverse=True)
             with self.lock:
-                keys = np.concatenate([self.known, boxes[new]])
-                order = np.argsort(keys, kind="stable")
-                keys, vals = keys[order], np.concatenate([self.values, value[new]])[order]
-                first = np.r_[True, keys[1:] != keys[:-1]]
-                self.known, self.values = keys[first], vals[first]
-        out[inside] = value[which.reshape(-1)]
-        return out
+                known, values = self.known, self.values
+            if len(known):
+                pos = np.minimum(np.searchsorted(known, boxes), len(known) - 1)
+                found = known[pos] == boxes
+                value = np.where(found, values[pos], 0.0)
+            else:
+                found, value = np.zeros(len(boxes), dtype=bool), np.zeros(len(boxes))
+            new = np.flatnonzero(~found)
+            if len(new):
+                value[new] = self._boxes(boxes[new])
+                with self.lock:
+                    keys_ = np.concatenate([self.known, boxes[new]])
+                    order = np.argsort(keys_, kind="stable")
+                    keys_ = keys_[order]
+                    vals = np.concatenate([self.values, value[new]])[order]
+                    first = np.r_[True, keys_[1:] != keys_[:-1]]
+                    self.known, self.values = keys_[first], vals[first]
+            out[inside] = value[which.reshape(-1)]
+        return (out, flat_all) if keys else out
 
     def cap(self, delta, x):
         """``delta`` at points ``x`` soft-capped by ``1 / kappa(x)`` (:func:`soft_cap`),
-        ``kappa`` taken only where :meth:`bound` lets ``|delta| kappa`` pass the knee."""
+        ``kappa`` taken only where :meth:`bound` lets ``|delta| kappa`` pass the knee (in
+        the order of their boxes, so that a block of them lies together)."""
         out = np.array(delta, dtype=float)
         if self.empty or not len(out):
             return out
+        bound, box = self.bound(x, keys=True)
         # a margin of a millionth covers the rounding of the bound and of kappa
-        k = np.flatnonzero(np.abs(out) * self.bound(x) > KNEE * (1.0 - 1e-6))
+        k = np.flatnonzero(np.abs(out) * bound > KNEE * (1.0 - 1e-6))
         if len(k):
+            k = k[np.argsort(box[k], kind="stable")]
             out[k] = soft_cap(out[k], self(x[k]))
         return out
 
