@@ -137,6 +137,10 @@ class _Limit:
             extent = points.max(axis=0) + self.reach - self.origin
             self.box = max(self.reach / BOXES_PER_REACH, float(np.max(extent)) * 1e-6)
             self.shape = tuple(int(n) for n in np.ceil(extent / self.box) + 1)
+            # a point rounded into the next box lies within this of its own (a millionth of
+            # the box, and a million times the rounding of the coordinates)
+            self.slack = 1e-6 * self.box + 1e-12 * float(np.max(np.abs(self.origin))
+                                                         + np.max(extent))
         self.tree = cKDTree(points) if not self.empty else None
         self.known, self.values = np.zeros(0, dtype=np.int64), np.zeros(0)
         self.lock = threading.Lock()
@@ -181,8 +185,8 @@ class _Limit:
                 low = lo[c:c + step, None, :]
                 pts = self.points[near]
                 gap = np.maximum(np.maximum(low - pts, pts - (low + self.box)), 0.0)
-                # less a millionth of the box: a point rounded onto its face is inside it
-                d = np.maximum(np.linalg.norm(gap, axis=2) - 1e-6 * self.box, 0.0)
+                # less the slack: a point rounded into the box next to its own is inside it
+                d = np.maximum(np.linalg.norm(gap, axis=2) - self.slack, 0.0)
                 term = np.where(d < self.reach, 1.0 / (self.radius[near] + SLOPE * d), 0.0)
                 out[a + c:a + c + len(low)] = np.sum(term ** P, axis=1) ** (1.0 / P)
         return out
