@@ -119,9 +119,15 @@ class ProgramOffset:
                     if pending is not None:      # what the block before raises first
                         write(self.write(pending[0].result(), *pending[1]))
                     raise
-                if pending is not None:
-                    write(self.write(pending[0].result(), *pending[1]))
-                pending = (submit(got[0]), got)
+                if pending is None:
+                    pending = (submit(got[0]), got)
+                    continue
+                # this block's plan starts before the block before is written (the
+                # planning needs nothing the writing changes): the planner is not idle
+                # while the text is written
+                op = pending[0].result()
+                done, pending = pending, (submit(got[0]), got)
+                write(self.write(op, *done[1]))
             if pending is not None:
                 write(self.write(pending[0].result(), *pending[1]))
 
