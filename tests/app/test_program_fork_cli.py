@@ -80,23 +80,30 @@ def test_the_forked_planner_writes_the_same_bytes(tmp_path):
     assert outs["1"] == outs["2"] and outs["1"] != program.read_bytes()
 
 
+@pytest.mark.parametrize("group", [False, True], ids=["command", "group"])
 @pytest.mark.parametrize("signame, code", [("SIGINT", 130), ("SIGTERM", 143),
                                             ("SIGHUP", 129)])
-def test_a_signal_while_the_child_plans_leaves_nothing(tmp_path, signame, code):
+def test_a_signal_while_the_child_plans_leaves_nothing(tmp_path, signame, code, group):
+    """The signal to the command alone, or to its process group (a terminal's Ctrl-C, a
+    session's hang-up): the child too gets it and must not die of it before the parent
+    has unwound (the exit code would be the child's death, 1)."""
     program = tmp_path / "raster.ngc"
     raster(program, 20)
     out = tmp_path / "out" / "moved.ngc"
     out.parent.mkdir()
     proc = subprocess.Popen(_cmd(program, out), cwd=ROOT, stderr=subprocess.PIPE, text=True,
                             env=_env(SURFCOMP_THREADS="2", HOLD_PLAN="1"),
-                            preexec_fn=default_signals)
+                            preexec_fn=default_signals, start_new_session=group)
     seen = []
     child = None
     for line in proc.stderr:
         seen.append(line)
         if line.startswith("HELD "):
             child = int(line.split()[1])
-            proc.send_signal(getattr(signal, signame))      # the parent alone
+            if group:
+                os.killpg(proc.pid, getattr(signal, signame))
+            else:
+                proc.send_signal(getattr(signal, signame))
             break
     rest = proc.stderr.read()
     assert proc.wait(timeout=300) == code, "".join(seen) + rest

@@ -245,11 +245,12 @@ class _Planner:
     blocks are planned in order, one at a time, so what the planning carries from one
     block to the next (the last displacement, the piece count) stays in the child.
 
-    The child ignores Ctrl-C (the parent has it too and ends the child) and dies of
-    SIGTERM and SIGHUP; it never returns into the caller's code (``os._exit``: no staged
-    file is removed or written by it, no buffer flushed twice). Leaving the ``with``
-    block ends the child: at once (SIGKILL) when an exception leaves it, else once it has
-    read the end of its pipe; it is always waited for."""
+    The child ignores Ctrl-C, SIGTERM and SIGHUP (sent to the process group, they reach
+    the parent, which ends the child) and ends by itself at the end of its pipe (the
+    parent gone, even by SIGKILL); it never returns into the caller's code (``os._exit``:
+    no staged file is removed or written by it, no buffer flushed twice). Leaving the
+    ``with`` block ends the child: at once (SIGKILL) when an exception leaves it, else
+    once it has read the end of its pipe; it is always waited for."""
 
     def __init__(self, worker):
         child_in, to_child = os.pipe()
@@ -336,11 +337,13 @@ def _serve(worker, child_in, child_out):
     """The planning child's loop (:class:`_Planner`)."""
     import gc
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    for name in ("SIGTERM", "SIGHUP"):
+    # Ctrl-C, SIGTERM and SIGHUP sent to the process group reach the parent too, which
+    # unwinds and ends the child; a child dying of them first would make the parent report
+    # its death instead of the interruption (the exit code 1, not 130/143/129)
+    for name in ("SIGINT", "SIGTERM", "SIGHUP"):
         sig = getattr(signal, name, None)
         if sig is not None:
-            signal.signal(sig, signal.SIG_DFL)
+            signal.signal(sig, signal.SIG_IGN)
     gc.freeze()         # the collector leaves the parent's objects (and their pages) alone
     with os.fdopen(child_in, "rb") as inp, os.fdopen(child_out, "wb") as out:
         while True:
