@@ -19,6 +19,7 @@ the process and of the children it waited for, such as the STEP reader):
   once), alternating the sizes; prints the times and t(largest) / t(smallest). Targets:
   1M moves within 10 s, t(1M) / t(250k) at most 4.5.
 
+The load averages at the start and the end of each row's runs are printed with it.
 Each command runs once before the timed runs (Python's compiled modules written and
 reused, as in an installation). ``--tree DIR`` runs another checkout's command in the same
 alternation (e.g. the code before a change). Absolute seconds depend on the machine and on
@@ -151,6 +152,11 @@ def _roots(tree):
     return dict([("", ROOT)] + ([(" (%s)" % tree, os.path.abspath(tree))] if tree else []))
 
 
+def load():
+    """The load averages (1, 5, 15 minutes), for the figures' record."""
+    return "load average %.2f, %.2f, %.2f" % os.getloadavg()
+
+
 def bench_finish(keep, tmp, pairs, tree=None):
     program = finish_program(keep)
     out = os.path.join(tmp, "out.ngc")
@@ -161,11 +167,13 @@ def bench_finish(keep, tmp, pairs, tree=None):
     for _name, cmd, root in cases:          # warm-up: compiled modules, page cache
         timed(cmd, root)
     rows = {name: [] for name, _c, _r in cases}
+    print("finish: %s at the start" % load(), flush=True)
     for k in range(pairs):
         for name, cmd, root in cases:
             rows[name].append(timed(cmd, root))
             print("  pair %d %-6s wall %6.2f s  cpu %6.2f s" % ((k + 1, name)
                                                                + rows[name][-1]), flush=True)
+    print("finish: %s at the end" % load())
     med = {n: [statistics.median(v[i] for v in rows[n]) for i in (0, 1)] for n in rows}
     for name, _c, _r in cases[1:]:
         print("finish: floor (read + write the STEP) wall %.2f s cpu %.2f s; %s wall %.2f s "
@@ -181,12 +189,14 @@ def bench_large(keep, tmp, sizes, pairs, tree=None):
     for root in roots.values():             # warm-up: compiled modules
         timed(direct(programs[min(sizes)], out), root)
     rows = {(n, label): [] for n in sizes for label in roots}
+    print("large: %s at the start" % load(), flush=True)
     for k in range(pairs):
         for n in sizes:
             for label, root in roots.items():
                 rows[n, label].append(timed(direct(programs[n], out), root))
                 print("  pair %d %8d moves%s wall %6.2f s  cpu %6.2f s"
                       % ((k + 1, n, label) + rows[n, label][-1]), flush=True)
+    print("large: %s at the end" % load())
     med = {key: [statistics.median(v[i] for v in rows[key]) for i in (0, 1)] for key in rows}
     lo, hi = min(sizes), max(sizes)
     for label in roots:

@@ -19,7 +19,7 @@ from ..core.compensation.program_offset import parse_tool
 from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
-from ..io.gcode.offset_stream import offset_stream
+from ..io.gcode.offset_stream import FORK_LINES, offset_stream
 from ..io.readers import read_any
 from . import fcenv
 from .program_geometry import offset_of
@@ -77,7 +77,8 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
                 done.append(offset_stream(
                     program, lambda text: fh.write(text.encode("latin-1")), offset,
                     tolerance=pj.tolerance, segment_length=pj.segment_length,
-                    decimals=pj.decimals, source=pj.program, max_memory=max_memory))
+                    decimals=pj.decimals, source=pj.program, max_memory=max_memory,
+                    fork=lines >= FORK_LINES))
 
         tr.write(pj.output, put)
         tr.commit()
