@@ -18,9 +18,14 @@ from tests.conftest import ROOT
 SHOP = os.path.join(ROOT, "tests", "data", "documents", "shop-0.20.FCStd")
 #: finer than the committed document's operation (142 commands), a few seconds to compute
 STEP_OVER = 40.0
+#: finer still for the cancel (step over %, sample interval mm): the child must still be
+#: computing the operation when the test cancels it, on a fast machine too (at 40 % and
+#: 3 mm one finished within a second; at 2 % and 0.2 mm it takes many); it is killed then,
+#: so the finer operation costs the test nothing
+CANCEL_FINE = (2.0, 0.2)
 
 
-def restored_shop(folder, name):
+def restored_shop(folder, name, step_over=STEP_OVER, sample=None):
     """A copy of the shop document with a finer Surface operation, after Restore (the model
     clone uses the block again): the operation and its dressup need a recompute."""
     cam.setup_workbench()
@@ -30,7 +35,9 @@ def restored_shop(folder, name):
     # FreeCAD 1.x opens the 0.20 document with its objects touched (their properties were
     # brought up to date): recompute them first, with the committed coarse operation
     progress.recompute_with_progress(doc, "open")
-    doc.getObject("Surface").StepOver = STEP_OVER
+    doc.getObject("Surface").StepOver = step_over
+    if sample is not None:
+        doc.getObject("Surface").SampleInterval = sample
     replace.restore(doc, doc.getObject("Round2"))
     return doc
 
@@ -147,14 +154,18 @@ def test_child_gives_the_in_process_result(both):
 def test_cancel_stops_the_child_and_changes_nothing(tmp_path):
     import FreeCAD
 
-    doc = restored_shop(tmp_path, "cancel")
+    doc = restored_shop(tmp_path, "cancel", *CANCEL_FINE)
     op = doc.getObject("Surface")
     calls = count_executions(op)
     before = commands(op)
     job = recompute.ChildRecompute(doc).start()
     tmp = job.tmp
-    time.sleep(1.0)
-    assert job.poll()
+    # cancelled while the child computes the operation (its status names it)
+    deadline = time.monotonic() + 60
+    while job.poll() and job.status()[2] != op.Label and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.2)
+    assert job.poll() and job.status()[2] == op.Label
     t0 = time.perf_counter()
     job.cancel()
     assert time.perf_counter() - t0 < 1.0

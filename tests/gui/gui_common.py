@@ -251,12 +251,29 @@ def click_tree(label, modifiers=None):
     """A real left click on the tree item ``label`` (its document expanded first); the
     selected objects' names after it."""
     t = tree()
-    t.expandAll()
-    Gui.updateGui()
-    item = t.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive, 0)[0]
+    # FreeCAD's tree adds a new object's item, and lays the items out, on timers of its own:
+    # the item is waited for, and its place until it stays put (up to 5 s each), so that a
+    # loaded machine's late layout does not move the item from under the click
+    item = None
+    for _ in range(50):
+        t.expandAll()
+        Gui.updateGui()
+        items = t.findItems(label, QtCore.Qt.MatchExactly | QtCore.Qt.MatchRecursive, 0)
+        if items:
+            item = items[0]
+            break
+        time.sleep(0.1)
+    if item is None:
+        raise AssertionError("no tree item labelled %r" % label)
     t.scrollToItem(item)
-    Gui.updateGui()
-    r = t.visualItemRect(item)
+    r = None
+    for _ in range(50):
+        Gui.updateGui()
+        here = t.visualItemRect(item)
+        if here == r:
+            break
+        r = here
+        time.sleep(0.05)
     click(t.viewport(), QtCore.QPointF(r.left() + min(40, r.width() / 2.0), r.center().y()),
           modifiers)
     wait_for_actions()

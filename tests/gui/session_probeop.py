@@ -74,6 +74,12 @@ def tree_parents(label):
 
 # the Job's first operation (made headless, the document's Job draws its Operations folder
 # where 0.20 puts it without the Job's view provider): the new one sits beside it
+# (FreeCAD's tree adds a new object's item on a timer of its own: waited for, up to 5 s)
+for _ in range(50):
+    Gui.updateGui()
+    if tree_parents(op.Label):
+        break
+    time.sleep(0.1)
 RESULTS["tree"] = [tree_parents(op.Label), tree_parents(job.Operations.Group[0].Label),
                    job.Operations.Label]
 text = probe_op.post_probe_job(job, "linuxcnc", "--no-show-editor --no-header")
