@@ -25,6 +25,8 @@ import subprocess
 import sys
 import time
 
+from ..io import forks
+
 #: a crash ends a reader child with its signal (FreeCAD's own SIGSEGV handler exits with
 #: code 1 and no message, which the parent could not tell from a reader error)
 FATAL_SIGNALS = ("SIGSEGV", "SIGBUS", "SIGFPE", "SIGILL", "SIGABRT")
@@ -41,14 +43,6 @@ def default_signals(names=DEFAULT_SIGNALS):
             signal.signal(sig, signal.SIG_DFL)
 
 
-def _threads():
-    """The number of threads of this process (Linux), or None when it cannot be told."""
-    try:
-        return len(os.listdir("/proc/self/task"))
-    except OSError:
-        return None
-
-
 def usable():
     """Whether the reader may be a fork of this process; imports FreeCAD and Part first
     (False when they cannot be imported: the fresh ``python3`` then says why)."""
@@ -61,7 +55,7 @@ def usable():
         import Part  # noqa: F401  (imported before the fork, so the child need not)
     except ImportError:
         return False
-    return _threads() == 1
+    return forks.threads() == 1
 
 
 class Forked:
@@ -71,11 +65,7 @@ class Forked:
 
     def __init__(self, work, cwd):
         read_end, write_end = os.pipe()
-        for stream in (sys.stdout, sys.stderr):     # nothing buffered is written twice
-            try:
-                stream.flush()
-            except (AttributeError, OSError, ValueError):
-                pass
+        forks.flush_streams()
         pid = os.fork()
         if pid == 0:                                # the child: never returns
             os.close(read_end)

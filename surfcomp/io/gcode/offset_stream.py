@@ -25,7 +25,6 @@ Python's interpreter lock (a million moves: about 2.7 s of planning beside 2 s o
 import os
 import pickle
 import signal
-import sys
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import replace
@@ -37,6 +36,7 @@ from ...core.compensation.program_limit import PieceCount
 from ...core.compensation.program_offset import CONTACT_TOL, fit_contact, plan_offset
 from ...core.limits import MAX_SEGMENTS
 from ...errors import ComputationError, GCodeError
+from .. import forks
 from .commands import _CommandWriter, command_words
 from .emitter import DEFAULT_DECIMALS, _TextWriter
 from .interpreter import _Interpreter, interpret
@@ -70,9 +70,9 @@ class ProgramOffset:
         block's pieces may take (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
     fork : bool
         Plan in a fork of this process (:class:`_Planner`) rather than on a second thread
-        when :meth:`run` may use two and :func:`forkable` allows it; for a caller that owns
-        the process (the command line), not one whose other threads or GUI a fork would
-        copy half of.
+        when :meth:`run` may use two and :func:`surfcomp.io.forks.may_fork` allows it;
+        for a caller that owns the process (the command line), not one whose other
+        threads or GUI a fork would copy half of.
     """
 
     def __init__(self, offset, tolerance=5e-4, segment_length=2.0, decimals=None, source=None,
@@ -142,7 +142,7 @@ class ProgramOffset:
         """``(submit, ahead)``: ``submit(prog)``, whose ``result()`` is :meth:`plan` of
         ``prog``, in a fork of this process (:class:`_Planner`; ``ahead`` True: a block
         is submitted before the one before is written) or on a second thread."""
-        if self.fork and forkable():
+        if self.fork and forks.may_fork():
             with _Planner(self) as planner:
                 yield planner.submit, True
             return
@@ -223,18 +223,6 @@ class ProgramOffset:
                 "points_displaced": self.checked, "largest_move_mm": self.largest}
 
 
-def forkable():
-    """Whether a fork of this process may plan: ``os.fork`` exists, the process has one
-    thread (a fork copies only the calling thread: a lock another one held would never be
-    released in the child) and the FreeCAD GUI is not loaded."""
-    if not hasattr(os, "fork") or "FreeCADGui" in sys.modules:
-        return False
-    try:
-        return len(os.listdir("/proc/self/task")) == 1
-    except OSError:
-        return False
-
-
 class _Planner:
     """:meth:`ProgramOffset.plan` of the blocks submitted, in a fork of this process.
 
@@ -255,11 +243,7 @@ class _Planner:
     def __init__(self, worker):
         child_in, to_child = os.pipe()
         from_child, child_out = os.pipe()
-        for stream in (sys.stdout, sys.stderr):     # nothing buffered is written twice
-            try:
-                stream.flush()
-            except (AttributeError, OSError, ValueError):
-                pass
+        forks.flush_streams()
         pid = os.fork()
         if pid == 0:                                # the child: never returns
             code = 1
