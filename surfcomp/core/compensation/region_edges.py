@@ -222,6 +222,29 @@ class SharpEdges:
         mk = _catmull_rom(mit, ks, tt)
         return k, d, mk[:, :9], mk[:, 9]
 
+    def feet(self, x, reach):
+        """The nearest point of the edge polylines to each of ``x`` (M, 3) and its
+        distance, for the points within ``reach`` (mm) of an edge sample's neighbourhood
+        (beyond: nan and inf)."""
+        x = np.asarray(x, dtype=float)
+        dist = np.full(len(x), np.inf)
+        foot = np.full((len(x), 3), np.nan)
+        for idx, tree in zip(self._edges, self._trees):
+            pts, last = self.points[idx], len(idx) - 1
+            _, j = tree.query(x, k=1, distance_upper_bound=reach + self._reach)
+            k = np.flatnonzero(j <= last)
+            j = j[k]
+            for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
+                a, ab = pts[k0], pts[k1] - pts[k0]
+                t = np.clip(np.einsum("ij,ij->i", x[k] - a, ab)
+                            / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+                p = a + t[:, None] * ab
+                d = np.linalg.norm(x[k] - p, axis=1)
+                better = d < dist[k]
+                dist[k[better]] = d[better]
+                foot[k[better]] = p[better]
+        return foot, dist
+
     def nearest(self, x):
         """Distance to the nearest edge, and the blended miter, exactness and excess (the
         turn along the face: :meth:`for_face`) at ``x``. The distance is exact within the
