@@ -336,8 +336,9 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
              for i, (f, k) in enumerate(zip(rp.blade_outward(faces), (2500, 2500, 200, 300)))]
     # and 8 points on each side 1 and 5 um from the trailing edge, where the 30 um
-    # correction slides that edge 11 to 22 um into each side (its normals 50 to 72 deg
-    # apart): no corrected face lies on their normal lines
+    # correction slides that edge 11.5 to 22 um into each side (delta tan(half the normals'
+    # angle) for a planar wedge: about 43 to 71 deg): no corrected face lies on their
+    # normal lines
     outward = rp.blade_outward(faces)
     beside = [rp.beside_edge(f, (0.22, 0.25, 0.28, 0.31), (1e-3, 5e-3)) for f in outward[:2]]
     parts += [(p, n, field(p)) for p, n in beside]
@@ -383,8 +384,10 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within
     # the points beside the trailing edge are counted apart (region_slide.py): the check
-    # reads the curl's sagitta over the rest of the slide there (measured 0.12 to 0.88 um,
-    # the points 0.3 to 6 um from the edge's sample polyline against slides of 14 to 26 um)
+    # reads the curl's sagitta over the rest of the slide there (measured 0.07 to 0.52 um
+    # on the suction side, 0.08 to 0.63 um on the pressure side, the points 0.3 to 5.8 um
+    # from the edge's sample polyline against slides of 11.5 to 21.9 um; counted beyond
+    # the zones before)
     assert "points nearer to a sharp edge than the edge slides along the face" in r.stdout
     for name in ("Face1", "Face2"):
         f = faces_rep[name]
