@@ -165,11 +165,16 @@ def main(argv=None):
         print("%s: poles %d x %d (nominal %d x %d), realised - intended %.4f um; %d points "
               "near knife edges and vertices (short by up to %.4f um by design), %d points "
               "where it curls tighter than the correction (short by up to %.4f um by "
-              "design), beyond them %s; largest turn of the normal %.1f deg"
+              "design), %d points its moved edge slides past (realised - intended up to "
+              "%.4f um, up to %.4f um from the edge, slide up to %.4f um), beyond them %s; "
+              "largest turn of the normal %.1f deg"
               % (fc["face"], *fc["poles"], *fc["nominal_poles"],
                  fc["max_realised_minus_intended_um"], fc.get("edge_zone_points", 0),
                  fc.get("edge_zone_max_designed_shortfall_um", 0.0), fc.get("curl_points", 0),
-                 fc.get("curl_max_shortfall_um", 0.0),
+                 fc.get("curl_max_shortfall_um", 0.0), fc.get("edge_slide_points", 0),
+                 fc.get("edge_slide_max_realised_minus_intended_um", 0.0),
+                 fc.get("edge_slide_max_distance_um", 0.0),
+                 fc.get("edge_slide_max_slide_um", 0.0),
                  "-" if beyond is None else "%.4f um" % beyond,
                  fc.get("normal_turn", {}).get("largest_normal_turn_deg", float("nan"))))
     return 0

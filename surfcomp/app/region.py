@@ -406,14 +406,15 @@ def sharp_edges(faces, edges, band, field=None):
     (:func:`~surfcomp.core.compensation.region_edges.at_vertices`); with ``field`` (the
     correction), each edge's second-order vector
     (:mod:`~surfcomp.core.compensation.region_second`), nil at vertices."""
-    pts, mit, cl, eid, nrm, ids = [], [], [], [], [], []
+    pts, mit, cl, eid, nrm, ids, inw = [], [], [], [], [], [], []
     for k, e in enumerate(edges):
         if e.nominal_angle <= G1_ANGLE:
             continue
         fa, fb = faces[e.a], faces[e.b]
         na, nb = normals_at(fa, e.samples)[0], normals_at(fb, e.samples)[0]
-        m, c = region_build.miters(na, nb, _inward(fa, e.edge_a, e.samples, na),
-                                   _inward(fb, e.edge_b, e.samples, nb))
+        ia, ib = _inward(fa, e.edge_a, e.samples, na), _inward(fb, e.edge_b, e.samples, nb)
+        m, c = region_build.miters(na, nb, ia, ib)
+        inw.append(np.stack([ia, ib], axis=1))
         pts.append(e.samples)
         mit.append(m)
         cl.append(c)
@@ -429,7 +430,7 @@ def sharp_edges(faces, edges, band, field=None):
         away=True)
     exact = region_edges.eased(exact, eid, pts, EASE_SHARE * band)
     ids = np.concatenate(ids)
-    out = region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, ids)
+    out = region_edges.SharpEdges(pts, mit, exact, eid, band, nrm, ids, np.concatenate(inw))
     if field is not None:
         out.second = away[:, None] * _second(faces, edges, pts, mit, eid, nrm, field)
     return out

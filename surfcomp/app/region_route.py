@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from ..core.compensation import curl_cap, region_build, region_field
+from ..core.compensation import curl_cap, region_build, region_field, region_slide
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..core.compensation.folds import find_fold, fold_warning
 from ..core.surface.trimmed import inside
@@ -258,7 +258,10 @@ def _build(faces, fld, sharp, field_radius, max_factor):
 def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
     """Per face: the largest |realised - intended| at its points (um), and the same beyond
     the zones where a knife edge or a vertex is moved by one vector (there the design
-    itself falls short of the correction: those points' count and largest shortfall)."""
+    itself falls short of the correction: those points' count and largest shortfall), the
+    curl cap's points and the points the face's moved edge slides past
+    (:mod:`surfcomp.core.compensation.region_slide`: no corrected face lies on their
+    normal line; their count, largest realised - intended and slide against distance)."""
     def one(i):
         k = np.flatnonzero(owner == i)
         if not len(k):
@@ -272,13 +275,23 @@ def _fidelity(faces, owner, u, v, fld, base, normal, sharp):
         share = region_build.designed_share(base[k], normal[k], sharp)
         zone = np.abs(share - 1.0) > 1e-9
         rest = ~zone & ~curl
+        slide, dist = region_slide.edge_slide(base[k][rest], normal[k][rest], intended[rest],
+                                              sharp and sharp.for_face(i))
+        passed = np.zeros(len(k), dtype=bool)
+        passed[np.flatnonzero(rest)[slide > dist]] = True
+        rest &= ~passed
+        near = slide > dist
         return {"all": float(np.max(miss)),
                 "beyond": float(np.max(miss[rest])) if np.any(rest) else None,
                 "zone_points": int(np.sum(zone)),
                 "zone_shortfall": float(np.max(np.abs(intended * (1 - share))[zone]))
                 * 1e3 if np.any(zone) else 0.0,
                 "curl_points": int(np.sum(curl)),
-                "curl_shortfall": float(np.max(short[curl])) * 1e3 if np.any(curl) else 0.0}
+                "curl_shortfall": float(np.max(short[curl])) * 1e3 if np.any(curl) else 0.0,
+                "slide_points": int(np.sum(passed)),
+                "slide_miss": float(np.max(miss[passed])) if np.any(passed) else 0.0,
+                "slide_distance": float(np.max(dist[near])) * 1e3 if np.any(near) else 0.0,
+                "slide_slide": float(np.max(slide[near])) * 1e3 if np.any(near) else 0.0}
 
     return {f.name: fid for f, fid in zip(faces, per_face(faces, one)) if fid is not None}
 
@@ -349,19 +362,23 @@ def _fidelity_keys(fid):
             "edge_zone_points": fid["zone_points"],
             "edge_zone_max_designed_shortfall_um": fid["zone_shortfall"],
             "curl_points": fid["curl_points"],
-            "curl_max_shortfall_um": fid["curl_shortfall"]}
+            "curl_max_shortfall_um": fid["curl_shortfall"],
+            "edge_slide_points": fid["slide_points"],
+            "edge_slide_max_realised_minus_intended_um": fid["slide_miss"],
+            "edge_slide_max_distance_um": fid["slide_distance"],
+            "edge_slide_max_slide_um": fid["slide_slide"]}
 
 
 def summary(rep):
     """The printed lines: per face, per edge, the volume."""
     lines = []
     for f in rep["faces"]:
+        beyond = f.get("max_realised_minus_intended_beyond_edge_zones_um")
         lines.append("%s: %d points, coverage %.0f %%, poles %d x %d (nominal %d x %d), "
                      "realised - intended at the points %.4f um"
                      % (f["face"], f["points"], 100 * f["coverage"], *f["poles"],
                         *f["nominal_poles"], f["max_realised_minus_intended_um"]))
         if f.get("edge_zone_points"):
-            beyond = f["max_realised_minus_intended_beyond_edge_zones_um"]
             lines.append("  %s: %d points near knife edges or vertices, where the edge moves "
                          "by one vector and the correction is short by up to %.4f um by "
                          "design; beyond them realised - intended %s"
@@ -374,6 +391,16 @@ def summary(rep):
                          "curvature): short by up to %.4f um by design"
                          % (f["face"], f["curl_points"], curl_cap.SHARE,
                             f["curl_max_shortfall_um"]))
+        if f.get("edge_slide_points"):
+            lines.append("  %s: %d points nearer to a sharp edge than the edge slides along "
+                         "the face (up to %.4f um from it, the slide up to %.4f um): no "
+                         "corrected face on their normal line, the corner cut back by "
+                         "design; realised - intended there up to %.4f um, beyond them and "
+                         "the zones %s"
+                         % (f["face"], f["edge_slide_points"], f["edge_slide_max_distance_um"],
+                            f["edge_slide_max_slide_um"],
+                            f["edge_slide_max_realised_minus_intended_um"],
+                            "-" if beyond is None else "%.4f um" % beyond))
         lines.extend("warning: " + text for text in f.get("warnings", ()))
     for e in rep["edges"]:
         lines.append("edge %s-%s (%s): largest gap %.4f um (nominal %.4f um, %.4f um more "

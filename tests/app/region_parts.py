@@ -218,3 +218,17 @@ def around_edge_field(edge_points, amplitude=0.03, width=12.0):
         return amplitude * np.exp(-(d / width) ** 2)
 
     return field
+
+
+def beside_edge(face, vs, dists):
+    """Points of ``face`` at ``dists`` (mm, along the face) from its edge u = u1 (the
+    BladeX sides' trailing edge) at parameters ``vs``, and their normals."""
+    _u0, u1, _v0, _v1 = face.ParameterRange
+    pts, nrm = [], []
+    for v in vs:
+        su = np.linalg.norm(np.array(face.Surface.getDN(u1, v, 1, 0)))
+        for d in dists:
+            u = u1 - d / su
+            pts.append(tuple(face.Surface.value(u, v)))
+            nrm.append(tuple(face.normalAt(u, v)))
+    return np.array(pts), np.array(nrm)

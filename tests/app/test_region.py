@@ -329,11 +329,19 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
     where the design shortens the correction, the root cap meets it within 0.02 um; the
     sides missed by up to 0.45 um next to the trailing edge, which curls with a 0.1 mm radius
     (see docs/regions.md); with the slide's second-order term and 8 times the nominal's
-    poles, within 0.1 um."""
+    poles, within 0.1 um. Points nearer to the trailing edge than the edge slides along
+    the face are counted apart (before they were beyond the zones, up to 0.88 um here)."""
     tmp, brep, faces = blade
     field = rp.around_edge_field(rp.leading_edge(faces))
     parts = [rp.sample_faces([f], k, field, seed=10 + i)
              for i, (f, k) in enumerate(zip(rp.blade_outward(faces), (2500, 2500, 200, 300)))]
+    # and 8 points on each side 1 and 5 um from the trailing edge, where the 30 um
+    # correction slides that edge 11.5 to 22 um into each side (delta tan(half the normals'
+    # angle) for a planar wedge: about 43 to 71 deg): no corrected face lies on their
+    # normal lines
+    outward = rp.blade_outward(faces)
+    beside = [rp.beside_edge(f, (0.22, 0.25, 0.28, 0.31), (1e-3, 5e-3)) for f in outward[:2]]
+    parts += [(p, n, field(p)) for p, n in beside]
     pts, nrm, dev = (np.concatenate([p[j] for p in parts]) for j in range(3))
     csv = str(tmp / "knife.csv")
     rp.write_csv(csv, pts, nrm, dev)
@@ -375,6 +383,19 @@ def test_blade_knife_edges_and_vertices_move_as_one(blade):
         f = faces_rep[name]
         assert f["edge_zone_points"] > 0
         assert f["max_realised_minus_intended_beyond_edge_zones_um"] <= within
+    # the points beside the trailing edge are counted apart (region_slide.py): the check
+    # reads the curl's sagitta over the rest of the slide there (measured 0.07 to 0.52 um
+    # on the suction side, 0.08 to 0.63 um on the pressure side, the points 0.3 to 5.8 um
+    # from the edge's sample polyline against slides of 11.5 to 21.9 um; counted beyond
+    # the zones before)
+    assert "points nearer to a sharp edge than the edge slides along the face" in r.stdout
+    for name in ("Face1", "Face2"):
+        f = faces_rep[name]
+        assert f["edge_slide_points"] >= 8, f
+        assert f["edge_slide_max_realised_minus_intended_um"] > 0.1
+        assert f["edge_slide_max_distance_um"] < 8.0
+        assert 20.0 < f["edge_slide_max_slide_um"] < 30.0
+    assert faces_rep["Face3"]["edge_slide_points"] == 0
     # the 30 um inward correction exceeds the pressure side's trailing-edge curl near the
     # tip (12 to 48 um in radius at 86 to 94 % of the span): uncapped, the corrected face
     # looped over itself there (its normal turned by 179.5 deg near u 0.998, v 0.924). The

@@ -151,9 +151,14 @@ class SharpEdges:
         The two faces' outward normals at each sample and the faces' indices: with them,
         :meth:`for_face` gives the edges as one face sees them (the turn taken relative to
         that face's own normal at the edge).
+    inward : ndarray, shape (K, 2, 3), optional
+        The two faces' unit directions into the face, normal to the edge, at each sample:
+        :meth:`for_face` gives the face's own as ``own_inward`` (nan along the edges of
+        other faces).
     """
 
-    def __init__(self, points, miter, exact, edge, band, normals=None, faces=None):
+    def __init__(self, points, miter, exact, edge, band, normals=None, faces=None,
+                 inward=None):
         self.points = np.asarray(points, dtype=float)
         self.miter = np.asarray(miter, dtype=float)
         exact = np.asarray(exact)
@@ -162,6 +167,8 @@ class SharpEdges:
         self.band = float(band)
         self.normals = None if normals is None else np.asarray(normals, dtype=float)
         self.faces = None if faces is None else np.asarray(faces)
+        self.inward = None if inward is None else np.asarray(inward, dtype=float)
+        self.own_inward = None
         # what the displacement turns by along the face, per sample: the miter itself
         # (seen from no face in particular), or the miter less the face's own normal
         self.excess = self.miter
@@ -184,9 +191,13 @@ class SharpEdges:
             return self
         out = copy.copy(self)
         out.excess = self.miter.copy()
+        if self.inward is not None:
+            out.own_inward = np.full_like(self.miter, np.nan)
         for side in (0, 1):
             mine = self.faces[:, side] == i
             out.excess[mine] = self.miter[mine] - self.normals[mine, side]
+            if self.inward is not None:
+                out.own_inward[mine] = self.inward[mine, side]
         return out
 
     def _one(self, x, idx, tree):
@@ -221,6 +232,32 @@ class SharpEdges:
         ks = (np.maximum(k0 - 1, 0), k0, k1, np.minimum(k1 + 1, last))
         mk = _catmull_rom(mit, ks, tt)
         return k, d, mk[:, :9], mk[:, 9]
+
+    def feet(self, x, reach):
+        """The nearest point of the edge polylines to each of ``x`` (M, 3), its distance
+        and the sample nearer to it of its segment's two (an index into ``points``), for
+        the points within ``reach`` (mm) of an edge sample's neighbourhood (beyond: nan,
+        inf and -1)."""
+        x = np.asarray(x, dtype=float)
+        dist = np.full(len(x), np.inf)
+        foot = np.full((len(x), 3), np.nan)
+        near = np.full(len(x), -1)
+        for idx, tree in zip(self._edges, self._trees):
+            pts, last = self.points[idx], len(idx) - 1
+            _, j = tree.query(x, k=1, distance_upper_bound=reach + self._reach)
+            k = np.flatnonzero(j <= last)
+            j = j[k]
+            for k0, k1 in ((np.maximum(j - 1, 0), j), (j, np.minimum(j + 1, last))):
+                a, ab = pts[k0], pts[k1] - pts[k0]
+                t = np.clip(np.einsum("ij,ij->i", x[k] - a, ab)
+                            / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+                p = a + t[:, None] * ab
+                d = np.linalg.norm(x[k] - p, axis=1)
+                better = d < dist[k]
+                dist[k[better]] = d[better]
+                foot[k[better]] = p[better]
+                near[k[better]] = idx[np.where(t < 0.5, k0, k1)[better]]
+        return foot, dist, near
 
     def nearest(self, x):
         """Distance to the nearest edge, and the blended miter, exactness and excess (the
