@@ -94,9 +94,10 @@ RESULTS["op_view"] = [type(op.ViewObject.Proxy).__name__, op.ViewObject.DisplayM
 RESULTS["bit_hidden"] = [o.Visibility for o in doc.Objects if o.Label.startswith("Probe ")]
 Gui.Selection.clearSelection()
 view = Gui.ActiveDocument.ActiveView
+settle(view)
 view.viewIsometric()
 Gui.SendMsgToActiveView("ViewFit")
-Gui.updateGui()
+settle(view)       # FreeCAD 1.x animates the camera: a picture taken before it ends varies
 view.saveImage(os.path.join(TMP, "probeop.png"), 800, 600, "White")
 op.ViewObject.Visibility = False
 Gui.updateGui()

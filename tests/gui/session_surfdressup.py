@@ -103,9 +103,10 @@ for o in (d, doc.getObject("Nominal")):
 doc.getObject("Nominal").ViewObject.DisplayMode = "Wireframe"
 view = Gui.ActiveDocument.ActiveView
 Gui.Selection.clearSelection()
+settle(view)
 view.viewIsometric()
 Gui.SendMsgToActiveView("ViewFit")
-Gui.updateGui()
+settle(view)       # FreeCAD 1.x animates the camera: a picture taken before it ends varies
 view.saveImage(os.path.join(TMP, "surfdressup.png"), 800, 600, "White")
 d.ViewObject.Visibility = False
 Gui.updateGui()

@@ -48,9 +48,11 @@ def test_probe_moves_drawn(session):
     shown = read_image(session["tmp"] / "probeop.png")
     hidden = read_image(session["tmp"] / "probeop_hidden.png")
     # the moves' lines (their colours differ between versions): the pixels that change when
-    # the operation is hidden
+    # the operation is hidden; all 20 probe moves drawn: 2207 (0.20), 2208 (1.0), 3159 to
+    # 3163 (1.1) pixels; pictures taken while FreeCAD 1.1 still animated the camera showed
+    # only parts of the moves, 683 to 1207 pixels
     changed = int((abs(shown - hidden).sum(axis=2) > 0.3).sum())
-    assert changed > 1000, changed
+    assert changed > 1800, changed
 
 
 def test_a_headless_operation_is_drawn_when_opened(session):
