@@ -74,9 +74,11 @@ doc.recompute()
 bad.ViewObject.Visibility = False
 n1 = len(doc.Objects)
 view_top()
+px = project(view, [tuple(c) for c in centres])    # where the faces are drawn now
 Gui.Selection.clearSelection()
 click_view(px[0], QtCore.Qt.NoModifier)
 click_view(px[1], QtCore.Qt.ControlModifier)
+RESULTS["bad_faces"] = selection()
 Gui.Selection.addSelection(doc.Name, bad.Name)
 del ERRORS[:]
 Gui.runCommand("SurfComp_CompensateRegion")

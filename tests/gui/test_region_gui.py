@@ -55,6 +55,7 @@ def test_undo_removes_the_region(session):
 
 
 def test_low_coverage_refused_naming_the_face(session):
+    assert session["bad_faces"] == [["Block", ["Face1", "Face2"]]]
     errors, added, visible = session["bad"]
     assert len(errors) == 1 and "Face2: the points cover" in errors[0][1]
     assert added == 0 and visible is True
