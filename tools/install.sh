@@ -101,6 +101,10 @@ fi
 launcher=/usr/local/bin/surfcomp
 want="#!/bin/sh
 # surfcomp's command line (written by $repo/tools/install.sh)
+if [ ! -f \"$repo/surfcomp/__main__.py\" ]; then
+  echo \"surfcomp: the checkout this command runs, $repo, is gone; run tools/install.sh in a checkout of surfcomp\" >&2
+  exit 2
+fi
 PYTHONPATH=\"$repo\${PYTHONPATH:+:\$PYTHONPATH}\" exec /usr/bin/python3 -m surfcomp \"\$@\""
 if [ "$(cat "$launcher" 2>/dev/null)" != "$want" ]; then
   if [ -e "$launcher" ] && ! grep -q "^# surfcomp's command line" "$launcher"; then

@@ -10,6 +10,29 @@ cd "$(dirname "$0")/.."
 # for the routes' modules alone), and every pytest worker rewrites every test module's
 # asserts again; the compiled files go to __pycache__ folders, which git ignores
 unset PYTHONDONTWRITEBYTECODE
+scratch=$(mktemp -d)
+trap 'rm -rf "$scratch"' EXIT
+# FreeCAD restores the proxies of saved surfcomp objects only from modules in its Mod
+# folders (a security rule of its current releases), so the tests that open a saved document
+# in a fresh FreeCAD need this checkout there. Where FreeCAD's Mod folder links another
+# checkout (tools/install.sh ran in that one), this run gets a FreeCAD data folder of its own
+# that links this checkout, and leaves the user's alone.
+mod_dirs() {
+  freecadcmd -c "import FreeCAD, os; print('MODDIRS ' + repr([os.path.realpath(d) for d in FreeCAD.__ModDirs__]))" 2>/dev/null | grep '^MODDIRS ' || true
+}
+here=$(pwd -P)
+if command -v freecadcmd >/dev/null && ! mod_dirs | grep -qF "'$here'"; then
+  mkdir -p "$scratch/data/FreeCAD/Mod" "$scratch/data/Mod"
+  ln -s "$here" "$scratch/data/FreeCAD/Mod/surfcomp"   # XDG_DATA_HOME's layout
+  ln -s "$here" "$scratch/data/Mod/surfcomp"           # FREECAD_USER_HOME's (FreeCAD 1.x)
+  export XDG_DATA_HOME="$scratch/data"
+  if [ -n "${FREECAD_USER_HOME:-}" ]; then export FREECAD_USER_HOME="$scratch/data"; fi
+  if mod_dirs | grep -qF "'$here'"; then
+    echo "surfcomp tests: FreeCAD's Mod folder links another checkout; this run uses its own FreeCAD data folder, linking this one"
+  else
+    echo "surfcomp tests: warning: FreeCAD does not load this checkout ($here) as a Mod; the tests that reopen saved documents will fail" >&2
+  fi
+fi
 if [ $# -eq 0 ]; then
   echo "surfcomp tests: lint with $(ruff --version) (pyproject.toml)"
   ruff check --no-cache .
@@ -19,8 +42,8 @@ if [ $# -eq 0 ]; then
   # (the kernels side by side, one process and one OpenBLAS thread each, so that neither
   # spins on the other's core; their output in turn)
   reference_files=$(grep -l "mark.reference_solver" tests/pure/test_*.py)
-  logs=$(mktemp -d)
-  trap 'rm -rf "$logs"' EXIT
+  logs="$scratch/logs"
+  mkdir "$logs"
   pids=()
   for kernel in Haswell:avx2 SkylakeX:avx512f; do
     if grep -qw "${kernel#*:}" /proc/cpuinfo; then

@@ -3,6 +3,7 @@
 ``surfcomp`` command that tools/install.sh puts on PATH."""
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -26,10 +27,23 @@ def test_a_python_without_numpy_gets_one_line_and_exit_2():
     assert "'/usr/bin/python3 -m surfcomp'" in lines[0] and "'surfcomp'" in lines[0]
 
 
-@pytest.mark.skipif(shutil.which("surfcomp") is None, reason="tools/install.sh has not run")
-def test_the_installed_command_runs_debians_python_from_any_folder(tmp_path):
+def _launcher():
+    """The ``surfcomp`` command on PATH and its text; skips unless this checkout's
+    tools/install.sh wrote it (a command installed from another checkout runs that one)."""
     launcher = shutil.which("surfcomp")
+    if launcher is None:
+        pytest.skip("tools/install.sh has not run")
     text = open(launcher).read()
+    written = re.search(r"written by (.*)/tools/install\.sh", text)
+    assert written, text
+    if os.path.realpath(written.group(1)) != os.path.realpath(ROOT):
+        pytest.skip("the surfcomp command runs another checkout (%s); run tools/install.sh "
+                    "here" % written.group(1))
+    return launcher, text
+
+
+def test_the_installed_command_runs_debians_python_from_any_folder(tmp_path):
+    launcher, text = _launcher()
     assert "exec /usr/bin/python3 -m surfcomp" in text
     # a PATH whose first python3 has no numpy, and a PYTHONPATH of the user's: kept behind
     fake = tmp_path / "bin"
@@ -45,3 +59,19 @@ def test_the_installed_command_runs_debians_python_from_any_folder(tmp_path):
                          cwd=str(tmp_path), capture_output=True, text=True, timeout=120, env=env)
     assert out.returncode == 2 and "missing.step" in out.stderr, out.stderr
     assert sorted(os.listdir(tmp_path)) == ["bin"]
+
+
+def test_the_installed_command_says_when_its_checkout_is_gone(tmp_path):
+    """The command names the checkout it runs; once that is deleted it says so and what to
+    run (exit 2, one line), not Python's "No module named surfcomp"."""
+    _launcher_path, text = _launcher()
+    gone = str(tmp_path / "deleted-checkout")
+    moved = tmp_path / "surfcomp"
+    moved.write_text(text.replace(os.path.realpath(ROOT), gone).replace(ROOT, gone))
+    moved.chmod(0o755)
+    out = subprocess.run([str(moved), "--version"], cwd=str(tmp_path), capture_output=True,
+                         text=True, timeout=60)
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr.splitlines() == [
+        "surfcomp: the checkout this command runs, %s, is gone; run tools/install.sh in a "
+        "checkout of surfcomp" % gone]
