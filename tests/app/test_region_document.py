@@ -96,7 +96,8 @@ def test_reopened_in_a_fresh_freecadcmd_recomputes_the_same(replaced, tmp_path):
     r = json.loads(line[-1][len("RESULT "):])
     assert r["module"] == "surfcomp.app.region_doc"
     assert r["type"] == "SurfComp_RegionCompensation"
-    assert r["invalid"] == [] and r["valid"] and r["faces"] == 7, p.stdout[-3000:] + p.stderr[-3000:]
+    assert r["invalid"] == [], p.stdout[-3000:] + p.stderr[-3000:]
+    assert r["valid"] and r["faces"] == 7
     assert r["points_stored"] == 6000
     assert r["points"] == ["Face1 3000", "Face2 3000"]
     assert r["faces_prop"] == "auto" and r["region_faces"] == ["Face1", "Face2"]
