@@ -24,7 +24,7 @@ MODEL = AxisErrorModel(slope=np.diag([1e-4, -5e-5, 2e-5]))
 
 @pytest.mark.parametrize("path, seg, arc_tol", [
     (BEAR, 0.001, 1e-3), (BEAR, 2.0, 1e-3), (WAVE, 0.05, 1e-3), (ARCS, 0.5, 1e-3),
-    (ARCS, 5.0, 1e-9)])
+    (ARCS, 5.0, 1e-9)], ids=lambda v: os.path.basename(v) if isinstance(v, str) else None)
 @pytest.mark.parametrize("block_lines", [1, 7, 10_000])
 def test_the_first_pass_counts_what_the_whole_program_needs(path, seg, arc_tol, block_lines):
     if block_lines == 1 and path == BEAR:
