@@ -60,7 +60,7 @@ def with_dressup(doc, job, comp, tmp, found):
     doc.recompute()
 
 
-def build(tmp):
+def build(tmp, deflection=0.001):
     """The example's Job before and after the replace (the document stays open):
     ``doc, nom, comp, job, op``; ``before``/``after`` (cutter locations, posted G-code,
     states, the nominal's shape, the replace's links); ``finish``, ``dressup``, ``regen``
@@ -71,10 +71,10 @@ def build(tmp):
     nom = doc.addObject("Part::Feature", "Nominal")
     nom.Shape = Part.read(EXAMPLE_STEP)
     doc.recompute()
-    job = settled_job(doc, nom, 0.001)
+    job = settled_job(doc, nom, deflection)
     tc = cam_job.ball_end_tool_controller(job, 2 * R)
     op = cam_job.surface_operation(job, nom, ["Face1"], tc, step_over=50.0, sample_interval=1.0,
-                                   linear_deflection=0.001)
+                                   linear_deflection=deflection)
     m = features.make_measurement(doc, EXAMPLE_CSV)
     comp = features.make_compensation(doc, nom, "Face1", m)
     comp.Refine = 1          # fewer knots: OCCT meshes the corrected face 7x faster

@@ -134,12 +134,14 @@ def own_build(tmp_path_factory):
     """A build of the example's Job for the restore alone: the restore changes its
     document, and on FreeCAD 1.x a parallel run's order of the session's other tests left
     the shared document's operation unregenerated after it (527 instead of 520 cutter
-    locations), so this test does not depend on what ran before it."""
+    locations), so this test does not depend on what ran before it. Its mesh deflection is
+    10 um, not 1 um: the restore must give back the nominal's program whatever the mesh,
+    and the coarser mesh takes 1 s of CPU instead of 10 s."""
     import FreeCAD
 
     from tests.app import cam_example as example
 
-    built = example.build(tmp_path_factory.mktemp("cam_restore"))
+    built = example.build(tmp_path_factory.mktemp("cam_restore"), deflection=0.01)
     yield built
     FreeCAD.closeDocument(built.doc.Name)
 
@@ -147,6 +149,12 @@ def own_build(tmp_path_factory):
 def test_restore_brings_the_nominal_tool_path_back(own_build):
     ex = own_build
     doc, nom, comp, job, op, before = ex.doc, ex.nom, ex.comp, ex.job, ex.op, ex.before
+    # the replace moved the tool (by up to 49 um at this mesh), so the restore has a change
+    # to undo
+    moved = ex.after["cl"]
+    assert moved.shape == before["cl"].shape
+    assert np.abs(moved[:, 2] - before["cl"][:, 2]).max() > 0.03
+    assert ex.after["gcode"] != before["gcode"]
     replace.restore(doc, comp)
     doc.recompute()
     clone = cam_job.model_clone(job, nom)
