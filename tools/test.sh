@@ -65,9 +65,13 @@ fi
 # In parallel on the machine's cores with pytest-xdist where it is installed (Debian's
 # python3-pytest-xdist, tools/install.sh): the tests that share a module fixture (a shop
 # document, a GUI session) on one worker, the rest spread test by test, the longest first
-# (tests/conftest.py, tests/schedule.py). SURFCOMP_TEST_WORKERS=1 runs everything in this
-# one process.
-workers="${SURFCOMP_TEST_WORKERS:-$(nproc 2>/dev/null || echo 1)}"
+# (tests/conftest.py, tests/schedule.py). One worker more than the cores: a GUI session, a
+# FreeCAD child or a command-line run often waits (its X server, FreeCAD's timers, a
+# child's recompute), and the extra worker keeps the cores busy meanwhile (on 2 cores the
+# parallel part took 2:51 with 3 workers, 3:06 with 2; docs/benchmarks.md).
+# SURFCOMP_TEST_WORKERS=1 runs everything in this one process.
+cores=$(nproc 2>/dev/null || echo 1)
+workers="${SURFCOMP_TEST_WORKERS:-$(( cores > 1 ? cores + 1 : 1 ))}"
 parallel=()
 if [ "$workers" -gt 1 ] && /usr/bin/python3 -c "import xdist" 2>/dev/null; then
   parallel=(-n "$workers" --dist loadgroup)
