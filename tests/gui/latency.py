@@ -145,16 +145,18 @@ class KeyWatch:
         self.app.removeEventFilter(self.filter)
 
 
-def wait_quiet(app, busy, probe, watch=None, keys=0, quiet=0.4, limit=10.0):
+def wait_quiet(app, busy, probe, watch=None, keys=0, quiet=0.4, limit=10.0, shown=False):
     """Run the event loop until ``watch`` has seen ``keys`` key releases, ``busy()`` is
-    false and ``probe`` saw no render for ``quiet`` seconds (at most ``limit`` seconds);
-    returns True when it got there, False at the limit."""
+    false, (with ``shown``) the last render showed the map's colours as they are, and
+    ``probe`` saw no render for ``quiet`` seconds (at most ``limit`` seconds); returns True
+    when it got there, False at the limit."""
     t0 = time.perf_counter()
     last = t0
     while time.perf_counter() - t0 < limit:
         app.processEvents()
         now = time.perf_counter()
-        if busy() or (watch is not None and len(watch.released) < keys):
+        if busy() or (watch is not None and len(watch.released) < keys) or \
+                (shown and not (probe.renders and probe.renders[-1][1] == probe.sample())):
             last = now
         elif probe.renders:
             last = max(last, probe.renders[-1][0])
@@ -164,24 +166,33 @@ def wait_quiet(app, busy, probe, watch=None, keys=0, quiet=0.4, limit=10.0):
     return False
 
 
-def press_latencies(app, keys, probe, watch, busy, presses, quiet=1.0):
-    """Press each key of ``presses`` in turn, the GUI quiet before each; returns one dict
-    per press: ``key``, ``seconds`` (press to the first render of the final colours; None
-    when that render never came), ``cpu`` (FreeCAD's CPU seconds over that time, all its
+#: seconds without a render after which a key's work counts as done, once the panel is
+#: idle, every key handled and a render has shown the map's colours as they are (a render
+#: follows the map's update within milliseconds; the quiet time is for a late second one)
+QUIET = 0.25
+
+
+def press_latencies(app, keys, probe, watch, busy, presses, quiet=QUIET):
+    """Press each key of ``presses`` in turn, the GUI quiet before each (waited for before
+    the first, and before any after a press whose wait ran out); returns one dict per
+    press: ``key``, ``seconds`` (press to the first render of the final colours; None when
+    that render never came), ``cpu`` (FreeCAD's CPU seconds over that time, all its
     threads), ``changed`` (the colours differ from those before the press)."""
     out = []
+    settled = False
     for key in presses:
-        wait_quiet(app, busy, probe, watch, len(watch.released), quiet=0.3)
+        if not settled:
+            wait_quiet(app, busy, probe, watch, len(watch.released), quiet=0.3)
         before = probe.sample()
         n = len(watch.released)
         cpu0 = time.process_time()
         t = keys.press(key)
-        wait_quiet(app, busy, probe, watch, n + 1, quiet=quiet)
+        settled = wait_quiet(app, busy, probe, watch, n + 1, quiet=quiet, shown=True)
         out.append(_result(key, probe, before, t, cpu0))
     return out
 
 
-def typing_latency(app, keys, probe, watch, busy, text, interval, quiet=1.0):
+def typing_latency(app, keys, probe, watch, busy, text, interval, quiet=QUIET):
     """Type ``text`` (:data:`KEYSYMS` characters) ``interval`` seconds a key, from a thread
     while the event loop runs; the figures of :func:`press_latencies` from the last key."""
     wait_quiet(app, busy, probe, watch, len(watch.released), quiet=0.3)
@@ -191,7 +202,7 @@ def typing_latency(app, keys, probe, watch, busy, text, interval, quiet=1.0):
     while thread.is_alive():
         app.processEvents()
         time.sleep(0.001)
-    wait_quiet(app, busy, probe, watch, n + len(text), quiet=quiet)
+    wait_quiet(app, busy, probe, watch, n + len(text), quiet=quiet, shown=True)
     return _result(text, probe, before, *times[-1])
 
 
