@@ -54,7 +54,9 @@ def _occt(face, X):
         dist.append(d)
         feet.append(tuple(foot))
         inside.append(info[0][0] == "Face")
-        a, b = surf.parameter(foot)
+        # BRepExtrema gives the (u, v) of a foot inside the face; a foot on an edge or a
+        # vertex is projected onto the surface for its normal
+        a, b = info[0][2] if inside[-1] else surf.parameter(foot)
         n = surf.normal(a, b)
         signed.append(np.sign((FreeCAD.Vector(*p) - foot).dot(n)) * d)
     return np.array(dist), np.array(feet), np.array(inside), np.array(signed)
