@@ -67,8 +67,8 @@ fi
 # document, a GUI session) on one worker, the rest spread test by test, the longest first
 # (tests/conftest.py, tests/schedule.py). One worker more than the cores: a GUI session, a
 # FreeCAD child or a command-line run often waits (its X server, FreeCAD's timers, a
-# child's recompute), and the extra worker keeps the cores busy meanwhile (on 2 cores the
-# parallel part took 2:51 with 3 workers, 3:06 with 2; docs/benchmarks.md).
+# child's recompute), and the extra worker keeps the cores busy meanwhile (measured in
+# docs/benchmarks.md, "The suite's time").
 # SURFCOMP_TEST_WORKERS=1 runs everything in this one process.
 cores=$(nproc 2>/dev/null || echo 1)
 workers="${SURFCOMP_TEST_WORKERS:-$(( cores > 1 ? cores + 1 : 1 ))}"
@@ -99,15 +99,15 @@ if [ ${#parallel[@]} -gt 0 ] && ! chooses_marks "$@"; then
   late_files=()
   if [ $# -eq 0 ]; then
     set -- tests/pure tests/fuzz tests/app tests/gui
-    # the latency part of a full run collects only the modules that hold such tests (the
-    # whole suite's collection took 1 s of that part)
+    # the latency part of a full run collects only the modules that hold such tests, not
+    # the whole suite
     mapfile -t late_files < <(grep -l "mark.latency" tests/*/test_*.py)
   fi
   rc=0
   # the workers keep every core busy: a second OpenBLAS thread in one of them (or in a
   # FreeCAD it starts) only spins on a core another worker needs (sched_yield after each
   # call it made parallel), so in this part, unless the caller chose its BLAS threads,
-  # each process has one (measured: tests/pure and tests/fuzz used 10 s less CPU, of 101 s)
+  # each process has one (docs/benchmarks.md, "The suite's time")
   (
     if [ -z "${OPENBLAS_NUM_THREADS:-}${GOTO_NUM_THREADS:-}${OMP_NUM_THREADS:-}" ]; then
       export OPENBLAS_NUM_THREADS=1
