@@ -33,6 +33,11 @@ if command -v freecadcmd >/dev/null && ! mod_dirs | grep -qF "'$here'"; then
     echo "surfcomp tests: warning: FreeCAD does not load this checkout ($here) as a Mod; the tests that reopen saved documents will fail" >&2
   fi
 fi
+# the test modules that hold tests marked $1 (for a part that runs only those: collecting
+# the whole suite to choose a few costs about a second)
+marked_modules() {
+  grep -l "mark\.$1" tests/*/test_*.py || true
+}
 if [ $# -eq 0 ]; then
   echo "surfcomp tests: lint with $(ruff --version) (pyproject.toml)"
   ruff check --no-cache .
@@ -41,7 +46,7 @@ if [ $# -eq 0 ]; then
   # one kernel and failed on another); only the modules that hold such tests are collected
   # (the kernels side by side, one process and one OpenBLAS thread each, so that neither
   # spins on the other's core; their output in turn)
-  reference_files=$(grep -l "mark.reference_solver" tests/pure/test_*.py)
+  reference_files=$(marked_modules reference_solver)
   logs="$scratch/logs"
   mkdir "$logs"
   pids=()
@@ -96,12 +101,12 @@ chooses_marks() {
   return 1
 }
 if [ ${#parallel[@]} -gt 0 ] && ! chooses_marks "$@"; then
-  late_files=()
+  late=("$@")
   if [ $# -eq 0 ]; then
     set -- tests/pure tests/fuzz tests/app tests/gui
-    # the latency part of a full run collects only the modules that hold such tests, not
-    # the whole suite
-    mapfile -t late_files < <(grep -l "mark.latency" tests/*/test_*.py)
+    # a full run's latency part collects only the modules that hold such tests
+    mapfile -t late < <(marked_modules latency)
+    [ ${#late[@]} -gt 0 ] || late=("$@")
   fi
   rc=0
   # the workers keep every core busy: a second OpenBLAS thread in one of them (or in a
@@ -114,15 +119,11 @@ if [ ${#parallel[@]} -gt 0 ] && ! chooses_marks "$@"; then
     fi
     run_pytest "${parallel[@]}" -m "not scale and not latency" "$@"
   ) || rc=$?
-  late=0
-  if [ ${#late_files[@]} -gt 0 ]; then
-    run_pytest -m "latency and not scale" "${late_files[@]}" || late=$?
-  else
-    run_pytest -m "latency and not scale" "$@" || late=$?
-  fi
+  lrc=0
+  run_pytest -m "latency and not scale" "${late[@]}" || lrc=$?
   # 5: no test chosen, as when the arguments name no latency test (or only latency tests)
-  if [ "$rc" -eq 5 ] && [ "$late" -ne 5 ]; then rc=0; fi
-  if [ "$late" -ne 0 ] && [ "$late" -ne 5 ]; then rc=$late; fi
+  if [ "$rc" -eq 5 ] && [ "$lrc" -ne 5 ]; then rc=0; fi
+  if [ "$lrc" -ne 0 ] && [ "$lrc" -ne 5 ]; then rc=$lrc; fi
   exit "$rc"
 fi
 run_pytest "${parallel[@]}" "$@"
