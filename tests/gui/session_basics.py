@@ -4,6 +4,8 @@
 RESULTS["surfcomp_file"] = surfcomp.__file__
 RESULTS["workbenches"] = sorted(Gui.listWorkbenches())
 RESULTS["active_workbench"] = Gui.activeWorkbench().name()
+# what loading the workbench (and the GUI modules the prologue imports) did not import
+RESULTS["not_loaded"] = sorted(m for m in ("scipy.optimize",) if m not in sys.modules)
 RESULTS["commands"] = sorted(c for c in Gui.listCommands() if c.startswith("SurfComp_"))
 RESULTS["toolbars"] = [t.objectName() for t in mw.findChildren(QtGui.QToolBar)]
 tb = [t for t in mw.findChildren(QtGui.QToolBar) if t.objectName() == "SurfComp"]

@@ -41,6 +41,9 @@ def test_workbench_menu_toolbar_and_icons(session):
     assert session["commands"] == COMMAND_IDS
     assert "SurfComp" in session["toolbars"]
     assert session["toolbar_icons_null"] == []
+    # the optimizer only the scattered fit needs is imported when it runs (its 0.04 s of CPU
+    # not at every start of the workbench)
+    assert session["not_loaded"] == ["scipy.optimize"]
     for cid, res in session["resources"].items():
         assert os.path.basename(res["Pixmap"]) == cid + ".svg"
         assert os.path.isfile(os.path.join(ROOT, "resources", "icons", cid + ".svg"))

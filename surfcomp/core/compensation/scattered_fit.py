@@ -42,7 +42,6 @@ The scattered counterpart of the grid path's mask filter
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 from scipy.spatial.distance import cdist
 
 from ...errors import InputError
@@ -228,6 +227,9 @@ def smooth(u, v, d, smoothing=None, scale=(1.0, 1.0), method="auto", progress=No
         scores = np.array([solver.gcv(to_par * (diam * 10 ** g) ** 4) for g in grid])
         k = int(np.nanargmin(scores))
         a, b = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+        # imported here: the module's importers (the workbench, the reports) need no optimizer
+        from scipy.optimize import minimize_scalar
+
         res = minimize_scalar(lambda g: solver.gcv(to_par * (diam * 10 ** g) ** 4),
                               bounds=(a, b), method="bounded", options={"xatol": 1e-4})
         g = res.x if res.fun <= scores[k] else grid[k]
