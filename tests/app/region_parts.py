@@ -147,10 +147,13 @@ def sample_faces(faces, count, field, seed=0, noise=0.0):
     pts, nrm = [], []
     for f in faces:
         u0, u1, v0, v1 = f.ParameterRange
+        # a face that fills its parameter rectangle holds every sample (asking OCCT costs
+        # more than the point itself)
+        whole = abs(f.Surface.toShape(u0, u1, v0, v1).Area - f.Area) <= 1e-9 * f.Area
         k = 0
         while k < count:
             u, v = rng.uniform(u0, u1), rng.uniform(v0, v1)
-            if not f.isPartOfDomain(u, v):
+            if not (whole or f.isPartOfDomain(u, v)):
                 continue
             p = f.Surface.value(u, v)
             n = f.normalAt(u, v)
