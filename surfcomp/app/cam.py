@@ -34,6 +34,7 @@ No FreeCADGui: everything here works in ``freecadcmd`` and in a plain ``python3`
 :func:`setup_workbench` has run.
 """
 
+import contextlib
 import importlib
 import importlib.util
 import os
@@ -129,13 +130,14 @@ _MODULES_1X = {"Job": "Path.Main.Job", "Surface": "Path.Op.Surface",
                "Preferences": "Path.Preferences", "Geom": "Path.Geom",
                "Dressup": "Path.Dressup.Utils", "PathUtils": "PathScripts.PathUtils",
                "ToolBit": "Path.Tool.Bit", "toolbit": "Path.Tool.toolbit",
-               "Custom": "Path.Op.Custom"}
+               "Custom": "Path.Op.Custom", "Log": "Path.Log"}
 _MODULES_020 = {"Job": "PathScripts.PathJob", "Surface": "PathScripts.PathSurface",
                 "Profile": "PathScripts.PathProfile",
                 "ToolController": "PathScripts.PathToolController",
                 "Preferences": "PathScripts.PathPreferences", "Geom": "PathScripts.PathGeom",
                 "Dressup": "PathScripts.PathDressup", "PathUtils": "PathScripts.PathUtils",
-                "ToolBit": "PathScripts.PathToolBit", "Custom": "PathScripts.PathCustom"}
+                "ToolBit": "PathScripts.PathToolBit", "Custom": "PathScripts.PathCustom",
+                "Log": "PathScripts.PathLog"}
 
 
 def api():
@@ -164,8 +166,37 @@ def api():
 def module(role):
     """The CAM module that plays ``role`` (``'Job'``, ``'Surface'``, ``'Profile'``,
     ``'ToolController'``, ``'Preferences'``, ``'Geom'``, ``'Dressup'``, ``'PathUtils'``,
-    ``'ToolBit'``, ``'toolbit'``, ``'Custom'``) on this FreeCAD, imported on first use."""
+    ``'ToolBit'``, ``'toolbit'``, ``'Custom'``, ``'Log'``) on this FreeCAD, imported on first
+    use."""
     return importlib.import_module(api().names[role])
+
+
+@contextlib.contextmanager
+def logged_errors():
+    """``with logged_errors() as messages:`` the errors the CAM workbench logs while the
+    block runs, appended to ``messages`` as they come.
+
+    CAM operations report many failures only through their log and then return, so FreeCAD
+    marks the object recomputed without error while its path is an old or a truncated one:
+    any operation's "No Tool Controller is selected", the 3D Surface operation's "Failed to
+    pre-process model and/or selected face(s)". The log module (``PathScripts.PathLog``,
+    ``Path.Log``: the same in every version) writes every message through its ``_log``;
+    that function is wrapped for the block, so the messages still reach FreeCAD's console
+    as before, and the calling module the log names is unchanged."""
+    log = module("Log")
+    real = log._log
+    messages = []
+
+    def _log(level, where, msg):
+        if level == log.Level.ERROR:
+            messages.append(str(msg).strip())
+        return real(level, where, msg)
+
+    log._log = _log
+    try:
+        yield messages
+    finally:
+        log._log = real
 
 
 def branches():

@@ -31,6 +31,7 @@ from ..io.atomic import Transaction, check_outputs
 from ..io.outpath import shown
 from ..io.readers import read_any
 from . import align_doc, cam, cam_job, features, toolpaths
+from . import progress as recompute_order
 from .documents import open_document, restore_failures
 from .properties import store_options
 
@@ -247,19 +248,16 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
 
 
 def _recompute(doc):
-    doc.recompute()
-    bad = [o for o in doc.Objects if "Invalid" in o.State or "Error" in o.State]
+    """Recompute ``doc``; refuse (nothing is written) when an object ends invalid or in error,
+    or a CAM operation logged an error: it kept an old or a truncated tool path, which no
+    summary may call regenerated and no program may be posted from
+    (:func:`surfcomp.app.progress.recompute_all`)."""
+    recompute_order.recompute_all(doc)
+    bad = [o for o in doc.Objects if recompute_order.failed(o)]
     if bad:
-        raise ComputationError("after the recompute %d object(s) are invalid: %s"
-                               % (len(bad), "; ".join("%s (%s): %s" % (o.Label, o.Name,
-                                                                       _status(o))
-                                                      for o in bad)))
-
-
-def _status(obj):
-    """What FreeCAD says is wrong with ``obj`` (its status string), or its state."""
-    text = obj.getStatusString() if hasattr(obj, "getStatusString") else ""
-    return text or ", ".join(obj.State)
+        raise ComputationError("after the recompute %d object(s) failed: %s"
+                               % (len(bad), "; ".join("%s (%s): %s" % (
+                                   o.Label, o.Name, recompute_order.state_text(o)) for o in bad)))
 
 
 def _one_job(jobs, job_name):

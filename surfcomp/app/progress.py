@@ -93,21 +93,61 @@ def is_path_generator(obj):
     return hasattr(base, "PropertiesList") and is_path_generator(base)
 
 
+#: the errors the CAM workbench logged at the last recompute of each tool path generator
+#: that logged any: ``{(document name, object name): [message, ...]}``
+_CAM_ERRORS = {}
+
+
+def cam_errors(obj):
+    """The errors the CAM workbench logged while :func:`recompute_one` last recomputed
+    ``obj`` (empty: none, or not recomputed there)."""
+    return list(_CAM_ERRORS.get((obj.Document.Name, obj.Name), ()))
+
+
 def state_text(obj):
-    """Why ``obj`` failed to recompute (its status, else its state)."""
+    """Why ``obj`` failed to recompute (the errors the CAM workbench logged for it, else its
+    status, else its state)."""
+    logged = cam_errors(obj)
+    if logged:
+        return "the CAM workbench reported: " + "; ".join(logged)
     status = obj.getStatusString() if hasattr(obj, "getStatusString") else ""
     return status or ", ".join(obj.State)
+
+
+def failed(obj):
+    """Whether the last recompute of ``obj`` failed: it is in error, or (a tool path
+    generator) the CAM workbench logged an error while :func:`recompute_one` computed it,
+    which leaves it marked recomputed without error (:func:`surfcomp.app.cam.logged_errors`)."""
+    return bool({"Invalid", "Error"} & set(obj.State)) or bool(cam_errors(obj))
 
 
 def recompute_one(obj):
     """Recompute ``obj`` alone, once, and mark it recomputed as ``doc.recompute()`` does
     (``obj.recompute()`` leaves the object touched, so a later ``doc.recompute()`` would
-    compute it a second time). Returns False when it failed (its state says why)."""
-    obj.recompute()
-    ok = not ({"Invalid", "Error"} & set(obj.State))
+    compute it a second time). Returns False when it failed (:func:`failed`; it stays
+    touched, and :func:`state_text` says why)."""
+    key = (obj.Document.Name, obj.Name)
+    _CAM_ERRORS.pop(key, None)
+    if is_path_generator(obj):
+        from . import cam
+
+        with cam.logged_errors() as logged:
+            obj.recompute()
+        if logged:
+            _CAM_ERRORS[key] = logged
+    else:
+        obj.recompute()
+    ok = not failed(obj)
     if ok:
         obj.purgeTouched()
     return ok
+
+
+def recompute_all(doc):
+    """Recompute what ``doc`` needs (:func:`pending`), each object once, in dependency
+    order, as ``doc.recompute()`` does, but so that each CAM operation's logged errors are
+    its own (:func:`cam_errors`). Returns the objects that failed."""
+    return [o for o in pending(doc) if not recompute_one(o)]
 
 
 def recompute_with_progress(doc, title, todo=None):

@@ -7,7 +7,10 @@ happened, from the operation's commands before and after the recompute
 
 - ``regenerated``: the operation recomputed without error and its commands changed;
 - ``unchanged``: no error, the same commands as before;
-- ``failed``: the operation is in error (FreeCAD's status message is kept);
+- ``failed``: the operation is in error (FreeCAD's status message is kept), or the CAM
+  workbench logged an error while it recomputed (those messages are kept): many operations
+  log their failure and return, keeping an old or a truncated path in an object FreeCAD
+  marks recomputed (:func:`surfcomp.app.progress.failed`);
 - ``lost``: its Python object did not restore when the document was opened (a module it
   needs could not be imported), so it cannot recompute at all and keeps its old commands;
 - ``inactive``: switched off (``Active`` false), Path does not recompute it;
@@ -26,6 +29,7 @@ loss permanent, and their tool paths could not follow the new face anyway).
 from dataclasses import dataclass, field
 
 from . import cam_job
+from . import progress as recompute_order
 
 #: statuses of :class:`OperationReport`
 STATUSES = ("regenerated", "unchanged", "inactive", "failed", "lost", "stale")
@@ -142,10 +146,9 @@ def _operation_report(op, old):
                           before=len(old) if old is not None else 0)
     if has_lost_proxy(op):
         rep.status = "lost"
-    elif "Error" in op.State or "Invalid" in op.State:
+    elif recompute_order.failed(op):
         rep.status = "failed"
-        status = op.getStatusString() if hasattr(op, "getStatusString") else ""
-        rep.detail = status or ", ".join(op.State)
+        rep.detail = recompute_order.state_text(op)
     elif getattr(op, "Active", True) is False:
         rep.status = "inactive"
     elif old is None or len(new) != len(old) or _changed(old, new):

@@ -5,6 +5,7 @@ import hashlib
 import os
 import re
 import sys
+import time
 
 import FreeCAD
 import numpy as np
@@ -14,7 +15,7 @@ from surfcomp.app import cam, cam_job, documents, features
 from surfcomp.app.document_route import run_document_job
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.compensation.pipeline import Options
-from surfcomp.errors import InputError, MeasurementFileError
+from surfcomp.errors import ComputationError, InputError, MeasurementFileError
 from tests.app.helpers import grid_on_face, write_cmm_csv
 from tests.app.test_features import add_part, block_solid, error_model
 from tests.app.test_path_regen import g1_points
@@ -215,3 +216,61 @@ def test_the_batch_command_line(shop, tmp_path):
     bad = subprocess.run(cmd[:-3] + ["--format", "xyzijk", "--quiet"], cwd=ROOT,
                          capture_output=True, text=True, timeout=600)
     assert bad.returncode == 2 and "XYZIJK" in bad.stderr and sha(shop["doc"]) == digest
+
+
+@pytest.fixture(scope="module")
+def no_tool(shop):
+    """The shop document with its tool controller's tool number 0: FreeCAD's operations log
+    "No Tool Controller is selected" and return, keeping their old path, in an object FreeCAD
+    marks recomputed without error."""
+    path = str(shop["dir"] / "no_tool.FCStd")
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        doc.getObject("Surface").ToolController.ToolNumber = 0
+        doc.saveAs(path)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    return path
+
+
+def test_a_cam_error_refuses_the_route_and_writes_nothing(shop, no_tool, tmp_path):
+    digest = sha(no_tool)
+    out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+    with pytest.raises(ComputationError) as err:
+        run_document_job(no_tool, shop["meas"], "Block", face="Face2", save=out, replace=True,
+                         gcode=ngc, post="linuxcnc", post_args=POST_ARGS,
+                         options=Options(refine=1))
+    # before: "Path job Job: Surface tool path unchanged", and the nominal's program written
+    assert "Surface (Surface): the CAM workbench reported: No Tool Controller is selected" \
+        in str(err.value)
+    assert os.listdir(tmp_path) == [] and sha(no_tool) == digest
+
+
+@pytest.mark.parametrize("route", ["in process", "child process"])
+def test_a_cam_error_is_reported_as_failed_not_unchanged(shop, no_tool, route):
+    """Replace and Restore in the GUI recompute in this process or in a child, then say what
+    happened to each operation (surfcomp.app.toolpaths)."""
+    from surfcomp.app import progress, recompute, toolpaths
+
+    doc = documents.open_document(no_tool)[0]
+    try:
+        op = doc.getObject("Surface")
+        before = toolpaths.snapshot(doc)
+        op.touch()
+        if route == "in process":
+            progress.recompute_with_progress(doc, route)
+        else:
+            job = recompute.ChildRecompute(doc).start()
+            while job.poll():
+                time.sleep(0.05)
+            job.finish()
+        (rep,) = toolpaths.compare(doc, before)
+        (found,) = rep.operations
+        assert found.status == "failed", found
+        assert found.detail == ("the CAM workbench reported: No Tool Controller is selected. "
+                                "We need a tool to build a Path.")
+        assert toolpaths.describe([rep]) == [
+            "Path job %s: Surface NOT regenerated, it failed: %s" % (rep.label, found.detail)]
+        assert "Touched" in op.State        # not marked as recomputed
+    finally:
+        FreeCAD.closeDocument(doc.Name)
