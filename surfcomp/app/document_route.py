@@ -317,7 +317,7 @@ def summary_lines(result):
              % (result.compensation, result.measurement)]
     if result.output == "solid":
         lines.append("output: the nominal's shape with the face replaced; volume change %.4f "
-                     "mm^3, the correction integrates to %.4f mm^3"
+                     "mm^3, expected from the correction %.4f mm^3 (-integral of delta dA)"
                      % (result.volume_change, -result.correction_volume))
     lines += [a for a in result.alignment if a not in result.alignment_warnings]
     return lines + outcome_lines(result)

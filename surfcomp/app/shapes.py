@@ -76,8 +76,8 @@ class Output:
         if mismatch is None or abs(mismatch) <= VOLUME_CHECK or \
                 abs(self.volume_change + self.correction_volume) < 1e-6:
             return []
-        return ["%s: the solid's volume changed by %.4f mm^3 where the correction integrates "
-                "to %.4f mm^3 (%+.1f %%, more than %g %%)"
+        return ["%s: the solid's volume changed by %.4f mm^3 where the correction gives "
+                "%.4f mm^3 (-integral of delta dA; %+.1f %%, more than %g %%)"
                 % (label, self.volume_change, -self.correction_volume, 100 * mismatch,
                    100 * VOLUME_CHECK)]
 

@@ -206,7 +206,7 @@ def output_lines(shape):
                 shape["max_edge_tolerance_mm"])] + size
     if shape["volume_change_mm3"] is not None:
         mismatch = shape["volume_change_vs_integral"]
-        lines.append("  volume change %.4f mm^3; the correction integrates to %.4f mm^3 "
+        lines.append("  volume change %.4f mm^3; expected from the correction %.4f mm^3 "
                      "(-integral of delta dA)%s"
                      % (shape["volume_change_mm3"], -shape["correction_integral_mm3"],
                         "" if mismatch is None else ", %+.2f %%" % (100 * mismatch)))
