@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from surfcomp.app import cam, cam_job, documents, features
-from surfcomp.app.document_route import run_document_job
+from surfcomp.app.document_route import run_document_job, summary_lines
 from surfcomp.app.nominal import nominal_from_face
 from surfcomp.core.compensation.pipeline import Options
 from surfcomp.errors import ComputationError, InputError, MeasurementFileError
@@ -62,6 +62,12 @@ def test_update_a_shop_document(shop, tmp_path):
                            options=Options(refine=1))
     assert sha(shop["doc"]) == digest                       # the input is untouched
     assert res.saved == out and res.gcode == ngc and res.jobs == ["Job"]
+    # the summary's volume figures: the change, and -integral(delta dA) named as such (the
+    # correction cuts here: its integral, CorrVol, is positive)
+    assert res.correction_volume > 1.0
+    assert ("volume change %.4f mm^3, expected from the correction %.4f mm^3 (-integral of "
+            "delta dA)" % (res.volume_change, -res.correction_volume)) in \
+        "\n".join(summary_lines(res))
     assert res.operations == ["Surface"] and res.replaced == [("Clone", "Objects")]
     assert res.statistics["deviation"]["count"] == 225
     assert res.checks["max_error_at_points_mm"] < 1e-4
