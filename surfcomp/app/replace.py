@@ -407,7 +407,8 @@ def summary(doc, comp):
     the objects whose links were rebound), ``links`` (number of link properties),
     ``jobs`` and ``job_names`` (labels and names of the Path jobs that use a rebound
     object: what happened to their tool paths is :mod:`surfcomp.app.toolpaths`), ``renamed``
-    (``(old label, new label)``)."""
+    (``(old label, new label)``), ``deleted`` (names of rebound objects deleted since: their
+    links count nowhere, and :func:`restore` skips them)."""
     try:
         record = json.loads(comp.ReplacedLinks or "{}")
     except ValueError:
@@ -426,9 +427,10 @@ def summary(doc, comp):
             jobs.append(job)
     renamed = [(old, doc.getObject(n).Label) for n, old in record.get("labels", {}).items()
                if doc.getObject(n) is not None]
-    return {"objects": [o.Label for o in objs], "links": len(record.get("links", [])),
+    links = [item for item in record.get("links", []) if doc.getObject(item["object"])]
+    return {"objects": [o.Label for o in objs], "links": len(links),
             "jobs": [j.Label for j in jobs], "job_names": [j.Name for j in jobs],
-            "renamed": renamed}
+            "renamed": renamed, "deleted": [n for n in names if doc.getObject(n) is None]}
 
 
 def is_replacing(comp):

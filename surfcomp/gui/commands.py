@@ -513,6 +513,9 @@ class _ReplaceCommand(Command):
             else translate("SurfComp", "Rebound")
         lines = [translate("SurfComp", "%s %d link(s) of %d object(s): %s")
                  % (verb, s["links"], len(s["objects"]), ", ".join(s["objects"]) or "-")]
+        if s.get("deleted"):
+            lines.append(translate("SurfComp", "Not restored (deleted since the replace): %s")
+                         % ", ".join(s["deleted"]))
         # what the recompute did to each Job's operations, not just which Jobs use the face
         from ..app import toolpaths
 

@@ -117,6 +117,20 @@ def test_replace_rebinds_every_user_and_restore_undoes_it(setup):
         replace.restore(doc, comp)
 
 
+def test_the_summary_counts_only_links_restore_can_put_back(setup):
+    """A rebound user deleted after the replace: Restore skips it, and the summary the GUI
+    shows (taken before the restore) neither counts its links nor hides it."""
+    doc, nom, comp, clone, other, user = setup
+    replace.replace(doc, comp)
+    doc.recompute()
+    assert replace.summary(doc, comp)["links"] == 5
+    doc.removeObject(user.Name)
+    s = replace.summary(doc, comp)
+    put_back = replace.restore(doc, comp)
+    assert put_back == [(clone.Name, "Objects")]
+    assert s["links"] == len(put_back) == 1 and s["deleted"] == ["User"]
+
+
 @pytest.mark.parametrize("step", [1, 3, 6])
 def test_a_failure_leaves_the_document_exactly_as_before(setup, monkeypatch, step):
     doc, nom, comp, clone, other, user = setup
