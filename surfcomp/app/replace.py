@@ -360,6 +360,14 @@ def restore(doc, comp):
         raise InputError("%s is not a surfcomp compensation" % comp.Label)
     if not comp.ReplacedLinks:
         raise InputError("%s does not replace its nominal (nothing to restore)" % comp.Label)
+    later = [o.Label for o in doc.Objects if o is not comp and _replaces(o)
+             and is_replacing(o) and any(x is comp for x in _chain(o)[1:])]
+    if later:
+        # its users moved on to the later round: putting back its record would take them
+        # from that round to the nominal and leave the later round's record pointing at
+        # links that no longer use it
+        raise InputError("%s: %s, a later round of its iteration, replaces it now; restore "
+                         "%s first" % (comp.Label, ", ".join(later), later[0]))
     try:
         record = json.loads(comp.ReplacedLinks)
     except ValueError as exc:

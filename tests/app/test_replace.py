@@ -216,6 +216,14 @@ def test_iteration_moves_users_from_the_previous_round(setup):
     # links to the nominal and the first round do not go into a cycle
     assert second.Base == comp and comp.Nominal == nom and second.Nominal == nom
     assert (clone.Name, "Objects") in changed
+    # the first round cannot be restored while the second replaces it (its users would go
+    # from the second round to the nominal, and the second round's record would point at
+    # links that no longer use it)
+    before = snapshot(doc)
+    with pytest.raises(InputError, match="Round2, a later round of its iteration, replaces "
+                                         "it now; restore Round2 first"):
+        replace.restore(doc, comp)
+    assert snapshot(doc) == before
     replace.restore(doc, second)
     assert clone.Objects == [comp] and user.Source == comp and comp.Visibility is True
     replace.restore(doc, comp)
