@@ -368,3 +368,30 @@ def test_interrupt_leaves_no_outputs(tmp_path, signame, code):
     assert ("interrupted" if code == 130 else "terminated by signal") in rest
     assert "; nothing was written" in rest
     assert sorted(os.listdir(tmp_path)) == ["m.csv"]
+
+
+@pytest.mark.parametrize("scale, unit, name", [(25.4, "in", "inches"), (1000.0, "m", "metres")])
+def test_measured_points_in_another_unit_are_refused_and_nothing_written(tmp_path, scale, unit,
+                                                                          name):
+    """The example's measured points written in inches or metres (no unit given) land in a
+    corner of the face, near enough to pass as on it: refused, naming the unit and the
+    option, nothing written; with the unit given they are taken (before: a 63 MB face built
+    from the corner, or a 36 GiB allocation)."""
+    rows = np.loadtxt(EXAMPLE_CSV, delimiter=",", comments="#", skiprows=3,
+                      usecols=range(1, 8))
+    P, N, d = rows[:, 0:3], rows[:, 3:6], rows[:, 6]
+    X = (P + d[:, None] * N) / scale
+    path = tmp_path / "xyz.csv"
+    np.savetxt(path, X, delimiter=",", header="x,y,z", comments="", fmt="%.9f")
+    out = run_in_process("compensate", EXAMPLE_STEP, path, "-o", tmp_path / "c.step",
+                         "--quiet")
+    assert out.returncode == 2, out.stdout + out.stderr
+    # the option where it offers the unit (inches), else the column names (metres)
+    advice = "--units in, or a column name like 'x [in]'" if unit == "in" else \
+        "a column name like 'x [m]'"
+    assert ("multiplied by %g they lie on it: the file's coordinates are in %s, not mm (give "
+            "the unit: %s)" % (scale, name, advice)) in out.stderr
+    assert sorted(os.listdir(tmp_path)) == ["xyz.csv"]
+    path.write_text(path.read_text().replace("x,y,z", "x [%s],y [%s],z [%s]" % ((unit,) * 3)))
+    ok = run_in_process("inspect", EXAMPLE_STEP, path, "--quiet")
+    assert ok.returncode == 0, ok.stderr

@@ -64,3 +64,48 @@ def test_prepare_warns_when_every_deviation_is_far_beyond_the_size_tolerance():
 
     assert len(warnings(20.0)) == 1 and "f.csv: every deviation" in warnings(20.0)[0]
     assert warnings(0.02) == []
+
+
+def _flat_face_and_points(scale, corner=(10.0, 10.0), size=80.0, n=9):
+    """A flat 100 x 100 mm face (z = 1 mm), and an n x n grid of points on it over ``size``
+    mm from ``corner``, divided by ``scale`` (a file in another unit read as mm)."""
+    from surfcomp.core.surface.bspline import Surface
+
+    P = np.array([[[0, 0, 1], [0, 100, 1]], [[100, 0, 1], [100, 100, 1]]], dtype=float)
+    surf = Surface(P, np.r_[0, 0, 1, 1.], np.r_[0, 0, 1, 1.], 1, 1)
+    g0, g1 = np.linspace(corner[0], corner[0] + size, n), np.linspace(corner[1],
+                                                                       corner[1] + size, n)
+    X, Y = np.meshgrid(g0, g1, indexing="ij")
+    pts = np.stack([X.ravel(), Y.ravel(), np.full(n * n, 1.002)], axis=1) / scale
+    return surf, pts
+
+
+@pytest.mark.parametrize("scale, unit", [(25.4, "in"), (10.0, "cm"), (1000.0, "m")])
+def test_points_in_another_length_unit_are_refused_naming_it(scale, unit):
+    """Points in inches, cm or m read as mm land in a corner of a face near the origin, and
+    still within max offset of it: multiplied back they lie on the face."""
+    from surfcomp.core.compensation.pipeline import Options, prepare
+    from surfcomp.errors import InputError
+    from surfcomp.io.measurements import MeasurementSet
+
+    surf, pts = _flat_face_and_points(scale)
+    ms = MeasurementSet(measured=pts, lines=np.arange(len(pts)) + 2, source="f.csv")
+    with pytest.raises(InputError, match=r"f.csv: the 81 points span .* mm where the face "
+                                         r"spans 141.4 mm, and multiplied by %g they lie on "
+                                         r"it: .*'x \[%s\]'" % (scale, unit)):
+        prepare(surf, 1, ms, Options(method="raw"))
+    # read in their unit, they are taken
+    ms = MeasurementSet(measured=pts * scale, lines=np.arange(len(pts)) + 2, source="f.csv")
+    assert prepare(surf, 1, ms, Options(method="raw")).deviation.size == 81
+
+
+@pytest.mark.parametrize("corner, size", [((0.0, 0.0), 5.0), ((60.0, 30.0), 5.0),
+                                          ((0.2, 0.2), 0.5)])
+def test_a_small_patch_measured_in_mm_is_no_unit_mistake(corner, size):
+    """A patch under a tenth of the face: scaled by 25.4, 10 or 1000 it would leave the face
+    or still cover a corner, so it is no unit mistake."""
+    from surfcomp.core.compensation.pipeline import project
+    from surfcomp.core.surface.bspline import Surface  # noqa: F401
+
+    surf, pts = _flat_face_and_points(1.0, corner, size, n=5)
+    assert pl.unit_mistake(surf, pts, 1.0, project) is None

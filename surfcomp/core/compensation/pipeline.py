@@ -205,6 +205,11 @@ def prepare(surface, outward, ms, options=None, progress=None):
     proj = project(surface, base, progress=sub(progress, 0.0, 0.8))
     # a tip centre lies one tip radius outside its contact point (along the normal)
     dist = proj.distance * outward - (tip if ms.nominal is None else 0.0)
+    # first: points in inches or metres near the origin can pass as on the face, or fail
+    # as beyond its border, which would not say why
+    mistake = plausibility.unit_mistake(surface, base, options.max_offset, project)
+    if mistake:
+        raise InputError(mistake, file=ms.source, options=("units",))
     _check_on_face(ms, base, proj, dist, options)
     normal = _normals(ms, proj.normal * outward, options, warnings)
     if ms.deviation is not None:

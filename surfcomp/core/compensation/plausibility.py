@@ -15,6 +15,11 @@ and the GUI's import preview:
   +-0.5 mm). A file whose deviations are *all* larger than :data:`UNITS_FACTOR` times
   that tolerance describes no part that passed a machining process: its deviations are
   almost certainly in another unit. :func:`units_warning` says so.
+- **length unit** (an error): points that cover only a small part of the face (under
+  :data:`SMALL_SPAN` of its extent) but lie on it once multiplied by 25.4, 10 or 1000 are
+  in inches, centimetres or metres, not millimetres: near the origin such points still
+  pass the on-face check, and compensating them would build the face from a corner
+  (:func:`unit_mistake`).
 - **mirror stock** (refused unless confirmed): the mirror method measures the part after
   a semi-finishing pass that left the stock ``s``, so in surfcomp's sign convention
   (deviation along the outward normal, + = material left) every measured deviation is
@@ -36,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..option_tables import INPUTS
 from ..options import OPTIONS
 
 #: ISO 2768-1 class f: (largest dimension up to, mm) -> permissible deviation (+- mm)
@@ -112,6 +118,49 @@ def offset_errors(deviation, lines=None, max_offset=DEFAULT_MAX_OFFSET, source="
         out[0] += " (%d of %d points): are the deviations in um? Choose the file's unit, or " \
                   "name the column like 'dev [um]'" % (bad.size, d.size)
     return out
+
+
+#: the length units a file's points are mistaken for in mm: (name, factor to mm, unit)
+UNIT_SCALES = (("inches", 25.4, "in"), ("centimetres", 10.0, "cm"), ("metres", 1000.0, "m"))
+#: points spanning less than this share of the face's extent are checked for another unit
+SMALL_SPAN = 0.1
+#: the share of the points that must lie on the face once scaled to call it a unit mistake
+ON_FACE_SHARE = 0.9
+
+
+def unit_mistake(surface, points, max_offset, project):
+    """Why the ``points`` (N, 3) are in another length unit than mm, or None.
+
+    Only points that span less than :data:`SMALL_SPAN` of the face's extent (the diagonal
+    of the bounding boxes) are tried: scaled by each factor of :data:`UNIT_SCALES`, at
+    least :data:`ON_FACE_SHARE` of them must lie within ``max_offset`` of the face and
+    inside its border (``project(surface, points)``, the projection engine), and span
+    between :data:`SMALL_SPAN` and 1.5 times the face. A small patch measured on purpose
+    fails that: scaled, it lands off the face."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    if len(pts) < 3:
+        return None
+    from ..surface import bspline
+
+    grid = bspline.evaluate_grid(surface, np.linspace(*surface.u_range, 9),
+                                 np.linspace(*surface.v_range, 9)).reshape(-1, 3)
+    face = float(np.linalg.norm(grid.max(axis=0) - grid.min(axis=0)))
+    span = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    if not span < SMALL_SPAN * face:
+        return None
+    for name, factor, unit in UNIT_SCALES:
+        if not SMALL_SPAN * face <= span * factor <= 1.5 * face:
+            continue    # scaled, they would still cover a corner, or more than the face
+        r = project(surface, pts * factor)
+        on = (np.abs(r.distance) <= max_offset) & ~np.asarray(r.outside, dtype=bool)
+        if on.mean() >= ON_FACE_SHARE:
+            option = "units %s, or " % unit if unit in INPUTS["units"].choices else ""
+            return ("the %d points span %.4g mm where the face spans %.4g mm, and multiplied "
+                    "by %g they lie on it: the file's coordinates are in %s, not mm (give "
+                    "the unit: %sa column name like 'x [%s]')"
+                    % (len(pts), span, face, factor, name, option, unit))
+    return None
 
 
 def units_warning(deviation, dimension, factor=UNITS_FACTOR):
