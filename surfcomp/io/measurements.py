@@ -535,7 +535,19 @@ class _Parser:
                              % (dev[k], computed[k], diff[k] * 1e3, DEV_CHECK_TOL * 1e3),
                              "deviations differ from (measured - nominal) . normal by more than "
                              "%g um" % (DEV_CHECK_TOL * 1e3))
-        if bad.size and np.all(np.abs(dev[bad] + computed[bad]) <= DEV_CHECK_TOL):
+        flipped = bad.size and np.all(np.abs(dev[bad] + computed[bad]) <= DEV_CHECK_TOL)
+        if flipped and 2 * bad.size >= dev.size:
+            # most rows say the opposite of their own points: whichever is right, the
+            # correction would go the wrong way for one of them
+            k = int(bad[0])
+            raise self.error("dev %.6f mm has the opposite sign of (measured - nominal) . "
+                             "normal = %.6f mm, as on %d of the %d rows (expected them to "
+                             "agree within %g um: does the dev column measure along the "
+                             "inward normal? Correct the file, or leave out the dev column or "
+                             "the measured points)"
+                             % (dev[k], computed[k], bad.size, dev.size, DEV_CHECK_TOL * 1e3),
+                             data[k])
+        if flipped:
             self.warnings.append("%s: the %d differing deviation(s) have the opposite sign of "
                                  "(measured - nominal) . normal: does the file measure along "
                                  "the inward normal?" % (self.source, bad.size))

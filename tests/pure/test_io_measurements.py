@@ -283,26 +283,45 @@ def test_deviation_without_normal_is_ignored_with_a_warning():
                            "deviation is computed from the face)"]
 
 
-def test_deviation_cross_check_caps_the_warnings_and_spots_the_sign():
+def _flipped_table(n_flipped, n=25):
+    """A table with nominal, measured, normal and dev columns whose last ``n_flipped`` dev
+    values have the wrong sign, and the given dev column."""
     rng = np.random.default_rng(3)
-    n = 25
     nom = np.column_stack([np.arange(n, dtype=float), rng.uniform(0, 10, n), np.zeros(n)])
     nrm = np.tile([0.0, 0.0, 1.0], (n, 1))
     dev = rng.uniform(0.01, 0.05, n)
     given = dev.copy()
-    given[5:] *= -1.0                                         # 20 points with the wrong sign
+    given[n - n_flipped:] *= -1.0
     given[2] += 0.0009                                        # within 1 um: no warning
     rows = np.column_stack([nom, nom + dev[:, None] * nrm, nrm, given])
-    text = nnd_text(header=["x_nom", "y_nom", "z_nom", "x_meas", "y_meas", "z_meas", "i", "j", "k",
-                            "dev"], rows=rows)
+    return nnd_text(header=["x_nom", "y_nom", "z_nom", "x_meas", "y_meas", "z_meas", "i", "j",
+                            "k", "dev"], rows=rows), given
+
+
+def test_deviation_cross_check_caps_the_warnings_and_spots_the_sign():
+    text, given = _flipped_table(12)                          # 12 of 25 with the wrong sign
     ms = parse_measurements(text, source="f.csv")
     assert ms.kind() == "all"
     assert_allclose(ms.deviation, given, atol=1e-12, rtol=0)
     assert len(ms.warnings) == 12
-    assert [w.split(":")[1] for w in ms.warnings[:10]] == [str(k) for k in range(7, 17)]
-    assert ms.warnings[10] == ("f.csv: 10 more deviations differ from (measured - nominal) . "
+    assert [w.split(":")[1] for w in ms.warnings[:10]] == [str(k) for k in range(15, 25)]
+    assert ms.warnings[10] == ("f.csv: 2 more deviations differ from (measured - nominal) . "
                                "normal by more than 1 um")
-    assert "20 differing deviation(s) have the opposite sign" in ms.warnings[11]
+    assert "12 differing deviation(s) have the opposite sign" in ms.warnings[11]
+
+
+def test_a_dev_column_against_its_own_points_on_most_rows_is_refused():
+    """Half the rows or more with the dev column's sign flipped against the row's own
+    measured and nominal points: whichever is right, the correction would go the wrong way
+    for one of them (before: a warning, and the face built from the flipped column)."""
+    text, given = _flipped_table(13)
+    with pytest.raises(MeasurementFileError) as err:
+        parse_measurements(text, source="f.csv")
+    assert str(err.value) == (
+        "f.csv:14: dev %.6f mm has the opposite sign of (measured - nominal) . normal = %.6f "
+        "mm, as on 13 of the 25 rows (expected them to agree within 1 um: does the dev column "
+        "measure along the inward normal? Correct the file, or leave out the dev column or the "
+        "measured points)" % (given[12], -given[12]))
 
 
 def test_normal_within_tolerance_gives_no_warning():
