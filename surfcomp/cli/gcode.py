@@ -201,8 +201,9 @@ def print_summary(args, table, model, stats, pred, vmap, warnings, out=None):
           % (_um(a["max_mm"]), _um(a["mean_mm"]), _um(a["rms_mm"])), file=out)
     if model.fits:
         worst = max(model.fits, key=lambda f: f.rms)
-        print("  the error functions fit the measurements within RMS %.3f um (worst: %s): "
-              "on the real machine the compensation is as good as that fit"
+        print("  these figures are the error model's own: on the machine the compensation is "
+              "as good as the model, whose error functions fit the measurements within RMS "
+              "%.3f um (worst: %s) and know nothing beyond the measured travel"
               % (_um(worst.rms), worst.name), file=out)
     if pred["points_unknown_axes"]:
         print("  (%d point(s) with an axis the program had not set are not counted)"

@@ -3,6 +3,7 @@
 
 import math
 import os
+import re
 
 import numpy as np
 import pytest
@@ -473,6 +474,12 @@ def test_cli_compensates_bear_and_writes_a_report(tmp_path, capsys):
     assert out.read_bytes() == expected.data
     assert "before compensation: max 88." in stdout
     assert "after compensation:  max 0.0" in stdout
+    # the model's figures, not a promise for the machine beyond what was measured
+    assert re.search(r"these figures are the error model's own: on the machine the "
+                     r"compensation is as good as the model, whose error functions fit the "
+                     r"measurements within RMS \d+\.\d{3} um \(worst: .+\) and know nothing "
+                     r"beyond the measured travel", stdout)
+    assert "as good as that fit" not in stdout
     assert "delta_z(z)" in stdout and "squareness [urad] XY 100.000" in stdout
     assert "no G90/G91 before the first move (line 4)" in stderr
     r = json.loads(rep.read_text())
