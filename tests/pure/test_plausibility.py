@@ -34,6 +34,11 @@ def test_units_warning_only_when_every_deviation_is_far_beyond_the_tolerance():
     assert pl.units_warning([16.0, -0.1, 30.0], 100.0) is None
     assert pl.units_warning([0.03, -0.02], 100.0) is None
     assert "+-0.15 mm" in pl.units_warning([16.0], 100.0)
+    # the other way: deviations in mm read as um (all below 0.5 um)
+    tiny = pl.units_warning([4.7e-5, -2.9e-5, 1e-6], 100.0)
+    assert tiny.startswith("every deviation is below 0.5 um (largest 0.047 um)")
+    assert "deviations in mm read as um?" in tiny
+    assert pl.units_warning([4.7e-5, -6e-4, 1e-6], 100.0) is None
 
 
 def test_largest_dimension_and_ranges_ignore_nan():

@@ -49,6 +49,9 @@ ISO2768_FINE = ((6.0, 0.05), (30.0, 0.1), (120.0, 0.15), (400.0, 0.2), (1000.0, 
                 (np.inf, 0.5))
 #: deviations all larger than this many size tolerances: flagged as a units mistake
 UNITS_FACTOR = 100.0
+#: deviations all smaller than this (mm) are below what a CMM or a probe resolves: flagged
+#: as deviations in mm read as um
+TINY_DEVIATION = 5e-4
 #: default largest accepted deviation (mm): the option registry's ``max_offset``
 DEFAULT_MAX_OFFSET = OPTIONS["max_offset"].default
 #: lines named one by one before "and N more"
@@ -165,11 +168,16 @@ def unit_mistake(surface, points, max_offset, project):
 
 def units_warning(deviation, dimension, factor=UNITS_FACTOR):
     """A warning when every finite deviation is larger than ``factor`` times the size
-    tolerance of a face of ``dimension`` mm (see module doc), else None."""
+    tolerance of a face of ``dimension`` mm (see module doc), or when (three or more) all lie
+    below :data:`TINY_DEVIATION`; else None."""
     d = np.abs(np.asarray(deviation, dtype=float).ravel())
     d = d[np.isfinite(d)]
     if not d.size or dimension <= 0:
         return None
+    if d.size >= 3 and float(d.max()) < TINY_DEVIATION:
+        return ("every deviation is below %g um (largest %.3g um), under what a CMM or a probe "
+                "resolves: deviations in mm read as um? Check the units of the file"
+                % (TINY_DEVIATION * 1e3, float(d.max()) * 1e3))
     tol = size_tolerance(dimension)
     if float(d.min()) <= factor * tol:
         return None
