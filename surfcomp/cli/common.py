@@ -170,7 +170,8 @@ def print_summary(comp, rep, out=None):
                                             else "INCONSISTENT, used by --accept-stock"),
                  "  " + plausibility.residual_assumption(o.method, o.stock)]
     print("", file=out)
-    print("Correction:   method %s%s; applied along the normal: %.2f .. %.2f um (mean %.2f um)"
+    print("Correction:   method %s%s; applied along the normal: %.2f .. %.2f um (mean %.2f um; "
+          "+ = material removed)"
           % (o.method, extra, st["correction"].min * 1e3,
              st["correction"].max * 1e3, st["correction"].mean * 1e3), file=out)
     for line in notes:

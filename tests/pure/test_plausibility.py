@@ -114,3 +114,24 @@ def test_a_small_patch_measured_in_mm_is_no_unit_mistake(corner, size):
 
     surf, pts = _flat_face_and_points(1.0, corner, size, n=5)
     assert pl.unit_mistake(surf, pts, 1.0, project) is None
+
+
+@pytest.mark.parametrize("mask, warned", [(5, False), (7, True)])
+def test_a_mask_larger_than_the_grid_is_warned_about(mask, warned):
+    """A 7 x 7 mask over a 5 x 5 grid leaves the determined part nearly the grid's mean."""
+    from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+    from surfcomp.io.measurements import MeasurementSet
+
+    surf, pts = _flat_face_and_points(1.0, n=5)
+    nrm = np.tile([0.0, 0.0, 1.0], (25, 1))
+    pts[:, 2] = 1.0
+    dev = 0.01 * np.sin(pts[:, 0] / 20.0)
+    ms = MeasurementSet(nominal=pts, normal=nrm, deviation=dev, lines=np.arange(25) + 2,
+                        source="f.csv")
+    opts = Options(mask_size=mask)
+    prepared = prepare(surf, 1, ms, opts)
+    compensate(surf, 1, prepared, opts, build=False)
+    found = [w for w in prepared.warnings if "mask is larger" in str(w)]
+    assert found == (["f.csv: the 7 x 7 mask is larger than the 5 x 5 grid, the determined "
+                      "part is nearly the mean: a smaller mask_size keeps its shape"]
+                     if warned else [])

@@ -448,6 +448,12 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
         corr = compute_correction(d, options.method, None, options.edge, options.stock,
                                   determined=fit.determined)
     else:
+        if options.mask_size > min(d.shape):   # the determined part: nearly the grid's mean
+            prepared.warnings.append(note("%s: the %d x %d mask is larger than the %d x %d grid, "
+                                          "the determined part is nearly the mean: a smaller "
+                                          % ((prepared.source,) + (options.mask_size,) * 2
+                                             + d.shape), ("mask_size", option_name(
+                                              options, "mask_size")), " keeps its shape"))
         corr = compute_correction(d, options.method, options.mask(), options.edge, options.stock)
     stats = {"deviation": statistics(corr.deviation),
              "determined": statistics(corr.determined),
