@@ -16,10 +16,13 @@ def test_points_on_the_face_and_off_it(fresh_doc):
     nom.Shape = Part.read(EXAMPLE_STEP)
     assert precheck.nominal_candidate(doc) == (nom, "Face1")
     assert precheck.check_on_face(nom, None, read_any(EXAMPLE_CSV)) == ([], [])
-    # the coordinates read in um: 1000 x smaller, all near one corner, 5 beyond the border
+    # the coordinates read in um: 1000 x smaller, all near one corner (5 beyond the border),
+    # and on the face once multiplied by 1000
     errors, _ = precheck.check_on_face(nom, "Face1", read_any(EXAMPLE_CSV, units="um"))
-    assert errors == ["%s:46: point (0.0406, 0.0009, 0.0007) lies beyond the border of the "
-                      "face (5 point(s) do; expected points on the face)" % EXAMPLE_CSV]
+    assert errors == ["%s: the 2025 points span 0.06177 mm where the face spans 64.27 mm, and "
+                      "multiplied by 1000 they lie on it: the file's coordinates are in mm, not "
+                      "um (give the unit: units mm, or a column name like 'x [mm]')"
+                      % EXAMPLE_CSV]
     # the nominal moved: the points (in document coordinates) are 5 mm above the face
     nom.Placement = FreeCAD.Placement(FreeCAD.Vector(0, 0, -5), FreeCAD.Rotation())
     errors, _ = precheck.check_on_face(nom, "Face1", read_any(EXAMPLE_CSV))

@@ -48,9 +48,10 @@ def test_points_off_the_face_are_shown_in_the_preview(session):
     s = session["preview_units"]
     text, status, ok, coords, dev = s["both_um"]
     assert (coords, dev, ok) == ("um", "um", False)
-    assert status.startswith("Cannot import:") and "beyond the border of the face" in status
-    assert "ERRORS (1)" in text and "deviations_in_um.csv:46: point (0.0406, 0.0009, 0.0007) " \
-        "lies beyond the border of the face (5 point(s) do" in text
+    assert status.startswith("Cannot import:") and "multiplied by 1000 they lie on" in status
+    assert "ERRORS (1)" in text and "deviations_in_um.csv: the 2025 points span 0.06177 mm " \
+        "where the face spans 64.27 mm, and multiplied by 1000 they lie on it: the file's " \
+        "coordinates are in mm, not um" in text
     assert "nominal x         0.8822 .. 44.12        µm" in text
     assert s["after_ok_click"] == [True, 0]          # the click on OK did nothing
     assert s["back"] == ["2025 points, no errors", True, "mm", "um"]
@@ -74,8 +75,9 @@ def test_a_map_of_points_off_the_face_has_no_traceback(session):
     errors, unchanged, report = session["bad_map"]
     (title, message), = errors
     assert title == "SurfComp: Deviation map" and unchanged is True
-    assert message.startswith("Measurement") and "deviations_in_um.csv:46: point (0.0406, " \
-        "0.0009, 0.0007) lies beyond the border of the face" in message
+    assert message.startswith("Measurement") and "deviations_in_um.csv: the 2025 points " \
+        "span 0.06177 mm where the face spans 64.27 mm, and multiplied by 1000 they lie on it: " \
+        "the file's coordinates are in mm, not um" in message
     # nothing recomputed: no traceback, no "Recompute failed" (the dialog recorder stands in
     # for the message box and its Report view line)
     assert "Traceback" not in report and "Recompute failed" not in report

@@ -284,18 +284,15 @@ def test_deviation_without_normal_is_ignored_with_a_warning():
 
 
 def _flipped_table(n_flipped, n=25):
-    """A table with nominal, measured, normal and dev columns whose last ``n_flipped`` dev
-    values have the wrong sign, and the given dev column."""
+    """A table of all four whose last ``n_flipped`` dev values have the wrong sign; dev."""
     rng = np.random.default_rng(3)
     nom = np.column_stack([np.arange(n, dtype=float), rng.uniform(0, 10, n), np.zeros(n)])
     nrm = np.tile([0.0, 0.0, 1.0], (n, 1))
     dev = rng.uniform(0.01, 0.05, n)
-    given = dev.copy()
-    given[n - n_flipped:] *= -1.0
-    given[2] += 0.0009                                        # within 1 um: no warning
+    given = np.r_[dev[:n - n_flipped], -dev[n - n_flipped:]] + 0.0009 * (np.arange(n) == 2)
     rows = np.column_stack([nom, nom + dev[:, None] * nrm, nrm, given])
-    return nnd_text(header=["x_nom", "y_nom", "z_nom", "x_meas", "y_meas", "z_meas", "i", "j",
-                            "k", "dev"], rows=rows), given
+    head = ["x_nom", "y_nom", "z_nom", "x_meas", "y_meas", "z_meas", "i", "j", "k", "dev"]
+    return nnd_text(header=head, rows=rows), given
 
 
 def test_deviation_cross_check_caps_the_warnings_and_spots_the_sign():
@@ -311,9 +308,8 @@ def test_deviation_cross_check_caps_the_warnings_and_spots_the_sign():
 
 
 def test_a_dev_column_against_its_own_points_on_most_rows_is_refused():
-    """Half the rows or more with the dev column's sign flipped against the row's own
-    measured and nominal points: whichever is right, the correction would go the wrong way
-    for one of them (before: a warning, and the face built from the flipped column)."""
+    """Half the rows or more with dev flipped against their own points: refused (before: a
+    warning, and the face built from the flipped column)."""
     text, given = _flipped_table(13)
     with pytest.raises(MeasurementFileError) as err:
         parse_measurements(text, source="f.csv")

@@ -123,16 +123,21 @@ def offset_errors(deviation, lines=None, max_offset=DEFAULT_MAX_OFFSET, source="
     return out
 
 
-#: the length units a file's points are mistaken for in mm: (name, factor to mm, unit)
-UNIT_SCALES = (("inches", 25.4, "in"), ("centimetres", 10.0, "cm"), ("metres", 1000.0, "m"))
+#: length units a file's coordinates can be in: name -> (factor to mm, name in messages)
+LENGTH_UNITS = {"mm": (1.0, "mm"), "um": (1e-3, "um"), "in": (25.4, "inches"),
+                "cm": (10.0, "cm"), "m": (1000.0, "metres")}
+#: the factors by which coordinates read in the wrong unit are too small (inches, cm or
+#: metres read as mm; mm read as um ...)
+UNIT_SCALES = (25.4, 10.0, 1000.0)
 #: points spanning less than this share of the face's extent are checked for another unit
 SMALL_SPAN = 0.1
 #: the share of the points that must lie on the face once scaled to call it a unit mistake
 ON_FACE_SHARE = 0.9
 
 
-def unit_mistake(surface, points, max_offset, project):
-    """Why the ``points`` (N, 3) are in another length unit than mm, or None.
+def unit_mistake(surface, points, max_offset, project, read_as="mm"):
+    """Why the ``points`` (N, 3, mm as read in the unit ``read_as``) are in another length
+    unit than the one they were read in, or None.
 
     Only points that span less than :data:`SMALL_SPAN` of the face's extent (the diagonal
     of the bounding boxes) are tried: scaled by each factor of :data:`UNIT_SCALES`, at
@@ -152,17 +157,26 @@ def unit_mistake(surface, points, max_offset, project):
     span = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     if not span < SMALL_SPAN * face:
         return None
-    for name, factor, unit in UNIT_SCALES:
+    read_factor, read_name = LENGTH_UNITS.get(read_as, LENGTH_UNITS["mm"])
+    for factor in UNIT_SCALES:
         if not SMALL_SPAN * face <= span * factor <= 1.5 * face:
             continue    # scaled, they would still cover a corner, or more than the face
         r = project(surface, pts * factor)
         on = (np.abs(r.distance) <= max_offset) & ~np.asarray(r.outside, dtype=bool)
-        if on.mean() >= ON_FACE_SHARE:
-            option = "units %s, or " % unit if unit in INPUTS["units"].choices else ""
-            return ("the %d points span %.4g mm where the face spans %.4g mm, and multiplied "
-                    "by %g they lie on it: the file's coordinates are in %s, not mm (give "
-                    "the unit: %sa column name like 'x [%s]')"
-                    % (len(pts), span, face, factor, name, option, unit))
+        if on.mean() < ON_FACE_SHARE:
+            continue
+        unit = next((u for u, (f, _n) in LENGTH_UNITS.items()
+                     if abs(f / (read_factor * factor) - 1.0) < 1e-9), None)
+        if unit is None:
+            give = "give the coordinates' unit"
+        else:
+            give = "give the unit: %sa column name like 'x [%s]'" % (
+                "units %s, or " % unit if unit in INPUTS["units"].choices else "", unit)
+        return ("the %d points span %.4g mm where the face spans %.4g mm, and multiplied "
+                "by %g they lie on it: the file's coordinates are in %s, not %s (%s)"
+                % (len(pts), span, face, factor,
+                   LENGTH_UNITS[unit][1] if unit else "a %g times larger unit" % factor,
+                   read_name, give))
     return None
 
 
