@@ -135,3 +135,22 @@ def test_a_mask_larger_than_the_grid_is_warned_about(mask, warned):
     assert found == (["f.csv: the 7 x 7 mask is larger than the 5 x 5 grid, the determined "
                       "part is nearly the mean: a smaller mask_size keeps its shape"]
                      if warned else [])
+
+
+def test_points_in_a_tiny_patch_are_refused_before_a_huge_face_is_sampled():
+    """60 points within 0.05 mm on a 100 mm face would need a corrected face of 38137 x
+    38137 poles: refused with what it needs (before: a 43 GiB allocation, an internal
+    error)."""
+    from surfcomp.core.compensation.pipeline import Options, compensate, prepare
+    from surfcomp.errors import InputError
+    from surfcomp.io.measurements import MeasurementSet
+
+    surf, _pts = _flat_face_and_points(1.0)
+    xy = 40 + np.random.default_rng(1).uniform(0, 0.05, (60, 2))
+    ms = MeasurementSet(nominal=np.column_stack([xy, np.ones(60)]),
+                        normal=np.tile([0, 0, 1.0], (60, 1)), deviation=0.01 * np.sin(xy[:, 0]),
+                        lines=np.arange(60) + 2, source="f.csv")
+    prepared = prepare(surf, 1, ms, Options())
+    with pytest.raises(InputError, match=r"needs a corrected face of 38137 x 38137 poles \(at "
+                                         r"most 9000000 in all\): the points cover a tiny part"):
+        compensate(surf, 1, prepared, Options())

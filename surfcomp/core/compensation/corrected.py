@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...errors import InputError
 from ..limits import ACCEPT_TOL, MATCH_ITERATIONS, MATCH_TOL, OVERSHOOT_TOL
 from ..options import OPTIONS
 from ..progress import report, sub
@@ -160,6 +161,15 @@ class _Sampling:
                  added=None):
         new_u, new_v = added or _added_knots(nominal, spacing_u, spacing_v, refine, lines,
                                              per_step)
+        shape = tuple(len(knots) + len(new) - p - 1 for knots, new, p in zip(
+            (nominal.knots_u, nominal.knots_v), (new_u, new_v),
+            (nominal.degree_u, nominal.degree_v)))
+        if shape[0] * shape[1] > POLE_LIMIT:
+            # its sampling alone would take tens of GiB
+            raise InputError("carrying the correction at the points' spacing needs a corrected "
+                             "face of %d x %d poles (at most %d in all): the points cover a "
+                             "tiny part of the face, or lie very close together (a file in "
+                             "another unit?)" % (shape + (POLE_LIMIT,)))
         self.nominal = nominal
         self.fine = bspline.insert_knots(nominal, new_u, new_v)
         self.us = bspline.greville(self.fine.knots_u, self.fine.degree_u)
@@ -269,6 +279,10 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
 SMOOTH_PARTS = (1, 2, 4, 8)
 #: the smooth route stops refining beyond this many poles
 SMOOTH_POLE_BUDGET = 1.1e6
+#: a corrected face of more poles is refused before it is sampled: twice the 2127 x 2127
+#: poles (3.7 GB) a turned 1000 x 1000 grid once needed (docs/benchmarks.md); points in
+#: metres read as mm asked for 38137 x 38137 (tens of GiB)
+POLE_LIMIT = 9_000_000
 
 
 def smooth_knots(knots, lo, hi, field_knots, parts):
