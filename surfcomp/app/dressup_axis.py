@@ -215,7 +215,9 @@ class DressupAxisErrors(DressupProxy):
     def execute(self, obj):
         path, result = compensate_path(obj)
         obj.Path = path
-        if result is None:
+        if result is None:      # no base: nothing compensated, no figures of an earlier run
+            obj.FitSummary = []
+            obj.ErrorBefore = obj.ErrorAfter = obj.MaxCorrection = 0.0
             return
         model, prog_model, res = result
         pred = res.predicted(prog_model)

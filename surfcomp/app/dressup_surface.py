@@ -120,7 +120,8 @@ class DressupSurfaceCorrection(DressupProxy):
     def execute(self, obj):
         path, result = move_path(obj)
         obj.Path = path
-        if result is None:
+        if result is None:      # no base: nothing moved, no figures of an earlier run kept
+            obj.MovedMoves, obj.MaxMove, obj.ContactPoints = 0, 0.0, 0
             return
         res, fit, op = result
         obj.MovedMoves = int(op.moved.sum())

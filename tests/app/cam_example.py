@@ -55,6 +55,12 @@ def with_dressup(doc, job, comp, tmp, found):
                  op_kept=[(c.Name, dict(c.Parameters)) for c in op.Path.Commands] == before,
                  touched="Touched" in op.State)
     (tmp / "DRESSUP.ngc").write_text(cam_job.post_process(job, "linuxcnc", POST_ARGS))
+    # without a base: an empty path and none of those figures kept
+    d.Base = None
+    d.recompute()
+    found.update(no_base=[len(d.Path.Commands), d.MovedMoves, float(d.MaxMove.Value),
+                          d.ContactPoints])
+    d.Base = op                # deleting it puts its base back into the Job
     d.Proxy.onDelete(d, None)
     doc.removeObject(d.Name)
     doc.recompute()

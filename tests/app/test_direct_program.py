@@ -226,6 +226,7 @@ def test_the_dressup_posts_the_moved_program_without_cam(programs):
     assert found["op_kept"] and not found["touched"]
     assert found["ops"] == ["DressupSurfaceCorrection"]
     assert found["moved"] > 450 and found["contact"] > 450
+    assert found["no_base"] == [0, 0, 0.0, 0]
     assert 0.03 < found["max_move"] < 0.05
     nominal = load_nominal(EXAMPLE_STEP)
     posted = feed_points(rs274(tmp / "DRESSUP.ngc", tmp)[0])

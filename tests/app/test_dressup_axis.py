@@ -124,6 +124,11 @@ def test_dressup_on_a_profile_operation(home, doc):
     assert d.ErrorBefore.Value > 0.03 and d.ErrorAfter.Value < 1e-9
     assert d.MaxCorrection.Value == pytest.approx(d.ErrorBefore.Value, rel=0.05)
     assert any("delta_z(z)" in s for s in d.FitSummary)
+    # without a base: an empty path, and none of the figures above kept
+    d.Base = None
+    doc.recompute()
+    assert d.Path.Commands == [] and d.FitSummary == []
+    assert d.ErrorBefore.Value == d.ErrorAfter.Value == d.MaxCorrection.Value == 0.0
 
 
 def test_zero_errors_leave_the_path_unchanged(home, doc):

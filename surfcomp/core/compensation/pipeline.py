@@ -449,13 +449,9 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
         corr = compute_correction(d, options.method, None, options.edge, options.stock,
                                   determined=fit.determined)
     else:
-        if options.mask_size > min(d.shape):   # the determined part: nearly the grid's mean
-            prepared.warnings.append(note("%s: the %d x %d mask is larger than the %d x %d grid, "
-                                          "the determined part is nearly the mean: a smaller "
-                                          % ((prepared.source,) + (options.mask_size,) * 2
-                                             + d.shape), ("mask_size", option_name(
-                                              options, "mask_size")), " keeps its shape"))
         corr = compute_correction(d, options.method, options.mask(), options.edge, options.stock)
+    wide = [] if prepared.scattered else plausibility.mask_warning(
+        prepared.source, options.mask_size, d.shape, option_name(options, "mask_size"))
     stats = {"deviation": statistics(corr.deviation),
              "determined": statistics(corr.determined),
              "random": statistics(corr.random),
@@ -463,6 +459,7 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
     result = Compensation(prepared=prepared, options=options, correction=corr, statistics=stats,
                           fit=fit, scale=scale)
     if not build:
+        prepared.warnings.extend(wide)
         return result
     try:
         build_surface(result, surface, outward, corr.delta, progress=sub(progress, 0.05, 1.0))
@@ -471,6 +468,7 @@ def compensate(surface, outward, prepared, options=None, build=True, progress=No
         if again is None:
             raise
         return compensate(surface, outward, again, options, build, progress)
+    prepared.warnings.extend(wide)      # the grid route's, once it is the one taken
     report(progress, 1.0, "done")
     return result
 

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...errors import note
 from ..option_tables import INPUTS
 from ..options import OPTIONS
 
@@ -178,6 +179,16 @@ def unit_mistake(surface, points, max_offset, project, read_as="mm"):
                    LENGTH_UNITS[unit][1] if unit else "a %g times larger unit" % factor,
                    read_name, give))
     return None
+
+
+def mask_warning(source, mask_size, shape, option="mask_size"):
+    """``[note]`` when the mask is larger than the grid of ``shape`` in both directions:
+    the determined part is then nearly the grid's mean; else ``[]``."""
+    if mask_size <= max(shape):
+        return []
+    return [note("%s: the %d x %d mask is larger than the %d x %d grid, the determined part "
+                 "is nearly the mean: a smaller " % ((source, mask_size, mask_size) + tuple(shape)),
+                 ("mask_size", option), " keeps its shape")]
 
 
 def units_warning(deviation, dimension, factor=UNITS_FACTOR):
