@@ -40,28 +40,19 @@ def write_cmm_csv(path, P, N, d, header="x_nom,y_nom,z_nom,i,j,k,dev"):
 def realised_by_occt(face, P, N, reach=0.5):
     """Correction realised by ``face`` at points P along normals N, measured with OCCT.
 
-    The segment P +- reach N is intersected with the face's surface (GeomAPI_IntCS); the one
-    intersection inside the face's trim is X, and t with X = P - t N is returned. Where
-    there is not exactly one (a point on the trim, within OCCT's tolerance on either side),
-    the segment's common point with the face comes from BRepExtrema (distToShape), four
-    times slower a point on a trimmed face.
+    The segment P +- reach N is intersected with the face (distToShape gives the
+    common point); returns t with X = P - t N.
     """
     import FreeCAD
     import Part
 
-    surface = face.Surface
     out = []
     for p, n in zip(P.reshape(-1, 3), N.reshape(-1, 3)):
         a = FreeCAD.Vector(*(p - reach * n))
         b = FreeCAD.Vector(*(p + reach * n))
-        segment = Part.LineSegment(a, b)
-        crossings = (FreeCAD.Vector(x.X, x.Y, x.Z) for x in segment.intersectCS(surface)[0])
-        inside = [x for x in crossings if face.isPartOfDomain(*surface.parameter(x))]
-        if len(inside) != 1:
-            dist, pairs, _ = face.distToShape(segment.toShape())
-            assert dist < 1e-7, dist
-            inside = [pairs[0][0]]
-        x = np.array(tuple(inside[0]))
+        dist, pairs, _ = face.distToShape(Part.LineSegment(a, b).toShape())
+        assert dist < 1e-7, dist
+        x = np.array(tuple(pairs[0][0]))
         out.append(float(np.dot(p - x, n)))
     return np.array(out)
 
