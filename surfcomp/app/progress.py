@@ -104,6 +104,13 @@ def cam_errors(obj):
     return list(_CAM_ERRORS.get((obj.Document.Name, obj.Name), ()))
 
 
+def forget_cam_errors(doc):
+    """Drop what :func:`cam_errors` holds for the objects of ``doc`` (a new command starts:
+    an operation it does not recompute has no error of its own to report)."""
+    for key in [k for k in _CAM_ERRORS if k[0] == doc.Name]:
+        del _CAM_ERRORS[key]
+
+
 def state_text(obj):
     """Why ``obj`` failed to recompute (the errors the CAM workbench logged for it, else its
     status, else its state)."""

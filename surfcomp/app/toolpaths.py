@@ -129,7 +129,10 @@ def _same(a, b):
 
 
 def snapshot(doc):
-    """``{job name: {operation name: commands}}`` of every Job of ``doc``, before a change."""
+    """``{job name: {operation name: commands}}`` of every Job of ``doc``, before a change
+    (the CAM errors logged at earlier recomputes are forgotten: :func:`compare` reports
+    those of the recompute after the change)."""
+    recompute_order.forget_cam_errors(doc)
     return {job.Name: {op.Name: _commands(op) for op in operations(job)}
             for job in cam_job.jobs_of(doc)}
 

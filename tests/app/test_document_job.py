@@ -278,5 +278,8 @@ def test_a_cam_error_is_reported_as_failed_not_unchanged(shop, no_tool, route):
         assert toolpaths.describe([rep]) == [
             "Path job %s: Surface NOT regenerated, it failed: %s" % (rep.label, found.detail)]
         assert "Touched" in op.State        # not marked as recomputed
+        # a next command that does not recompute it does not report that failure again
+        (rep,) = toolpaths.compare(doc, toolpaths.snapshot(doc))
+        assert rep.operations[0].status == "unchanged"
     finally:
         FreeCAD.closeDocument(doc.Name)
