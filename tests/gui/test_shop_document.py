@@ -104,6 +104,18 @@ def test_restore_and_replace_report_the_regenerated_operation(session):
     assert session["after_replace"] == ["Round2", True]
 
 
+def test_an_operation_that_only_logs_its_failure_is_reported_failed(session):
+    """Before: 'Surface: tool path unchanged' (the replaced, now stale path kept)."""
+    infos, errors = session["no_tool"]
+    assert errors == [] and session["no_tool_kept"] is True
+    (_title, text), = infos
+    line, = [s for s in text.splitlines() if s.startswith("Path job Job: ")]
+    assert ("Surface NOT regenerated, it failed: the CAM workbench reported: No Tool "
+            "Controller is selected. We need a tool to build a Path.") in line
+    assert "DressupAxisErrors NOT regenerated: its base operation Surface was not" in line
+    assert "Surface regenerated" not in line and "tool path unchanged" not in line
+
+
 def test_the_commands_move_by_what_the_correction_implies(session):
     before = np.array(session["restored"])
     after = np.array(session["replaced"])
