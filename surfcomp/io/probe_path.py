@@ -145,12 +145,18 @@ class ProbeSettings:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
+#: the option names of the settings whose field names differ
+_OPTION_OF = {"standoff": "stand_off"}
+
+
 def _finite(name, value, low, high, low_open=False):
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
     if ok and (value > low if low_open else value >= low) and value <= high:
         return
+    option = _OPTION_OF.get(name, name)
     raise InputError("%s %r: expected a number %s %g and at most %g"
-                     % (name, value, "above" if low_open else "from", low, high))
+                     % (option, value, "above" if low_open else "from", low, high),
+                     options=(option,) if option in PLAN or option in PROGRAM else ())
 
 
 @dataclass

@@ -183,6 +183,11 @@ def test_simulate_at_a_written_plan(tmp_path):
     methods = {m["label"]: m for m in d["methods"]}
     assert methods["filtered"]["replicas"][0]["grid"]["count"] == 120
     assert methods["filtered"]["replicas"][0]["all"]["count"] == 29 * 29
+    # what the sets are, as counted (before: "grid = nodes only" for the plan's points)
+    assert d["probed_points"] == 120
+    assert d["where"] == ("all = the evaluation grid's points; grid = the 120 probed points "
+                          "of the plan; between = the evaluation grid's points between its "
+                          "nodes")
     # the example's default model: about 16.5 um before, well under a quarter after
     before = methods["none"]["replicas"][0]["all"]["std"]
     assert 0.014 < before < 0.019

@@ -219,10 +219,15 @@ def test_bad_point_counts(n):
 def test_bad_settings():
     for kw, text in ((dict(tip_radius=0.0), "--tip-radius"), (dict(max_tilt=91), "--max-tilt"),
                      (dict(edge_margin=-1), "--edge-margin"),
-                     (dict(clearance=float("nan")), "--clearance")):
+                     (dict(clearance=float("nan")), "--clearance"),
+                     # 0 as the probing program refuses it (a plan written without one took
+                     # it before: the touch starting at the face, the safe height on the top)
+                     (dict(stand_off=0.0), "--stand-off 0.0: expected a finite length above"),
+                     (dict(clearance=0.0), "--clearance 0.0: expected a finite length above")):
         with pytest.raises(InputError, match="^%s " % list(kw)[0]) as err:
             PlanSettings(**kw).check()
         assert err.value.shown(flag).startswith(text + " ")
+    assert PlanSettings(edge_margin=0.0).check().edge_margin == 0.0
 
 
 # ------------------------------------------------------------------ order and travel

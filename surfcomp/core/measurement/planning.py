@@ -96,13 +96,14 @@ class PlanSettings:
 
     def check(self):
         """Refuse values out of range, naming the option."""
-        for name, low in (("tip_radius", 0.0), ("edge_margin", 0.0), ("stand_off", 0.0),
-                          ("clearance", 0.0)):
+        # the probe starts its touch off the face and moves at a safe height above the part:
+        # stand-off and clearance above 0, as the probing program needs them
+        for name in ("tip_radius", "edge_margin", "stand_off", "clearance"):
             val = getattr(self, name)
-            if not (np.isfinite(val) and val >= low) or (name == "tip_radius" and val <= 0):
+            above = name != "edge_margin"
+            if not (np.isfinite(val) and (val > 0 if above else val >= 0)):
                 raise InputError("%s %r: expected a finite length %s 0 mm"
-                                 % (name, val, "above" if name == "tip_radius" else ">="),
-                                 options=(name,))
+                                 % (name, val, "above" if above else ">="), options=(name,))
         if not (np.isfinite(self.max_tilt) and 0 <= self.max_tilt <= 90):
             raise InputError("max_tilt %r: expected an angle from 0 to 90 degrees"
                              % (self.max_tilt,), options=("max_tilt",))

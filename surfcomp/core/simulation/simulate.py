@@ -363,7 +363,8 @@ def simulate(surface, outward, model=None, grid=(45, 45), specs=None, replicas=4
     n, m = layout.grid
     result = SimulationResult(model=model, specs=specs, grid=(n, m), eval_shape=layout.eval_shape,
                               between=b, margin=margin, replicas=int(replicas), seed=int(seed),
-                              noise_floor=model.noise_floor(nrm.reshape(-1, 3)))
+                              noise_floor=model.noise_floor(nrm.reshape(-1, 3)),
+                              probed=None if points is None else len(prepared.u))
     steps = replicas * (1 + len(specs))
     k = 0
     for r in range(replicas):
@@ -441,6 +442,8 @@ class SimulationResult:
     semi_error: dict = field(default_factory=dict)
     points: object = None
     preset: object = None
+    #: the plan's points measured instead of the grid nodes (None: the nodes)
+    probed: int = None
 
     @property
     def labels(self):
@@ -519,7 +522,11 @@ class SimulationResult:
                "between": self.between, "margin": self.margin,
                "replicas": self.replicas, "seed": self.seed,
                "where": "all = grid nodes and points between them; grid = nodes only; "
-                        "between = the points between nodes",
+                        "between = the points between nodes" if self.probed is None else
+                        "all = the evaluation grid's points; grid = the %d probed points of "
+                        "the plan; between = the evaluation grid's points between its nodes"
+                        % self.probed,
+               "probed_points": self.probed,
                "before": block(self.before),
                "methods": methods,
                "table": self.table(),
