@@ -18,6 +18,10 @@ OVERSHOOT_TOL = 1e-3
 #: below this integral of the correction (mm^3) a volume check gives no relative figure
 #: (a nil correction: the difference alone is reported)
 NIL_INTEGRAL = 1e-9
+#: a corrected face of more poles is refused before it is sampled: twice the 2127 x 2127
+#: poles (3.7 GB) a turned 1000 x 1000 grid once needed (docs/benchmarks.md); points in
+#: metres read as mm asked for 38137 x 38137 (tens of GiB)
+POLE_LIMIT = 9_000_000
 #: target of the residual iteration at the measured points (0.02 um)
 MATCH_TOL = 2e-5
 #: iterations of the residual iteration at most

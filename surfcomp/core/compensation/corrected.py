@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from ..limits import ACCEPT_TOL, MATCH_ITERATIONS, MATCH_TOL, OVERSHOOT_TOL
+from ..limits import ACCEPT_TOL, MATCH_ITERATIONS, MATCH_TOL, OVERSHOOT_TOL, POLE_LIMIT
 from ..options import OPTIONS
 from ..progress import report, sub
 from ..surface import bspline
@@ -279,10 +279,6 @@ def construct(nominal, U, V, delta, outward=1, spacing_u=None, spacing_v=None,
 SMOOTH_PARTS = (1, 2, 4, 8)
 #: the smooth route stops refining beyond this many poles
 SMOOTH_POLE_BUDGET = 1.1e6
-#: a corrected face of more poles is refused before it is sampled: twice the 2127 x 2127
-#: poles (3.7 GB) a turned 1000 x 1000 grid once needed (docs/benchmarks.md); points in
-#: metres read as mm asked for 38137 x 38137 (tens of GiB)
-POLE_LIMIT = 9_000_000
 
 
 def smooth_knots(knots, lo, hi, field_knots, parts):
