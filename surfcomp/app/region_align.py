@@ -101,8 +101,9 @@ def _absorbed(record, refs, own, before_points, after, assign):
     record.absorbed = dict(absorbed(before[on], after[on], normal[on]), where="region")
     record.warnings.append(
         "the best fit used the region's faces themselves: it absorbed a mean offset of %.3f "
-        "um and a tilt of %.3f um of the machining error, which the corrected faces will "
-        "leave in the part (name datum faces with --align-faces to keep them)"
+        "um and a tilt of %.3f um, of the machining error or of the points' frame (the fit "
+        "cannot tell them apart); what is machining error the corrected faces will leave in "
+        "the part (name datum faces with --align-faces to keep it)"
         % (record.absorbed["mean_offset_um"], record.absorbed["tilt_um"]))
 
 

@@ -274,6 +274,13 @@ def _section_statistics(report, arrays):
         note = ("<p>Expected RMS of the next part (predicted residual plus a new random scatter "
                 'like this one): <span class="num">%.2f µm</span>.</p>'
                 % (1e3 * float(np.hypot(rms_res, rms_rnd))))
+        absorbed = (report.get("alignment") or {}).get("absorbed")
+        if absorbed:
+            # the prediction is in the fitted frame: what the fit absorbed stays in the part
+            note += ("<p>That figure is in the best fit's frame: the mean offset (%.3f µm) and "
+                     "tilt (%.3f µm) the fit absorbed on the compensated face are not in it, and "
+                     "what of them is machining error stays in the next part.</p>"
+                     % (absorbed["mean_offset_um"], absorbed["tilt_um"]))
     assumes = report.get("method", {}).get("residual_assumes")
     if assumes:
         note += "<p>Predicted residual: %s.</p>" % _e(assumes)

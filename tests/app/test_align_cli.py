@@ -66,6 +66,10 @@ def test_bestfit_on_the_compensated_face_reports_what_it_absorbed(tmp_path):
     assert "Alignment:    bestfit" in out.stdout and "iterations, converged" in out.stdout
     page = (tmp_path / "r.html").read_text()
     assert '<section id="alignment">' in page and "Absorbed on the compensated face" in page
+    # the next part's prediction is in the fitted frame, and says so with what it leaves out
+    assert "Expected RMS of the next part" in page
+    assert ("That figure is in the best fit's frame: the mean offset (%.3f µm)"
+            % a["absorbed"]["mean_offset_um"]) in page
     # from the measuring frame itself: the absorbed part cannot be told apart from the move
     out = run_in_process("inspect", EXAMPLE_STEP, _points(tmp_path, MOVE), "--align",
                          "bestfit", "--report", tmp_path / "f.json", "--quiet")

@@ -238,10 +238,11 @@ def _absorbed_warning(absorbed_, normal, shift):
                     "near with " % moved, ("transform",), ", or name datum faces with ",
                     ("align_faces",), ")")
     return note("the best fit used the compensated face itself: it absorbed a mean offset of "
-                "%.3f um and a tilt of %.3f um of the machining error, which the corrected face "
+                "%.3f um and a tilt of %.3f um, of the machining error or of the points' frame "
+                "(the fit cannot tell them apart); what is machining error the corrected face "
                 "will leave in the part (name datum faces with "
                 % (absorbed_["mean_offset_um"], absorbed_["tilt_um"]), ("align_faces",),
-                " to keep them)")
+                " to keep it)")
 
 
 __all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms",
