@@ -90,7 +90,7 @@ def settings_of(op):
         tool=int(tc.ToolNumber) if tc is not None else _DEF.tool,
         work_offset=op.WorkOffset,
         safe_z=float(plan.SafeZ) - float(plan.TipRadius) - float(plan.Clearance),
-        clearance=float(plan.Clearance), standoff=float(plan.StandOff),
+        clearance=float(plan.Clearance), stand_off=float(plan.StandOff),
         overtravel=float(op.Overtravel), feed=float(op.Feed), touch_feed=float(op.TouchFeed),
         log_file=op.LogFile)
 

@@ -17,7 +17,7 @@ it cannot be made first: a best fit or a 3-2-1 alignment needs the region's face
 import numpy as np
 
 from ..core.measurement.align import Distances, Reference, apply
-from ..core.measurement.align_report import absorbed, align
+from ..core.measurement.align_report import absorbed, absorbed_note, align
 from ..errors import InputError
 from .align_doc import options_of
 from .alignment import assigned_faces, subset
@@ -99,12 +99,8 @@ def _absorbed(record, refs, own, before_points, after, assign):
     if not on.any():
         return
     record.absorbed = dict(absorbed(before[on], after[on], normal[on]), where="region")
-    record.warnings.append(
-        "the best fit used the region's faces themselves: it absorbed a mean offset of %.3f "
-        "um and a tilt of %.3f um, of the machining error or of the points' frame (the fit "
-        "cannot tell them apart); what is machining error the corrected faces will leave in "
-        "the part (name datum faces with --align-faces to keep it)"
-        % (record.absorbed["mean_offset_um"], record.absorbed["tilt_um"]))
+    record.warnings.append(absorbed_note(record.absorbed, "the region's faces themselves",
+                                         "faces"))
 
 
 __all__ = ["aligned", "references"]

@@ -35,7 +35,7 @@ def settings_from_args(args, safe_z, plan_hash):
     return ProbeSettings(
         dialect=args.dialect, tip_radius=args.tip_radius, tool=args.tool,
         work_offset=args.work_offset, safe_z=safe_z, clearance=args.clearance,
-        standoff=args.stand_off, overtravel=args.overtravel, feed=args.feed,
+        stand_off=args.stand_off, overtravel=args.overtravel, feed=args.feed,
         touch_feed=args.touch_feed, second_touch=args.second_touch,
         second_feed=args.second_feed, backoff=args.backoff, plan_hash=plan_hash,
         log_file=args.probe_log)

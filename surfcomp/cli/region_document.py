@@ -7,6 +7,7 @@ import sys
 
 from ..errors import InputError
 from .common import ProgressLine
+from .option_flags import shown
 
 
 def run_region_document_command(args):
@@ -45,5 +46,5 @@ def run_region_document_command(args):
     for line in summary_lines(res):
         print(line)
     for w in res.alignment_warnings:
-        print("warning: " + w, file=sys.stderr)
+        print("warning: " + shown(w), file=sys.stderr)
     return 0

@@ -8,9 +8,9 @@ contact is ``c = p + R n``. Per point, in the plan's order:
 
 1. traverse at the safe height ``Zs = safe_z + R + clearance`` (the ball's lowest point
    ``clearance`` above the part's top ``safe_z``) to above the retract point
-   ``r = c + max(clearance, standoff) n``, then traverse down to ``r``;
-2. feed at the fast feed to the stand-off point ``s = c + standoff n`` (the fast
-   approach; left out when ``standoff >= clearance``: then ``r`` is ``s``);
+   ``r = c + max(clearance, stand_off) n``, then traverse down to ``r``;
+2. feed at the fast feed to the stand-off point ``s = c + stand_off n`` (the fast
+   approach; left out when ``stand_off >= clearance``: then ``r`` is ``s``);
 3. probe at the touch feed from there along ``-n`` to ``e = c - overtravel n``, the
    overtravel past the nominal contact (the probe stops at the contact);
 4. with ``second_touch``: back off ``backoff`` along ``n`` from where the probe stopped
@@ -58,7 +58,7 @@ class ProbeSettings:
         The part's top (highest Z of the part in the work offset).
     clearance : float
         How far the ball stays from the part during traverses.
-    standoff : float
+    stand_off : float
         Distance along the normal from the nominal contact at which the probe move starts.
     overtravel : float
         How far past the nominal contact the probe move is programmed to end.
@@ -87,7 +87,7 @@ class ProbeSettings:
     work_offset: str = PROGRAM["work_offset"].default
     safe_z: float = None
     clearance: float = PLAN["clearance"].default
-    standoff: float = PLAN["stand_off"].default
+    stand_off: float = PLAN["stand_off"].default
     overtravel: float = PROGRAM["overtravel"].default
     feed: float = PROGRAM["feed"].default
     touch_feed: float = PROGRAM["touch_feed"].default
@@ -120,7 +120,7 @@ class ProbeSettings:
             raise InputError("safe_z (the part's top) is needed for the safe height")
         _finite("safe_z", self.safe_z, -MAX_COORDINATE, MAX_COORDINATE)
         _finite("tip_radius", self.tip_radius, 0.0, 50.0, low_open=True)
-        for name in ("clearance", "standoff", "overtravel", "backoff"):
+        for name in ("clearance", "stand_off", "overtravel", "backoff"):
             _finite(name, getattr(self, name), 0.0, 1000.0, low_open=True)
         for name in ("feed", "touch_feed"):
             _finite(name, getattr(self, name), 0.0, 1e6, low_open=True)
@@ -128,10 +128,10 @@ class ProbeSettings:
         if self.touch_feed > self.feed:
             raise InputError("touch_feed %g mm/min is above feed %g mm/min (expected a slow "
                              "touch after a fast approach)" % (self.touch_feed, self.feed))
-        if self.second_touch and self.backoff > self.standoff:
+        if self.second_touch and self.backoff > self.stand_off:
             raise InputError("backoff %g mm is larger than standoff %g mm (expected the second "
                              "touch to start inside the first one's approach)"
-                             % (self.backoff, self.standoff))
+                             % (self.backoff, self.stand_off))
         if self.log_file and any(ch in self.log_file for ch in "()\r\n;"):
             raise InputError("log_file %r: a file name in a G-code comment cannot hold "
                              "parentheses, ';' or line breaks" % self.log_file)
@@ -145,18 +145,13 @@ class ProbeSettings:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
 
-#: the option names of the settings whose field names differ
-_OPTION_OF = {"standoff": "stand_off"}
-
-
 def _finite(name, value, low, high, low_open=False):
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
     if ok and (value > low if low_open else value >= low) and value <= high:
         return
-    option = _OPTION_OF.get(name, name)
     raise InputError("%s %r: expected a number %s %g and at most %g"
-                     % (option, value, "above" if low_open else "from", low, high),
-                     options=(option,) if option in PLAN or option in PROGRAM else ())
+                     % (name, value, "above" if low_open else "from", low, high),
+                     options=(name,) if name in PLAN or name in PROGRAM else ())
 
 
 @dataclass
@@ -239,9 +234,9 @@ def probe_path(ids, points, normals, settings):
     R = s.tip_radius
     contact = P + R * N
     return ProbePath(ids=ids, points=P, normals=N, contact=contact,
-                     retract=contact + max(s.clearance, s.standoff) * N,
-                     standoff=contact + s.standoff * N,
-                     end=contact - s.overtravel * N, approach=s.standoff < s.clearance,
+                     retract=contact + max(s.clearance, s.stand_off) * N,
+                     standoff=contact + s.stand_off * N,
+                     end=contact - s.overtravel * N, approach=s.stand_off < s.clearance,
                      safe=s.safe_height(), backoff=s.backoff if s.second_touch else 0.0)
 
 

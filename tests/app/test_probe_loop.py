@@ -224,7 +224,7 @@ def test_second_touch_round_trip(loop, probed):
     --touches 2."""
     tmp = loop["tmp"]
     s = ProbeSettings(tip_radius=R, safe_z=loop["solid"].BoundBox.ZMax, clearance=CLEARANCE,
-                      standoff=2.0, overtravel=OVERTRAVEL, second_touch=True, backoff=1.0)
+                      stand_off=2.0, overtravel=OVERTRAVEL, second_touch=True, backoff=1.0)
     prog = tmp / "probe2.ngc"
     summary = write_probe_program(str(prog), loop["ids"], loop["P"], loop["N"], s)
     probes, worst = check_probe_moves(rs274_moves(prog, tmp, diameter=2 * R), loop["P"],

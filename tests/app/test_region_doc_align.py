@@ -126,6 +126,7 @@ def test_bestfit_on_the_region_itself_says_what_it_absorbed(shop):
     absorbed = a["absorbed"]
     assert "absorbed a mean offset of %.3f um and a tilt of %.3f um" \
         % (absorbed["mean_offset_um"], absorbed["tilt_um"]) in r.stderr
+    assert "(name datum faces with --align-faces to keep it)" in r.stderr
     assert a["faces"] == ["Face1", "Face2"] and a["dof"] == ["z", "rx", "ry"]
     # the summary speaks of the region, not of one face
     assert absorbed["where"] == "region"

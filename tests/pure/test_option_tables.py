@@ -103,7 +103,7 @@ def test_the_dataclasses_default_to_the_registry():
     for name, o in PROGRAM.items():
         assert probe[name] == o.default, name
     for name, plan_name in (("tip_radius", "tip_radius"), ("clearance", "clearance"),
-                            ("standoff", "stand_off")):
+                            ("stand_off", "stand_off")):
         assert probe[name] == PLAN[plan_name].default, name
     model = {f.name: f.default for f in dataclasses.fields(MachiningModel)}
     for name, o in MODEL.items():

@@ -33,7 +33,7 @@ def dome_plan(n=37, seed=3):
 
 
 def settings(**kw):
-    base = dict(tip_radius=R, safe_z=10.0, plan_hash=HASH, clearance=4.0, standoff=2.0,
+    base = dict(tip_radius=R, safe_z=10.0, plan_hash=HASH, clearance=4.0, stand_off=2.0,
                 overtravel=1.0)
     base.update(kw)
     return ProbeSettings(**base)
@@ -179,7 +179,7 @@ def test_program_options_from_the_command_line(tmp_path):
     moves = rs274_moves(prog, tmp_path, tool=7, diameter=3.0)
     check_probe_moves(moves, P, N, 1.5, 1.0)
     _text, path = program_text(ids, P, N, ProbeSettings(
-        tip_radius=1.5, safe_z=10.0, clearance=4.0, standoff=2.0, overtravel=1.0))
+        tip_radius=1.5, safe_z=10.0, clearance=4.0, stand_off=2.0, overtravel=1.0))
     total = float(re.search(r"Travel: +([0-9.]+) mm", lines[1]).group(1))
     pos, _kinds = path.polyline()
     assert abs(total - np.linalg.norm(np.diff(pos, axis=0), axis=1).sum()) < 0.05

@@ -18,7 +18,6 @@ from ..memory import return_free_memory
 from ..options import DOMAINS as _DOMAINS
 from ..options import OPTIONS
 from ..progress import report, sub
-from ..surface import bspline
 from ..surface.grid import Scattered, grid_from_indices, grid_from_uv
 from ..surface.kdtree import cKDTree
 from ..surface.projection import project, tangent_lengths
@@ -326,9 +325,7 @@ def _check_units(surface, d, warnings, source):
     """Warn when every deviation is far beyond the face's size tolerance (see
     :mod:`surfcomp.core.compensation.plausibility`): plausible against max-offset, but not for a
     part."""
-    us = np.linspace(surface.u_range[0], surface.u_range[1], 9)
-    vs = np.linspace(surface.v_range[0], surface.v_range[1], 9)
-    size = plausibility.largest_dimension(bspline.evaluate_grid(surface, us, vs))
+    size = plausibility.largest_dimension(plausibility.face_samples(surface))
     message = plausibility.units_warning(d, size)
     if message:
         warnings.append("%s: %s" % (source, message))

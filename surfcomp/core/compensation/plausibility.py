@@ -136,6 +136,15 @@ SMALL_SPAN = 0.1
 ON_FACE_SHARE = 0.9
 
 
+def face_samples(surface, n=9):
+    """Points of the face on an ``n`` x ``n`` grid of its parameters, (n * n, 3): its extent
+    for the checks here."""
+    from ..surface import bspline
+
+    return bspline.evaluate_grid(surface, np.linspace(*surface.u_range, n),
+                                 np.linspace(*surface.v_range, n)).reshape(-1, 3)
+
+
 def unit_mistake(surface, points, max_offset, project, read_as="mm"):
     """Why the ``points`` (N, 3, mm as read in the unit ``read_as``) are in another length
     unit than the one they were read in, or None.
@@ -150,10 +159,7 @@ def unit_mistake(surface, points, max_offset, project, read_as="mm"):
     pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts) < 3:
         return None
-    from ..surface import bspline
-
-    grid = bspline.evaluate_grid(surface, np.linspace(*surface.u_range, 9),
-                                 np.linspace(*surface.v_range, 9)).reshape(-1, 3)
+    grid = face_samples(surface)
     face = float(np.linalg.norm(grid.max(axis=0) - grid.min(axis=0)))
     span = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     if not span < SMALL_SPAN * face:

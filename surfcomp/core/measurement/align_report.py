@@ -237,13 +237,20 @@ def _absorbed_warning(absorbed_, normal, shift):
                     "error's mean and tilt cannot be told apart from that move (bring them "
                     "near with " % moved, ("transform",), ", or name datum faces with ",
                     ("align_faces",), ")")
-    return note("the best fit used the compensated face itself: it absorbed a mean offset of "
-                "%.3f um and a tilt of %.3f um, of the machining error or of the points' frame "
-                "(the fit cannot tell them apart); what is machining error the corrected face "
-                "will leave in the part (name datum faces with "
-                % (absorbed_["mean_offset_um"], absorbed_["tilt_um"]), ("align_faces",),
-                " to keep it)")
+    return absorbed_note(absorbed_)
 
 
-__all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "align", "per_face_rms",
-           "summary_lines"]
+def absorbed_note(absorbed_, fitted="the compensated face itself", corrected="face"):
+    """The warning that a best fit on the ``fitted`` faces absorbed ``absorbed_``
+    (:func:`absorbed`), which the corrected ``corrected`` leaves in the part as far as it
+    is machining error (face and region routes)."""
+    return note("the best fit used %s: it absorbed a mean offset of %.3f um and a tilt of "
+                "%.3f um, of the machining error or of the points' frame (the fit cannot tell "
+                "them apart); what is machining error the corrected %s will leave in the part "
+                "(name datum faces with " % (fitted, absorbed_["mean_offset_um"],
+                                             absorbed_["tilt_um"], corrected),
+                ("align_faces",), " to keep it)")
+
+
+__all__ = ["AlignOptions", "Alignment", "Reference", "absorbed", "absorbed_note", "align",
+           "per_face_rms", "summary_lines"]
