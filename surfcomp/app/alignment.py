@@ -29,7 +29,8 @@ def references(nominal, names):
     """``(references, index of the compensated face, passive indices)``: the named faces of
     the nominal's shape and the compensated face (passive when not named: it only claims
     its points), or the compensated face alone."""
-    from .nominal import nominal_from_face, pick_face
+    from .face_data import pick_face
+    from .nominal import nominal_from_face
 
     own = Reference(nominal.face_name, nominal.surface, nominal.outward)
     if not names:

@@ -5,6 +5,7 @@ import numpy as np
 
 from ..core.memory import collector_paused
 from ..core.surface.bspline import Surface, compress_knots
+from .face_data import raw_surface
 
 
 def _flat_knots(knots, mults):
@@ -23,19 +24,18 @@ def surface_from_part(bs, u_range=None, v_range=None):
     u_range, v_range : (float, float), optional
         The face's parameter bounds; default: the surface's own bounds.
     """
-    if bs.isUPeriodic() or bs.isVPeriodic():
-        bs = bs.copy()
-        if bs.isUPeriodic():
-            bs.setUNotPeriodic()
-        if bs.isVPeriodic():
-            bs.setVNotPeriodic()
+    return surface_from_raw(raw_surface(bs), u_range, v_range)
+
+
+def surface_from_raw(raw, u_range=None, v_range=None):
+    """The core :class:`Surface` of a :class:`surfcomp.app.face_data.RawSurface`
+    (``u_range``, ``v_range`` as :func:`surface_from_part`)."""
     with collector_paused():
-        poles = np.array([[tuple(p) for p in row] for row in bs.getPoles()], dtype=float)
-    weights = (np.array(bs.getWeights(), dtype=float) if bs.isURational() or bs.isVRational()
-               else None)
-    ku = _flat_knots(bs.getUKnots(), bs.getUMultiplicities())
-    kv = _flat_knots(bs.getVKnots(), bs.getVMultiplicities())
-    return Surface(poles, ku, kv, bs.UDegree, bs.VDegree, weights, u_range, v_range)
+        poles = np.array(raw.poles, dtype=float)
+    weights = None if raw.weights is None else np.array(raw.weights, dtype=float)
+    ku = _flat_knots(raw.u_knots, raw.u_mults)
+    kv = _flat_knots(raw.v_knots, raw.v_mults)
+    return Surface(poles, ku, kv, raw.u_degree, raw.v_degree, weights, u_range, v_range)
 
 
 def surface_to_part(surf):

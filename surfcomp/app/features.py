@@ -367,7 +367,8 @@ def nominal_in(nom_obj, face_name=None, label=None):
     """The :class:`~surfcomp.app.nominal.Nominal` of face ``face_name`` (None: the only
     B-spline face) of a document object, in its own coordinates, and its Placement;
     ``label`` names the asking object in messages."""
-    from .nominal import nominal_from_face, pick_face
+    from .face_data import pick_face
+    from .nominal import nominal_from_face
 
     shape = getattr(nom_obj, "Shape", None)
     if shape is None or shape.isNull() or not shape.Faces:
@@ -570,7 +571,7 @@ def make_compensation(doc, nominal, face, measurement, method="filtered",
     obj.StockOk = bool(accept_stock)
     obj.Output = output
     if not obj.FaceName:
-        from .nominal import pick_face
+        from .face_data import pick_face
         obj.FaceName = pick_face(nominal.Shape, None, source=nominal.Label)[1]
     return _created(obj)
 

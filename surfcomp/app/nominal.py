@@ -10,12 +10,13 @@ from functools import cached_property
 
 import numpy as np
 
-from ..core.surface.surface_checks import MAX_DEGREE, check_nominal
+from ..core.surface.surface_checks import check_nominal
 from ..core.surface.trimmed import inside, whole_domain
 from ..errors import GeometryError
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
-from .convert import surface_from_part
+from .convert import surface_from_raw
+from .face_data import EDGE_POINTS, boundary_points, face_data, line_ends, pick_face, surface_type
 
 
 @dataclass
@@ -31,13 +32,18 @@ class Nominal:
         or its ``toNurbs`` form; its pcurves are in the parametrisation of ``surface``.
     surface : surfcomp.core.surface.bspline.Surface
         Core arrays of ``bspline_face.Surface`` made non-periodic and cut to the face's UV
-        bounds (:func:`work_surface`, same parametrisation); ``u_range``/``v_range`` = those
-        bounds.
+        bounds (:func:`surfcomp.app.face_data.work_surface`, same parametrisation);
+        ``u_range``/``v_range`` = those bounds.
     outward : int
         +1 when the face's outward normal is Su x Sv, -1 when the face is reversed.
     source, face_name, object_name : str
     converted : str or None
         What the original surface was when it had to be converted (e.g. 'Cylinder').
+    data : surfcomp.app.face_data.FaceData
+        The face as plain data (:func:`nominal_from_data`). A nominal the reader child sent
+        (:func:`surfcomp.app.cadread.take_face`) has only this: ``face``, ``bspline_face``
+        and ``shape`` are None (the process has no FreeCAD), and its ``data`` holds the
+        boundary polylines.
     """
 
     face: object
@@ -49,14 +55,21 @@ class Nominal:
     object_name: str = None
     converted: str = None
     shape: object = None
+    data: object = None
 
     @cached_property
     def untrimmed(self):
         """True when the face is bounded by its surface's whole domain
         (:func:`bounds_whole_domain`), told once for the trim warning, the correction's
         volume and the direct program's trim."""
-        return bounds_whole_domain(self.bspline_face, self.surface.u_range,
-                                   self.surface.v_range)
+        ends = self.data.line_ends if self.data is not None else line_ends(self.bspline_face)
+        return ends_whole_domain(ends, self.surface.u_range, self.surface.v_range)
+
+    def boundary(self):
+        """The face's :func:`boundary_polylines` (:data:`EDGE_POINTS` per edge)."""
+        if self.data is not None and self.data.boundary is not None:
+            return [np.array(p, dtype=float) for p in self.data.boundary]
+        return boundary_polylines(self.bspline_face)
 
 
 def read_shape(path, object_name=None):
@@ -113,95 +126,6 @@ def _shape_from_document(path, object_name):
             FreeCAD.closeDocument(doc.Name)
 
 
-def pick_face(shape, face_name=None, source=None):
-    """Return ``(face, 'FaceN')``: the named face, or the only B-spline face of ``shape``."""
-    faces = shape.Faces
-    if face_name:
-        name = face_name.strip()
-        if not (name.startswith("Face") and name[4:].isdigit()):
-            raise GeometryError("invalid face name %r (expected Face1 .. Face%d)"
-                                % (face_name, len(faces)), file=source)
-        k = int(name[4:])
-        if not 1 <= k <= len(faces):
-            raise GeometryError("the shape has no %s (it has %d faces: Face1 .. Face%d)"
-                                % (name, len(faces), len(faces)), file=source)
-        return faces[k - 1], name
-    bs = [(k, f) for k, f in enumerate(faces, 1) if surface_type(f) == "BSplineSurface"]
-    if len(faces) == 1:
-        return faces[0], "Face1"
-    if len(bs) == 1:
-        return bs[0][1], "Face%d" % bs[0][0]
-    kinds = {}
-    for f in faces:
-        kind = surface_type(f) or "unreadable"
-        kinds[kind] = kinds.get(kind, 0) + 1
-    raise GeometryError("%s B-spline faces among %d faces (%s): choose one with --face FaceN"
-                        % ("no" if not bs else "%d" % len(bs), len(faces),
-                           ", ".join("%d %s" % (c, k) for k, c in sorted(kinds.items())))
-                        + ("; B-spline faces: " + ", ".join("Face%d" % k for k, _ in bs[:20])
-                           if bs else ""), file=source)
-
-
-def surface_type(face):
-    """The face's surface type (``'BSplineSurface'``, ``'Plane'``, ...), or None when
-    OpenCASCADE holds no surface for it (a B-spline read with a degree above its limit)."""
-    try:
-        return face.Surface.TypeId.split("::Geom")[-1]
-    except (TypeError, RuntimeError, AttributeError):
-        return None
-
-
-def to_bspline_face(face):
-    """Return ``(bspline_face, converted)``: the face's geometry as a B-spline face.
-
-    B-spline faces are kept as they are; Bezier, analytic, revolution, extrusion and
-    offset surfaces are converted with OCCT (``Face.toNurbs``), which keeps the geometry,
-    the boundary (its pcurves move to the B-spline's parametrisation), the order of the
-    edges and the orientation.
-    """
-    import Part
-
-    converted = surface_type(face)
-    if converted is None:
-        raise GeometryError("the face's surface cannot be read: OpenCASCADE holds no surface "
-                            "for it (a B-spline of degree above %d, its limit, or a damaged "
-                            "file?)" % MAX_DEGREE)
-    if converted == "BSplineSurface":
-        return face, None
-    try:
-        return face.toNurbs().Faces[0], converted
-    except (Part.OCCError, RuntimeError, IndexError) as exc:
-        raise GeometryError("cannot convert the %s face to a B-spline surface: %s"
-                            % (converted, exc)) from exc
-
-
-#: share of the face's UV range the work surface keeps beyond the face's UV bounds (where
-#: the underlying surface extends that far): the edges of a neighbour re-trimmed to meet the
-#: corrected face can leave the face's UV box by the correction's slope, and their 2D curves
-#: must stay on the surface (else a STEP reader that rebuilds them, OCCT 7.7 and later,
-#: widens the edge's tolerance to the gap)
-WORK_MARGIN = 0.05
-
-
-def work_surface(bface):
-    """The B-spline surface of ``bface`` made non-periodic and cut to the face's UV bounds
-    widened by :data:`WORK_MARGIN` (same parametrisation): the surface the compensation
-    works on."""
-    u0, u1, v0, v1 = bface.ParameterRange
-    du, dv = WORK_MARGIN * (u1 - u0), WORK_MARGIN * (v1 - v0)
-    u0, u1, v0, v1 = u0 - du, u1 + du, v0 - dv, v1 + dv
-    bs = bface.Surface.copy()
-    if bs.isUPeriodic():
-        bs.setUNotPeriodic()
-    if bs.isVPeriodic():
-        bs.setVNotPeriodic()
-    bu0, bu1, bv0, bv1 = bs.bounds()
-    tol = 1e-12
-    if u0 > bu0 + tol or u1 < bu1 - tol or v0 > bv0 + tol or v1 < bv1 - tol:
-        bs.segment(max(u0, bu0), min(u1, bu1), max(v0, bv0), min(v1, bv1))
-    return bs
-
-
 def load_nominal(path, face_name=None, object_name=None):
     """Load the nominal face (see module docstring) as a :class:`Nominal`."""
     shape, obj = read_shape(path, object_name)
@@ -211,28 +135,30 @@ def load_nominal(path, face_name=None, object_name=None):
 
 def nominal_from_face(face, source="<document>", face_name="Face1", object_name=None, shape=None):
     """Build a :class:`Nominal` from a ``Part.Face`` (a copy is kept)."""
-    import Part
-
     face = face.copy()
     try:
-        bface, converted = to_bspline_face(face)
+        data, bface = face_data(face, face_name)
     except GeometryError as exc:
         exc.file = exc.file or source
         raise
-    u0, u1, v0, v1 = bface.ParameterRange
+    return nominal_from_data(data, source, object_name, face, bface, shape)
+
+
+def nominal_from_data(data, source, object_name=None, face=None, bspline_face=None, shape=None):
+    """Build a :class:`Nominal` from its :class:`surfcomp.app.face_data.FaceData` (and the
+    face it was taken from, where this process has it)."""
+    u0, u1, v0, v1 = data.bounds
     try:
-        surface = surface_from_part(work_surface(bface), (u0, u1), (v0, v1))
-    except (Part.OCCError, ValueError, OverflowError) as exc:
+        surface = surface_from_raw(data.surface, (u0, u1), (v0, v1))
+    except (ValueError, OverflowError) as exc:
         raise GeometryError("the face's B-spline surface cannot be used: %s" % exc,
                             file=source) from None
-    check_nominal(surface, source, "the surface of %s" % face_name)
-    outward = -1 if bface.Orientation == "Reversed" else 1
-    return Nominal(face=face, bspline_face=bface, surface=surface, outward=outward, source=source,
-                   face_name=face_name, object_name=object_name, converted=converted, shape=shape)
+    check_nominal(surface, source, "the surface of %s" % data.face_name)
+    return Nominal(face=face, bspline_face=bspline_face, surface=surface, outward=data.outward,
+                   source=source, face_name=data.face_name, object_name=object_name,
+                   converted=data.converted, shape=shape, data=data)
 
 
-#: boundary points per edge for integrals over trimmed faces and the inside test
-EDGE_POINTS = 400
 #: a measured point farther than this (mm) outside the trimmed face is reported
 OUTSIDE_TOLERANCE = 1e-3
 
@@ -241,36 +167,26 @@ def boundary_polylines(face, points=EDGE_POINTS):
     """The face's edges as polylines in (u, v) (pcurves sampled at ``points`` parameters),
     each in its direction in the face's wire: together they bound the face (outer wire and
     holes, which run the other way round; a seam edge's two pcurves)."""
-    out = []
-    for e in (e for w in face.Wires for e in w.childShapes()):
-        c2d, a, b = face.curveOnSurface(e)[:3]
-        ts = np.linspace(a, b, points)
-        if e.Orientation == "Reversed":
-            ts = ts[::-1]
-        pts = [c2d.value(float(t)) for t in ts]
-        out.append(np.array([(p.x, p.y) for p in pts], dtype=float))
-    return out
+    return [np.array(p, dtype=float) for p in boundary_points(face, points)]
 
 
 def bounds_whole_domain(face, u_range, v_range):
     """True when every edge of ``face`` is a straight line in (u, v) along one side of the
-    rectangle ``u_range x v_range`` and together they go once around it: the answer
-    :func:`surfcomp.core.surface.trimmed.whole_domain` gives on the
-    :func:`boundary_polylines`, from the ends of each edge alone (the points between the
-    ends of a line lie on the same side), without sampling 400 points of every pcurve.
-    False for anything else (then sample them)."""
-    import Part
+    rectangle ``u_range x v_range`` and together they go once around it
+    (:func:`ends_whole_domain` of its :func:`surfcomp.app.face_data.line_ends`)."""
+    return ends_whole_domain(line_ends(face), u_range, v_range)
 
-    ends = []
-    for e in (e for w in face.Wires for e in w.childShapes()):
-        c2d, a, b = face.curveOnSurface(e)[:3]
-        if not isinstance(c2d, (Part.Geom2d.Line2d, Part.Geom2d.Line2dSegment)):
-            return False
-        p, q = c2d.value(a), c2d.value(b)
-        if e.Orientation == "Reversed":
-            p, q = q, p
-        ends.append(np.array([(p.x, p.y), (q.x, q.y)], dtype=float))
-    if not ends or not all(_one_side(piece, u_range, v_range) for piece in ends):
+
+def ends_whole_domain(ends, u_range, v_range):
+    """The answer :func:`surfcomp.core.surface.trimmed.whole_domain` gives on the
+    :func:`boundary_polylines` of a face whose edges are the straight lines ``ends``
+    (:func:`surfcomp.app.face_data.line_ends`), from the ends of each edge alone (the points
+    between the ends of a line lie on the same side), without sampling 400 points of every
+    pcurve. False for anything else (None: an edge is not a line; then sample them)."""
+    if not ends:
+        return False
+    ends = [np.array(piece, dtype=float) for piece in ends]
+    if not all(_one_side(piece, u_range, v_range) for piece in ends):
         return False
     return whole_domain(ends, u_range, v_range)
 

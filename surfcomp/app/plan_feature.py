@@ -71,7 +71,8 @@ def trial_plan(obj, **values):
     ``Count``, ``Points``, ``TipRadius``, ...), nothing written: a task panel checks its
     fields with it before they reach the object, so no recompute fails. Raises the
     planner's :class:`~surfcomp.errors.SurfcompError`."""
-    from .nominal import nominal_from_face, pick_face
+    from .face_data import pick_face
+    from .nominal import nominal_from_face
     from .plan_reach import plan_face
 
     def val(name):

@@ -15,7 +15,7 @@ from .features import is_compensation, is_measurement, local_measurements, nomin
 def nominal_candidate(doc):
     """``(object, 'FaceN')`` of the only object of ``doc`` with one B-spline face to take as
     the nominal (surfcomp's own objects left out), else None."""
-    from .nominal import pick_face
+    from .face_data import pick_face
 
     found = []
     for obj in doc.Objects if doc is not None else []:

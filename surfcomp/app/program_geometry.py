@@ -6,7 +6,7 @@ The correction at a contact point is what the corrected face realises there alon
 nominal's normal (:class:`surfcomp.core.compensation.realised_feet.RealisedAt`, from the
 projection's feet; Newton starts on the nominal point itself, or from the neighbouring
 point's intersection along a path); a trimmed face's boundary
-(:func:`surfcomp.app.nominal.boundary_polylines`) fades the correction out beyond it
+(:meth:`surfcomp.app.nominal.Nominal.boundary`) fades the correction out beyond it
 (:class:`surfcomp.core.compensation.program_trim.Trim`).
 """
 
@@ -17,13 +17,11 @@ from ..core.compensation.realised_feet import RealisedAt
 def offset_of(nominal, corrected, radius, blend):
     """The :class:`surfcomp.core.compensation.program_offset.BallOffset` of ``nominal``
     (:class:`surfcomp.app.nominal.Nominal`) corrected to the surface ``corrected``."""
-    from .nominal import boundary_polylines
-
     surface = nominal.surface
     trim = None
     if not nominal.untrimmed:   # imported here: its KD-tree needs the whole scipy.spatial
         from ..core.compensation.program_trim import Trim
 
-        trim = Trim.of(surface, boundary_polylines(nominal.bspline_face))
+        trim = Trim.of(surface, nominal.boundary())
     return BallOffset(nominal.surface, nominal.outward, radius,
                       RealisedAt(nominal.surface, corrected, nominal.outward), blend, trim=trim)

@@ -53,10 +53,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
     _kind, radius = parse_tool(pj.tool)
     job = pj.job
     job.options.validate()
-    fcenv.import_freecad()
-    from .nominal import load_nominal
-
-    nominal = load_nominal(job.nominal, job.face, job.object)
+    nominal = _nominal(job)
     ms = read_any(job.measurements, job.units, job.fmt, job.sample,
                   deviation_units=job.deviation_units)
     budget.check_job(len(ms), True, max_memory)
@@ -84,6 +81,20 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
         tr.commit()
     report(progress, 1.0, "done")
     return comp, done[0]
+
+
+def _nominal(job):
+    """The job's :class:`surfcomp.app.nominal.Nominal`: the face the reader child sent
+    (:func:`surfcomp.app.cadread.prefetch_face`; FreeCAD is not imported here), else the
+    face loaded in this process."""
+    from . import cadread
+    from .nominal import load_nominal, nominal_from_data
+
+    data = None if job.object else cadread.take_face(job.nominal, job.face)
+    if data is not None:
+        return nominal_from_data(data, job.nominal)
+    fcenv.import_freecad()
+    return load_nominal(job.nominal, job.face, job.object)
 
 
 def summary_lines(comp, po, pj):

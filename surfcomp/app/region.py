@@ -27,7 +27,8 @@ from ..core.surface.projection import Projector
 from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError
 from .convert import surface_from_part
-from .nominal import boundary_polylines, to_bspline_face, work_surface
+from .face_data import to_bspline_face, work_surface
+from .nominal import boundary_polylines
 
 #: nominal edges of two faces closer than this (mm) are one shared edge
 SHARE_TOL = 0.05

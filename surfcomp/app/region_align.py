@@ -26,7 +26,8 @@ from .alignment import assigned_faces, subset
 def references(shape, region, datum, source):
     """``(references, indices of the region's faces among them)``: the region's faces
     (0-based indices ``region``), then the datum faces (names) not in the region."""
-    from .nominal import nominal_from_face, pick_face
+    from .face_data import pick_face
+    from .nominal import nominal_from_face
 
     names = ["Face%d" % (k + 1) for k in region]
     refs, own = [], []

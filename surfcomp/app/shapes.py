@@ -312,7 +312,7 @@ def corrected_shape(nominal, corrected, output="face", label="compensation"):
         (:func:`replace_face`): same number and order of faces; a lone face (in no shell or
         solid) gives the face.
     """
-    from .nominal import to_bspline_face
+    from .face_data import to_bspline_face
 
     bs = surface_to_part(corrected)
     integral = correction_volume(nominal, corrected)

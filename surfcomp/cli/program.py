@@ -62,8 +62,10 @@ def run_program(args):
     try:
         with collector_paused():
             # the nominal's reader child starts first (a fork while this process has one
-            # thread, before the numerics' imports start theirs) and runs beside them
-            cadread.prefetch(args.nominal)
+            # thread and no FreeCAD, before the numerics' imports start theirs): it imports
+            # FreeCAD, reads the file and sends the face back while they run
+            if not args.object:
+                cadread.prefetch_face(args.nominal, args.face)
             from ..app.program_route import ProgramJob, run_program_job, summary_lines
             from ..core.compensation.program_offset import parse_tool
 

@@ -7,6 +7,10 @@ registry (:mod:`surfcomp.core.options`) takes its domains from here. Words as in
 ``docs/architecture.md``.
 """
 
+# ------------------------------------------------------------------ the nominal face
+#: OpenCASCADE's largest B-spline degree (``Geom_BSplineSurface::MaxDegree``)
+MAX_DEGREE = 25
+
 # ------------------------------------------------------------------ the corrected face
 #: the corrected face must realise the intended correction at the measured points within
 #: this, and its zero correction reproduce the nominal within this (0.1 um): a lean or

@@ -13,9 +13,8 @@ collapsed edges (a sphere's pole, a cone's apex) are valid and handled by
 import numpy as np
 
 from ...errors import GeometryError
+from ..limits import MAX_DEGREE
 
-#: OpenCASCADE's largest B-spline degree (``Geom_BSplineSurface::MaxDegree``)
-MAX_DEGREE = 25
 #: largest accepted pole coordinate, mm (10 km: beyond any machined part; squares and
 #: products of such values stay far from overflow)
 MAX_COORDINATE = 1e7
