@@ -41,6 +41,18 @@ FOLD_ANGLE_DEG = 90.0
 # ------------------------------------------------------------------ the measured points
 #: a given normal more than this many degrees off the face normal is reported
 NORMAL_WARNING_DEG = 5.0
+#: a file's nominal point farther than this from the face is not a nominal point of this
+#: face (another face, another revision of the model, another frame): refused. A CMM
+#: program's nominal points are the CAD face's own, printed to 3 or 4 decimals (at most
+#: 0.9 um off it)
+NOMINAL_OFF_FACE = 0.01
+#: ... and one farther than this is reported: the deviations are taken against the file's
+#: nominal points, so they are off by as much
+NOMINAL_OFF_FACE_WARNING = 1e-3
+#: a measured point farther beside its own nominal point (across the normal) than this
+#: share of the distance from that nominal point to the next one lies nearer another
+#: nominal point than its own: the rows of the file are not pairs
+PAIRING_SHARE = 0.5
 
 # ------------------------------------------------------------------ option domains
 #: the largest mask accepted (a window of 201 x 201 grid steps); also the largest

@@ -212,6 +212,7 @@ def prepare(surface, outward, ms, options=None, progress=None):
         raise InputError(mistake, file=ms.source, options=("units",))
     _check_on_face(ms, base, proj, dist, options)
     normal = _normals(ms, proj.normal * outward, options, warnings)
+    plausibility.check_file_points(ms, dist, normal, options.max_offset, warnings)
     if ms.deviation is not None:
         d = np.asarray(ms.deviation, dtype=float) * (-1.0 if options.flip_normals else 1.0)
     elif ms.nominal is not None and ms.measured is not None:

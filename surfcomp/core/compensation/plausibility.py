@@ -20,6 +20,16 @@ and the GUI's import preview:
   in inches, centimetres or metres, not millimetres: near the origin such points still
   pass the on-face check, and compensating them would build the face from a corner
   (:func:`unit_mistake`).
+- **nominal points on the face** (an error, or a warning for small offsets): a file's nominal
+  points are the CAD face's own, so one farther than
+  :data:`surfcomp.core.limits.NOMINAL_OFF_FACE` from the face belongs to another face,
+  model revision or frame, and the deviations against it are not deviations of this face
+  (:func:`nominal_off_face`).
+- **pairs** (an error, or a warning for a few points): a CMM probes each point along its
+  nominal normal, so the measured point lies on that normal; one farther beside it than
+  :data:`surfcomp.core.limits.PAIRING_SHARE` of the distance to the next nominal point
+  (or than ``max_offset``) lies nearer another nominal point: the file's measured column
+  is shifted or sorted apart from its nominal column (:func:`unpaired`).
 - **mirror stock** (refused unless confirmed): the mirror method measures the part after
   a semi-finishing pass that left the stock ``s``, so in surfcomp's sign convention
   (deviation along the outward normal, + = material left) every measured deviation is
@@ -41,9 +51,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import note
+from ...errors import MeasurementFileError, note
+from ..limits import NOMINAL_OFF_FACE, NOMINAL_OFF_FACE_WARNING, PAIRING_SHARE
 from ..option_tables import INPUTS
 from ..options import OPTIONS
+from ..surface.kdtree import cKDTree
 
 #: ISO 2768-1 class f: (largest dimension up to, mm) -> permissible deviation (+- mm)
 ISO2768_FINE = ((6.0, 0.05), (30.0, 0.1), (120.0, 0.15), (400.0, 0.2), (1000.0, 0.3),
@@ -185,6 +197,79 @@ def unit_mistake(surface, points, max_offset, project, read_as="mm"):
                    LENGTH_UNITS[unit][1] if unit else "a %g times larger unit" % factor,
                    read_name, give))
     return None
+
+
+def nominal_off_face(dist):
+    """The file's nominal points against the face, from their distances ``dist`` (mm):
+    None when every one lies within :data:`surfcomp.core.limits.NOMINAL_OFF_FACE_WARNING`
+    of it, else ``(k, message, refused)``: the farthest point's index, what to say about
+    it (the caller adds the file and line) and whether it is refused (farther than
+    :data:`surfcomp.core.limits.NOMINAL_OFF_FACE`)."""
+    off = np.abs(np.asarray(dist, dtype=float))
+    k = int(np.argmax(off))
+    if not off[k] > NOMINAL_OFF_FACE_WARNING:
+        return None
+    limit = NOMINAL_OFF_FACE if off[k] > NOMINAL_OFF_FACE else NOMINAL_OFF_FACE_WARNING
+    count = "%d of %d nominal points are more than %g um from it" % (
+        np.count_nonzero(off > limit), off.size, limit * 1e3)
+    if limit == NOMINAL_OFF_FACE:
+        return k, ("the nominal point of this line is %.4f mm from the face (%s): the file's "
+                   "nominal points are not on this face; expected the nominal points of this "
+                   "face (is it another face, another revision of the model, or another "
+                   "frame?)" % (off[k], count)), True
+    return k, ("the file's nominal points lie up to %.2f um off the face (this line; %s): "
+               "the deviations are taken against them, so they are off by as much"
+               % (off[k] * 1e3, count)), False
+
+
+def unpaired(nominal, measured, normal, max_offset):
+    """The measured points that do not lie on their own nominal point's normal: an index
+    array of those farther beside it (across ``normal``) than
+    :data:`surfcomp.core.limits.PAIRING_SHARE` of the distance from their nominal point to
+    the next one, or than ``max_offset``; and ``(beside, spacing)`` of every point (mm)."""
+    delta = np.asarray(measured, dtype=float) - nominal
+    along = np.einsum("ij,ij->i", delta, normal)
+    beside = np.linalg.norm(delta - along[:, None] * normal, axis=1)
+    spacing = np.full(beside.size, np.inf)
+    if beside.size > 1:
+        spacing = cKDTree(nominal).query(nominal, k=2)[0][:, 1]
+    bad = np.flatnonzero(~(beside <= np.minimum(PAIRING_SHARE * spacing, max_offset)))
+    return bad, (beside, spacing)
+
+
+def check_file_points(ms, dist, normal, max_offset, warnings):
+    """Refuse a file whose nominal points are not on the face (:func:`nominal_off_face`,
+    ``dist`` their distances from it) or whose measured points do not pair with them
+    (:func:`unpaired`, half of them or more); warn of smaller offsets and of a few unpaired
+    points (appended to ``warnings``). ``normal``: the normals the deviations are taken
+    along."""
+    if ms.nominal is None:
+        return
+    got = nominal_off_face(dist)
+    if got is not None:
+        k, message, refused = got
+        if refused:
+            raise MeasurementFileError(message, file=ms.source, line=int(ms.lines[k]))
+        warnings.append("%s:%d: %s" % (ms.source, ms.lines[k], message))
+    if ms.measured is None:
+        return
+    bad, (beside, spacing) = unpaired(ms.nominal, ms.measured, normal, max_offset)
+    if not bad.size:
+        return
+    k = int(bad[0])
+    text = ("%d of %d measured points lie beside their own nominal point rather than on its "
+            "normal (this line: %.4f mm beside it, the next nominal point %.4f mm away; "
+            "expected at most half that, and at most max_offset %g mm)"
+            % (bad.size, beside.size, beside[k], spacing[k], max_offset))
+    if 2 * bad.size >= beside.size:
+        raise MeasurementFileError(
+            text + ": the measured points do not pair with the nominal points of their rows; "
+            "expected each row's measured point probed along its nominal normal (is the "
+            "measured column shifted or sorted apart?)", file=ms.source, line=int(ms.lines[k]),
+            options=("max_offset",))
+    warnings.append(note("%s:%d: " % (ms.source, ms.lines[k]), text.split("max_offset")[0],
+                         ("max_offset",), text.split("max_offset")[1],
+                         "; their deviations are taken along the normal of the nominal point"))
 
 
 def mask_warning(source, mask_size, shape, option="mask_size"):
