@@ -122,4 +122,4 @@ def summary_lines(comp, po, pj):
 
 def _range(stats):
     return ("%.2f to %.2f um at the measured points (RMS %.2f um)"
-            % (stats.max_negative * 1e3, stats.max_positive * 1e3, stats.rms * 1e3))
+            % (stats.min * 1e3, stats.max * 1e3, stats.rms * 1e3))

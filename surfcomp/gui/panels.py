@@ -17,7 +17,7 @@ from ..app import reports
 from ..app.undo import UndoStep
 from ..core import colormap
 from ..core.compensation import plausibility
-from ..core.compensation.deviations import Statistics, format_table
+from ..core.compensation.deviations import Statistics, cell_text, format_table
 from ..core.options import OPTIONS, tooltip
 from ..errors import SurfcompError
 from . import dialogs, option_labels, prefs
@@ -66,11 +66,9 @@ class ReportDialog(QtGui.QDialog):
         self.table = QtGui.QTableWidget(len(rows), len(cols))
         self.table.setHorizontalHeaderLabels([h for h, _ in cols])
         self.table.setVerticalHeaderLabels([r[0] for r in rows])
-        fmt = "%.2f" if self.unit == "um" else "%.4f"
         for j, (_, st) in enumerate(cols):
             for i, (_label, value) in enumerate(st.rows(self.unit)):
-                text = str(value) if i == 0 else fmt % value
-                item = QtGui.QTableWidgetItem(text)
+                item = QtGui.QTableWidgetItem(cell_text(value, i, self.unit))
                 item.setTextAlignment(QtCore.Qt.AlignRight | QtCore.Qt.AlignVCenter)
                 self.table.setItem(i, j, item)
         self.table.resizeColumnsToContents()

@@ -37,7 +37,7 @@ import html
 
 import numpy as np
 
-from ..core.compensation.deviations import statistics
+from ..core.compensation.deviations import NONE, statistics
 from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
 from .html_figures import (
@@ -130,6 +130,14 @@ def grid_arrays(report):
     return out
 
 
+def _no_side(st, key):
+    """No deviation of the statistics dict ``st`` lies on the side ``key`` names (as
+    :meth:`surfcomp.core.compensation.deviations.Statistics.rows` tells it)."""
+    if key == "max_negative":
+        return st.get("min") is not None and st["min"] >= 0
+    return key == "max_positive" and st.get("max") is not None and st["max"] <= 0
+
+
 def _stat_table(columns):
     """``columns``: list of (header, statistics dict in mm)."""
     out = ["<table><tr><th>Deviations (µm)</th>%s</tr>"
@@ -138,8 +146,13 @@ def _stat_table(columns):
         cells = []
         for _, st in columns:
             v = st.get(key)
-            cells.append('<td class="num">%s</td>' % ("" if v is None else
-                                                     ("%d" % v if f is None else "%.2f" % (v * f))))
+            if v is None:
+                text = ""
+            elif _no_side(st, key):
+                text = NONE
+            else:
+                text = "%d" % v if f is None else "%.2f" % (v * f)
+            cells.append('<td class="num">%s</td>' % text)
         out.append("<tr><th>%s</th>%s</tr>" % (_e(label), "".join(cells)))
     out.append("</table>")
     return "".join(out)

@@ -57,3 +57,25 @@ def test_a_dict_from_before_min_and_max_reads_with_the_meaning_of_today():
     assert (st.max_negative, st.max_positive) == (0.0, 0.0471)
     assert_allclose([st.mean, st.std, st.rms, st.profile], [0.0201, 0.023, 0.028, 0.0942],
                     rtol=0, atol=0)
+
+
+def test_a_side_without_deviations_is_shown_as_none_not_as_zero():
+    """The tables showed "Max. negative 0.00" for an all-positive set, as if a point lay
+    on the nominal; the smallest deviation was +171.1 um. The table, the HTML report and the
+    GUI panel now say "none" (the JSON keeps 0.0 and gives ``min``)."""
+    from surfcomp.core.compensation.deviations import format_table
+    from surfcomp.io.html_report import _stat_table
+
+    up, down = statistics([0.1711, 0.2, 0.25]), statistics([-0.03, -0.005])
+    assert [r[1] for r in up.rows("um")[1:3]] == [None, pytest.approx(250.0)]
+    assert [r[1] for r in down.rows("um")[1:3]] == [pytest.approx(-30.0), None]
+    table = format_table([("up", up), ("down", down)]).splitlines()
+    assert table[2].split() == ["Max.", "negative", "none", "-30.00"]
+    assert table[3].split() == ["Max.", "positive", "250.00", "none"]
+    html = _stat_table([("up", up.as_dict()), ("down", down.as_dict())])
+    assert ('<tr><th>Max. negative</th><td class="num">none</td><td class="num">-30.00</td>'
+            in html)
+    assert ('<tr><th>Max. positive</th><td class="num">250.00</td><td class="num">none</td>'
+            in html)
+    mixed = statistics([-0.001, 0.002])
+    assert [r[1] for r in mixed.rows("mm")[1:3]] == [pytest.approx(-0.001), pytest.approx(0.002)]

@@ -91,11 +91,13 @@ class Statistics:
         return cls(**{f: d[f] for f in cls.__dataclass_fields__})
 
     def rows(self, unit="mm"):
-        """Table rows ``(label, value)`` in ``unit`` (``mm`` or ``um``)."""
+        """Table rows ``(label, value)`` in ``unit`` (``mm`` or ``um``); the value of
+        "Max. negative" is None when no value is negative, that of "Max. positive" when none
+        is positive (shown as :data:`NONE`, not as a deviation of 0)."""
         f = 1000.0 if unit == "um" else 1.0
         return [("Points", self.count),
-                ("Max. negative", self.max_negative * f),
-                ("Max. positive", self.max_positive * f),
+                ("Max. negative", self.max_negative * f if self.min < 0 else None),
+                ("Max. positive", self.max_positive * f if self.max > 0 else None),
                 ("Average value", self.mean * f),
                 ("Standard deviation (ddof=1)", self.std * f),
                 ("RMS", self.rms * f),
@@ -149,11 +151,21 @@ def format_table(columns, unit="um", title=None):
         out.append(title)
     out.append(("Deviations (%s)" % ("µm" if unit == "um" else "mm")).ljust(width)
                + "".join(h.rjust(colw) for h, _ in columns))
-    fmt = "%.2f" if unit == "um" else "%.4f"
     for k, label in enumerate(labels):
-        cells = []
-        for _, st in columns:
-            v = st.rows(unit)[k][1]
-            cells.append(("%d" % v if k == 0 else fmt % v).rjust(colw))
+        cells = [cell_text(st.rows(unit)[k][1], k, unit).rjust(colw) for _, st in columns]
         out.append(label.ljust(width) + "".join(cells))
     return "\n".join(out)
+
+
+#: the cell of "Max. negative" when no deviation is negative (and of "Max. positive" when
+#: none is positive)
+NONE = "none"
+
+
+def cell_text(value, row, unit="um"):
+    """The text of a :meth:`Statistics.rows` value in row ``row`` (row 0: the count)."""
+    if value is None:
+        return NONE
+    if row == 0:
+        return "%d" % value
+    return ("%.2f" if unit == "um" else "%.4f") % value
