@@ -260,3 +260,22 @@ def test_bad_input_fewer_points_and_no_convergence():
     with pytest.raises(InputError, match="did not converge in 1 iterations"):
         align.best_fit(align.apply(transform(93), pts), REF, coarse=False, max_iter=1)
 
+
+
+def test_rms_before_is_over_the_points_of_each_face():
+    """Each face's "RMS before" is over the points the fit gives it, as its "after" and its
+    count are. Before, it was over the faces nearest the points before the fit: on a corner
+    moved by (2, -3, 4) mm a point of A near B counted for B, and a face no point was
+    nearest before had no figure (printed "nan um before")."""
+    s, t = np.random.default_rng(5).uniform(5.0, 35.0, (2, 3, 60))
+    zero = np.zeros(60)
+    # A: z = 0, B: y = 0, C: x = 0
+    P = np.vstack([np.column_stack(c) for c in ((s[0], t[0], zero), (s[1], zero, t[1]),
+                                                (zero, s[2], t[2]))])
+    shift = np.array([2.0, -3.0, 4.0])
+    _after, rec = run_align(P + shift, AlignOptions(method="bestfit"), corner())
+    d = rec.as_dict()
+    assert d["points"] == {"A": 60, "B": 60, "C": 60}
+    assert d["rms_before_um"] == pytest.approx({"A": 4000.0, "B": 3000.0, "C": 2000.0},
+                                               abs=1e-6)
+    assert max(d["rms_after_um"].values()) < 1e-6

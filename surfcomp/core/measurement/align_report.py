@@ -209,16 +209,13 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
                               progress=progress, passive=passive, distances=dist)
         outliers = int(((fit.weight == 0) & np.isfinite(fit.residual)).sum())
     before, after = apply(start, P), apply(fit.matrix, P)
-    # before: on a sample (far points cost a projection each); after: the fit's last state
-    s = spread(P.shape[0], BEFORE_SAMPLE)
-    r0, _g, f0 = dist(before[s], None if assign is None else np.asarray(assign)[s])
     if options.method == "bestfit" and not passive:
         r1, g1, f1 = fit.residual, fit.gradient, fit.face
     else:
         r1, g1, f1 = dist(after, assign)
         r1 = r1 - offset
-    rms_before, _ = per_face_rms(r0 - offset, f0, every)
     rms_after, count = per_face_rms(r1, f1, every)
+    rms_before = _rms_before(dist, before, np.asarray(f1), every, offset)
     rec = Alignment(options.method, fit.matrix, known, dof, active, fit.iterations,
                     fit.converged, label, rms_before, rms_after, count, outliers)
     rec.point_face = f1
@@ -227,6 +224,23 @@ def align(points, options, references, compensated=None, ids=None, assign=None, 
         rec.absorbed = absorbed(before[on], after[on], g1[on])
         rec.warnings.append(_absorbed_warning(rec.absorbed, g1[on], after[on] - before[on]))
     return after, rec
+
+
+def _rms_before(dist, before, face, names, offset):
+    """Per reference, the RMS distance before the fit of the points the fit gave it
+    (``face``: the references of the points after the fit), so that each face's before and
+    after are over the same points: on a sample of :data:`BEFORE_SAMPLE` points spread over
+    the file (far points cost a projection each), and every point of a face the sample
+    missed."""
+    s = spread(before.shape[0], BEFORE_SAMPLE)
+    r0, _g, _f = dist(before[s], face[s])
+    rms, _count = per_face_rms(r0 - offset, face[s], names)
+    for k, name in enumerate(names):
+        idx = np.flatnonzero(face == k)
+        if name not in rms and idx.size:
+            r, _g, _f = dist(before[idx], face[idx])
+            rms.update(per_face_rms(r - offset, face[idx], names)[0])
+    return rms
 
 
 def _absorbed_warning(absorbed_, normal, shift):
