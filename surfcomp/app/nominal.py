@@ -232,7 +232,7 @@ def trim_warning(nominal, prepared):
     more = " and %d more" % (idx.size - 5) if idx.size > 5 else ""
     return ("%s: %d of %d measured points lie on the surface of %s but outside its trimmed "
             "boundary (lines %s%s), up to %.3f mm beyond it at (%.3f, %.3f, %.3f), line %d "
-            "(a probe near a fillet or a hole?); they are used for the correction, and the "
-            "corrected face keeps the nominal's boundary"
+            "(a probe near a fillet or a hole?); they are used for the correction and counted "
+            "in the statistics, and the corrected face keeps the nominal's boundary"
             % ((prepared.source, idx.size, prepared.u.size, nominal.face_name, lines, more,
                 float(dist.max())) + tuple(prepared.nominal[far]) + (int(prepared.lines[far]),)))

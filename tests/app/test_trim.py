@@ -127,6 +127,10 @@ def test_points_outside_the_trim_are_reported(tmp_path):
     corners = P.reshape(-1, 3)[r == r.max()]
     expected = max(face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0] for p in corners)
     assert far == pytest.approx(expected, abs=1e-3) and 5.0 < far < 8.0
+    # and it says where they went: the statistics count them (81 points), as the
+    # correction uses them
+    assert "they are used for the correction and counted in the statistics" in warning[0]
+    assert rep["statistics"]["deviation"]["count"] == 81
 
 
 # -- a trimmed face as the top of a solid ---------------------------------------------------
