@@ -36,6 +36,22 @@ MAX_COORDINATE = 1e6
 MAX_POINT_WARNINGS = 10
 
 
+def check_duplicates(points, lines, source, what="nominal point"):
+    """Refuse a point given twice (within :data:`DUPLICATE_TOL`): names the second line,
+    the first and how many pairs there are. ``lines``: the 1-based line of every point."""
+    from ..core.surface.kdtree import cKDTree
+
+    pairs = cKDTree(points, balanced_tree=False).query_pairs(DUPLICATE_TOL,
+                                                              output_type="ndarray")
+    if len(pairs):
+        first, again = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))[0]]
+        raise MeasurementFileError(
+            "%s (%.9g, %.9g, %.9g) mm is given again; first on line %d (expected each %s "
+            "once; %d duplicate pair(s) in all)" % ((what,) + tuple(points[again])
+                                                   + (int(lines[first]), what, len(pairs))),
+            file=source, line=int(lines[again]))
+
+
 def check_coordinates(values, lines, source, columns=None, limit=MAX_COORDINATE,
                       what="coordinate"):
     """Refuse values (N, k) in mm that are not finite (a unit conversion can overflow) or

@@ -87,7 +87,6 @@ import re
 
 import numpy as np
 
-from ..core.surface.kdtree import cKDTree
 from ..errors import InputError, MeasurementFileError
 from .columns import ALIASES, GROUP_TEXT, GROUPS, HINTS, LENGTH_ROLES, norm, role_of
 from .files import clip, read_bytes
@@ -101,6 +100,7 @@ from .measurement_set import (  # noqa: F401  (MeasurementSet: the readers' resu
     NORMAL_ZERO,
     MeasurementSet,
     check_coordinates,
+    check_duplicates,
     decode_utf8,
     ignored_column_warnings,
     listed_names,
@@ -277,7 +277,7 @@ class _Parser:
         ms.nominal = take(GROUPS["nominal"])
         check_coordinates(ms.nominal, line_numbers, self.source,
                           [col_of[r] + 1 for r in GROUPS["nominal"]])
-        self._check_duplicates(ms.nominal, data)
+        check_duplicates(ms.nominal, line_numbers, self.source)
         if "measured" in have:
             ms.measured = take(GROUPS["measured"])
             check_coordinates(ms.measured, line_numbers, self.source,
@@ -498,14 +498,6 @@ class _Parser:
                              % (names[c], float(values[k])), data[k], c + 1)
         return values.astype(np.int64)
 
-    def _check_duplicates(self, nominal, data):
-        pairs = cKDTree(nominal, balanced_tree=False).query_pairs(
-            DUPLICATE_TOL, output_type="ndarray")
-        if len(pairs):
-            first, again = pairs[np.lexsort((pairs[:, 0], pairs[:, 1]))[0]]
-            raise self.error("nominal point (%.9g, %.9g, %.9g) mm is given again; first on line %d "
-                             "(expected each nominal point once; %d duplicate pair(s) in all)"
-                             % (tuple(nominal[again]) + (data[first] + 1, len(pairs))), data[again])
 
     def _unit_normals(self, n, data, columns):
         length = np.linalg.norm(n, axis=1)

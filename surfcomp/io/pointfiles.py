@@ -46,6 +46,7 @@ from .measurement_set import (
     NORMAL_ZERO,
     MeasurementSet,
     check_coordinates,
+    check_duplicates,
     decode_utf8,
 )
 from .pointfile_rows import (
@@ -243,6 +244,7 @@ def read_point_file(path, fmt="auto", units=None, sample=None):
     with np.errstate(over="ignore"):    # overflowing values are refused by the checks
         fields = reader(path, lines, units, warnings)
     check_coordinates(fields["measured"], fields["lines"], str(path))
+    check_duplicates(fields["measured"], fields["lines"], str(path), "measured point")
     fields["columns"] = {_ROLE_NAMES[r]: name for r, name in fields["columns"].items()}
     source = str(path)
     texts = [("%s:%d: " % (source, line) if line is not None else "%s: " % source) + text

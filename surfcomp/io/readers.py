@@ -78,5 +78,8 @@ def _read(path, units, fmt, sample):
     except MeasurementFileError as table_error:
         try:
             return read_point_file(path, fmt="xyz", units=units)
-        except MeasurementFileError:
-            raise table_error from None
+        except MeasurementFileError as xyz_error:
+            # the reading that got further is the file's: a plain x y z file with a bad
+            # value on line 7 is that, not a table whose header names no known column
+            raise (xyz_error if (xyz_error.line or 0) > (table_error.line or 0)
+                   else table_error) from None

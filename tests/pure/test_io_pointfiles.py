@@ -303,7 +303,7 @@ def test_probe_log_default_mm_and_inch():
 
 
 def test_probe_log_rotary_axes_warn(tmp_path):
-    path = write(tmp_path, "1 2 3 0 0 0 0 0 0\n1 2 3 0 90 0 0 0 0.5\n")
+    path = write(tmp_path, "1 2 3 0 0 0 0 0 0\n1 2 4 0 90 0 0 0 0.5\n")
     ms = read_point_file(path, fmt="probe", units="mm")
     assert ms.warnings == [path + ": axes B W are not zero in the probe log; only X Y Z are used"]
 
@@ -319,3 +319,36 @@ def test_probe_log_malformed(tmp_path, text, line, column, match):
     err = error_of(write(tmp_path, text), fmt="probe")
     assert (err.line, err.column) == (line, column), str(err)
     assert re.search(match, err.message), err.message
+
+
+@pytest.mark.parametrize("fmt, text, pairs", [
+    ("xyz", "x y z\n1 2 3\n4 5 6\n7 8 9\n1 2 3\n4 5 6.0000000000001\n", 2),
+    ("xyzijk", "XYZIJK    METRIC\n1,2,3,0,0,1\n4,5,6,0,0,1\n7,8,9,0,0,1\n1,2,3,0,0,1\n", 1),
+    ("probe", "1 2 3 0 0 0 0 0 0\n4 5 6 0 0 0 0 0 0\n7 8 9 0 0 0 0 0 0\n1 2 3 0 0 0 0 0 0\n", 1),
+])
+def test_a_measured_point_given_twice_is_refused(tmp_path, fmt, text, pairs):
+    """As the tables refuse a nominal point given twice (README: duplicate points, exit code
+    2): before, a point file's repeated rows were counted twice, and the repeated points
+    broke the grid, so the data went to the scattered fit with a warning about a row."""
+    with pytest.raises(MeasurementFileError) as err:
+        read_point_file(write(tmp_path, text), fmt=fmt)
+    first = 2 if fmt != "probe" else 1
+    assert str(err.value).endswith("is given again; first on line %d (expected each measured "
+                                   "point once; %d duplicate pair(s) in all)" % (first, pairs))
+    assert err.value.line == first + 3
+    # the same file without its repeated rows: read
+    once = "".join(text.splitlines(True)[:4 if fmt != "probe" else 3])
+    assert len(read_point_file(write(tmp_path, once, name="g.txt"), fmt=fmt)) == 3
+
+
+def test_a_bad_value_in_a_plain_xyz_file_is_named_not_its_header(tmp_path):
+    """Read without a format, a plain 'x,y,z' file with 'nan' on line 7 was reported as a
+    table whose header names no known column (line 1)."""
+    from surfcomp.io.readers import read_any
+
+    rows = ["%d,%d,%d" % (k, k + 1, k + 2) for k in range(8)]
+    rows[5] = "nan,1,2"
+    with pytest.raises(MeasurementFileError) as err:
+        read_any(str(write(tmp_path, "x,y,z\n" + "\n".join(rows) + "\n", name="p.csv")))
+    assert str(err.value).endswith("p.csv:7:1: 'nan' in field 1 (x) is not a finite number; "
+                                   "expected a finite decimal number")
