@@ -362,3 +362,12 @@ def test_model_input_errors_are_input_errors():
     assert exc.value.file == "e.csv"
     # SimulatedMachine moved to core/axis/machine.py; the old import still works
     assert axis_errors.SimulatedMachine is machine.SimulatedMachine
+
+
+def test_work_offset_change_without_a_named_first_offset_is_refused(tmp_path, capsys):
+    """No offset named: the moves run in the active one (G54 at power-up); G55 after them
+    is a change, refused with its line like G54 ... G55."""
+    text = "G21 G90 G17\nG0 X10 Y10 Z-1\nG1 X100 F100\nG55\nG0 X10 Y10\nG1 X100\nM2\n"
+    stderr = _refused(tmp_path, capsys, text)
+    assert "in.ngc:4:1: G55 selects a second work coordinate system after moves in G54" \
+        in stderr
