@@ -143,7 +143,7 @@ def run(args):
             warnings.append("%d program point(s) lie outside the measured travel (up to %.3f "
                             "mm): the error functions are extrapolated there"
                             % (travel.count, travel.dist))
-        warnings.extend(_model_warnings(model))
+        warnings.extend(table.warnings + _model_warnings(model))
         vmap = volumetric_map(model)
         if args.report:
             outputs["report"] = shown(args.report)
@@ -235,8 +235,7 @@ def build_report(args, table, model, prog_model, stats, pred, vmap, warnings, ou
                     "work_offset_mm": None if offset is None else offset.tolist(),
                     "start_mm": None if start is None else start.tolist()},
         "model": {**model.to_dict(), "components": model.components(),
-                  "fits": [dict(f.as_dict(), lines=table.lines[f.axis].tolist())
-                           for f in model.fits],
+                  "fits": [dict(f.as_dict(), lines=_fit_lines(table, f)) for f in model.fits],
                   "offset_spread_mm": model.offset_spread.tolist(),
                   "sign": "error = actual - commanded; command X' solves X' + E(X') = X",
                   "program_coordinates": prog_model.to_dict()},
@@ -246,3 +245,9 @@ def build_report(args, table, model, prog_model, stats, pred, vmap, warnings, ou
         "warnings": list(warnings),
         "outputs": outputs,
     }
+
+
+def _fit_lines(table, fit):
+    """The file lines of the rows a fit used (a table that leaves its column out: none)."""
+    measured = ~np.isnan(table.data[fit.axis][1][:, "xyz".index(fit.component)])
+    return table.lines[fit.axis][measured].tolist()

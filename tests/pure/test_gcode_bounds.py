@@ -371,3 +371,20 @@ def test_work_offset_change_without_a_named_first_offset_is_refused(tmp_path, ca
     stderr = _refused(tmp_path, capsys, text)
     assert "in.ngc:4:1: G55 selects a second work coordinate system after moves in G54" \
         in stderr
+
+
+def test_report_counts_the_rows_each_fit_used(tmp_path, capsys):
+    """Two X runs, one giving EXX and one EYX: each fit counts and names its own 3 rows."""
+    import json
+    text = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50\nG1 X150 Y150 Z-5\nM2\n"
+    csv = "X EXX\n0 0\n100 0.010\n200 0.020\nX EYX\n0 0\n100 0.002\n200 0.004\n"
+    rc, stderr, out = _run(tmp_path, capsys, text, csv=csv)
+    assert rc == 0, stderr
+    fits = {f["function"]: f for f in json.loads(
+        (out.parent / "r.json").read_text())["model"]["fits"]}
+    assert (fits["delta_x(x)"]["n"], fits["delta_x(x)"]["lines"]) == (3, [2, 3, 4])
+    assert (fits["delta_y(x)"]["n"], fits["delta_y(x)"]["lines"]) == (3, [6, 7, 8])
+    assert fits["delta_z(x)"]["lines"] == [2, 3, 4, 6, 7, 8]
+    assert abs(fits["delta_x(x)"]["b1"] - 1e-4) < 1e-12
+    assert abs(fits["delta_y(x)"]["b1"] - 2e-5) < 1e-12
+    assert "EZX in no table, taken as 0" in stderr
