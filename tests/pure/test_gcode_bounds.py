@@ -388,3 +388,42 @@ def test_report_counts_the_rows_each_fit_used(tmp_path, capsys):
     assert abs(fits["delta_x(x)"]["b1"] - 1e-4) < 1e-12
     assert abs(fits["delta_y(x)"]["b1"] - 2e-5) < 1e-12
     assert "EZX in no table, taken as 0" in stderr
+
+
+BASIC = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50\nG1 X150 Y150 Z-5\nG0 Z5\nM2\n"
+#: errors of tens of um over 200 mm of X and Y (the brief's example)
+TENS_CSV = ("axis,position,ex,ey,ez\nX,0,0,0,0\nX,50,0.010,0.002,0.001\nX,100,0.025,0.004,0.003\n"
+            "X,150,0.045,0.007,0.005\nX,200,0.070,0.010,0.008\nY,0,0,0,0\n"
+            "Y,100,0.006,-0.018,0.002\nY,200,0.012,-0.044,0.006\nZ,-100,0.002,0.001,-0.030\n"
+            "Z,0,0,0,0\n")
+
+
+@pytest.mark.parametrize("decimals, after_um", [("0", "750.8"), ("1", "71.12")])
+def test_rounding_coarser_than_the_corrections_is_refused(tmp_path, capsys, decimals,
+                                                          after_um):
+    """0 or 1 decimals land the tool farther from the program than no compensation at all
+    (60.74 um before): refused, nothing written, the option to change named."""
+    stderr = _refused(tmp_path, capsys, BASIC, "--decimals", decimals, csv=TENS_CSV)
+    assert ("the compensated program would be worse than the input: the error model "
+            "predicts up to %s um at the program's points after compensation against 60.74 "
+            "um before, as its numbers are rounded to %s decimal place(s)"
+            % (after_um, decimals)) in stderr
+    assert "--decimals 3 or more" in stderr
+
+
+def test_two_decimals_improve_the_program_and_are_written(tmp_path, capsys):
+    rc, stderr, out = _run(tmp_path, capsys, BASIC, "--decimals", "2", csv=TENS_CSV)
+    assert rc == 0, stderr
+    import json
+    pred = json.loads((out.parent / "r.json").read_text())["predicted"]
+    assert abs(pred["before"]["max_mm"] - 0.060739) < 1e-6
+    assert pred["after"]["max_mm"] < 0.0069           # 6.87 um: rounding to 0.01 mm
+
+
+def test_library_refuses_an_output_worse_than_its_input():
+    model = fit_axis_errors(read_axis_errors("e.csv", text=TENS_CSV).data)
+    with pytest.raises(GCodeError, match="would be worse than the input") as exc:
+        compensate_gcode(BASIC.encode(), model, source="t.ngc", decimals=0)
+    assert exc.value.options == ("decimals",)
+    res = compensate_gcode(BASIC.encode(), model, source="t.ngc", decimals=3)
+    assert res.predicted(model)["after"]["max_mm"] < 1e-3

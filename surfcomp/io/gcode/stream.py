@@ -241,6 +241,26 @@ class Compensator:
             refuse_segments(self.est, self.n_moves, self.lengths[0], self.lengths[2],
                             self.max_segments, self.names, self.source)
         self.bounds.finish(self.resolution(self.inch), self.source)
+        self.check_gain()
+
+    def check_gain(self):
+        """Refuse an output the model predicts to land farther from the programmed points
+        than the input (numbers rounded more coarsely than the corrections they carry)."""
+        before, after = self.totals.before.max, self.totals.after.max
+        if not after > before + 1e-9:
+            return
+        dmin = self.dmin_in if self.inch else self.dmin_mm
+        need = next((d for d in range(dmin + 1, 10) if self.resolution(self.inch)
+                     * 10.0 ** (dmin - d) <= 0.1 * before), 9)
+        raise GCodeError("the compensated program would be worse than the input: the error "
+                         "model predicts up to %.4g um at the program's points after "
+                         "compensation against %.4g um before, as its numbers are rounded to "
+                         "%d decimal place(s) (up to %.4g um per point), too coarse for "
+                         "corrections of up to %.4g um; nothing was written (expected a "
+                         "rounding finer than the corrections: decimals %d or more)"
+                         % (after * 1e3, before * 1e3, dmin, self.resolution(self.inch) * 1e3,
+                            self.totals.max_correction * 1e3, need),
+                         file=self.source, options=("decimals",))
 
     def warnings(self):
         """The warnings of the program read by :meth:`lines`."""
