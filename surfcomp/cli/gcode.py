@@ -77,7 +77,8 @@ def _um(v):
 
 class _Travel:
     """Program points outside the measured travel, block by block: count and largest
-    distance (mm) of the move ends whose axes are all known."""
+    distance (mm) of the points written whose axes are all known (move ends and the points
+    along split moves and arcs turned into segments, as the --max-error check sees them)."""
 
     def __init__(self, model):
         lo, hi = model.travel[:, 0], model.travel[:, 1]
@@ -85,8 +86,8 @@ class _Travel:
         self.lo, self.hi = lo, hi
         self.count, self.dist = 0, 0.0
 
-    def add(self, prog):
-        points = prog.end[prog.known.all(axis=1)]
+    def add(self, nominal, known):
+        points = nominal[known]
         if points.size == 0:
             return
         below = np.where(self.ok, self.lo - points, 0.0)

@@ -427,3 +427,22 @@ def test_library_refuses_an_output_worse_than_its_input():
     assert exc.value.options == ("decimals",)
     res = compensate_gcode(BASIC.encode(), model, source="t.ngc", decimals=3)
     assert res.predicted(model)["after"]["max_mm"] < 1e-3
+
+
+def test_arc_points_outside_the_measured_travel_are_warned_about(tmp_path, capsys):
+    """A full circle from (20, 20) around (0, 20) ends inside X 0..200 but its written
+    points reach X = -20: they are extrapolated and must be warned about."""
+    import json
+    import re
+    text = "G21 G90 G17\nG0 X20 Y20 Z-1\nG1 Z-2 F100\nG2 X20 Y20 I-20 J0\nG1 X25\nM2\n"
+    rc, stderr, out = _run(tmp_path, capsys, text, csv=TENS_CSV)
+    assert rc == 0, stderr
+    m = re.search(r"(\d+) program point\(s\) lie outside the measured travel \(up to "
+                  r"([0-9.]+) mm\)", stderr)
+    assert m, stderr
+    count, dist = int(m.group(1)), float(m.group(2))
+    written = [ln for ln in out.read_text().splitlines()
+               if re.match(r"^X-", ln) or " X-" in ln]
+    assert count == len(written) > 100        # every written point with X < 0, no other
+    assert abs(dist - 20.0) < 0.01            # the circle's leftmost point, X = -20
+    assert m.group(0) in json.loads((out.parent / "r.json").read_text())["warnings"][0]

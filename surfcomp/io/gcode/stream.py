@@ -154,7 +154,9 @@ class Compensator:
     file's word separator and first line ending, :func:`file_sep`, :func:`default_eol`),
     ``keep_points`` (keep every output point for a :class:`GCodeResult`), ``names`` (of the
     segment length and arc tolerance in messages) and ``visit`` (called with each block's
-    :class:`surfcomp.io.gcode.Program`).
+    output points as ``visit(nominal (n, 3) mm, known (n,) bool)``: the programmed points
+    of every command written, pieces of split moves and arcs included, as the bounds check
+    sees them).
     """
 
     def __init__(self, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e-3,
@@ -210,8 +212,6 @@ class Compensator:
         self.est = self.est + estimate_segments(prog, seg, arc_tol)
         if self.est.total > self.max_segments:
             return ""
-        if self.visit is not None:
-            self.visit(prog)
         self.inch = self.inch or bool((prog.factor != 1.0).any())
         still = np.where(prog.factor == 1.0, 0.5 * 10.0 ** -self.dmin_mm,
                          0.5 * 10.0 ** -self.dmin_in * prog.factor) * 0.999
@@ -223,6 +223,8 @@ class Compensator:
         nominal, emitted, known, line = w.state.take_points()
         self.n_points += line.size
         self.totals.add(nominal, emitted, known)
+        if self.visit is not None:
+            self.visit(nominal, known)
         self.bounds.add(nominal, emitted, line, self.resolution(False))
         if self.points is not None:
             self.points.append((nominal, emitted, known, line))
