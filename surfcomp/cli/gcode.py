@@ -77,7 +77,8 @@ def _um(v):
 
 class _Travel:
     """Program points outside the measured travel, block by block: count and largest
-    distance (mm) of the move ends whose axes are all known."""
+    distance (mm) of the points written whose axes are all known (move ends and the points
+    along split moves and arcs turned into segments, as the --max-error check sees them)."""
 
     def __init__(self, model):
         lo, hi = model.travel[:, 0], model.travel[:, 1]
@@ -85,8 +86,8 @@ class _Travel:
         self.lo, self.hi = lo, hi
         self.count, self.dist = 0, 0.0
 
-    def add(self, prog):
-        points = prog.end[prog.known.all(axis=1)]
+    def add(self, nominal, known):
+        points = nominal[known]
         if points.size == 0:
             return
         below = np.where(self.ok, self.lo - points, 0.0)
@@ -143,7 +144,7 @@ def run(args):
             warnings.append("%d program point(s) lie outside the measured travel (up to %.3f "
                             "mm): the error functions are extrapolated there"
                             % (travel.count, travel.dist))
-        warnings.extend(_model_warnings(model))
+        warnings.extend(table.warnings + _model_warnings(model))
         vmap = volumetric_map(model)
         if args.report:
             outputs["report"] = shown(args.report)
@@ -235,8 +236,7 @@ def build_report(args, table, model, prog_model, stats, pred, vmap, warnings, ou
                     "work_offset_mm": None if offset is None else offset.tolist(),
                     "start_mm": None if start is None else start.tolist()},
         "model": {**model.to_dict(), "components": model.components(),
-                  "fits": [dict(f.as_dict(), lines=table.lines[f.axis].tolist())
-                           for f in model.fits],
+                  "fits": [dict(f.as_dict(), lines=_fit_lines(table, f)) for f in model.fits],
                   "offset_spread_mm": model.offset_spread.tolist(),
                   "sign": "error = actual - commanded; command X' solves X' + E(X') = X",
                   "program_coordinates": prog_model.to_dict()},
@@ -246,3 +246,9 @@ def build_report(args, table, model, prog_model, stats, pred, vmap, warnings, ou
         "warnings": list(warnings),
         "outputs": outputs,
     }
+
+
+def _fit_lines(table, fit):
+    """The file lines of the rows a fit used (a table that leaves its column out: none)."""
+    measured = ~np.isnan(table.data[fit.axis][1][:, "xyz".index(fit.component)])
+    return table.lines[fit.axis][measured].tolist()

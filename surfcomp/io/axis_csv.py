@@ -24,7 +24,9 @@ Two layouts are read; the first non-blank, non-comment line tells which.
        ...
 
    ``E<i><a>`` is the error along ``i`` while slide ``a`` moves. A slide may appear in
-   several tables (repeated runs); their rows are pooled.
+   several tables (repeated runs); their rows are pooled. A column a table leaves out is
+   not measured in its rows (NaN: left out of that component's fit); a column no table of
+   the slide gives is taken as 0 in all its rows (with a warning).
 
 Common rules
 ------------
@@ -70,7 +72,8 @@ class AxisErrorTable:
     ----------
     data : dict
         ``{'x': (positions (n,), errors (n, 3))}`` in mm, the input of
-        :func:`surfcomp.core.axis.axis_errors.fit_axis_errors`.
+        :func:`surfcomp.core.axis.axis_errors.fit_axis_errors`; NaN where a table left
+        that component out.
     lines : dict
         ``{'x': ndarray (n,) int}``: the 1-based file line of every row.
     path : str or None
@@ -283,7 +286,7 @@ def _read_tables(path, lines, first, units, max_error=None):
             raise MeasurementFileError("%d fields, expected %d like the table header"
                                        % (len(fields), ncols), file=path, line=k + 1)
         pos = _position(fields[0], path, k + 1, 1, ax.upper(), pfac)
-        err = [0.0, 0.0, 0.0]
+        err = [math.nan, math.nan, math.nan]      # a column the table leaves out: not measured
         for comp, fac, col in comps:
             err[comp] = _error(fields[col], path, k + 1, col + 1,
                                "E%s%s" % (AXES[comp].upper(), ax.upper()), fac, max_error)
@@ -326,17 +329,23 @@ def _table_header(path, lineno, text, units):
 
 
 def _finish(path, rows, layout, lines):
-    data, where = {}, {}
+    data, where, unmeasured = {}, {}, []
     for ax in AXES:
         pos, err, ln = rows[ax]
         if pos:
-            data[ax] = (np.array(pos, dtype=float), np.array(err, dtype=float).reshape(-1, 3))
+            err = np.array(err, dtype=float).reshape(-1, 3)
+            for i in np.flatnonzero(np.isnan(err).all(axis=0)):
+                err[:, i] = 0.0                   # in no table of the slide: no error
+                unmeasured.append("E%s%s" % (AXES[i].upper(), ax.upper()))
+            data[ax] = (np.array(pos, dtype=float), err)
             where[ax] = np.array(ln, dtype=int)
     if not data:
         last = max((k + 1 for k, t in enumerate(lines) if t.strip()), default=1)
         raise MeasurementFileError("no data rows (expected at least two positions of one "
                                    "slide)", file=path, line=last)
-    return AxisErrorTable(data, where, path=path, layout=layout)
+    warnings = ["%s: %s in no table, taken as 0 (no error measured, none compensated)"
+                % (path, ", ".join(unmeasured))] if unmeasured else []
+    return AxisErrorTable(data, where, path=path, layout=layout, warnings=warnings)
 
 
 def format_axis_errors(data, units="mm"):

@@ -193,7 +193,30 @@ def test_fit_refuses_bad_input():
     with pytest.raises(InputError, match="no axis error measurements"):
         fit_axis_errors({})
     with pytest.raises(InputError, match="non-finite"):
+        fit_axis_errors({"z": (p, np.full((2, 3), np.inf))})
+    with pytest.raises(InputError, match="axis Z: error along X/Y/Z measured at 0 distinct"):
         fit_axis_errors({"z": (p, np.full((2, 3), np.nan))})
+    half = np.array([[0.0, 0.0, 0.0], [0.001, np.nan, 0.0], [0.002, np.nan, 0.0]])
+    with pytest.raises(InputError, match="axis X: error along Y measured at 1 distinct"):
+        fit_axis_errors({"x": (np.array([0.0, 10.0, 20.0]), half)})
+
+
+def test_unmeasured_rows_are_left_out_of_their_component_fit():
+    """NaN = not measured in that row: each component is fitted on its own rows only, the
+    others on all rows as before (same numbers as fitting those rows alone)."""
+    pos = np.array([0.0, 100.0, 200.0, 0.0, 100.0, 200.0])
+    err = np.array([[0.0, np.nan, 0.0], [0.010, np.nan, 0.001], [0.020, np.nan, 0.002],
+                    [np.nan, 0.0, 0.0], [np.nan, 0.002, 0.001], [np.nan, 0.004, 0.002]])
+    m = fit_axis_errors({"x": (pos, err)}, model="linear")
+    f = {fit.component: fit for fit in m.fits}
+    assert [fit.component for fit in m.fits] == ["x", "y", "z"]
+    assert (f["x"].n, f["y"].n, f["z"].n) == (3, 3, 6)
+    assert_allclose(m.slope[0], [1e-4, 2e-5, 1e-5], rtol=1e-12, atol=1e-18)
+    assert_allclose(f["x"].positions, [0, 100, 200], atol=0)
+    assert_allclose(f["y"].values, [0, 0.002, 0.004], atol=0)
+    assert_allclose(m.offset, [0, 0, 0], atol=1e-15)
+    whole = fit_axis_errors({"x": (pos[:3], np.nan_to_num(err[:3]))}, model="linear")
+    assert_allclose(m.slope[0, 0], whole.slope[0, 0], rtol=0, atol=0)
 
 
 # ------------------------------------------------------------------ compensation
@@ -344,9 +367,27 @@ def test_table_layout_several_tables_pooled_runs(tmp_path):
     t = read_axis_errors(str(f))
     assert t.layout == "tables"
     assert_allclose(t.data["x"][0], [0, 25.4, 50])
-    assert_allclose(t.data["x"][1], [[0, 0, 0], [0.001, 0, -0.002], [0.004, 0, 0.001]])
+    # the second run did not measure EYX: not measured (NaN) there, not a zero
+    assert_allclose(t.data["x"][1], [[0, 0, 0], [0.001, 0, -0.002], [0.004, np.nan, 0.001]])
+    assert t.warnings == []
     assert_allclose(t.data["z"][1][0], [0.001, 0.002, 0.003], atol=1e-15)
     assert t.lines["x"].tolist() == [2, 3, 8]
+
+
+def test_tables_that_leave_columns_out_fit_what_they_measured(tmp_path):
+    """One X run gives EXX, another EYX: delta_x(x) is 100 um/m and delta_y(x) 20 um/m,
+    each from its own 3 rows (not halved by the other run's rows read as zeros); EZX, in
+    no table, is 0 at all 6 rows, with a warning."""
+    f = tmp_path / "runs.txt"
+    f.write_text("X EXX\n0 0\n100 0.010\n200 0.020\nX EYX\n0 0\n100 0.002\n200 0.004\n")
+    t = read_axis_errors(str(f))
+    assert np.isnan(t.data["x"][1][3:, 0]).all() and np.isnan(t.data["x"][1][:3, 1]).all()
+    assert_allclose(t.data["x"][1][:, 2], np.zeros(6), atol=0)
+    assert t.warnings == ["%s: EZX in no table, taken as 0 (no error measured, none "
+                          "compensated)" % f]
+    m = fit_axis_errors(t.data)
+    assert_allclose(m.slope[0], [1e-4, 2e-5, 0.0], rtol=1e-9, atol=1e-15)
+    assert [fit.n for fit in m.fits] == [3, 3, 6]
 
 
 @pytest.mark.parametrize("text, where, what", [

@@ -242,6 +242,8 @@ def test_wave_compensated_with_a_fitted_model():
     ("G21 G90\nG0 X0 Y0\nG2 X10 Y0 R4\n", 3, "radius R4 is smaller than half"),
     ("G21 G90\nG0 X0 Y0\nG2 X10 Y0\n", 3, "without I/J or R"),
     ("G21 G90 G54\nG0 X0 Y0\nG55\n", 3, "G55 selects a second work coordinate system"),
+    ("G21 G90\nG0 X0 Y0\nG55\n", 3, "G55 selects a second work coordinate system after "
+     "moves in G54 (none was named"),
     ("G21 G90\nX1\n", 2, "axis words but no motion mode"),
     ("G21 G90\nG0 X0\n/G1 X5\n", 3, "block delete"),
     ("G21 G90\nG0 X0 Y0 Z0\nG1 X100 M30\n", 3, "program stop"),
@@ -257,6 +259,18 @@ def test_refusals_name_the_line(text, line, what):
     assert exc.value.line == line, str(exc.value)
     assert what in str(exc.value)
     assert str(exc.value).startswith("t.ngc:%d" % line)
+
+
+def test_g54_after_moves_without_a_named_offset_is_no_change():
+    """A program naming no work offset runs in G54 (power-up): G54 named after moves keeps
+    it, so the program is compensated as if G54 had come first, with a warning."""
+    body = "G0 X10 Y10 Z-1\nG1 X100 F100\nG54\nG0 X10 Y10\nG1 X100 Y50\nM2\n"
+    late = comp("G21 G90 G17\n" + body, segment_length=10.0)
+    first = comp("G21 G90 G17 G54\n" + body, segment_length=10.0)
+    assert output_lines(late)[1:] == output_lines(first)[1:]
+    assert_allclose(late.emitted, first.emitted, rtol=0, atol=0)
+    assert [w for w in late.warnings if "G54 on line 4 after moves" in w]
+    assert not [w for w in first.warnings if "G54" in w]
 
 
 def test_tokenizer_spans_comments_and_case():

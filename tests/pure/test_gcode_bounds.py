@@ -362,3 +362,87 @@ def test_model_input_errors_are_input_errors():
     assert exc.value.file == "e.csv"
     # SimulatedMachine moved to core/axis/machine.py; the old import still works
     assert axis_errors.SimulatedMachine is machine.SimulatedMachine
+
+
+def test_work_offset_change_without_a_named_first_offset_is_refused(tmp_path, capsys):
+    """No offset named: the moves run in the active one (G54 at power-up); G55 after them
+    is a change, refused with its line like G54 ... G55."""
+    text = "G21 G90 G17\nG0 X10 Y10 Z-1\nG1 X100 F100\nG55\nG0 X10 Y10\nG1 X100\nM2\n"
+    stderr = _refused(tmp_path, capsys, text)
+    assert "in.ngc:4:1: G55 selects a second work coordinate system after moves in G54" \
+        in stderr
+
+
+def test_report_counts_the_rows_each_fit_used(tmp_path, capsys):
+    """Two X runs, one giving EXX and one EYX: each fit counts and names its own 3 rows."""
+    import json
+    text = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50\nG1 X150 Y150 Z-5\nM2\n"
+    csv = "X EXX\n0 0\n100 0.010\n200 0.020\nX EYX\n0 0\n100 0.002\n200 0.004\n"
+    rc, stderr, out = _run(tmp_path, capsys, text, csv=csv)
+    assert rc == 0, stderr
+    fits = {f["function"]: f for f in json.loads(
+        (out.parent / "r.json").read_text())["model"]["fits"]}
+    assert (fits["delta_x(x)"]["n"], fits["delta_x(x)"]["lines"]) == (3, [2, 3, 4])
+    assert (fits["delta_y(x)"]["n"], fits["delta_y(x)"]["lines"]) == (3, [6, 7, 8])
+    assert fits["delta_z(x)"]["lines"] == [2, 3, 4, 6, 7, 8]
+    assert abs(fits["delta_x(x)"]["b1"] - 1e-4) < 1e-12
+    assert abs(fits["delta_y(x)"]["b1"] - 2e-5) < 1e-12
+    assert "EZX in no table, taken as 0" in stderr
+
+
+BASIC = "G21 G90 G17\nG0 X0 Y0 Z5\nG1 Z-1 F100\nG1 X100 Y50\nG1 X150 Y150 Z-5\nG0 Z5\nM2\n"
+#: errors of tens of um over 200 mm of X and Y (the brief's example)
+TENS_CSV = ("axis,position,ex,ey,ez\nX,0,0,0,0\nX,50,0.010,0.002,0.001\nX,100,0.025,0.004,0.003\n"
+            "X,150,0.045,0.007,0.005\nX,200,0.070,0.010,0.008\nY,0,0,0,0\n"
+            "Y,100,0.006,-0.018,0.002\nY,200,0.012,-0.044,0.006\nZ,-100,0.002,0.001,-0.030\n"
+            "Z,0,0,0,0\n")
+
+
+@pytest.mark.parametrize("decimals, after_um", [("0", "750.8"), ("1", "71.12")])
+def test_rounding_coarser_than_the_corrections_is_refused(tmp_path, capsys, decimals,
+                                                          after_um):
+    """0 or 1 decimals land the tool farther from the program than no compensation at all
+    (60.74 um before): refused, nothing written, the option to change named."""
+    stderr = _refused(tmp_path, capsys, BASIC, "--decimals", decimals, csv=TENS_CSV)
+    assert ("the compensated program would be worse than the input: the error model "
+            "predicts up to %s um at the program's points after compensation against 60.74 "
+            "um before, as its numbers are rounded to %s decimal place(s)"
+            % (after_um, decimals)) in stderr
+    assert "--decimals 3 or more" in stderr
+
+
+def test_two_decimals_improve_the_program_and_are_written(tmp_path, capsys):
+    rc, stderr, out = _run(tmp_path, capsys, BASIC, "--decimals", "2", csv=TENS_CSV)
+    assert rc == 0, stderr
+    import json
+    pred = json.loads((out.parent / "r.json").read_text())["predicted"]
+    assert abs(pred["before"]["max_mm"] - 0.060739) < 1e-6
+    assert pred["after"]["max_mm"] < 0.0069           # 6.87 um: rounding to 0.01 mm
+
+
+def test_library_refuses_an_output_worse_than_its_input():
+    model = fit_axis_errors(read_axis_errors("e.csv", text=TENS_CSV).data)
+    with pytest.raises(GCodeError, match="would be worse than the input") as exc:
+        compensate_gcode(BASIC.encode(), model, source="t.ngc", decimals=0)
+    assert exc.value.options == ("decimals",)
+    res = compensate_gcode(BASIC.encode(), model, source="t.ngc", decimals=3)
+    assert res.predicted(model)["after"]["max_mm"] < 1e-3
+
+
+def test_arc_points_outside_the_measured_travel_are_warned_about(tmp_path, capsys):
+    """A full circle from (20, 20) around (0, 20) ends inside X 0..200 but its written
+    points reach X = -20: they are extrapolated and must be warned about."""
+    import json
+    import re
+    text = "G21 G90 G17\nG0 X20 Y20 Z-1\nG1 Z-2 F100\nG2 X20 Y20 I-20 J0\nG1 X25\nM2\n"
+    rc, stderr, out = _run(tmp_path, capsys, text, csv=TENS_CSV)
+    assert rc == 0, stderr
+    m = re.search(r"(\d+) program point\(s\) lie outside the measured travel \(up to "
+                  r"([0-9.]+) mm\)", stderr)
+    assert m, stderr
+    count, dist = int(m.group(1)), float(m.group(2))
+    written = [ln for ln in out.read_text().splitlines()
+               if re.match(r"^X-", ln) or " X-" in ln]
+    assert count == len(written) > 100        # every written point with X < 0, no other
+    assert abs(dist - 20.0) < 0.01            # the circle's leftmost point, X = -20
+    assert m.group(0) in json.loads((out.parent / "r.json").read_text())["warnings"][0]

@@ -156,6 +156,13 @@ def test_modes_are_refused_with_the_line(program, tmp_path, edit, line, message)
     assert exc.value.line == line
 
 
+def test_a_work_offset_change_is_refused_when_none_was_named(program, tmp_path):
+    text = program.replace("M2\n", "G55\nM2\n")
+    with pytest.raises(GCodeError, match="G55 selects a second work coordinate") as exc:
+        run(text, wave, tmp_path)
+    assert exc.value.line == text.split("\n").index("G55") + 1
+
+
 def test_a_wrong_ball_radius_is_refused(tmp_path):
     text = raster(radius=2.0)
     # a larger ball than the program's cuts into the face

@@ -466,13 +466,21 @@ def _axis_data(ax, data, source):
         raise InputError("axis %s: %d positions but %d error rows" % (ax, pos.size,
                                                                        err.shape[0]),
                          file=source)
-    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(err))):
+    if not (np.all(np.isfinite(pos)) and not np.isinf(err).any()):
         raise InputError("axis %s: non-finite measured values" % ax.upper(), file=source)
-    if not (np.all(np.abs(pos) <= MAX_VALUE) and np.all(np.abs(err) <= MAX_VALUE)):
+    if not (np.all(np.abs(pos) <= MAX_VALUE) and not (np.abs(err) > MAX_VALUE).any()):
         raise InputError("axis %s: measured positions or errors beyond %g mm (1 km; expected "
                          "a machine's travel and errors in mm)" % (ax.upper(), MAX_VALUE),
                          file=source)
     return pos, err
+
+
+def _row_sets(err):
+    """``[(rows (n,) bool, [component, ...]), ...]``: components measured at the same rows."""
+    sets = {}
+    for i in range(3):
+        sets.setdefault(tuple(~np.isnan(err[:, i])), []).append(i)
+    return [(np.array(rows, dtype=bool), comps) for rows, comps in sets.items()]
 
 
 def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_ALPHA,
@@ -484,8 +492,8 @@ def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_
     data : mapping
         ``{'x': (positions (n,), errors (n, 3)), ...}``: for each measured slide, its
         positions (mm, absolute) and the tool-position errors along x, y, z (mm, actual
-        minus commanded) with the other slides at the reference. Missing slides get no
-        error (reported in the summary).
+        minus commanded) with the other slides at the reference; NaN: that component was
+        not measured in that row (left out of its fit). Missing slides get no error.
     model : {'linear', 'quadratic', 'auto'}
         Degree of every function, or ``'auto'``: per function, quadratic when the partial
         F-test of the quadratic term is significant at ``alpha`` (needs n >= 4).
@@ -528,52 +536,65 @@ def fit_axis_errors(data, model="auto", reference=(0.0, 0.0, 0.0), alpha=F_TEST_
     for a, ax in enumerate(AXES):
         if ax not in keys:
             continue
-        pos, err = _axis_data(ax, keys[ax], source)
-        n_distinct = np.unique(pos).size
-        need = 3 if model == "quadratic" else 2
-        if n_distinct < need:
-            raise InputError("axis %s: %d distinct position(s) measured; a %s fit needs at "
-                             "least %d" % (ax.upper(), n_distinct,
-                                           "quadratic" if need == 3 else "linear", need),
-                             file=source)
-        travel[a] = pos.min(), pos.max()
-        t = pos - ref[a]
-        n = pos.size
-        c1, r1 = _polyfit(t, err, 1)
-        c2, r2 = (_polyfit(t, err, 2) if n_distinct >= 3 else (None, None))
-        for i, comp in enumerate(AXES):
-            rss1 = float(np.sum(r1[:, i] ** 2))
-            f_stat = p_val = float("nan")
-            if model == "linear":
-                deg, rule = 1, "given"
-            elif model == "quadratic":
-                deg, rule = 2, "given"
-            elif c2 is None or n < 4:
-                deg, rule = 1, "n < 4"
-            elif rss1 <= n * EXACT_RMS ** 2:
-                deg, rule = 1, "exact line"
-            else:
-                rss2 = float(np.sum(r2[:, i] ** 2))
-                if rss2 <= n * EXACT_RMS ** 2:
-                    f_stat, p_val = float("inf"), 0.0
-                else:
-                    f_stat = (rss1 - rss2) / (rss2 / (n - 3))
-                    p_val = float(stats.f.sf(f_stat, 1, n - 3))
-                deg, rule = (2 if p_val < alpha else 1), "F-test"
-            coef = (c1 if deg == 1 else c2)[:, i].copy()
-            res = (r1 if deg == 1 else r2)[:, i].copy()
-            rss = float(np.sum(res ** 2))
-            tss = float(np.sum((err[:, i] - err[:, i].mean()) ** 2))
-            dof = n - deg - 1
-            r2a = (1.0 - (rss / dof) / (tss / (n - 1))) if (dof > 0 and tss > 0) else np.nan
-            fits.append(ComponentFit(ax, comp, deg, coef, pos.copy(), err[:, i].copy(), res,
-                                     rss, float(np.sqrt(rss / n)), float(np.abs(res).max()),
-                                     float(r2a), rule, float(f_stat), float(p_val)))
-            slope[a, i] = coef[1]
-            curv[a, i] = coef[2]
-            b0[a, i] = coef[0]
+        pos_all, err_all = _axis_data(ax, keys[ax], source)
+        travel[a] = pos_all.min(), pos_all.max()
+        axis_fits = []
+        for rows, comps in _row_sets(err_all):
+            pos = pos_all[rows]
+            axis_fits += _fit_set(ax, comps, rows.all(), pos, pos - ref[a],
+                                  err_all[rows][:, comps], model, alpha, source)
+        for f in sorted(axis_fits, key=lambda f: AXES.index(f.component)):
+            i = AXES.index(f.component)
+            b0[a, i], slope[a, i], curv[a, i] = f.coefficients
+            fits.append(f)
     measured = np.isfinite(b0[:, 0])
     offset = b0[measured].mean(axis=0)
     spread = b0[measured].max(axis=0) - b0[measured].min(axis=0)
     return AxisErrorModel(slope, curv, reference=ref, offset=offset, travel=travel, fits=fits,
                           offset_spread=spread)
+
+
+def _fit_set(ax, comps, every_row, pos, t, err, model, alpha, source):
+    """Fits of the components ``comps`` of slide ``ax`` measured at the same rows:
+    positions ``pos`` and travels ``t`` (n,), errors ``err`` (n, len(comps));
+    ``every_row``: measured at all the slide's rows."""
+    n_distinct = np.unique(pos).size
+    need = 3 if model == "quadratic" else 2
+    if n_distinct < need:
+        what = ("%d distinct position(s) measured" if every_row else "error along %s measured "
+                "at %%d distinct position(s)" % "/".join(AXES[i].upper() for i in comps))
+        raise InputError("axis %s: %s; a %s fit needs at least %d" % (ax.upper(), what % n_distinct,
+                         "quadratic" if need == 3 else "linear", need), file=source)
+    n = t.size
+    c1, r1 = _polyfit(t, err, 1)
+    c2, r2 = (_polyfit(t, err, 2) if n_distinct >= 3 else (None, None))
+    fits = []
+    for j, i in enumerate(comps):
+        rss1 = float(np.sum(r1[:, j] ** 2))
+        f_stat = p_val = float("nan")
+        if model == "linear":
+            deg, rule = 1, "given"
+        elif model == "quadratic":
+            deg, rule = 2, "given"
+        elif c2 is None or n < 4:
+            deg, rule = 1, "n < 4"
+        elif rss1 <= n * EXACT_RMS ** 2:
+            deg, rule = 1, "exact line"
+        else:
+            rss2 = float(np.sum(r2[:, j] ** 2))
+            if rss2 <= n * EXACT_RMS ** 2:
+                f_stat, p_val = float("inf"), 0.0
+            else:
+                f_stat = (rss1 - rss2) / (rss2 / (n - 3))
+                p_val = float(stats.f.sf(f_stat, 1, n - 3))
+            deg, rule = (2 if p_val < alpha else 1), "F-test"
+        coef = (c1 if deg == 1 else c2)[:, j].copy()
+        res = (r1 if deg == 1 else r2)[:, j].copy()
+        rss = float(np.sum(res ** 2))
+        tss = float(np.sum((err[:, j] - err[:, j].mean()) ** 2))
+        dof = n - deg - 1
+        r2a = (1.0 - (rss / dof) / (tss / (n - 1))) if (dof > 0 and tss > 0) else np.nan
+        fits.append(ComponentFit(ax, AXES[i], deg, coef, pos.copy(), err[:, j].copy(), res,
+                                 rss, float(np.sqrt(rss / n)), float(np.abs(res).max()),
+                                 float(r2a), rule, float(f_stat), float(p_val)))
+    return fits

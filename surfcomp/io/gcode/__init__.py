@@ -37,7 +37,8 @@ What is refused (:class:`surfcomp.errors.GCodeError` naming ``file:line:column``
 Parameters and expressions (``#1``, ``#<name>``, ``[...]``), ``O`` words (subroutines,
 loops), ``M98/M99``, other axes (``A B C U V W``), ``E`` words, canned cycles
 (``G73 G76 G81-G89``), cutter radius compensation (``G41 G42``), coordinate system changes
-inside the program (``G10 G52 G92``, a second work offset after the first move), inverse
+inside the program (``G10 G52 G92``, a second work offset after the first move; naming
+none counts as G54, the power-up default), inverse
 time feed ``G93``, probing ``G38.x``, threading ``G33``, splines ``G5``, lathe, polar and
 rotation modes, any G code not listed above, an incremental move of an axis whose position
 is not known, arcs whose end is not on the circle.

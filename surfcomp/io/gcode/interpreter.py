@@ -26,6 +26,8 @@ _MOTION = {0: 0, 10: 1, 20: 2, 30: 3}
 _PASS_G = {40, 400, 430, 490, 540, 550, 560, 570, 580, 590, 591, 592, 593, 610, 611, 640,
            690, 940, 950, 960, 970, 980, 990, 281, 301}
 _STOP_M = {0, 1, 2, 30, 60}
+#: the work offset a program that names none runs in (LinuxCNC and Fanuc at power-up)
+_POWER_UP_WCS = 540
 _REFUSED_G = {
     (730, 760, 810, 820, 830, 840, 850, 860, 870, 880, 890):
         "canned cycles cannot be compensated (the plunge would need X/Y corrections along "
@@ -255,12 +257,22 @@ class _Interpreter:
         cur.nonmodal = code
 
     def _g_wcs(self, code, k, w, ln, cur):
-        if self.wcs is not None and code != self.wcs and self.moved:
+        # a program naming none runs in the controller's active offset: G54 at power-up
+        active = _POWER_UP_WCS if self.wcs is None else self.wcs
+        if self.moved and code != active:
             raise GCodeError("G%s selects a second work coordinate system after moves in "
-                             "G%s: the error model's positions cannot follow; compensate "
+                             "G%s%s: the error model's positions cannot follow; compensate "
                              "each work offset's part separately"
-                             % (_code_text(code), _code_text(self.wcs)), file=self.source,
-                             line=ln, column=_column(w))
+                             % (_code_text(code), _code_text(active),
+                                "" if self.wcs is not None else
+                                " (none was named before the first move, so the moves ran "
+                                "in the controller's active one, G54 at power-up)"),
+                             file=self.source, line=ln, column=_column(w))
+        if self.moved and self.wcs is None and not self.path:
+            self.warnings.append("G54 on line %d after moves with no work offset named: the "
+                                 "moves before it were taken to be in G54 (the power-up "
+                                 "default); if the machine may be in another work offset, "
+                                 "name G54 before the first move" % ln)
         self.wcs = code
 
     def _g_codes(self, gs, ln):

@@ -154,7 +154,9 @@ class Compensator:
     file's word separator and first line ending, :func:`file_sep`, :func:`default_eol`),
     ``keep_points`` (keep every output point for a :class:`GCodeResult`), ``names`` (of the
     segment length and arc tolerance in messages) and ``visit`` (called with each block's
-    :class:`surfcomp.io.gcode.Program`).
+    output points as ``visit(nominal (n, 3) mm, known (n,) bool)``: the programmed points
+    of every command written, pieces of split moves and arcs included, as the bounds check
+    sees them).
     """
 
     def __init__(self, model, segment_length=2.0, tolerance=1e-4, arc_tolerance=1e-3,
@@ -210,8 +212,6 @@ class Compensator:
         self.est = self.est + estimate_segments(prog, seg, arc_tol)
         if self.est.total > self.max_segments:
             return ""
-        if self.visit is not None:
-            self.visit(prog)
         self.inch = self.inch or bool((prog.factor != 1.0).any())
         still = np.where(prog.factor == 1.0, 0.5 * 10.0 ** -self.dmin_mm,
                          0.5 * 10.0 ** -self.dmin_in * prog.factor) * 0.999
@@ -223,6 +223,8 @@ class Compensator:
         nominal, emitted, known, line = w.state.take_points()
         self.n_points += line.size
         self.totals.add(nominal, emitted, known)
+        if self.visit is not None:
+            self.visit(nominal, known)
         self.bounds.add(nominal, emitted, line, self.resolution(False))
         if self.points is not None:
             self.points.append((nominal, emitted, known, line))
@@ -241,6 +243,26 @@ class Compensator:
             refuse_segments(self.est, self.n_moves, self.lengths[0], self.lengths[2],
                             self.max_segments, self.names, self.source)
         self.bounds.finish(self.resolution(self.inch), self.source)
+        self.check_gain()
+
+    def check_gain(self):
+        """Refuse an output the model predicts to land farther from the programmed points
+        than the input (numbers rounded more coarsely than the corrections they carry)."""
+        before, after = self.totals.before.max, self.totals.after.max
+        if not after > before + 1e-9:
+            return
+        dmin = self.dmin_in if self.inch else self.dmin_mm
+        need = next((d for d in range(dmin + 1, 10) if self.resolution(self.inch)
+                     * 10.0 ** (dmin - d) <= 0.1 * before), 9)
+        raise GCodeError("the compensated program would be worse than the input: the error "
+                         "model predicts up to %.4g um at the program's points after "
+                         "compensation against %.4g um before, as its numbers are rounded to "
+                         "%d decimal place(s) (up to %.4g um per point), too coarse for "
+                         "corrections of up to %.4g um; nothing was written (expected a "
+                         "rounding finer than the corrections: decimals %d or more)"
+                         % (after * 1e3, before * 1e3, dmin, self.resolution(self.inch) * 1e3,
+                            self.totals.max_correction * 1e3, need),
+                         file=self.source, options=("decimals",))
 
     def warnings(self):
         """The warnings of the program read by :meth:`lines`."""
