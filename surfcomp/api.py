@@ -195,11 +195,9 @@ def compensate(nominal, measurements, options=None, build=True, progress=None, *
     prepared = _prepare(nominal.surface, nominal.outward, measurements, opts,
                         progress=_part(progress, 0.0, 0.3))
     if getattr(nominal, "bspline_face", None) is not None:    # a loaded face: its trim
-        from .app.nominal import trim_warning
+        from .app.nominal import face_warnings
 
-        warning = trim_warning(nominal, prepared)
-        if warning:
-            prepared.warnings.append(warning)
+        prepared.warnings.extend(face_warnings(nominal, prepared))
     comp = _compensate(nominal.surface, nominal.outward, prepared, opts, build=build,
                        progress=_part(progress, 0.3, 1.0))
     return Result(nominal, measurements, opts, comp)

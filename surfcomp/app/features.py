@@ -55,7 +55,7 @@ from ..io.measurements import MeasurementSet
 from ..io.readers import FORMATS, read_any
 from . import align_doc, result_cache
 from . import preview as preview_cache
-from .nominal import trim_warning
+from .nominal import face_warnings
 from .progress import freecad_progress
 from .properties import (
     COMPENSATION_PROPERTIES,
@@ -451,15 +451,14 @@ def _prepared(obj, nominal, placement, ms, options, preview, progress):
     recompute when nothing they depend on changed (:mod:`surfcomp.app.preview`)."""
     def make():
         prep = prepare(nominal.surface, nominal.outward, ms, options, progress=progress)
-        return prep, trim_warning(nominal, prep), parameter_scale(nominal.surface, prep)
+        return prep, face_warnings(nominal, prep), parameter_scale(nominal.surface, prep)
 
     if preview:
         key = preview_cache.fingerprint(nominal, placement, ms, options)
-        prep, warning, scale = preview_cache.prepared(obj, key, make)
+        prep, warnings, scale = preview_cache.prepared(obj, key, make)
     else:
-        prep, warning, scale = make()
-    if warning:
-        prep.warnings.append(warning)
+        prep, warnings, scale = make()
+    prep.warnings.extend(w for w in warnings if w not in prep.warnings)
     return prep, scale
 
 

@@ -182,7 +182,7 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
         ms, alignment = align_measurements(job, nominal, ms, progress=sub(progress, 0, 0.1))
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
-    _warn_outside_trim(nominal, prepared)
+    _face_warnings(nominal, prepared)
     if alignment is not None:
         prepared.warnings.extend(alignment.warnings)
     build = job.command == "compensate"
@@ -250,12 +250,10 @@ def _texts(job, comp, rep):
     return texts
 
 
-def _warn_outside_trim(nominal, prepared):
-    from .nominal import trim_warning
+def _face_warnings(nominal, prepared):
+    from .nominal import face_warnings
 
-    warning = trim_warning(nominal, prepared)
-    if warning:
-        prepared.warnings.append(warning)
+    prepared.warnings.extend(face_warnings(nominal, prepared))
 
 
 def _inputs_record(job, nominal, ms):

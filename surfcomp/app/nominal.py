@@ -236,3 +236,56 @@ def trim_warning(nominal, prepared):
             "in the statistics, and the corrected face keeps the nominal's boundary"
             % ((prepared.source, idx.size, prepared.u.size, nominal.face_name, lines, more,
                 float(dist.max())) + tuple(prepared.nominal[far]) + (int(prepared.lines[far]),)))
+
+
+#: measured points that cover less than this share of the face's area are reported
+MIN_COVERAGE = 0.5
+#: a face sample is covered when a measured point lies within this many point spacings
+COVERAGE_SPACINGS = 3.0
+
+
+def coverage(nominal, prepared, n=60):
+    """The share of the face's area (inside its trim) within :data:`COVERAGE_SPACINGS`
+    median point spacings of a measured point, on an ``n`` x ``n`` grid of its parameters
+    weighted by the area element."""
+    from ..core.surface import bspline
+    from ..core.surface.kdtree import cKDTree
+
+    pts = np.asarray(prepared.nominal, dtype=float)
+    if len(pts) < 2:
+        return 0.0
+    u0, u1, v0, v1 = nominal.data.bounds
+    U, V = (a.ravel() for a in np.meshgrid(np.linspace(u0, u1, n), np.linspace(v0, v1, n),
+                                            indexing="ij"))
+    if not nominal.untrimmed:
+        keep = inside(nominal.boundary(), U, V)
+        U, V = U[keep], V[keep]
+    if not U.size:
+        return 0.0
+    P, Su, Sv = bspline.derivatives(nominal.surface, U, V, order=1)
+    area = np.linalg.norm(np.cross(Su, Sv), axis=1)
+    tree = cKDTree(pts)
+    step = float(np.median(tree.query(pts, k=2)[0][:, 1]))
+    d, _ = tree.query(P, k=1, distance_upper_bound=COVERAGE_SPACINGS * step)
+    return float(area[np.isfinite(d)].sum() / area.sum())
+
+
+def coverage_warning(nominal, prepared):
+    """A warning when the measured points cover less than :data:`MIN_COVERAGE` of the face
+    (:func:`coverage`): elsewhere the correction is the field's continuation from the
+    measured area, which nothing measured (None otherwise)."""
+    share = coverage(nominal, prepared)
+    if share >= MIN_COVERAGE:
+        return None
+    return ("%s: the measured points cover %.0f %% of %s (its area within %g point spacings "
+            "of a point); over the rest of the face the correction is continued from the "
+            "border of the measured area, where nothing was measured (expected measurements "
+            "over the whole face)" % (prepared.source, 100 * share, nominal.face_name,
+                                      COVERAGE_SPACINGS))
+
+
+def face_warnings(nominal, prepared):
+    """What the face's trim and extent say about the measured points: the
+    :func:`trim_warning` and the :func:`coverage_warning`, those that apply."""
+    return [w for w in (trim_warning(nominal, prepared), coverage_warning(nominal, prepared))
+            if w]
