@@ -28,6 +28,7 @@ from ..core.measurement.planning import (
     check_points,
     parse_count,
 )
+from ..core.measurement.planning_reach import NEAREST_LIMIT
 from ..core.option_tables import INPUTS, PLAN
 from ..errors import InputError
 from ..io.atomic import Transaction
@@ -41,6 +42,11 @@ from .options import add_arguments
 PROBE = ("tip_radius", "edge_margin", "max_tilt", "stand_off", "clearance")
 #: printed examples per drop reason
 _EXAMPLES = 3
+#: what each visiting order is (:func:`surfcomp.core.measurement.planning_reach.visiting_order`)
+ORDER_TEXT = {
+    "serpentine": "row by row, every other row reversed",
+    "nearest": "greedy nearest neighbour from the first point of the serpentine",
+}
 
 
 def add_parser(subparsers):
@@ -116,9 +122,18 @@ def _comments(args, plan, nominal):
             "%.6f mm (part top %.6f + tip radius + clearance %g)"
             % (s.tip_radius, s.edge_margin, s.max_tilt, s.stand_off, plan.safe_z, plan.top_z,
                s.clearance),
-            "visiting order %s (the row order), travel %.3f mm between retract positions"
-            % (plan.order, plan.travel),
+            "visiting order %s (%s%s), travel %.3f mm between retract positions"
+            % (plan.order, ORDER_TEXT[plan.order], _auto_text(args, plan), plan.travel),
             "nominal surface points (mm) and outward unit normals; no deviation: not measured"]
+
+
+def _auto_text(args, plan):
+    """How ``--order auto`` chose the plan's order (empty for an order given by name)."""
+    if args.order != "auto":
+        return ""
+    if len(plan) > NEAREST_LIMIT:
+        return "; order auto: nearest is not tried above %d points" % NEAREST_LIMIT
+    return "; order auto: the shorter of serpentine and nearest"
 
 
 def _reason_text(key):

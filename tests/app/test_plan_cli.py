@@ -83,6 +83,38 @@ def test_plan_xyzijk_read_as_pcdmis(tmp_path):
     assert_allclose(pts.normal, ms.normal, atol=1e-12)
 
 
+def _header(path, start):
+    return next(ln for ln in path.read_text().splitlines() if ln.startswith(start))
+
+
+@pytest.mark.parametrize("order", ["nearest", "serpentine", "auto"])
+def test_plan_header_says_what_the_visiting_order_is(tmp_path, order):
+    """The header names the order the rows are in and says what it is; a nearest-neighbour
+    plan is one (every next retract position, 6 mm out along the normal, is the nearest
+    one not visited yet, within 1 um)."""
+    out = plan_in_process(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--count", "10x10",
+                          "--order", order)
+    assert out.returncode == 0, out.stderr
+    line = _header(tmp_path / "plan.csv", "# visiting order")
+    travel = float(line.split("travel ")[1].split(" mm")[0])
+    want = {"nearest": "nearest (greedy nearest neighbour from the first point of the "
+                       "serpentine)",
+            "serpentine": "serpentine (row by row, every other row reversed)",
+            "auto": "serpentine (row by row, every other row reversed; order auto: the "
+                    "shorter of serpentine and nearest)"}[order]
+    assert line == "# visiting order %s, travel %.3f mm between retract positions" % (
+        want, travel)
+    assert "row order" not in line
+    ms = read_measurements(tmp_path / "plan.csv", plan=True)
+    so = ms.nominal + 6.0 * ms.normal       # tip radius 1 + clearance 5
+    assert travel == pytest.approx(np.linalg.norm(np.diff(so, axis=0), axis=1).sum(),
+                                   abs=2e-3)
+    if order == "nearest":
+        for k in range(len(so) - 1):
+            rest = np.linalg.norm(so[k + 1:] - so[k], axis=1)
+            assert rest[0] <= rest.min() + 1e-3
+
+
 @pytest.mark.parametrize("args,message", [
     (("--count", "0x5"), "--count '0x5': expected at least 1 point in each direction"),
     (("--count", "1001x1000"), "1001000 points, expected at most 1000000"),
