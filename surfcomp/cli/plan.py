@@ -165,6 +165,7 @@ def _write(args, plan, nominal):
 def run(args):
     layout, count = layout_count(args)
     settings = settings_from_args(args)
+    plan_program.check_args(args)
     progress = ProgressLine(args.quiet)
     plan, nominal, part = make_plan(args.nominal, args.face, args.object, layout, count,
                                     settings, args.order, progress)

@@ -137,6 +137,37 @@ def test_bad_input_exit_2_nothing_written(tmp_path, args, message):
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.parametrize("args,message", [
+    (("--probe-log", ""), "--probe-log '': expected the name of the file LinuxCNC writes the "
+                          "probe log to"),
+    (("--second-feed", "7", "--backoff", "1.5"),
+     "--second-feed 7 mm/min applies to the second touch only (expected --second-touch"),
+    (("--backoff", "1.5"), "--backoff 1.5 mm applies to the second touch only"),
+    (("--probe-log", "x.log", "--dialect", "fanuc"),
+     "--probe-log 'x.log' applies to --dialect linuxcnc only"),
+    (("--touch-feed", "2000"), "--touch-feed 2000 mm/min is above --feed 1000 mm/min"),
+    (("--tool", "0"), "--tool 0: expected a whole number from 1 to 9999"),
+])
+def test_probe_options_that_cannot_take_effect_are_refused(tmp_path, args, message):
+    target, prog = tmp_path / "plan.csv", tmp_path / "probe.ngc"
+    out = run_plan(EXAMPLE_STEP, "-o", target, "--program", prog, *args)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert message in out.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_program_options_without_program_are_refused(tmp_path):
+    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--dialect", "fanuc")
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert ("--dialect is an option of the probing program: expected --program PROBE.ngc "
+            "with it, or no --dialect") in out.stderr
+    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--second-touch", "--probe-log",
+                   "a.log")
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert "--second-touch, --probe-log are options of the probing program" in out.stderr
+    assert os.listdir(tmp_path) == []
+
+
 # ------------------------------------------------------------------ a solid with a roof
 def _roofed_solid(path, roof_bottom):
     """A 60 x 40 x 10 mm block with a 5 mm wall at x = 40..45 and a roof from x = 20 to 45

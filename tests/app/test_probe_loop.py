@@ -257,7 +257,7 @@ def test_plan_and_program_are_written_together_or_not_at_all(tmp_path):
     out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", prog,
                   "--second-touch", "--backoff", 3, "--stand-off", 2, "--quiet")
     assert out.returncode == 2, out.stderr
-    assert "backoff 3 mm is larger than standoff 2 mm" in out.stderr, out.stderr
+    assert "--backoff 3 mm is larger than --stand-off 2 mm" in out.stderr, out.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []
     out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", plan,
                   "--quiet")
