@@ -3,8 +3,9 @@
 
 Places measurement points on the nominal face (``--layout grid|xy|adaptive``,
 :mod:`surfcomp.core.measurement.planning`), keeps those a 3-axis probe reaches (margin to the trim
-boundary and holes, ``--max-tilt``, the stylus' paths clear of the face and, for a face of a
-solid, of the part: :mod:`surfcomp.app.plan_reach`), orders them for a short travel and
+boundary and holes, ``--max-tilt``, the stylus' moves along the normal clear of the face
+and, for a face of a solid, of the part, its rapid moves ``--clearance`` from them:
+:mod:`surfcomp.app.plan_reach`), orders them for a short travel and
 writes the plan: the measurement-file contract (``id,x_nom,y_nom,z_nom,i,j,k``, mm) or, with
 ``--format xyzijk``, a PC-DMIS nominal point file. Dropped points are counted by reason
 (every one of them, with ``--dropped FILE``). Bad input (a face with no reachable point, a
@@ -58,11 +59,12 @@ def add_parser(subparsers):
                     "them for a short travel and write the plan (id, nominal XYZ, outward "
                     "normal IJK in mm; or a PC-DMIS XYZIJK nominal file).",
         epilog="Margin to the boundary and holes: --tip-radius + --edge-margin (mm, in space). "
-               "Reach: the outward normal within --max-tilt of +Z, the stylus ball clear of "
-               "the part from the safe height (ball centre at part top + --tip-radius + "
-               "--clearance) down to the retract point (the larger of --stand-off and "
-               "--clearance out along the normal) and along the normal to the touch. See "
-               "README 'On-machine probing'.")
+               "Reach: the outward normal within --max-tilt of +Z; the stylus ball "
+               "--clearance from the part on the rapid move from the safe height (ball "
+               "centre at part top + --tip-radius + --clearance) down to the retract point "
+               "(the larger of --stand-off and --clearance out along the normal), and clear "
+               "of it on the feed along the normal to the touch. See README 'On-machine "
+               "probing'.")
     registry.add_options(p, "plan", flags=("nominal",))
     add_arguments(p, ("face", "object"), INPUTS)
     registry.add_options(p, "plan", flags=("-o",))

@@ -17,10 +17,13 @@ contact is ``c = p + R n``. Per point, in the plan's order:
    and probe again to ``e`` at the slower ``second_feed``;
 5. feed back along ``n`` to ``r`` and traverse up to ``Zs``.
 
-The traverses thus keep the ball ``clearance`` away from the nominal points, and from the
-part wherever the way down from the safe height to ``r`` is free: this module has no solid
-to check that against (``tests/app/test_probe_loop.py`` checks it on the example's solid
-with OpenCASCADE).
+The traverses at the safe height keep the ball ``clearance`` above the part's top. The
+rapid moves down to ``r`` and back up keep it ``clearance`` away from the part only for the
+points a plan kept: this module has no solid to check that against; ``plan`` drops every
+point whose rapid descent would come closer (:mod:`surfcomp.core.measurement.planning_reach`,
+:mod:`surfcomp.app.plan_reach`; ``tests/app/test_probe_loop.py`` checks the moves rs274
+reads against the solid with OpenCASCADE). The moves along the normal (steps 2 to 5, at
+the feeds) only keep the ball off the part: they end at the contact.
 """
 
 import math

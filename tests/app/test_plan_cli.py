@@ -189,15 +189,21 @@ def _roofed_solid(path, roof_bottom):
     return "Face%d" % (k + 1)
 
 
+_DESCENT = ("the rapid descent from the safe height comes closer than --clearance to another "
+            "face of the part")
+
+
 @pytest.mark.parametrize("roof_bottom,reason,text", [
-    (25.0, "part-descent", "on the descent from the safe height"),
+    (25.0, "part-descent", _DESCENT),
     (12.5, "part-approach", "on the approach along the normal"),
 ])
 def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     """Floor points under the roof are dropped (the ball, r 1 mm, meets the roof on the way
     down from the safe height, or, with the roof 2.5 mm above the floor, already on the
-    approach from the 2 mm stand-off); the floor clear of the roof's edge (x = 20) by the ball
-    radius is kept; the plan's top Z is the roof's top."""
+    approach from the 2 mm stand-off). The rapid descent keeps the ball the clearance (5 mm)
+    from the roof's edge (x = 20): floor points up to x = 20 - 1 - 5 = 14 are kept, those
+    from there to the ball radius from the edge are dropped as closer than the clearance;
+    the plan's top Z is the roof's top."""
     step = tmp_path / "roofed.step"
     face = _roofed_solid(step, roof_bottom)
     out = plan_in_process(step, "--face", face, "-o", tmp_path / "plan.csv", "--count",
@@ -208,7 +214,6 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     assert "Safe Z:    %.4f mm (part top %.4f" % (roof_bottom + 11, roof_bottom + 5) in out.stdout
     ms = read_measurements(tmp_path / "plan.csv", plan=True)
     assert_allclose(ms.nominal[:, 2], 10.0, atol=1e-9)
-    assert ms.nominal[:, 0].max() <= 19.0 + 1e-3
     assert ms.nominal[:, 0].min() >= 1.5 - 1e-6
     rows = np.genfromtxt(tmp_path / "dropped.csv", delimiter=",", dtype=None, names=True,
                          encoding="utf-8")
@@ -217,9 +222,12 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     assert all(text in r for r in rows["reason"][under])
     line = next(t for t in out.stdout.splitlines() if t.startswith("Dropped:") and text in t)
     assert int(line.split()[1]) == (rows["reason"] == rows["reason"][under][0]).sum()
-    # the kept floor points up to x = 19 are all there: 41 columns 1 mm apart from 1.5 mm
+    near = (rows["x"] > 14.0) & (rows["x"] < 19.0)
+    assert near.sum() >= 9 * 5 and all(r == _DESCENT for r in rows["reason"][near])
+    # the kept floor points up to x = 14 are all there: 41 columns 0.92 mm apart from 1.53
     xs = np.unique(np.round(ms.nominal[:, 0], 6))
-    assert len(ms.nominal) == 9 * len(xs) and xs.size >= 17
+    assert len(ms.nominal) == 9 * len(xs) and xs.size == 14
+    assert 14.0 - 0.93 < xs.max() <= 14.0 + 1e-3
 
 
 # ------------------------------------------------------------------ simulate with a plan

@@ -25,10 +25,12 @@ reason (:class:`Drop`):
 * ``margin``: closer than ``tip_radius + edge_margin`` (mm, in space) to the trim
   boundary or a hole;
 * ``tilt``: its outward normal leans more than ``max_tilt`` from the spindle axis +Z;
-* ``approach`` / ``descent``: the stylus ball would meet the face on the way along the
-  normal from the stand-off, or down from the safe height
-  (:mod:`surfcomp.core.measurement.planning_reach`); the rest of a solid is checked by the app
-  layer, passed in as ``extra_check``.
+* ``approach``: the stylus ball would meet the face on the feed moves along the normal
+  from the retract point to the touch;
+* ``descent``: the ball would come closer than ``clearance`` to the face on the rapid
+  descent from the safe height to the retract point (and the rapid climb back): the rapid
+  moves keep the clearance (:mod:`surfcomp.core.measurement.planning_reach`); the rest of
+  a solid is checked by the app layer, passed in as ``extra_check``.
 
 A stylus ball larger than the face's smallest concave radius cannot touch the face where it
 is most concave: such a plan is refused. The kept points are visited in the order that keeps
@@ -68,7 +70,8 @@ REASONS = {
     "margin": "closer than the margin to the boundary or a hole",
     "tilt": note("normal leans more than ", ("max_tilt",), " from +Z"),
     "approach": "the stylus meets the face on the approach along the normal",
-    "descent": "the stylus meets the face on the descent from the safe height",
+    "descent": note("the rapid descent from the safe height comes closer than ",
+                    ("clearance",), " to the face"),
 }
 
 
@@ -378,7 +381,9 @@ def _screen(domain, u, v, settings, safe_z, cloud):
     fail(blocked, "approach")
     idx = np.flatnonzero(todo)
     blocked[:] = False
-    blocked[idx] = blocked_by_cloud(top[idx], standoff[idx], cl, settings.tip_radius, tree)
+    # the rapid moves keep the ball the clearance away: its centre R + clearance
+    blocked[idx] = blocked_by_cloud(top[idx], standoff[idx], cl,
+                                    settings.tip_radius + settings.clearance, tree)
     fail(blocked, "descent")
     return todo, reason, S, n, touch, standoff, top
 
