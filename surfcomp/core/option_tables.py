@@ -134,7 +134,9 @@ PLAN = _table(
            metavar="MM",
            help="distance along the normal from which the probe starts its touch (mm)"),
     Option("clearance", float, 5.0, "Clearance", label="Clearance", flag="--clearance",
-           metavar="MM", help="safe height above the part's top (mm)"),
+           metavar="MM",
+           help="least distance (mm) the stylus ball keeps from the part on rapid moves: "
+                "above the part's top at the safe height, and on the way down to the point"),
     Option("order", str, "auto", None, flag="--order", choices=PLAN_ORDERS,
            help="visiting order: serpentine rows, nearest neighbour, or auto (the shorter)"),
     Option("plan_format", str, "csv", None, flag="--format", dest="plan_format",

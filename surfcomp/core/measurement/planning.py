@@ -466,7 +466,7 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
                     tuple(float(x) for x in S[i])) for i in np.flatnonzero(~keep)]
     if not keep.any():
         raise InputError(_nothing_left(layout, requested, dropped, info),
-                         options=("max_tilt", "edge_margin", "tip_radius"))
+                         options=("max_tilt", "edge_margin", "tip_radius", "clearance"))
     report(progress, 0.8, "ordering %d points" % int(keep.sum()))
     idx = np.flatnonzero(keep)
     tour, name, travel = visiting_order(standoff[idx], lay["row"][idx], lay["along"][idx],
@@ -490,5 +490,6 @@ def _nothing_left(layout, requested, dropped, info):
         why = ("%d nodes have no face under them; " % clipped) + why
     return ("no reachable point on the face: the %s layout placed %d point(s) and every one "
             "was dropped (%s); expected at least one point that a 3-axis probe reaches "
-            "(a larger max_tilt, a smaller edge_margin or tip_radius, or another face)"
+            "(a larger max_tilt, a smaller edge_margin, tip_radius or clearance, or another "
+            "face)"
             % (layout, requested, why or "none placed"))
