@@ -3,22 +3,25 @@
 
 The core (:mod:`surfcomp.core.measurement.planning_reach`) checks the probe's paths against the
 planned face itself; when the nominal face is a face of a solid (or of a shell with other faces),
-the stylus ball must also stay clear of every other face: on the approach along the normal
-(stand-off to touch) and on the descent from the safe height to the stand-off. Each path is
-a segment; a face whose bounding box, widened by the ball radius, misses the segment's is
-skipped, the others are measured with ``distToShape`` (exact, OCCT's BRepExtrema).
+the stylus ball must also keep off every other face: clear of it on the feed moves along the
+normal (retract point to touch), and at least the clearance away from it on the rapid descent
+from the safe height to the retract point (and the rapid climb back on the same line). Each
+path is a segment; a face whose bounding box, widened by the distance kept, misses the
+segment's is skipped, the others are measured with ``distToShape`` (exact, OCCT's
+BRepExtrema).
 """
 
 import numpy as np
 
 from ..core.measurement.planning_reach import CLEAR_TOL
+from ..errors import note
 
 #: the reasons added to :data:`surfcomp.core.measurement.planning.REASONS`
 REASONS = {
     "part-approach": "the stylus meets another face of the part on the approach along the "
                      "normal",
-    "part-descent": "the stylus meets another face of the part on the descent from the safe "
-                    "height",
+    "part-descent": note("the rapid descent from the safe height comes closer than ",
+                         ("clearance",), " to another face of the part"),
 }
 
 
@@ -78,10 +81,11 @@ def blocked_by_faces(a, b, faces, boxes, radius, tol=CLEAR_TOL):
     return out
 
 
-def part_check(shape, face_name, tip_radius):
+def part_check(shape, face_name, tip_radius, clearance):
     """The ``extra_check`` of :func:`surfcomp.core.measurement.planning.plan_points` for the face
     ``face_name`` (``FaceN``) of ``shape`` (None when the shape has no other face: a lone
-    face)."""
+    face): the ball (radius ``tip_radius``) clear of the other faces along the normal, and
+    ``clearance`` away from them on the rapid descent."""
     faces = other_faces(shape, face_name)
     if not faces:
         return None
@@ -89,7 +93,7 @@ def part_check(shape, face_name, tip_radius):
 
     def check(points, normals, touch, standoff, top):
         approach = blocked_by_faces(standoff, touch, faces, boxes, tip_radius)
-        descent = blocked_by_faces(top, standoff, faces, boxes, tip_radius)
+        descent = blocked_by_faces(top, standoff, faces, boxes, tip_radius + clearance)
         descent &= ~approach
         return [("part-approach", approach), ("part-descent", descent)]
 
@@ -106,7 +110,8 @@ def plan_face(nominal, layout, count, settings, order="auto", progress=None):
 
     domain = FaceDomain(nominal.surface, nominal.outward,
                         boundary_polylines(nominal.bspline_face))
-    check = part_check(nominal.shape, nominal.face_name, settings.tip_radius)
+    check = part_check(nominal.shape, nominal.face_name, settings.tip_radius,
+                       settings.clearance)
     plan = plan_points(domain, layout, count, settings,
                        top_z=part_top(nominal.shape, nominal.face), order=order,
                        extra_check=check, progress=progress)

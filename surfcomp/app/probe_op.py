@@ -120,7 +120,7 @@ def path_commands(path, settings, label):
     out = [C("(surfcomp probe plan %s: %d points, tip radius %.4f mm, tip centres)"
              % (_safe(label), len(path.ids), settings.tip_radius)),
            C(settings.work_offset), C("G0", {"Z": path.safe}),
-           C("(PROBEOPEN %s)" % settings.log_file)]
+           C("(PROBEOPEN %s)" % settings.log_name())]
     for k, pid in enumerate(path.ids):
         r = path.retract[k]
         out += [C("(point %d %s)" % (k + 1, _safe(pid))),

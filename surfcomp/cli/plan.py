@@ -3,8 +3,9 @@
 
 Places measurement points on the nominal face (``--layout grid|xy|adaptive``,
 :mod:`surfcomp.core.measurement.planning`), keeps those a 3-axis probe reaches (margin to the trim
-boundary and holes, ``--max-tilt``, the stylus' paths clear of the face and, for a face of a
-solid, of the part: :mod:`surfcomp.app.plan_reach`), orders them for a short travel and
+boundary and holes, ``--max-tilt``, the stylus' moves along the normal clear of the face
+and, for a face of a solid, of the part, its rapid moves ``--clearance`` from them:
+:mod:`surfcomp.app.plan_reach`), orders them for a short travel and
 writes the plan: the measurement-file contract (``id,x_nom,y_nom,z_nom,i,j,k``, mm) or, with
 ``--format xyzijk``, a PC-DMIS nominal point file. Dropped points are counted by reason
 (every one of them, with ``--dropped FILE``). Bad input (a face with no reachable point, a
@@ -28,6 +29,7 @@ from ..core.measurement.planning import (
     check_points,
     parse_count,
 )
+from ..core.measurement.planning_reach import NEAREST_LIMIT
 from ..core.option_tables import INPUTS, PLAN
 from ..errors import InputError
 from ..io.atomic import Transaction
@@ -41,6 +43,11 @@ from .options import add_arguments
 PROBE = ("tip_radius", "edge_margin", "max_tilt", "stand_off", "clearance")
 #: printed examples per drop reason
 _EXAMPLES = 3
+#: what each visiting order is (:func:`surfcomp.core.measurement.planning_reach.visiting_order`)
+ORDER_TEXT = {
+    "serpentine": "row by row, every other row reversed",
+    "nearest": "greedy nearest neighbour from the first point of the serpentine",
+}
 
 
 def add_parser(subparsers):
@@ -52,11 +59,12 @@ def add_parser(subparsers):
                     "them for a short travel and write the plan (id, nominal XYZ, outward "
                     "normal IJK in mm; or a PC-DMIS XYZIJK nominal file).",
         epilog="Margin to the boundary and holes: --tip-radius + --edge-margin (mm, in space). "
-               "Reach: the outward normal within --max-tilt of +Z, the stylus ball clear of "
-               "the part from the safe height (ball centre at part top + --tip-radius + "
-               "--clearance) down to the retract point (the larger of --stand-off and "
-               "--clearance out along the normal) and along the normal to the touch. See "
-               "README 'On-machine probing'.")
+               "Reach: the outward normal within --max-tilt of +Z; the stylus ball "
+               "--clearance from the part on the rapid move from the safe height (ball "
+               "centre at part top + --tip-radius + --clearance) down to the retract point "
+               "(the larger of --stand-off and --clearance out along the normal), and clear "
+               "of it on the feed along the normal to the touch. See README 'On-machine "
+               "probing'.")
     registry.add_options(p, "plan", flags=("nominal",))
     add_arguments(p, ("face", "object"), INPUTS)
     registry.add_options(p, "plan", flags=("-o",))
@@ -116,9 +124,18 @@ def _comments(args, plan, nominal):
             "%.6f mm (part top %.6f + tip radius + clearance %g)"
             % (s.tip_radius, s.edge_margin, s.max_tilt, s.stand_off, plan.safe_z, plan.top_z,
                s.clearance),
-            "visiting order %s (the row order), travel %.3f mm between retract positions"
-            % (plan.order, plan.travel),
+            "visiting order %s (%s%s), travel %.3f mm between retract positions"
+            % (plan.order, ORDER_TEXT[plan.order], _auto_text(args, plan), plan.travel),
             "nominal surface points (mm) and outward unit normals; no deviation: not measured"]
+
+
+def _auto_text(args, plan):
+    """How ``--order auto`` chose the plan's order (empty for an order given by name)."""
+    if args.order != "auto":
+        return ""
+    if len(plan) > NEAREST_LIMIT:
+        return "; order auto: nearest is not tried above %d points" % NEAREST_LIMIT
+    return "; order auto: the shorter of serpentine and nearest"
 
 
 def _reason_text(key):
@@ -150,6 +167,7 @@ def _write(args, plan, nominal):
 def run(args):
     layout, count = layout_count(args)
     settings = settings_from_args(args)
+    plan_program.check_args(args)
     progress = ProgressLine(args.quiet)
     plan, nominal, part = make_plan(args.nominal, args.face, args.object, layout, count,
                                     settings, args.order, progress)

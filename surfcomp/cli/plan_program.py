@@ -12,6 +12,7 @@ program makes with them).
 """
 
 from ..core.option_tables import PROGRAM
+from ..errors import InputError
 from ..io.atomic import write_text
 from ..io.probe_program import ProbeSettings, program_summary, program_text
 from . import registry
@@ -27,6 +28,22 @@ def add_program_options(parser):
         "the points are probed in the plan's order along their normals.")
     registry.add_options(parser, "plan", {registry.PROBE_PROGRAM: g}, flags=("--program",))
     add_arguments(g, tuple(PROGRAM), PROGRAM)
+
+
+def check_args(args):
+    """Refuse, before any planning, program options that cannot take effect: any of them
+    without ``--program``, and settings :meth:`ProbeSettings.validate` refuses."""
+    if not getattr(args, "program", None):
+        given = [o.flag for name, o in PROGRAM.items()
+                 if getattr(args, o.dest or name) != (False if o.type is bool else o.default)]
+        if len(given) == 1:
+            raise InputError("%s is an option of the probing program: expected --program "
+                             "PROBE.ngc with it, or no %s" % (given[0], given[0]))
+        if given:
+            raise InputError("%s are options of the probing program: expected --program "
+                             "PROBE.ngc with them, or none of them" % ", ".join(given))
+        return
+    settings_from_args(args, 0.0, "").validate()
 
 
 def settings_from_args(args, safe_z, plan_hash):
@@ -65,7 +82,7 @@ def program_from_args(args, ids, points, normals, safe_z, plan_hash):
     text, moves = program_text(ids, points, normals, s)
     res = program_summary(args.program, moves, s)
     t = res["travel"]
-    log = ("probe log %s, %d lines" % (s.log_file, res["log_lines"])
+    log = ("probe log %s, %d lines" % (s.log_name(), res["log_lines"])
            if s.dialect == "linuxcnc" else "DPRNT log, %d lines" % res["log_lines"])
     return text, [
         "Program:      %s (%s, %d points, tip radius %g mm, %s, %s, safe height Z%.3f)"

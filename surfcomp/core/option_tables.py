@@ -134,7 +134,9 @@ PLAN = _table(
            metavar="MM",
            help="distance along the normal from which the probe starts its touch (mm)"),
     Option("clearance", float, 5.0, "Clearance", label="Clearance", flag="--clearance",
-           metavar="MM", help="safe height above the part's top (mm)"),
+           metavar="MM",
+           help="least distance (mm) the stylus ball keeps from the part on rapid moves: "
+                "above the part's top at the safe height, and on the way down to the point"),
     Option("order", str, "auto", None, flag="--order", choices=PLAN_ORDERS,
            help="visiting order: serpentine rows, nearest neighbour, or auto (the shorter)"),
     Option("plan_format", str, "csv", None, flag="--format", dest="plan_format",
@@ -161,12 +163,14 @@ PROGRAM = _table(
            help="back off and touch again slower (a LinuxCNC log then holds two lines per "
                 "point: read it back with {touches} 2)"),
     Option("second_feed", float, None, None, flag="--second-feed", metavar="MM/MIN",
-           unset="a fifth of {touch_feed}", help="feed of the second touch (mm/min)"),
-    Option("backoff", float, 1.0, None, flag="--backoff", metavar="MM",
-           help="back-off before the second touch (mm)"),
-    Option("log_file", str, "probe.log", "LogFile", label="Log file", flag="--probe-log",
-           metavar="NAME", dest="probe_log",
-           help="file LinuxCNC writes the probe log to (PROBEOPEN)"),
+           unset="a fifth of {touch_feed}",
+           help="feed of the second touch (mm/min; with {second_touch} only)"),
+    Option("backoff", float, None, None, flag="--backoff", metavar="MM", unset="1",
+           stored=1.0,
+           help="back-off before the second touch (mm; with {second_touch} only)"),
+    Option("log_file", str, None, "LogFile", label="Log file", flag="--probe-log",
+           metavar="NAME", dest="probe_log", unset="probe.log", stored="probe.log",
+           help="file LinuxCNC writes the probe log to (PROBEOPEN; linuxcnc dialect only)"),
 )
 
 

@@ -17,10 +17,13 @@ contact is ``c = p + R n``. Per point, in the plan's order:
    and probe again to ``e`` at the slower ``second_feed``;
 5. feed back along ``n`` to ``r`` and traverse up to ``Zs``.
 
-The traverses thus keep the ball ``clearance`` away from the nominal points, and from the
-part wherever the way down from the safe height to ``r`` is free: this module has no solid
-to check that against (``tests/app/test_probe_loop.py`` checks it on the example's solid
-with OpenCASCADE).
+The traverses at the safe height keep the ball ``clearance`` above the part's top. The
+rapid moves down to ``r`` and back up keep it ``clearance`` away from the part only for the
+points a plan kept: this module has no solid to check that against; ``plan`` drops every
+point whose rapid descent would come closer (:mod:`surfcomp.core.measurement.planning_reach`,
+:mod:`surfcomp.app.plan_reach`; ``tests/app/test_probe_loop.py`` checks the moves rs274
+reads against the solid with OpenCASCADE). The moves along the normal (steps 2 to 5, at
+the feeds) only keep the ball off the part: they end at the contact.
 """
 
 import math
@@ -70,13 +73,21 @@ class ProbeSettings:
         Back off and touch again at ``second_feed`` (the log then holds two lines per
         point on LinuxCNC, the second one the measurement; one line on Fanuc).
     second_feed : float or None
-        Feed of the second touch (default a fifth of ``touch_feed``).
-    backoff : float
-        Back-off distance before the second touch.
+        Feed of the second touch (None: a fifth of ``touch_feed``); only with
+        ``second_touch``.
+    backoff : float or None
+        Back-off distance before the second touch (None: 1 mm, :meth:`backoff_length`);
+        only with ``second_touch``.
     plan_hash : str
         Hex SHA-256 of the plan file, recorded in the header.
-    log_file : str
-        File LinuxCNC writes the probe log to (``PROBEOPEN``).
+    log_file : str or None
+        File LinuxCNC writes the probe log to (``PROBEOPEN``; None: ``probe.log``,
+        :meth:`log_name`); the linuxcnc dialect only (Fanuc's DPRNT writes to the control's
+        output device).
+
+    A setting that cannot take effect (``second_feed`` or ``backoff`` without
+    ``second_touch``, ``log_file`` with the fanuc dialect) is refused by :meth:`validate`,
+    never dropped without notice.
     program_number : int
         Fanuc program number (``O....``).
     """
@@ -101,48 +112,91 @@ class ProbeSettings:
     def touch2_feed(self):
         return self.second_feed if self.second_feed is not None else self.touch_feed / 5.0
 
+    def backoff_length(self):
+        """The back-off (mm) before the second touch: ``backoff``, or 1 mm when unset."""
+        return PROGRAM["backoff"].stored if self.backoff is None else self.backoff
+
+    def log_name(self):
+        """The file LinuxCNC writes the probe log to: ``log_file``, or ``probe.log``."""
+        return PROGRAM["log_file"].stored if self.log_file is None else self.log_file
+
     def safe_height(self):
         """Tip-centre Z of the traverses: the ball ``clearance`` above the part's top."""
         return self.safe_z + self.tip_radius + self.clearance
 
     def validate(self):
-        """Refuse settings no program can be written with (InputError naming the option)."""
+        """Refuse settings no program can be written with, or that would not take effect
+        (InputError naming the options: the command line shows them as flags, the GUI as
+        labels)."""
         if self.dialect not in DIALECTS:
             raise InputError("dialect %r is not known (expected %s)"
-                             % (self.dialect, " or ".join(DIALECTS)))
+                             % (self.dialect, " or ".join(DIALECTS)), options=("dialect",))
         if self.work_offset not in WORK_OFFSETS:
             raise InputError("work_offset %r is not known (expected one of %s)"
-                             % (self.work_offset, ", ".join(WORK_OFFSETS)))
+                             % (self.work_offset, ", ".join(WORK_OFFSETS)),
+                             options=("work_offset",))
         if (isinstance(self.tool, bool) or not isinstance(self.tool, int)
                 or not 1 <= self.tool <= 9999):
-            raise InputError("tool %r: expected a tool number from 1 to 9999" % (self.tool,))
+            raise InputError("tool %r: expected a whole number from 1 to 9999" % (self.tool,),
+                             options=("tool",))
+        self._check_unused()
         if self.safe_z is None:
             raise InputError("safe_z (the part's top) is needed for the safe height")
         _finite("safe_z", self.safe_z, -MAX_COORDINATE, MAX_COORDINATE)
         _finite("tip_radius", self.tip_radius, 0.0, 50.0, low_open=True)
-        for name in ("clearance", "stand_off", "overtravel", "backoff"):
+        for name in ("clearance", "stand_off", "overtravel"):
             _finite(name, getattr(self, name), 0.0, 1000.0, low_open=True)
+        _finite("backoff", self.backoff_length(), 0.0, 1000.0, low_open=True)
         for name in ("feed", "touch_feed"):
             _finite(name, getattr(self, name), 0.0, 1e6, low_open=True)
         _finite("second_feed", self.touch2_feed(), 0.0, self.touch_feed, low_open=True)
         if self.touch_feed > self.feed:
             raise InputError("touch_feed %g mm/min is above feed %g mm/min (expected a slow "
-                             "touch after a fast approach)" % (self.touch_feed, self.feed))
-        if self.second_touch and self.backoff > self.stand_off:
-            raise InputError("backoff %g mm is larger than standoff %g mm (expected the second "
-                             "touch to start inside the first one's approach)"
-                             % (self.backoff, self.stand_off))
-        if self.log_file and any(ch in self.log_file for ch in "()\r\n;"):
-            raise InputError("log_file %r: a file name in a G-code comment cannot hold "
-                             "parentheses, ';' or line breaks" % self.log_file)
+                             "touch after a fast approach)" % (self.touch_feed, self.feed),
+                             options=("touch_feed", "feed"))
+        if self.second_touch and self.backoff_length() > self.stand_off:
+            raise InputError("backoff %g mm is larger than stand_off %g mm (expected the "
+                             "second touch to start inside the first one's approach)"
+                             % (self.backoff_length(), self.stand_off),
+                             options=("backoff", "stand_off"))
+        self._check_log()
         if not all(ch in "0123456789abcdefABCDEF" for ch in self.plan_hash):
             raise InputError("plan_hash %r: expected a hexadecimal digest" % self.plan_hash)
         if not 1 <= int(self.program_number) <= 9999:
             raise InputError("program_number %r: expected 1 to 9999" % (self.program_number,))
         return self
 
+    def _check_unused(self):
+        """Refuse a setting that the program would not use."""
+        if not self.second_touch:
+            for name, unit in (("second_feed", "mm/min"), ("backoff", "mm")):
+                value = getattr(self, name)
+                if value is not None:
+                    raise InputError(
+                        "%s %s %s applies to the second touch only (expected second_touch "
+                        "with it, or no %s)" % (name, _g(value), unit, name),
+                        options=(name, "second_touch"))
+        if self.dialect != "linuxcnc" and self.log_file is not None:
+            raise InputError("log_file %r applies to dialect linuxcnc only (expected no "
+                             "log_file with dialect %s: its DPRNT writes to the control's "
+                             "output device)" % (self.log_file, self.dialect),
+                             options=("log_file", "dialect"))
+
+    def _check_log(self):
+        name = self.log_name()
+        if not isinstance(name, str) or not name.strip():
+            raise InputError("log_file %r: expected the name of the file LinuxCNC writes the "
+                             "probe log to" % (name,), options=("log_file",))
+        if any(ch in name for ch in "()\r\n;"):
+            raise InputError("log_file %r: a file name in a G-code comment cannot hold "
+                             "parentheses, ';' or line breaks" % name, options=("log_file",))
+
     def as_dict(self):
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+def _g(value):
+    return "%g" % value if isinstance(value, (int, float)) else repr(value)
 
 
 def _finite(name, value, low, high, low_open=False):
@@ -237,7 +291,8 @@ def probe_path(ids, points, normals, settings):
                      retract=contact + max(s.clearance, s.stand_off) * N,
                      standoff=contact + s.stand_off * N,
                      end=contact - s.overtravel * N, approach=s.stand_off < s.clearance,
-                     safe=s.safe_height(), backoff=s.backoff if s.second_touch else 0.0)
+                     safe=s.safe_height(),
+                     backoff=s.backoff_length() if s.second_touch else 0.0)
 
 
 def _check_rows(ids, bad, why):

@@ -86,7 +86,7 @@ def _points_text(path, s, comments):
         # back off along n from the trip point #5061..#5063 (signed offsets)
         lines += [g1 + " X[#5061%+.4f] Y[#5062%+.4f] Z[#5063%+.4f] F" + feed,
                   "%s %s F%s" % (probe, xyz, touch2)]
-        columns += [s.backoff * path.normals, path.end]
+        columns += [path.backoff * path.normals, path.end]
     if s.dialect == "fanuc":
         lines.append(_DPRNT)
     lines += ["%s %s F%s" % (g1, xyz, feed), "%s Z%s" % (g0, _num(path.safe))]
@@ -103,7 +103,7 @@ def _linuxcnc(path, s):
 
     out = _header(path, s, comment)
     out += ["G21 G90 G17 G40 G94", "T%d M6" % s.tool, "G43 H%d" % s.tool, s.work_offset,
-            "G0 Z%s" % _num(path.safe), "(PROBEOPEN %s)" % s.log_file]
+            "G0 Z%s" % _num(path.safe), "(PROBEOPEN %s)" % s.log_name()]
     out.append(_points_text(path, s, [comment("point %d %s" % (k + 1, pid))
                                       for k, pid in enumerate(path.ids)]))
     out += ["(PROBECLOSE)", "M2"]

@@ -83,6 +83,38 @@ def test_plan_xyzijk_read_as_pcdmis(tmp_path):
     assert_allclose(pts.normal, ms.normal, atol=1e-12)
 
 
+def _header(path, start):
+    return next(ln for ln in path.read_text().splitlines() if ln.startswith(start))
+
+
+@pytest.mark.parametrize("order", ["nearest", "serpentine", "auto"])
+def test_plan_header_says_what_the_visiting_order_is(tmp_path, order):
+    """The header names the order the rows are in and says what it is; a nearest-neighbour
+    plan is one (every next retract position, 6 mm out along the normal, is the nearest
+    one not visited yet, within 1 um)."""
+    out = plan_in_process(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--count", "10x10",
+                          "--order", order)
+    assert out.returncode == 0, out.stderr
+    line = _header(tmp_path / "plan.csv", "# visiting order")
+    travel = float(line.split("travel ")[1].split(" mm")[0])
+    want = {"nearest": "nearest (greedy nearest neighbour from the first point of the "
+                       "serpentine)",
+            "serpentine": "serpentine (row by row, every other row reversed)",
+            "auto": "serpentine (row by row, every other row reversed; order auto: the "
+                    "shorter of serpentine and nearest)"}[order]
+    assert line == "# visiting order %s, travel %.3f mm between retract positions" % (
+        want, travel)
+    assert "row order" not in line
+    ms = read_measurements(tmp_path / "plan.csv", plan=True)
+    so = ms.nominal + 6.0 * ms.normal       # tip radius 1 + clearance 5
+    assert travel == pytest.approx(np.linalg.norm(np.diff(so, axis=0), axis=1).sum(),
+                                   abs=2e-3)
+    if order == "nearest":
+        for k in range(len(so) - 1):
+            rest = np.linalg.norm(so[k + 1:] - so[k], axis=1)
+            assert rest[0] <= rest.min() + 1e-3
+
+
 @pytest.mark.parametrize("args,message", [
     (("--count", "0x5"), "--count '0x5': expected at least 1 point in each direction"),
     (("--count", "1001x1000"), "1001000 points, expected at most 1000000"),
@@ -102,6 +134,37 @@ def test_bad_input_exit_2_nothing_written(tmp_path, args, message):
     assert out.returncode == 2, out.stdout + out.stderr
     assert message in out.stderr
     assert not target.exists() and not dropped.exists()
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("args,message", [
+    (("--probe-log", ""), "--probe-log '': expected the name of the file LinuxCNC writes the "
+                          "probe log to"),
+    (("--second-feed", "7", "--backoff", "1.5"),
+     "--second-feed 7 mm/min applies to the second touch only (expected --second-touch"),
+    (("--backoff", "1.5"), "--backoff 1.5 mm applies to the second touch only"),
+    (("--probe-log", "x.log", "--dialect", "fanuc"),
+     "--probe-log 'x.log' applies to --dialect linuxcnc only"),
+    (("--touch-feed", "2000"), "--touch-feed 2000 mm/min is above --feed 1000 mm/min"),
+    (("--tool", "0"), "--tool 0: expected a whole number from 1 to 9999"),
+])
+def test_probe_options_that_cannot_take_effect_are_refused(tmp_path, args, message):
+    target, prog = tmp_path / "plan.csv", tmp_path / "probe.ngc"
+    out = run_plan(EXAMPLE_STEP, "-o", target, "--program", prog, *args)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert message in out.stderr
+    assert os.listdir(tmp_path) == []
+
+
+def test_program_options_without_program_are_refused(tmp_path):
+    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--dialect", "fanuc")
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert ("--dialect is an option of the probing program: expected --program PROBE.ngc "
+            "with it, or no --dialect") in out.stderr
+    out = run_plan(EXAMPLE_STEP, "-o", tmp_path / "plan.csv", "--second-touch", "--probe-log",
+                   "a.log")
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert "--second-touch, --probe-log are options of the probing program" in out.stderr
     assert os.listdir(tmp_path) == []
 
 
@@ -126,15 +189,21 @@ def _roofed_solid(path, roof_bottom):
     return "Face%d" % (k + 1)
 
 
+_DESCENT = ("the rapid descent from the safe height comes closer than --clearance to another "
+            "face of the part")
+
+
 @pytest.mark.parametrize("roof_bottom,reason,text", [
-    (25.0, "part-descent", "on the descent from the safe height"),
+    (25.0, "part-descent", _DESCENT),
     (12.5, "part-approach", "on the approach along the normal"),
 ])
 def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     """Floor points under the roof are dropped (the ball, r 1 mm, meets the roof on the way
     down from the safe height, or, with the roof 2.5 mm above the floor, already on the
-    approach from the 2 mm stand-off); the floor clear of the roof's edge (x = 20) by the ball
-    radius is kept; the plan's top Z is the roof's top."""
+    approach from the 2 mm stand-off). The rapid descent keeps the ball the clearance (5 mm)
+    from the roof's edge (x = 20): floor points up to x = 20 - 1 - 5 = 14 are kept, those
+    from there to the ball radius from the edge are dropped as closer than the clearance;
+    the plan's top Z is the roof's top."""
     step = tmp_path / "roofed.step"
     face = _roofed_solid(step, roof_bottom)
     out = plan_in_process(step, "--face", face, "-o", tmp_path / "plan.csv", "--count",
@@ -145,7 +214,6 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     assert "Safe Z:    %.4f mm (part top %.4f" % (roof_bottom + 11, roof_bottom + 5) in out.stdout
     ms = read_measurements(tmp_path / "plan.csv", plan=True)
     assert_allclose(ms.nominal[:, 2], 10.0, atol=1e-9)
-    assert ms.nominal[:, 0].max() <= 19.0 + 1e-3
     assert ms.nominal[:, 0].min() >= 1.5 - 1e-6
     rows = np.genfromtxt(tmp_path / "dropped.csv", delimiter=",", dtype=None, names=True,
                          encoding="utf-8")
@@ -154,9 +222,12 @@ def test_solid_roof_hides_the_floor(tmp_path, roof_bottom, reason, text):
     assert all(text in r for r in rows["reason"][under])
     line = next(t for t in out.stdout.splitlines() if t.startswith("Dropped:") and text in t)
     assert int(line.split()[1]) == (rows["reason"] == rows["reason"][under][0]).sum()
-    # the kept floor points up to x = 19 are all there: 41 columns 1 mm apart from 1.5 mm
+    near = (rows["x"] > 14.0) & (rows["x"] < 19.0)
+    assert near.sum() >= 9 * 5 and all(r == _DESCENT for r in rows["reason"][near])
+    # the kept floor points up to x = 14 are all there: 41 columns 0.92 mm apart from 1.53
     xs = np.unique(np.round(ms.nominal[:, 0], 6))
-    assert len(ms.nominal) == 9 * len(xs) and xs.size >= 17
+    assert len(ms.nominal) == 9 * len(xs) and xs.size == 14
+    assert 14.0 - 0.93 < xs.max() <= 14.0 + 1e-3
 
 
 # ------------------------------------------------------------------ simulate with a plan

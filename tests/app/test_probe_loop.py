@@ -257,8 +257,47 @@ def test_plan_and_program_are_written_together_or_not_at_all(tmp_path):
     out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", prog,
                   "--second-touch", "--backoff", 3, "--stand-off", 2, "--quiet")
     assert out.returncode == 2, out.stderr
-    assert "backoff 3 mm is larger than standoff 2 mm" in out.stderr, out.stderr
+    assert "--backoff 3 mm is larger than --stand-off 2 mm" in out.stderr, out.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == []
     out = run_cli("plan", EXAMPLE_STEP, "-o", plan, "--count", "4x4", "--program", plan,
                   "--quiet")
     assert out.returncode == 2 and not plan.exists(), out.stderr
+
+
+@pytest.mark.parametrize("count, clearance, stand_off, kept, descent", [
+    ("25x25", 5.0, 2.0, 555, 45),
+    ("10x10", 2.0, 1.0, 90, 2),
+])
+def test_rapid_moves_keep_the_clearance_beside_a_wall(tmp_path, count, clearance, stand_off,
+                                                      kept, descent):
+    """The example part with a 50 mm high wall along its x = 45 side: a rapid plunge from
+    the safe height (above the wall's top) to a floor point near the wall passed 1.80 mm
+    (0.018 mm with --clearance 2) from the wall. The points whose rapid moves would come
+    closer than --clearance to the solid are dropped and counted; every rapid move rs274
+    reads keeps the ball --clearance from the solid (less the 1 um check tolerance and
+    rs274's 4 printed decimals), and the closest one is at the clearance, not far above."""
+    import FreeCAD
+    import Part
+
+    V = FreeCAD.Vector
+    solid = Part.read(EXAMPLE_STEP).Faces[0].extrude(V(0, 0, -20)).fuse(
+        Part.makeBox(5, 45, 50, V(45, 0, -20))).removeSplitter()
+    part = tmp_path / "wall.step"
+    solid.exportStep(str(part))
+    solid = Part.read(str(part))
+    face = next("Face%d" % (k + 1) for k, f in enumerate(solid.Faces)
+                if f.Surface.TypeId == "Part::GeomBSplineSurface")
+    plan, prog = tmp_path / "plan.csv", tmp_path / "probe.ngc"
+    out = run_in_process("plan", part, "--face", face, "-o", plan, "--count", count,
+                         "--clearance", clearance, "--stand-off", stand_off, "--program",
+                         prog, "--quiet")
+    assert out.returncode == 0, out.stderr
+    moves = rs274_moves(prog, tmp_path, diameter=2 * R)
+    trav = [(a, b) for kind, a, b in moves if kind == "STRAIGHT_TRAVERSE"][1:]
+    gap = np.array([solid.distToShape(Part.LineSegment(V(*a), V(*b)).toShape())[0]
+                    for a, b in trav if np.linalg.norm(b - a) > 1e-9]) - R
+    assert gap.min() >= clearance - 1e-3 - 1e-4, gap.min()
+    assert gap.min() <= clearance + 0.05, gap.min()
+    assert ("Dropped:   %d the rapid descent from the safe height comes closer than "
+            "--clearance to another face of the part" % descent) in out.stdout, out.stdout
+    assert len(read_plan(str(plan))) == kept

@@ -20,7 +20,12 @@ import pytest
 
 from surfcomp.app import cam, documents, progress
 from surfcomp.app.plan_feature import make_measurement_plan
-from surfcomp.app.probe_op import add_probe_operation, is_probe_operation, post_probe_job
+from surfcomp.app.probe_op import (
+    add_probe_operation,
+    is_probe_operation,
+    post_probe_job,
+    probe_moves,
+)
 from surfcomp.errors import GCodeError, InputError
 from tests.conftest import ROOT
 from tests.probe_checks import check_probe_moves, rs274_moves
@@ -138,6 +143,16 @@ def test_no_claim_without_moves(shop):
     with pytest.raises(GCodeError, match=r"wrote 16 G38.2, 0 PROBEOPEN, 0 PROBECLOSE where "
                                          r"the probe operations need 16 G38.2, 1 PROBEOPEN"):
         post_probe_job(job, "linuxcnc", POST_ARGS + " --no-comments")
+    # an empty log file name would write "(PROBEOPEN )": refused, the field named by its
+    # label as the GUI shows it
+    from surfcomp.gui import option_labels
+
+    op.LogFile = ""
+    with pytest.raises(InputError) as err:
+        probe_moves(op)
+    assert option_labels.shown(err.value) == ("Log file '': expected the name of the file "
+                                              "LinuxCNC writes the probe log to")
+    op.LogFile = "probe.log"
     # a plan the probe cannot reach from above (all points dropped) fails, and so does the
     # post: the operation's old moves are never posted
     plan.MaxTilt = 0.001
@@ -145,5 +160,5 @@ def test_no_claim_without_moves(shop):
     with pytest.raises(InputError, match="did not recompute"):
         post_probe_job(job, "linuxcnc", POST_ARGS)
     assert op.Probes in (0, 16)
-    with pytest.raises(InputError, match=r"tool 0: expected a tool number"):
+    with pytest.raises(InputError, match=r"tool 0: expected a whole number from 1 to 9999"):
         add_probe_operation(job, plan, tool=0)

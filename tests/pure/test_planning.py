@@ -154,25 +154,36 @@ def _hook(gap):
     return Surface(P, ku, np.array([0.0, 0.0, 1.0, 1.0]), 1, 1)
 
 
-@pytest.mark.parametrize("gap,reason", [(2.5, "approach"), (12.0, "descent")])
-def test_face_hiding_itself(gap, reason):
+@pytest.mark.parametrize("gap,reason,keep_to", [
+    (2.5, "approach", 10.0 - np.sqrt(6.0 ** 2 - 3.5 ** 2)),
+    (12.0, "descent", 4.0),
+])
+def test_face_hiding_itself(gap, reason, keep_to):
     """Floor points under the ceiling are dropped: with a 2.5 mm gap the ball (r 1 mm,
-    stand-off 2 mm) meets the ceiling on the approach, with 12 mm on the way down; floor
-    points farther than the ball radius from the ceiling's edge (x = 10) are kept; the wall
-    and the ceiling lean too far."""
+    stand-off 2 mm) meets the ceiling on the approach, with 12 mm on the way down; the wall
+    and the ceiling lean too far. The rapid descent keeps the ball the clearance (5 mm) from
+    the ceiling's edge (x = 10, z = gap): its centre 6 mm away. It runs from the safe height
+    (gap + 6) down to the retract point 6 mm above the floor, so floor points up to
+    x = 10 - 6 = 4 are kept under a 12 mm gap and up to x = 10 - sqrt(6^2 - 3.5^2) under a
+    2.5 mm one (the retract point 3.5 mm above the edge); floor points beyond, up to the
+    ball radius from the edge, are dropped as descent (the ball would pass within 5 mm)."""
     st = PlanSettings(tip_radius=1.0, edge_margin=0.5, stand_off=2.0)
+    assert st.clearance == 5.0
     plan = plan_points(FaceDomain(_hook(gap), 1), "grid", (106, 5), st)
     assert np.all(plan.points[:, 2] == 0.0)
-    assert plan.points[:, 0].max() <= 9.0 + 1e-3
+    xs = np.unique(np.round(plan.points[:, 0], 9))
+    # the last kept column is the last one within keep_to (columns about 0.5 mm apart)
+    assert keep_to - 0.6 < xs.max() <= keep_to + 1e-3
+    assert xs.min() <= 1.5 + 0.6
     x = np.array([d.point[0] for d in plan.dropped])
     z = np.array([d.point[2] for d in plan.dropped])
     why = np.array([d.reason for d in plan.dropped])
     under = (z == 0.0) & (x > 10.0) & (x < 28.5)
     assert under.sum() >= 5 * 30 and np.all(why[under] == reason)
+    near = (z == 0.0) & (x > keep_to) & (x < 9.0)     # 1 mm from the edge: approach
+    assert near.sum() >= 5 * 6 and np.all(why[near] == "descent")
     assert np.all(why[z > 0] == "tilt")
-    floor = (plan.points[:, 0] > 1.5) & (plan.points[:, 0] < 8.99)
-    assert floor.sum() == 5 * len(np.unique(np.round(plan.points[floor, 0], 9)))
-    assert np.unique(np.round(plan.points[:, 0], 9)).size >= 12
+    assert len(plan) == 5 * len(xs)
 
 
 # ------------------------------------------------------------------ concave radius

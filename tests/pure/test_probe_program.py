@@ -141,6 +141,11 @@ def test_fanuc_program_by_parsing(tmp_path):
     (dict(settings=settings(work_offset="G92")), ("work_offset 'G92'",)),
     (dict(settings=settings(log_file="a)b")), ("log_file",)),
     (dict(settings=settings(second_touch=True, backoff=3.0)), ("backoff 3",)),
+    (dict(settings=settings(log_file="")), ("log_file ''",)),
+    (dict(settings=settings(second_feed=7.0)), ("second_feed 7 mm/min", "second_touch")),
+    (dict(settings=settings(backoff=1.5)), ("backoff 1.5 mm", "second_touch")),
+    (dict(settings=settings(log_file="x.log", dialect="fanuc")),
+     ("log_file 'x.log'", "dialect fanuc")),
 ])
 def test_bad_plans_and_settings_write_nothing(tmp_path, change, words):
     case = dict(ids=["P00"], points=np.array([[0, 0, 9.0]]), normals=np.array([[0, 0, 1.0]]),
@@ -155,6 +160,32 @@ def test_bad_plans_and_settings_write_nothing(tmp_path, change, words):
         assert w in str(err.value)
     assert prog.read_text() == "old\n" and sorted(p.name for p in tmp_path.iterdir()) == \
         ["probe.ngc"]
+
+
+@pytest.mark.parametrize("change, text", [
+    (dict(touch_feed=2000.0), "--touch-feed 2000 mm/min is above --feed 1000 mm/min"),
+    (dict(second_touch=True, backoff=3.0), "--backoff 3 mm is larger than --stand-off 2 mm"),
+    (dict(tool=0), "--tool 0: expected a whole number from 1 to 9999"),
+    (dict(dialect="siemens"), "--dialect 'siemens' is not known"),
+    (dict(work_offset="G92"), "--work-offset 'G92' is not known"),
+    (dict(log_file=""), "--probe-log '': expected the name of the file LinuxCNC writes"),
+    (dict(log_file="a;b"), "--probe-log 'a;b': a file name in a G-code comment"),
+    (dict(second_feed=7.0), "--second-feed 7 mm/min applies to the second touch only "
+                            "(expected --second-touch with it, or no --second-feed)"),
+    (dict(backoff=1.5), "--backoff 1.5 mm applies to the second touch only (expected "
+                        "--second-touch with it, or no --backoff)"),
+    (dict(log_file="x.log", dialect="fanuc"),
+     "--probe-log 'x.log' applies to --dialect linuxcnc only (expected no --probe-log with "
+     "--dialect fanuc"),
+])
+def test_refusals_name_the_options(change, text):
+    """A setting that cannot be used or would not take effect is refused with a message
+    whose options the command line shows as its flags."""
+    from surfcomp.cli.option_flags import shown
+
+    with pytest.raises(InputError) as err:
+        settings(**change).validate()
+    assert text in shown(err.value)
 
 
 def test_program_options_from_the_command_line(tmp_path):

@@ -25,10 +25,12 @@ reason (:class:`Drop`):
 * ``margin``: closer than ``tip_radius + edge_margin`` (mm, in space) to the trim
   boundary or a hole;
 * ``tilt``: its outward normal leans more than ``max_tilt`` from the spindle axis +Z;
-* ``approach`` / ``descent``: the stylus ball would meet the face on the way along the
-  normal from the stand-off, or down from the safe height
-  (:mod:`surfcomp.core.measurement.planning_reach`); the rest of a solid is checked by the app
-  layer, passed in as ``extra_check``.
+* ``approach``: the stylus ball would meet the face on the feed moves along the normal
+  from the retract point to the touch;
+* ``descent``: the ball would come closer than ``clearance`` to the face on the rapid
+  descent from the safe height to the retract point (and the rapid climb back): the rapid
+  moves keep the clearance (:mod:`surfcomp.core.measurement.planning_reach`); the rest of
+  a solid is checked by the app layer, passed in as ``extra_check``.
 
 A stylus ball larger than the face's smallest concave radius cannot touch the face where it
 is most concave: such a plan is refused. The kept points are visited in the order that keeps
@@ -68,7 +70,8 @@ REASONS = {
     "margin": "closer than the margin to the boundary or a hole",
     "tilt": note("normal leans more than ", ("max_tilt",), " from +Z"),
     "approach": "the stylus meets the face on the approach along the normal",
-    "descent": "the stylus meets the face on the descent from the safe height",
+    "descent": note("the rapid descent from the safe height comes closer than ",
+                    ("clearance",), " to the face"),
 }
 
 
@@ -378,7 +381,9 @@ def _screen(domain, u, v, settings, safe_z, cloud):
     fail(blocked, "approach")
     idx = np.flatnonzero(todo)
     blocked[:] = False
-    blocked[idx] = blocked_by_cloud(top[idx], standoff[idx], cl, settings.tip_radius, tree)
+    # the rapid moves keep the ball the clearance away: its centre R + clearance
+    blocked[idx] = blocked_by_cloud(top[idx], standoff[idx], cl,
+                                    settings.tip_radius + settings.clearance, tree)
     fail(blocked, "descent")
     return todo, reason, S, n, touch, standoff, top
 
@@ -461,7 +466,7 @@ def plan_points(domain, layout, count=None, settings=None, top_z=None, order="au
                     tuple(float(x) for x in S[i])) for i in np.flatnonzero(~keep)]
     if not keep.any():
         raise InputError(_nothing_left(layout, requested, dropped, info),
-                         options=("max_tilt", "edge_margin", "tip_radius"))
+                         options=("max_tilt", "edge_margin", "tip_radius", "clearance"))
     report(progress, 0.8, "ordering %d points" % int(keep.sum()))
     idx = np.flatnonzero(keep)
     tour, name, travel = visiting_order(standoff[idx], lay["row"][idx], lay["along"][idx],
@@ -485,5 +490,6 @@ def _nothing_left(layout, requested, dropped, info):
         why = ("%d nodes have no face under them; " % clipped) + why
     return ("no reachable point on the face: the %s layout placed %d point(s) and every one "
             "was dropped (%s); expected at least one point that a 3-axis probe reaches "
-            "(a larger max_tilt, a smaller edge_margin or tip_radius, or another face)"
+            "(a larger max_tilt, a smaller edge_margin, tip_radius or clearance, or another "
+            "face)"
             % (layout, requested, why or "none placed"))

@@ -6,11 +6,18 @@ A 3-axis probe (spindle axis +Z) reaches a point ``P`` with outward unit normal 
 
 * its approach along the normal leans at most ``max_tilt`` from +Z: ``n_z >= cos(max_tilt)``;
 * the stylus ball (radius ``r``) travels clear of the face from the retract position
-  ``P + (r + d) n`` to the touch position ``P + r n`` (the approach line) and clear of the
-  face on the vertical line from the safe height down to the retract position (the
-  descent), ``d`` being the larger of the stand-off and the clearance, where the probing
-  program's rapid descent ends (:mod:`surfcomp.io.probe_path`): no point of the face comes
-  closer than ``r`` to either segment, save the touched point itself (tolerance :data:`CLEAR_TOL`).
+  ``P + (r + d) n`` to the touch position ``P + r n`` (the approach line, fed along the
+  normal): no point of the face comes closer than ``r`` to it, save the touched point
+  itself;
+* on the vertical line from the safe height down to the retract position (the rapid
+  descent, and the rapid climb back on the same line) the ball keeps the clearance ``c``
+  from the face: no point of the face comes closer than ``r + c`` to it (the retract
+  position itself is ``r + d >= r + c`` from ``P``),
+
+``d`` being the larger of the stand-off and the clearance, where the probing program's
+rapid descent ends (:mod:`surfcomp.io.probe_path`); tolerance :data:`CLEAR_TOL`. The
+traverses at the safe height keep the clearance above the part's top by construction, so
+every rapid move of the program keeps the ball ``c`` from the part.
 
 Here the face is checked at its samples (a point cloud on the trimmed face): a face that
 bends back over a point hides it. The rest of the part (a face of a solid) is checked with
