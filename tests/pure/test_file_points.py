@@ -121,3 +121,27 @@ def test_a_probe_on_the_normal_with_a_tilted_surface_is_no_mistake(face):
     got = run(s, nominal=nominal, measured=nominal + dev[:, None] * normal + side)
     assert not [w for w in got.warnings if "beside" in w or "nominal points" in w]
     np.testing.assert_allclose(got.deviation, dev, atol=1e-12)
+
+
+def test_measured_points_with_x_and_y_swapped_are_reported(face):
+    """Before: deviations spread by half a millimetre (within max_offset 1 mm) were taken
+    without a word; the face's size tolerance is +-0.15 mm (ISO 2768-1 fine)."""
+    s, nominal, normal, dev = face
+    measured = nominal + dev[:, None] * normal
+    ok = run(s, measured=measured)
+    assert not [w for w in ok.warnings if "spread" in w]
+    swapped = run(s, measured=measured[:, [1, 0, 2]])
+    said = [w for w in swapped.warnings if "spread" in w]
+    spread = np.std(swapped.deviation, ddof=1)
+    assert 0.15 < spread < 1.0
+    assert said == ["m.csv: the deviations spread by %.0f um (standard deviation), more than "
+                    "the face's size tolerance (ISO 2768-1 fine: +-0.15 mm for its largest "
+                    "dimension %.1f mm): more than a machining error leaves; is this the "
+                    "measurement of this face, in its frame, with the columns in the right "
+                    "order?" % (spread * 1e3, pl.largest_dimension(pl.face_samples(s)))]
+
+
+@pytest.mark.parametrize("spread, warned", [(0.149, False), (0.151, True)])
+def test_the_spread_limit_is_the_size_tolerance(spread, warned):
+    d = np.array([-1.0, 0.0, 1.0]) * spread        # sample standard deviation = spread
+    assert (pl.spread_warning(d, 100.0) is not None) is warned

@@ -323,13 +323,13 @@ def _check_deviations(ms, d, options):
 
 
 def _check_units(surface, d, warnings, source):
-    """Warn when every deviation is far beyond the face's size tolerance (see
-    :mod:`surfcomp.core.compensation.plausibility`): plausible against max-offset, but not for a
-    part."""
+    """Warn when every deviation is far beyond the face's size tolerance, or they spread by
+    more than it (see :mod:`surfcomp.core.compensation.plausibility`): plausible against
+    max-offset, but not for a part."""
     size = plausibility.largest_dimension(plausibility.face_samples(surface))
-    message = plausibility.units_warning(d, size)
-    if message:
-        warnings.append("%s: %s" % (source, message))
+    for message in (plausibility.units_warning(d, size), plausibility.spread_warning(d, size)):
+        if message:
+            warnings.append("%s: %s" % (source, message))
 
 
 #: fewest points of a scattered layout (its smoothing fit needs them off one line)

@@ -302,6 +302,24 @@ def units_warning(deviation, dimension, factor=UNITS_FACTOR):
             "check the units of the file" % (factor, tol, dimension, float(d.min())))
 
 
+def spread_warning(deviation, dimension):
+    """A warning when the deviations spread (sample standard deviation, three or more)
+    by more than the size tolerance of a face of ``dimension`` mm (see module doc): a
+    machined face that far from its own mean is not what a machining error leaves, but
+    points of another part or frame, or columns in another order; else None."""
+    d = np.asarray(deviation, dtype=float).ravel()
+    d = d[np.isfinite(d)]
+    if d.size < 3 or dimension <= 0:
+        return None
+    spread, tol = float(np.std(d, ddof=1)), size_tolerance(dimension)
+    if spread <= tol:
+        return None
+    return ("the deviations spread by %.0f um (standard deviation), more than the face's size "
+            "tolerance (ISO 2768-1 fine: +-%g mm for its largest dimension %.1f mm): more than "
+            "a machining error leaves; is this the measurement of this face, in its frame, with "
+            "the columns in the right order?" % (spread * 1e3, tol, dimension))
+
+
 def value_ranges(columns):
     """``{name: (min, max)}`` of the finite values of each named array (mm), for a
     preview; names whose array is None or has no finite value are left out."""
