@@ -34,13 +34,12 @@ class Nominal:
         Core arrays of ``bspline_face.Surface`` made non-periodic and cut to the face's UV
         bounds (:func:`surfcomp.app.face_data.work_surface`, same parametrisation);
         ``u_range``/``v_range`` = those bounds.
-    outward : int
-        +1 when the face's outward normal is Su x Sv, -1 when the face is reversed.
-    source, face_name, object_name : str
-    converted : str or None
-        What the original surface was when it had to be converted (e.g. 'Cylinder').
+    source, object_name : str
     data : surfcomp.app.face_data.FaceData
-        The face as plain data (:func:`nominal_from_data`). A nominal the reader child sent
+        The face as plain data (:func:`nominal_from_data`): ``outward`` (+1 when the face's
+        outward normal is Su x Sv, -1 when the face is reversed), ``face_name`` and
+        ``converted`` (what the original surface was when it had to be converted, e.g.
+        'Cylinder') are its. A nominal the reader child sent
         (:func:`surfcomp.app.cadread.take_face`) has only this: ``face``, ``bspline_face``
         and ``shape`` are None (the process has no FreeCAD), and its ``data`` holds the
         boundary polylines.
@@ -49,25 +48,34 @@ class Nominal:
     face: object
     bspline_face: object
     surface: object
-    outward: int
     source: str
-    face_name: str
+    data: object
     object_name: str = None
-    converted: str = None
     shape: object = None
-    data: object = None
+
+    @property
+    def outward(self):
+        return self.data.outward
+
+    @property
+    def face_name(self):
+        return self.data.face_name
+
+    @property
+    def converted(self):
+        return self.data.converted
 
     @cached_property
     def untrimmed(self):
         """True when the face is bounded by its surface's whole domain
         (:func:`bounds_whole_domain`), told once for the trim warning, the correction's
         volume and the direct program's trim."""
-        ends = self.data.line_ends if self.data is not None else line_ends(self.bspline_face)
-        return ends_whole_domain(ends, self.surface.u_range, self.surface.v_range)
+        return ends_whole_domain(self.data.line_ends, self.surface.u_range,
+                                 self.surface.v_range)
 
     def boundary(self):
         """The face's :func:`boundary_polylines` (:data:`EDGE_POINTS` per edge)."""
-        if self.data is not None and self.data.boundary is not None:
+        if self.data.boundary is not None:
             return [np.array(p, dtype=float) for p in self.data.boundary]
         return boundary_polylines(self.bspline_face)
 
@@ -154,9 +162,8 @@ def nominal_from_data(data, source, object_name=None, face=None, bspline_face=No
         raise GeometryError("the face's B-spline surface cannot be used: %s" % exc,
                             file=source) from None
     check_nominal(surface, source, "the surface of %s" % data.face_name)
-    return Nominal(face=face, bspline_face=bspline_face, surface=surface, outward=data.outward,
-                   source=source, face_name=data.face_name, object_name=object_name,
-                   converted=data.converted, shape=shape, data=data)
+    return Nominal(face=face, bspline_face=bspline_face, surface=surface, source=source,
+                   data=data, object_name=object_name, shape=shape)
 
 
 #: a measured point farther than this (mm) outside the trimmed face is reported
