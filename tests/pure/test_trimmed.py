@@ -119,3 +119,20 @@ def test_correction_integral_of_a_sphere_cap():
     got = correction_integral(outer, inner, 1, square)
     assert got == pytest.approx(octant * (R ** 3 - (R - d) ** 3) / 3, rel=1e-6)
     assert got < 0.99 * octant * d * R ** 2
+
+
+def test_a_ray_along_a_seam_that_closes_to_rounding_counts_it_once():
+    """A circle's pcurve sampled from its seam at (0.85, 0.5) ends 1e-12 from where it began:
+    points on the face at the seam's v were counted outside (the ray met the seam twice),
+    which the file route's trim warning hid behind OCCT's distance and the direct route
+    (its face from the reader child, no OCCT) reported as 2.7 mm beyond the face."""
+    from surfcomp.core.surface.trimmed import inside, snap_ends
+
+    t = np.linspace(0.0, 2.0 * np.pi, 400)
+    circle = np.column_stack([0.5 + 0.35 * np.cos(t), 0.5 + 0.35 * np.sin(t)])
+    circle[-1, 1] = 0.5 + 1e-12
+    u = np.array([0.675, 0.7625, 0.2, 0.95])
+    v = np.full(4, 0.5 + 1e-13)
+    assert list(inside([circle], u, v)) == [True, True, True, False]
+    snapped = snap_ends([circle])[0]
+    assert np.array_equal(snapped[-1], snapped[0]) and circle[-1, 1] == 0.5 + 1e-12

@@ -242,6 +242,30 @@ def _layer(nominal, points, outward):
     return np.where(jac > 0, layer * jac, 0.0)
 
 
+#: ends of boundary pieces closer than this share of the boundary's extent are one vertex
+SNAP = 1e-9
+
+
+def snap_ends(polylines, share=SNAP):
+    """Copies of ``polylines`` whose ends that meet (within ``share`` of the boundary's
+    extent) are the very same point: the crossing rule of :func:`inside` counts a shared
+    vertex once only when both pieces hold it exactly, and an edge's pcurve ends where the
+    next begins only to rounding (a closed circle's seam 1e-16 apart counted a ray along
+    the seam's v twice, and points on the face there as outside)."""
+    lines = [np.array(p, dtype=float) for p in polylines]
+    ends = np.array([p[k] for p in lines for k in (0, -1)])
+    if not len(ends):
+        return lines
+    tol = share * max(float(np.ptp(np.concatenate(lines), axis=0).max()), 1e-300)
+    for i in range(len(ends)):
+        near = np.flatnonzero(np.abs(ends[:i] - ends[i]).max(axis=1) <= tol)
+        if near.size:
+            ends[i] = ends[near[0]]
+    for j, p in enumerate(lines):
+        p[0], p[-1] = ends[2 * j], ends[2 * j + 1]
+    return lines
+
+
 def inside(polylines, u, v, buckets=256):
     """Which points ``(u, v)`` lie inside the region bounded by ``polylines`` (even-odd
     rule, so neither order nor direction of the pieces matters): a bool array of the
@@ -252,8 +276,8 @@ def inside(polylines, u, v, buckets=256):
     """
     u = np.asarray(u, dtype=float)
     v = np.asarray(v, dtype=float)
-    segs = np.concatenate([np.stack([np.asarray(p, float)[:-1], np.asarray(p, float)[1:]],
-                                    axis=1) for p in polylines])
+    polylines = snap_ends(polylines)
+    segs = np.concatenate([np.stack([p[:-1], p[1:]], axis=1) for p in polylines])
     lo = np.minimum(segs[:, 0, 1], segs[:, 1, 1])
     hi = np.maximum(segs[:, 0, 1], segs[:, 1, 1])
     v0, v1 = lo.min(), hi.max()
