@@ -212,19 +212,44 @@ def outside_trim(nominal, prepared):
     """The measured points that lie on the nominal surface but outside the trimmed face:
     ``(indices, distances)`` in file order, distances (mm) from the face (its boundary).
     Nothing (empty arrays) on a face bounded by its surface's whole domain
-    (:func:`bounds_whole_domain`): every point on the surface is on the face."""
-    import FreeCAD
-    import Part
-
-    face = nominal.bspline_face
+    (:func:`bounds_whole_domain`): every point on the surface is on the face. The distances
+    are OCCT's where this process has the face, else to its boundary polylines on the
+    surface (:func:`_boundary_distance`: the face the reader child sent)."""
     if nominal.untrimmed:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
-    candidates = np.nonzero(~inside(boundary_polylines(face, 200), prepared.u,
-                                    prepared.v))[0]
-    dist = np.array([face.distToShape(Part.Vertex(FreeCAD.Vector(*prepared.nominal[k])))[0]
-                     for k in candidates])
+    face = nominal.bspline_face
+    polylines = boundary_polylines(face, 200) if face is not None else nominal.boundary()
+    candidates = np.nonzero(~inside(polylines, prepared.u, prepared.v))[0]
+    points = np.asarray(prepared.nominal, dtype=float)[candidates]
+    if face is not None:
+        import FreeCAD
+        import Part
+
+        dist = np.array([face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0] for p in points])
+    else:
+        dist = _boundary_distance(nominal.surface, polylines, points)
     keep = dist > OUTSIDE_TOLERANCE
     return candidates[keep], dist[keep]
+
+
+def _boundary_distance(surface, polylines, points):
+    """Distances (mm) of ``points`` (N, 3) from the face's boundary: the polylines (u, v) on
+    ``surface``, as 3D segments."""
+    from ..core.surface import bspline
+
+    if not len(points):
+        return np.zeros(0)
+    best = np.full(len(points), np.inf)
+    for line in polylines:
+        q = bspline.evaluate(surface, line[:, 0], line[:, 1])
+        a, ab = q[:-1], np.diff(q, axis=0)
+        for k in range(0, len(points), 256):
+            p = points[k:k + 256, None, :]
+            t = np.clip(np.einsum("nsj,sj->ns", p - a, ab)
+                        / np.maximum(np.einsum("sj,sj->s", ab, ab), 1e-300), 0.0, 1.0)
+            d = np.linalg.norm(p - (a + t[..., None] * ab), axis=2).min(axis=1)
+            best[k:k + 256] = np.minimum(best[k:k + 256], d)
+    return best
 
 
 def trim_warning(nominal, prepared):

@@ -22,6 +22,7 @@ from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import FORK_LINES, offset_stream
 from ..io.readers import read_any
 from . import fcenv
+from .nominal import face_warnings
 from .program_geometry import offset_of
 
 
@@ -63,6 +64,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
                  "split the program into parts")
     prepared = prepare(nominal.surface, nominal.outward, ms, job.options,
                        progress=sub(progress, 0, 0.3))
+    prepared.warnings.extend(face_warnings(nominal, prepared))
     comp = compensate(nominal.surface, nominal.outward, prepared, job.options,
                       progress=sub(progress, 0.3, 0.7))
     offset = offset_of(nominal, comp.corrected, radius, pj.blend)

@@ -177,3 +177,43 @@ def test_the_program_route_writes_the_same_bytes_with_and_without_the_child(tmp_
         assert res.stdout.strip().splitlines()[-1] == "FREECAD %s 0" % (case == "thread")
     assert outs["child"].read_bytes() == outs["thread"].read_bytes()
     assert outs["child"].read_bytes() != program.read_bytes()
+
+
+def test_points_outside_the_trim_are_told_from_the_childs_face_too(tmp_path):
+    """The direct route said nothing of measured points outside a trimmed face (the file
+    route names them); with the face from the child (no OCCT in the process) they are found
+    alike, their distances from the boundary polylines on the surface within 2 um of OCCT's."""
+    from surfcomp.app.nominal import outside_trim
+    from surfcomp.core.compensation.pipeline import Options, prepare
+    from surfcomp.io.readers import read_any
+    from tests.app.trim_cases import measure, raw_deviation
+
+    path = tmp_path / "trimmed.step"
+    circle_face(hole=HOLE).exportStep(str(path))
+    _got, data = take(tmp_path, path)
+    mine, ref = nominal_from_data(data, str(path)), load_nominal(str(path))
+    measure(tmp_path / "m.csv", ref, 9, lambda P, U, V: raw_deviation(P))
+    prep = prepare(ref.surface, ref.outward, read_any(str(tmp_path / "m.csv")), Options())
+    (k1, d1), (k2, d2) = outside_trim(mine, prep), outside_trim(ref, prep)
+    assert np.array_equal(k1, k2) and k1.size > 20
+    np.testing.assert_allclose(d1, d2, atol=2e-3)
+
+
+def test_the_program_route_prints_the_faces_warnings(tmp_path):
+    """A corner patch of the example's points: the direct route says how little of the face
+    they cover, as the file route does."""
+    program = tmp_path / "finish.ngc"
+    raster(program, rows=12)
+    rows = open(EXAMPLE_CSV).read().splitlines()
+    start = next(k for k, t in enumerate(rows) if t.startswith("id,"))
+    xy = np.array([[float(f) for f in r.split(",")[1:3]] for r in rows[start + 1:]])
+    xs, ys = np.unique(xy[:, 0])[8], np.unique(xy[:, 1])[8]
+    patch = tmp_path / "patch.csv"
+    patch.write_text("\n".join(rows[:start + 1] + [r for r, (x, y) in zip(rows[start + 1:], xy)
+                                                   if x <= xs and y <= ys]) + "\n")
+    res = subprocess.run([sys.executable, "-m", "surfcomp", "compensate", EXAMPLE_STEP,
+                          str(patch), "--program", str(program), "--tool", "ball:3", "-o",
+                          str(tmp_path / "out.ngc")], capture_output=True, text=True,
+                         timeout=300, cwd=ROOT)
+    assert res.returncode == 0, res.stderr
+    assert "warning: %s: the measured points cover 12 %% of Face1" % patch in res.stderr
