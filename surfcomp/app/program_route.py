@@ -21,8 +21,8 @@ from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import FORK_LINES, offset_stream
 from ..io.readers import read_any
-from . import fcenv
-from .nominal import face_warnings
+from . import cadread, fcenv
+from .nominal import face_warnings, load_nominal, nominal_from_data
 from .program_geometry import offset_of
 
 
@@ -89,9 +89,6 @@ def _nominal(job):
     """The job's :class:`surfcomp.app.nominal.Nominal`: the face the reader child sent
     (:func:`surfcomp.app.cadread.prefetch_face`; FreeCAD is not imported here), else the
     face loaded in this process."""
-    from . import cadread
-    from .nominal import load_nominal, nominal_from_data
-
     data = None if job.object else cadread.take_face(job.nominal, job.face)
     if data is not None:
         return nominal_from_data(data, job.nominal)

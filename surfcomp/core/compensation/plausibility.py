@@ -257,18 +257,18 @@ def check_file_points(ms, dist, normal, max_offset, warnings):
     if not bad.size:
         return
     k = int(bad[0])
-    text = ("%d of %d measured points lie beside their own nominal point rather than on its "
+    head = ("%d of %d measured points lie beside their own nominal point rather than on its "
             "normal (this line: %.4f mm beside it, the next nominal point %.4f mm away; "
-            "expected at most half that, and at most max_offset %g mm)"
-            % (bad.size, beside.size, beside[k], spacing[k], max_offset))
+            "expected at most half that, and at most " % (bad.size, beside.size, beside[k],
+                                                          spacing[k]))
+    tail = " %g mm)" % max_offset
     if 2 * bad.size >= beside.size:
         raise MeasurementFileError(
-            text + ": the measured points do not pair with the nominal points of their rows; "
-            "expected each row's measured point probed along its nominal normal (is the "
-            "measured column shifted or sorted apart?)", file=ms.source, line=int(ms.lines[k]),
-            options=("max_offset",))
-    warnings.append(note("%s:%d: " % (ms.source, ms.lines[k]), text.split("max_offset")[0],
-                         ("max_offset",), text.split("max_offset")[1],
+            head + "max_offset" + tail + ": the measured points do not pair with the nominal "
+            "points of their rows; expected each row's measured point probed along its "
+            "nominal normal (is the measured column shifted or sorted apart?)",
+            file=ms.source, line=int(ms.lines[k]), options=("max_offset",))
+    warnings.append(note("%s:%d: " % (ms.source, ms.lines[k]), head, ("max_offset",), tail,
                          "; their deviations are taken along the normal of the nominal point"))
 
 
