@@ -173,12 +173,19 @@ def prefetch(path):
     start (its imports, the measurement file) runs beside it; :func:`read_cad` of the same
     path takes the result. Anything not a readable CAD file is left to :func:`read_cad`
     (which then says what is wrong, in its turn); :func:`discard` stops what nobody took."""
+    _start(_STARTED, path)
+
+
+def _start(started, path, **kw):
+    """A :class:`_Reader` of the CAD file ``path`` (``kw`` its arguments) kept in
+    ``started`` by the file's absolute path; nothing for anything not a readable CAD
+    file (left to :func:`read_cad`, which says what is wrong) or already started."""
     key = os.path.abspath(path)
-    if key in _STARTED or not os.path.isfile(path) or \
+    if key in started or not os.path.isfile(path) or \
             os.path.splitext(path)[1].lower() not in CAD_EXTENSIONS:
         return
     try:
-        _STARTED[key] = _Reader(path)
+        started[key] = _Reader(path, **kw)
     except (InputError, OSError):
         return
 
@@ -195,14 +202,8 @@ def prefetch_face(path, face_name=None):
     not import FreeCAD at all. Nothing is started where no fork may be taken
     (:func:`surfcomp.io.forks.may_fork`) or ``path`` is not a CAD file; :func:`discard`
     stops what nobody took."""
-    key = os.path.abspath(path)
-    if key in _FACES or not forks.may_fork() or not os.path.isfile(path) or \
-            os.path.splitext(path)[1].lower() not in CAD_EXTENSIONS:
-        return
-    try:
-        _FACES[key] = _Reader(path, face=True, face_name=face_name)
-    except (InputError, OSError):
-        return
+    if forks.may_fork():
+        _start(_FACES, path, face=True, face_name=face_name)
 
 
 def take_face(path, face_name=None, label="NOMINAL"):

@@ -10,8 +10,9 @@ from functools import cached_property
 
 import numpy as np
 
+from ..core.compensation import region_field
 from ..core.surface.surface_checks import check_nominal
-from ..core.surface.trimmed import inside, whole_domain
+from ..core.surface.trimmed import area_samples, inside, whole_domain
 from ..errors import GeometryError
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
@@ -73,8 +74,10 @@ class Nominal:
         return ends_whole_domain(self.data.line_ends, self.surface.u_range,
                                  self.surface.v_range)
 
+    @cached_property
     def boundary(self):
-        """The face's :func:`boundary_polylines` (:data:`EDGE_POINTS` per edge)."""
+        """The face's :func:`boundary_polylines` (:data:`EDGE_POINTS` per edge), sampled
+        once: the child's when it sent them."""
         if self.data.boundary is not None:
             return [np.array(p, dtype=float) for p in self.data.boundary]
         return boundary_polylines(self.bspline_face)
@@ -214,42 +217,26 @@ def outside_trim(nominal, prepared):
     Nothing (empty arrays) on a face bounded by its surface's whole domain
     (:func:`bounds_whole_domain`): every point on the surface is on the face. The distances
     are OCCT's where this process has the face, else to its boundary polylines on the
-    surface (:func:`_boundary_distance`: the face the reader child sent)."""
+    surface (:meth:`surfcomp.core.compensation.program_trim.Trim.closest`: the face the
+    reader child sent)."""
     if nominal.untrimmed:
         return np.zeros(0, dtype=np.int64), np.zeros(0)
-    face = nominal.bspline_face
-    polylines = boundary_polylines(face, 200) if face is not None else nominal.boundary()
-    candidates = np.nonzero(~inside(polylines, prepared.u, prepared.v))[0]
+    candidates = np.nonzero(~inside(nominal.boundary, prepared.u, prepared.v))[0]
     points = np.asarray(prepared.nominal, dtype=float)[candidates]
+    face = nominal.bspline_face
     if face is not None:
         import FreeCAD
         import Part
 
         dist = np.array([face.distToShape(Part.Vertex(FreeCAD.Vector(*p)))[0] for p in points])
+    elif len(points):
+        from ..core.compensation.program_trim import Trim
+
+        dist = Trim(nominal.surface, nominal.boundary).closest(points)[3]
     else:
-        dist = _boundary_distance(nominal.surface, polylines, points)
+        dist = np.zeros(0)
     keep = dist > OUTSIDE_TOLERANCE
     return candidates[keep], dist[keep]
-
-
-def _boundary_distance(surface, polylines, points):
-    """Distances (mm) of ``points`` (N, 3) from the face's boundary: the polylines (u, v) on
-    ``surface``, as 3D segments."""
-    from ..core.surface import bspline
-
-    if not len(points):
-        return np.zeros(0)
-    best = np.full(len(points), np.inf)
-    for line in polylines:
-        q = bspline.evaluate(surface, line[:, 0], line[:, 1])
-        a, ab = q[:-1], np.diff(q, axis=0)
-        for k in range(0, len(points), 256):
-            p = points[k:k + 256, None, :]
-            t = np.clip(np.einsum("nsj,sj->ns", p - a, ab)
-                        / np.maximum(np.einsum("sj,sj->s", ab, ab), 1e-300), 0.0, 1.0)
-            d = np.linalg.norm(p - (a + t[..., None] * ab), axis=2).min(axis=1)
-            best[k:k + 256] = np.minimum(best[k:k + 256], d)
-    return best
 
 
 def trim_warning(nominal, prepared):
@@ -276,30 +263,17 @@ MIN_COVERAGE = 0.5
 COVERAGE_SPACINGS = 3.0
 
 
-def coverage(nominal, prepared, n=60):
+def coverage(nominal, prepared, n=80):
     """The share of the face's area (inside its trim) within :data:`COVERAGE_SPACINGS`
-    median point spacings of a measured point, on an ``n`` x ``n`` grid of its parameters
-    weighted by the area element."""
-    from ..core.surface import bspline
-    from ..core.surface.kdtree import cKDTree
-
+    median point spacings of a measured point (on ``n`` x ``n`` area samples,
+    :func:`surfcomp.core.surface.trimmed.area_samples`), as the region route tells it."""
     pts = np.asarray(prepared.nominal, dtype=float)
     if len(pts) < 2:
         return 0.0
-    u0, u1, v0, v1 = nominal.data.bounds
-    U, V = (a.ravel() for a in np.meshgrid(np.linspace(u0, u1, n), np.linspace(v0, v1, n),
-                                            indexing="ij"))
-    if not nominal.untrimmed:
-        keep = inside(nominal.boundary(), U, V)
-        U, V = U[keep], V[keep]
-    if not U.size:
-        return 0.0
-    P, Su, Sv = bspline.derivatives(nominal.surface, U, V, order=1)
-    area = np.linalg.norm(np.cross(Su, Sv), axis=1)
-    tree = cKDTree(pts)
-    step = float(np.median(tree.query(pts, k=2)[0][:, 1]))
-    d, _ = tree.query(P, k=1, distance_upper_bound=COVERAGE_SPACINGS * step)
-    return float(area[np.isfinite(d)].sum() / area.sum())
+    samples, area = area_samples(nominal.surface, nominal.data.bounds,
+                                 None if nominal.untrimmed else nominal.boundary, n)
+    return region_field.coverage(samples, pts, COVERAGE_SPACINGS * region_field.spacing(pts),
+                                 area)
 
 
 def coverage_warning(nominal, prepared):

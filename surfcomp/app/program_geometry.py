@@ -6,7 +6,7 @@ The correction at a contact point is what the corrected face realises there alon
 nominal's normal (:class:`surfcomp.core.compensation.realised_feet.RealisedAt`, from the
 projection's feet; Newton starts on the nominal point itself, or from the neighbouring
 point's intersection along a path); a trimmed face's boundary
-(:meth:`surfcomp.app.nominal.Nominal.boundary`) fades the correction out beyond it
+(:attr:`surfcomp.app.nominal.Nominal.boundary`) fades the correction out beyond it
 (:class:`surfcomp.core.compensation.program_trim.Trim`).
 """
 
@@ -22,6 +22,6 @@ def offset_of(nominal, corrected, radius, blend):
     if not nominal.untrimmed:   # imported here: its KD-tree needs the whole scipy.spatial
         from ..core.compensation.program_trim import Trim
 
-        trim = Trim.of(surface, nominal.boundary())
+        trim = Trim.of(surface, nominal.boundary)
     return BallOffset(nominal.surface, nominal.outward, radius,
                       RealisedAt(nominal.surface, corrected, nominal.outward), blend, trim=trim)

@@ -24,7 +24,7 @@ from scipy.spatial import cKDTree
 from ..core.compensation import region_build, region_edges, region_field
 from ..core.surface.bspline import derivatives, evaluate, normals
 from ..core.surface.projection import Projector
-from ..core.surface.trimmed import inside
+from ..core.surface.trimmed import area_samples, inside  # noqa: F401  (region.inside)
 from ..errors import GeometryError, InputError
 from .convert import surface_from_part
 from .face_data import to_bspline_face, work_surface
@@ -187,15 +187,9 @@ def covering_radius(g):
 
 
 def face_samples(f, n=60):
-    """Points on the face (inside its trim) and the area each stands for."""
-    u0, u1, v0, v1 = f.bface.ParameterRange
-    us, vs = (np.linspace(u0, u1, n + 1)[:-1] + 0.5 * (u1 - u0) / n,
-              np.linspace(v0, v1, n + 1)[:-1] + 0.5 * (v1 - v0) / n)
-    U, V = np.meshgrid(us, vs, indexing="ij")
-    ok = inside(f.polylines, U.ravel(), V.ravel())
-    S, Su, Sv = derivatives(f.surface, U.ravel()[ok], V.ravel()[ok], order=1)
-    area = np.linalg.norm(np.cross(Su, Sv), axis=1) * (u1 - u0) * (v1 - v0) / n / n
-    return S, area
+    """Points on the face (inside its trim) and the area each stands for
+    (:func:`surfcomp.core.surface.trimmed.area_samples`)."""
+    return area_samples(f.surface, f.bface.ParameterRange, f.polylines, n)
 
 
 def _edge_points(edge, n=EDGE_SAMPLES):

@@ -126,9 +126,9 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     step = region_field.spacing(pts)
     # coverage of every face
     for i, f in enumerate(faces):
-        samples, _area = region.face_samples(f)
+        samples, area = region.face_samples(f)
         f.points = counts[f.name]
-        f.coverage = region_field.coverage(samples, base[owner == i], 3.0 * step)
+        f.coverage = region_field.coverage(samples, base[owner == i], 3.0 * step, area)
         if f.coverage < min_coverage:
             raise MeasurementFileError(
                 "%s: the points cover %.0f %% of the face, less than min_coverage %.0f %% "

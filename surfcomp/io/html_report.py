@@ -37,7 +37,7 @@ import html
 
 import numpy as np
 
-from ..core.compensation.deviations import NONE, statistics
+from ..core.compensation.deviations import Statistics, cell_text, statistics
 from ..core.compensation.methods import predicted_residual
 from .atomic import write_text
 from .html_figures import (
@@ -130,30 +130,15 @@ def grid_arrays(report):
     return out
 
 
-def _no_side(st, key):
-    """No deviation of the statistics dict ``st`` lies on the side ``key`` names (as
-    :meth:`surfcomp.core.compensation.deviations.Statistics.rows` tells it)."""
-    if key == "max_negative":
-        return st.get("min") is not None and st["min"] >= 0
-    return key == "max_positive" and st.get("max") is not None and st["max"] <= 0
-
-
 def _stat_table(columns):
-    """``columns``: list of (header, statistics dict in mm)."""
+    """``columns``: list of (header, statistics dict in mm), shown as
+    :meth:`surfcomp.core.compensation.deviations.Statistics.rows` gives them."""
+    rows = [Statistics.from_dict(st).rows("um") for _, st in columns]
     out = ["<table><tr><th>Deviations (µm)</th>%s</tr>"
            % "".join("<th>%s</th>" % _e(h) for h, _ in columns)]
-    for key, label, f in _STAT_ROWS:
-        cells = []
-        for _, st in columns:
-            v = st.get(key)
-            if v is None:
-                text = ""
-            elif _no_side(st, key):
-                text = NONE
-            else:
-                text = "%d" % v if f is None else "%.2f" % (v * f)
-            cells.append('<td class="num">%s</td>' % text)
-        out.append("<tr><th>%s</th>%s</tr>" % (_e(label), "".join(cells)))
+    for k, (label, _v) in enumerate(rows[0]):
+        cells = "".join('<td class="num">%s</td>' % cell_text(r[k][1], k) for r in rows)
+        out.append("<tr><th>%s</th>%s</tr>" % (_e(label), cells))
     out.append("</table>")
     return "".join(out)
 

@@ -27,9 +27,9 @@ correction.
 """
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from ...errors import InputError, MeasurementFileError
+from ..surface.kdtree import cKDTree
 from .filters import WERNER_MASK_SIZE
 
 #: the wider kernels the field falls back on where no point lies within R: (factor, weight)
@@ -225,21 +225,23 @@ class RegionField:
         return (num + MEAN_WEIGHT * self.mean) / (den + MEAN_WEIGHT)
 
 
-def coverage(samples, points, radius):
+def coverage(samples, points, radius, area=None):
     """Share of a face's area samples with a measured point within ``radius``.
 
     Parameters
     ----------
     samples : ndarray, shape (M, 3)
-        Points on the face (inside its trim), each standing for an equal area.
+        Points on the face (inside its trim).
     points : ndarray, shape (N, 3)
         The measured points assigned to the face.
     radius : float
+    area : ndarray, shape (M,), optional
+        The area each sample stands for (default: equal areas).
     """
-    if len(points) == 0:
+    if len(points) == 0 or len(samples) == 0:
         return 0.0
     d, _ = cKDTree(points).query(samples, k=1, distance_upper_bound=radius)
-    return float(np.mean(np.isfinite(d)))
+    return float(np.average(np.isfinite(d), weights=area))
 
 
 def check_straddle(points, d, face, edges, radius, max_offset, lines, source, names):

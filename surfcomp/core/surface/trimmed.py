@@ -242,6 +242,21 @@ def _layer(nominal, points, outward):
     return np.where(jac > 0, layer * jac, 0.0)
 
 
+def area_samples(surface, bounds, polylines=None, n=60):
+    """Points on the face and the area each stands for: the midpoints of an ``n`` x ``n``
+    grid of its parameter ``bounds`` ``(u0, u1, v0, v1)`` on ``surface``, those inside the
+    boundary ``polylines`` (all of them without)."""
+    u0, u1, v0, v1 = bounds
+    us, vs = (np.linspace(u0, u1, n + 1)[:-1] + 0.5 * (u1 - u0) / n,
+              np.linspace(v0, v1, n + 1)[:-1] + 0.5 * (v1 - v0) / n)
+    U, V = (a.ravel() for a in np.meshgrid(us, vs, indexing="ij"))
+    if polylines is not None:
+        ok = inside(polylines, U, V)
+        U, V = U[ok], V[ok]
+    S, Su, Sv = bspline.derivatives(surface, U, V, order=1)
+    return S, np.linalg.norm(np.cross(Su, Sv), axis=1) * (u1 - u0) * (v1 - v0) / n / n
+
+
 #: ends of boundary pieces closer than this share of the boundary's extent are one vertex
 SNAP = 1e-9
 
@@ -250,7 +265,7 @@ def snap_ends(polylines, share=SNAP):
     """Copies of ``polylines`` whose ends that meet (within ``share`` of the boundary's
     extent) are the very same point: the crossing rule of :func:`inside` counts a shared
     vertex once only when both pieces hold it exactly, and an edge's pcurve ends where the
-    next begins only to rounding (a closed circle's seam 1e-16 apart counted a ray along
+    next begins only to rounding (a closed circle's seam 1e-13 apart counted a ray along
     the seam's v twice, and points on the face there as outside)."""
     lines = [np.array(p, dtype=float) for p in polylines]
     ends = np.array([p[k] for p in lines for k in (0, -1)])
