@@ -37,8 +37,9 @@ def one_blas_thread(environ, argv):
     in chunks (:mod:`surfcomp.core.chunks`). OpenBLAS's worker thread then only waits:
     after each call it made parallel it spins in ``sched_yield`` on the other core (8 459
     calls in one ``compensate -o`` of the example, none with one thread): on an idle
-    machine that command's CPU seconds were 0.17 s above its wall seconds, with no other
-    thread of it at work. The outputs are the same bytes."""
+    machine that command's CPU time was well above its wall time, with no other thread of
+    it at work (docs/benchmarks.md, "Costs behind choices in the code"). The outputs are
+    the same bytes."""
     if not argv or argv[0] not in ONE_BLAS_THREAD_COMMANDS:
         return False
     if any(name in environ for name in BLAS_THREAD_VARIABLES):
@@ -75,6 +76,7 @@ if __name__ == "__main__":
         one_command_process()
     code = main()
     # the process ends here: the interpreter's exit need not search the objects still alive
-    # (numpy's, scipy's, FreeCAD's) for reference cycles, which took 0.04 s of CPU
+    # (numpy's, scipy's, FreeCAD's) for reference cycles (docs/benchmarks.md, "Costs
+    # behind choices in the code")
     gc.freeze()
     sys.exit(code)

@@ -442,7 +442,7 @@ class _AliasLoader:
 
     The import machinery asks a loader only for these two methods; deriving from
     ``importlib.abc.Loader`` would import ``importlib.resources``, ``pathlib`` and
-    ``typing`` at every start (0.02 s of a command's CPU)."""
+    ``typing`` at every start (docs/benchmarks.md, "Costs behind choices in the code")."""
 
     def __init__(self, target):
         self.target = target

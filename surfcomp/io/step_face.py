@@ -50,7 +50,7 @@ def real(x):
 
 
 #: the four ASCII digits of 0 ... 9999 (made by array arithmetic: a list of 10 000 byte
-#: strings took 5 ms of every start)
+#: strings cost every start more, docs/benchmarks.md, "Costs behind choices in the code")
 _QUADS = (np.arange(10000)[:, None] // np.array([1000, 100, 10, 1]) % 10 + ord("0")) \
     .astype(np.uint8)
 

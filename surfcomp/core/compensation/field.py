@@ -52,7 +52,8 @@ _HERMITE_2D = np.kron(_HERMITE, _HERMITE)
 #: nodes' (u, v): the grid check (:mod:`surfcomp.core.compensation.grid_check`) and the corrected
 # face's
 #: construction locate on the same map, and a small grid's seeds cost more than the rest of
-#: its locating (0.011 s on the example's 45 x 45 grid). Large maps are not kept (memory).
+#: its locating (docs/benchmarks.md, "Costs behind choices in the code"). Large maps are
+#: not kept (memory).
 _LAST_SEEDS = []
 _SEEDS_KEPT = 100_000
 

@@ -164,7 +164,8 @@ def mask_filter(d, mask, edge="renormalize"):
 
 
 #: masks up to this size are applied by :func:`correlate`'s shifted sums; larger ones by
-#: ``scipy.ndimage.correlate`` (imported then: 0.015 s of every start otherwise)
+#: ``scipy.ndimage.correlate`` (imported only then: its import would cost every start,
+#: docs/benchmarks.md, "Costs behind choices in the code")
 SHIFTED_MAX = 11
 #: numpy.pad's name of each edge mode
 _PAD = {"renormalize": "constant", "reflect": "reflect", "nearest": "edge"}

@@ -525,7 +525,7 @@ def fit_contact(gap, tilt, interior, lines, radius):
     fitted = None           # the points the last pass fitted
     for _ in range(3):
         # a pass on the points the one before fitted fits the same coefficients and keeps
-        # the same points: the passes end (the million-move raster's points: 0.20 -> 0.06 s)
+        # the same points: the passes end (docs/direct_program.md, eighth round)
         if fitted is not None and np.array_equal(keep, fitted):
             break
         fitted = keep

@@ -16,9 +16,10 @@ import scipy.sparse as _sp
 
 #: from this many parameters on, :func:`basis_matrix` takes scipy's compiled collocation
 #: matrix (:func:`scipy_design_matrix`); below, the hand-written one. Importing
-#: ``scipy.interpolate`` (it brings ``scipy.optimize``) costs about 0.06 s of CPU, about
-#: what the compiled matrix saves on 100 000 parameters (``bench/bench_basis.py``); a
-#: measurement grid of a few thousand points would pay it to save a millisecond.
+#: ``scipy.interpolate`` (it brings ``scipy.optimize``) costs about what the compiled
+#: matrix saves on 100 000 parameters (``bench/bench_basis.py``; docs/benchmarks.md,
+#: "Costs behind choices in the code"); a measurement grid of a few thousand points would
+#: pay the import for a fraction of it.
 SCIPY_FROM = 100_000
 
 _DESIGN = []

@@ -22,7 +22,8 @@ from .bspline_basis import SCIPY_FROM
 @functools.cache
 def ndbspline():
     """``scipy.interpolate.NdBSpline`` when the installed scipy has it, else None (imported
-    on the first call: ``scipy.interpolate`` costs about 0.06 s of CPU)."""
+    on the first call: ``scipy.interpolate`` is slow to import, see
+    :data:`surfcomp.core.surface.bspline_basis.SCIPY_FROM`)."""
     import scipy.interpolate
 
     return getattr(scipy.interpolate, "NdBSpline", None)

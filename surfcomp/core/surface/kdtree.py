@@ -3,8 +3,9 @@
 
 ``from scipy.spatial import cKDTree`` runs the package's ``__init__``, which imports the
 distance functions, Delaunay and Voronoi, and the rotations (``scipy.spatial.transform``,
-which imports ``scipy.special`` and ``scipy.constants``): 0.035-0.04 s of CPU at the start
-of every command (scipy 1.10, Debian 12), for the one class the compensation routes use.
+which imports ``scipy.special`` and ``scipy.constants``): a large share of every
+command's start (scipy 1.10, Debian 12; docs/benchmarks.md, "Costs behind choices in the
+code"), for the one class the compensation routes use.
 
 Here, while ``scipy.spatial`` is not imported yet, only its extension module
 ``scipy.spatial._ckdtree`` is loaded, under its own name, so that a later ``import

@@ -174,7 +174,8 @@ def correction_integral(nominal, corrected, outward, polylines):
     # panels at both surfaces' knots (each holds one polynomial piece of the correction) and
     # 16 more; a correction with very many knots gets the nominal's knots and 64 panels. A
     # face bounded by its whole domain (the example's) takes the tensor rule: 1e-11 of the
-    # integral from 1000 panels, 0.01 s (Green's rule along 400 boundary points: 6e-8, 0.04 s)
+    # integral from 1000 panels, and faster than Green's rule along 400 boundary points
+    # (6e-8; docs/benchmarks.md, "Costs behind choices in the code")
     knots = knots_of(nominal, corrected)
     if max(len(k) for k in knots) > MAX_KNOTS:
         knots, panels = knots_of(nominal), 64

@@ -19,7 +19,7 @@ sampled (:class:`surfcomp.core.compensation.program_limit.PieceCount`).
 The moves of a block are planned beside the reading and writing of the blocks around it:
 on a second thread, or, for a long program whose caller allows it (``fork``), in a fork of
 this process (:class:`_Planner`), where the planning does not wait for the text's share of
-Python's interpreter lock (a million moves: about 2.7 s of planning beside 2 s of text).
+Python's interpreter lock (figures in docs/direct_program.md, eighth round).
 """
 
 import os
@@ -127,8 +127,8 @@ class ProgramOffset:
                     # the forked planner starts on this block before the block before is
                     # written (the planning needs nothing the writing changes), so it is
                     # not idle while the text is written; a thread would contend for the
-                    # interpreter lock with the writing instead (on the example's
-                    # finishing program 0.01-0.02 s more CPU, 9 pairs, twice)
+                    # interpreter lock with the writing instead (more CPU on the
+                    # example's finishing program: docs/benchmarks.md, eighth round)
                     done, pending = pending, (submit(got[0]), got)
                     write(self.write(op, *done[1]))
                 else:
