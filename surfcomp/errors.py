@@ -101,7 +101,7 @@ class SurfcompError(Exception):
         self.file = file
         self.line = line
         self.column = column
-        self.options = tuple(options)
+        self.options = tuple(options) or tuple(getattr(message, "options", ()))
 
     def __str__(self):
         return self._where() + self.message
@@ -109,7 +109,11 @@ class SurfcompError(Exception):
     def shown(self, name_of=None):
         """The text of ``str(self)`` with every option in ``options`` named as
         ``name_of(option)`` (the command line's ``--max-offset``) in the message; a quoted
-        value such as ``'rps'`` is not an option's name."""
+        value such as ``'rps'`` is not an option's name. A message that is a :class:`Note`
+        is renamed at the places it marks only (``output`` in "the same standard output"
+        stays)."""
+        if name_of and getattr(self.message, "refs", None):
+            return self._where() + self.message.shown(name_of)
         return self._where() + renamed(self.message, self.options if name_of else (), name_of)
 
     def _where(self):

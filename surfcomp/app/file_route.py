@@ -16,7 +16,7 @@ from ..core.compensation.pipeline import Options, compensate, prepare
 from ..core.memory import return_free_memory
 from ..core.progress import report as report_progress
 from ..core.progress import sub
-from ..errors import InputError
+from ..errors import InputError, note
 from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
@@ -123,13 +123,13 @@ def job_keys():
 
 #: the commands a job file runs
 JOB_COMMANDS = ("compensate", "inspect")
-#: the files of a job: (attribute of :class:`Job`, role, name in messages); the command
-#: line's are in :mod:`surfcomp.cli.registry`
-JOB_FILES = (("nominal", "input", "NOMINAL"), ("measurements", "input", "MEASUREMENTS"),
-             ("plan", "input", "--plan"),
-             ("output", "output", "-o"), ("report", "output", "--report"),
-             ("points", "output", "--points"), ("curves", "output", "--curves"),
-             ("html", "output", "--html"), ("transform", "input", "--transform"))
+#: the files of a job: (attribute of :class:`Job`, role, name in messages). Messages name
+#: each as its job key (a script's ``Job`` field, a job file's key), which the command line
+#: shows as its flag or argument (``-o``, ``NOMINAL``; :mod:`surfcomp.cli.option_flags`)
+JOB_FILES = tuple((attr, role, note((attr,))) for attr, role in (
+    ("nominal", "input"), ("measurements", "input"), ("plan", "input"),
+    ("output", "output"), ("report", "output"), ("points", "output"), ("curves", "output"),
+    ("html", "output"), ("transform", "input")))
 #: ignored measurement columns named in the report (the rest are counted)
 IGNORED_LISTED = 100
 
@@ -227,7 +227,8 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
 def read_measured(job):
     """The job's measurement set: the file, joined to the plan when the job has one."""
     if job.plan is None and job.touches != 1:
-        raise InputError("touches applies to a probe log read with a plan (--plan)")
+        raise InputError(note(("touches",), " applies to a probe log read with a "
+                              "measurement plan (", ("plan",), ")"))
     ms = read_any(job.measurements, job.units, job.fmt, job.sample,
                   deviation_units=job.deviation_units)
     if job.plan is None:
@@ -292,8 +293,8 @@ def curve_net(comp):
     import Part
 
     if comp.prepared.scattered:
-        raise InputError("--curves needs a measurement grid (the curve net runs along its rows "
-                         "and columns); these points are scattered")
+        raise InputError(note(("curves",), " needs a measurement grid (the curve net runs "
+                              "along its rows and columns); these points are scattered"))
     pts = comp.prepared.grid.take(comp.corrected_points())
     edges = []
     for line in list(pts) + list(pts.transpose(1, 0, 2)):
@@ -312,8 +313,8 @@ def cad_format(path, option="output"):
     """The CAD format of an output file from its extension (checked before any work)."""
     ext = os.path.splitext(path)[1].lower()
     if ext not in CAD_FORMATS:
-        raise InputError("%s: unsupported file type %r (expected .step, .iges or .brep)"
-                         % (option, ext), file=path)
+        raise InputError(option + ": unsupported file type %r (expected .step, .iges or "
+                         ".brep)" % ext, file=path)
     return CAD_FORMATS[ext]
 
 

@@ -13,7 +13,7 @@ import numpy as np
 from ..core.compensation import region_field
 from ..core.surface.surface_checks import check_nominal
 from ..core.surface.trimmed import area_samples, inside, whole_domain
-from ..errors import GeometryError
+from ..errors import GeometryError, note
 from . import fcenv
 from .cadread import CAD_EXTENSIONS, read_cad
 from .convert import surface_from_raw
@@ -101,7 +101,7 @@ def read_shape(path, object_name=None):
         raise GeometryError("unsupported nominal file type %r (expected .step/.stp, .iges/.igs, "
                             ".brep/.brp or .FCStd)" % ext, file=path)
     if object_name:
-        raise GeometryError("--object applies to FCStd documents only", file=path)
+        raise GeometryError(note(("object",), " applies to FCStd documents only"), file=path)
     return read_cad(path), None
 
 

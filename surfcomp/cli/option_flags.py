@@ -9,6 +9,10 @@ Errors and warnings below the command line name options as the API and job files
 
 from ..core.option_tables import find
 
+#: the job's files that are no option of the registry: ``output`` is ``-o``, the inputs are
+#: the positional arguments
+FILE_FLAGS = {"output": "-o", "nominal": "NOMINAL", "measurements": "MEASUREMENTS"}
+
 
 def flag(name):
     """The flag of option ``name`` (``max_offset`` -> ``--max-offset``): the option
@@ -17,6 +21,8 @@ def flag(name):
     files only), or a name that is a flag already."""
     if name.startswith("-"):
         return name
+    if name in FILE_FLAGS:
+        return FILE_FLAGS[name]
     o = find(name)
     if o is not None:
         return o.flag or name

@@ -127,7 +127,9 @@ def check_outputs(outputs, inputs=()):
     Parameters
     ----------
     outputs : iterable of (option, path)
-        What the command writes, with the option that names it (``-o``, ``--report``);
+        What the command writes, with the option that names it (``-o``, ``--report``, or
+        a :class:`surfcomp.errors.Note` naming a job key, shown as the flag by the
+        command line);
         ``None`` paths are skipped, an empty one is refused; ``-`` is standard output.
     inputs : iterable of (what, path) or (what, path, options)
         What it reads (``NOMINAL``, ``MEASUREMENTS``, ``--axis-errors``, ...); ``options``
@@ -153,12 +155,14 @@ def check_outputs(outputs, inputs=()):
             if dest.key == ikey and option not in allowed:
                 link = "" if os.path.abspath(path) == os.path.abspath(ipath) else \
                     " (the same file through a link)"
-                raise InputError("%s would overwrite the input %s %s%s; nothing was written"
-                                 % (option, what, ipath, link), file=path)
+                # joined, not formatted: a label that is a Note (an option's name, shown
+                # as a flag on the command line) stays one
+                raise InputError(option + " would overwrite the input " + what
+                                 + " %s%s; nothing was written" % (ipath, link), file=path)
         if dest.key in seen:
-            raise InputError("%s and %s name the same %s; give each output its own name"
-                             % (seen[dest.key], option,
-                                "standard output" if dest.stdout else "file"), file=path)
+            raise InputError(seen[dest.key] + " and " + option
+                             + " name the same %s; give each output its own name"
+                             % ("standard output" if dest.stdout else "file"), file=path)
         seen[dest.key] = option
         dests[os.fspath(path)] = dest
     return dests

@@ -12,7 +12,9 @@ Two layouts are read; the first non-blank, non-comment line tells which.
 
    ``axis`` is ``X``, ``Y`` or ``Z`` (any case); ``ex, ey, ez`` are the tool-position errors
    along X, Y and Z (actual minus commanded) when that slide stands at ``position`` and the
-   others at the reference. Column order is free; names are case-insensitive.
+   others at the reference. Column order is free; names are case-insensitive. An empty
+   error field is not measured in that row (NaN, as a column a table leaves out); a row
+   needs at least one error.
 
 2. Per-axis tables (the common laser-calibration form); several tables may follow one
    another, each starting with its header::
@@ -256,8 +258,15 @@ def _read_long(path, lines, first, units, max_error=None):
                                        file=path, line=k + 1, column=role["axis"] + 1)
         vals = [_position(fields[role["position"]], path, k + 1, role["position"] + 1,
                           "position", factor["position"])]
-        vals += [_error(fields[role[c]], path, k + 1, role[c] + 1, c, factor[c], max_error)
+        # an empty error field: not measured in this row (what format_axis_errors writes
+        # for NaN, a column a table left out)
+        vals += [math.nan if not fields[role[c]].strip().strip('"') else
+                 _error(fields[role[c]], path, k + 1, role[c] + 1, c, factor[c], max_error)
                  for c in ("ex", "ey", "ez")]
+        if all(math.isnan(v) for v in vals[1:]):
+            raise MeasurementFileError("no error in this row (expected a value in at least "
+                                       "one of ex, ey, ez; an empty field is not measured)",
+                                       file=path, line=k + 1)
         rows[ax][0].append(vals[0])
         rows[ax][1].append(vals[1:])
         rows[ax][2].append(k + 1)
@@ -343,20 +352,29 @@ def _finish(path, rows, layout, lines):
         last = max((k + 1 for k, t in enumerate(lines) if t.strip()), default=1)
         raise MeasurementFileError("no data rows (expected at least two positions of one "
                                    "slide)", file=path, line=last)
-    warnings = ["%s: %s in no table, taken as 0 (no error measured, none compensated)"
-                % (path, ", ".join(unmeasured))] if unmeasured else []
+    warnings = ["%s: %s in no %s, taken as 0 (no error measured, none compensated)"
+                % (path, ", ".join(unmeasured), "table" if layout == "tables" else "row")
+                ] if unmeasured else []
     return AxisErrorTable(data, where, path=path, layout=layout, warnings=warnings)
 
 
 def format_axis_errors(data, units="mm"):
-    """Text of a long-form file (``axis,position,ex,ey,ez``) for ``data`` (mm).
+    """Text of a long-form file (``axis,position,ex,ey,ez``) for ``data`` (mm), which
+    :func:`read_axis_errors` reads back to the same data.
 
     Parameters
     ----------
     data : mapping
-        ``{'x': (positions (n,), errors (n, 3))}`` in mm.
+        ``{'x': (positions (n,), errors (n, 3))}`` in mm; NaN where a component was not
+        measured (a column a table left out), written as an empty field.
     units : {'mm', 'um'}
         Unit of the error columns (positions are always written in mm).
+
+    Raises
+    ------
+    InputError
+        A position that is not finite, an infinite error, or a row with no error at all:
+        no file could say it.
     """
     f = unit_factor(units)
     head = "axis,position[mm],ex[%s],ey[%s],ez[%s]" % (units, units, units)
@@ -365,8 +383,15 @@ def format_axis_errors(data, units="mm"):
         if ax not in data:
             continue
         pos, err = data[ax]
-        for p, e in zip(np.asarray(pos, dtype=float), np.asarray(err, dtype=float)):
-            out.append("%s,%.6f,%s" % (ax.upper(), p, ",".join("%.9g" % (v / f) for v in e)))
+        pos, err = np.asarray(pos, dtype=float), np.asarray(err, dtype=float).reshape(-1, 3)
+        for k, (p, e) in enumerate(zip(pos, err)):
+            if not np.isfinite(p) or np.isinf(e).any() or np.isnan(e).all():
+                raise InputError("axis %s, row %d: position %r, errors %s: a file holds a "
+                                 "finite position and at least one finite error per row "
+                                 "(NaN: not measured)" % (ax.upper(), k + 1, float(p),
+                                                          e.tolist()))
+            out.append("%s,%.6f,%s" % (ax.upper(), p, ",".join(
+                "" if np.isnan(v) else "%.9g" % (v / f) for v in e)))
     return "\n".join(out) + "\n"
 
 

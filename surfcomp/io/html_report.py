@@ -312,13 +312,41 @@ def _section_checks(report):
             if key in labels:
                 text, f, unit = labels[key]
                 rows.append((text, '<span class="num">%.4f %s</span>' % (val * f, unit)))
+            elif key == "normal_turn" and isinstance(val, dict):
+                rows.append(("Largest turn of the normal from the nominal's",
+                             _e(_normal_turn(val))))
             else:
-                rows.append((key.replace("_", " "), _e(val)))
+                rows.append((key.replace("_", " "), _e(_plain(val))))
         size = (report.get("output_shape") or {}).get("file_bytes")
         if size is not None:
             rows.append(("Written file size", '<span class="num">%d bytes</span>' % size))
         body = _kv_table(rows)
     return '<section id="checks"><h2>Corrected face checks</h2>%s</section>' % body
+
+
+def _plain(value):
+    """A check figure in words: yes/no, ``49 x 49`` for a pair of counts, else as it is
+    (not Python's ``False`` and ``[49, 49]``)."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, (list, tuple)) and value and all(
+            isinstance(v, int) and not isinstance(v, bool) for v in value):
+        return " x ".join(str(v) for v in value)
+    return value
+
+
+def _normal_turn(turn):
+    """The corrected face's ``normal_turn`` (:class:`surfcomp.core.compensation.folds.Fold`)
+    as a sentence."""
+    text = "%.3f deg" % turn.get("largest_normal_turn_deg", float("nan"))
+    at = turn.get("at_mm")
+    if at and all(np.isfinite(at)):
+        text += " at (%.3f, %.3f, %.3f) mm" % tuple(at)
+    text += "; folds over itself: %s" % ("yes" if turn.get("folds") else "no")
+    if turn.get("samples"):
+        text += " (%.2g %% of %d samples past the fold angle)" % (
+            100.0 * turn.get("folded_share", 0.0), turn["samples"])
+    return text
 
 
 def simulation_maps(result):

@@ -47,7 +47,7 @@ def _special(real):
 
 
 def _refuse(option, path, why):
-    raise InputError("%s %s" % (option, why), file=path)
+    raise InputError(option + " " + why, file=path)     # a Note label stays one
 
 
 def _unreachable(option, path, folder, why):
@@ -86,8 +86,8 @@ def resolve(option, path):
     if path == STDOUT:
         return Destination(option, path, None, ("stdout",))
     if not path:
-        raise InputError("%s: the file name is empty (expected a file name, or - for "
-                         "standard output)" % option)
+        raise InputError(option + ": the file name is empty (expected a file name, or - "
+                         "for standard output)")
     name = os.path.basename(path)
     if not name:
         _refuse(option, path, "ends with '/' (expected a file name, not a folder)")

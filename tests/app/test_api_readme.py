@@ -127,3 +127,27 @@ def test_written_document_recomputes_to_the_same_statistics(runs):
         assert len(comp.Shape.Faces) == 1
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+def readme_report_keys():
+    """The keys the README's "JSON report" table names in its first column (``inputs.nominal``
+    as written)."""
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as fh:
+        text = fh.read()
+    section = text[text.index("\n## JSON report\n"):]
+    section = section[:section.index("\n## ", 1)]
+    rows = re.findall(r"^\| ([^|]+) \|", section, re.M)
+    return {key for row in rows for key in re.findall(r"`([\w.]+)`", row)}
+
+
+def test_readme_report_table_names_every_key_the_report_has(runs):
+    """Every top-level key of the command line's report (and every input it records) is in
+    the README's table, and the table names no top-level key the report lacks but the
+    scattered layouts' fit."""
+    _out, _stdout, report, _cli = runs
+    documented = readme_report_keys()
+    present = {k for k in report if k != "inputs"} | {"inputs." + k for k in report["inputs"]}
+    assert present - documented == set(), sorted(present - documented)
+    # the example is a grid: no scattered fit; everything else is in its report
+    assert {k for k in documented if "." not in k} - set(report) == {"scattered_fit"}
+    assert report["units"] == "mm" and report["statistics_ddof"] == 1

@@ -234,3 +234,23 @@ def test_checks_state_the_poles_and_the_written_file_size(rendered):
     checks = html_report._section_checks(rep).split('<section id="checks">')[1].split(
         "</section>")[0]
     assert "Written file size" in checks and "238855 bytes" in checks
+
+
+def test_checks_are_in_words_not_python():
+    """The checks name the corrected face's normal turn in a sentence and its counts and
+    flags in words (the page showed the dict ``{'largest_normal_turn_deg': ...}``,
+    ``[49, 49]`` and ``False``)."""
+    from surfcomp.io import html_report
+
+    rep = _report()
+    rep["corrected_face"]["normal_turn"] = {
+        "largest_normal_turn_deg": 0.20944, "folds": False, "at_mm": [25.5471, 39.8085, 4.6556],
+        "at_uv": [0.6, 0.93], "folded_share": 0.0, "samples": 9409}
+    rep["corrected_face"]["poles"] = [49, 49]
+    rep["corrected_face"]["rational"] = False
+    checks = html_report._section_checks(rep)
+    assert "{" not in checks and "[" not in checks and "False" not in checks, checks
+    assert ("0.209 deg at (25.547, 39.809, 4.656) mm; folds over itself: no (0 % of 9409 "
+            "samples past the fold angle)") in checks
+    assert "<th>poles</th><td>49 x 49</td>" in checks
+    assert "<th>rational</th><td>no</td>" in checks

@@ -199,7 +199,8 @@ def test_a_log_that_does_not_fit_exits_2_and_writes_nothing(loop):
     assert out.returncode == 2 and not report.exists()
     assert "%s:%d:2: column 'x_nom' holds 'x" % (bad_plan, rows[4]) in out.stderr, out.stderr
     out = run_cli("inspect", EXAMPLE_STEP, log, "--touches", "2", "--quiet")
-    assert out.returncode == 2 and "touches applies to a probe log read with a plan" in out.stderr
+    assert out.returncode == 2 and ("--touches applies to a probe log read with a "
+                                    "measurement plan (--plan)") in out.stderr, out.stderr
 
 
 def test_job_file_with_a_plan(loop, probed):

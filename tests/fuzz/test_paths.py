@@ -235,9 +235,10 @@ def _run_job(sandbox, **keys):
 JOB_ITSELF = "the job file"
 JOB_OUTPUTS = [attr for attr, role, _label in JOB_FILES if role == "output"]
 JOB_REFUSED = (
-    [({attr: s.format(x=x)}, s.format(x=x), "would overwrite the input %s" % label)
-     for attr in JOB_OUTPUTS for x, label in (("nominal.step", "NOMINAL"),
-                                              ("m.csv", "MEASUREMENTS"),
+    # named as the job file's keys: "report would overwrite the input nominal ..."
+    [({attr: s.format(x=x)}, s.format(x=x), "%s would overwrite the input %s" % (attr, label))
+     for attr in JOB_OUTPUTS for x, label in (("nominal.step", "nominal"),
+                                              ("m.csv", "measurements"),
                                               ("job.json", "job file"))
      for s in ("{x}", "./{x}", "v/../{x}", "vlink/../../{x}")]
     + [({attr: s.format(x="nominal.step")}, s.format(x="nominal.step"),

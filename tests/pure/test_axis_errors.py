@@ -423,3 +423,46 @@ def test_csv_write_read_round_trip(tmp_path):
     for ax in "xyz":
         assert_allclose(t.data[ax][0], data[ax][0], atol=1e-6)
         assert_allclose(t.data[ax][1], data[ax][1], rtol=1e-8, atol=1e-12)
+
+
+def test_csv_round_trip_keeps_what_a_table_did_not_measure(tmp_path):
+    """A column a table left out is NaN; write_axis_errors writes it as an empty field,
+    which the long form reads as not measured again: the same data, the same fit (it wrote
+    'nan', which the reader refused)."""
+    src = tmp_path / "runs.txt"
+    src.write_text("X EXX\n0 0\n100 0.010\n200 0.020\nX EYX\n0 0\n100 0.002\n200 0.004\n")
+    t = read_axis_errors(str(src))
+    out = tmp_path / "long.csv"
+    write_axis_errors(str(out), t.data, units="um")
+    text = out.read_text()
+    assert "nan" not in text.lower()
+    assert text.splitlines()[1:3] == ["X,0.000000,0,,0", "X,100.000000,10,,0"]
+    back = read_axis_errors(str(out))
+    assert back.layout == "long" and back.warnings == []
+    assert_allclose(back.data["x"][0], t.data["x"][0])
+    assert_allclose(back.data["x"][1], t.data["x"][1], rtol=1e-12, atol=1e-15)   # NaN too
+    assert back.lines["x"].tolist() == [2, 3, 4, 5, 6, 7]
+    assert_allclose(fit_axis_errors(back.data).slope[0], fit_axis_errors(t.data).slope[0],
+                    rtol=1e-9, atol=1e-15)
+    assert [fit.n for fit in fit_axis_errors(back.data).fits] == [3, 3, 6]
+
+
+def test_long_form_empty_fields_and_what_cannot_be_written(tmp_path):
+    f = tmp_path / "e.csv"
+    f.write_text("axis,position,ex,ey,ez\nX,0,0.001,,\nX,100,,0.002,\n")
+    t = read_axis_errors(str(f))
+    assert_allclose(t.data["x"][1], [[0.001, np.nan, 0.0], [np.nan, 0.002, 0.0]])
+    # ez is in no row: taken as 0, with a warning that says so
+    assert t.warnings == ["%s: EZX in no row, taken as 0 (no error measured, none "
+                          "compensated)" % f]
+    f.write_text("axis,position,ex,ey,ez\nX,0,0,0,0\nX,100,,,\n")
+    with pytest.raises(MeasurementFileError, match=r"e\.csv:3: no error in this row"):
+        read_axis_errors(str(f))
+    f.write_text("axis,position,ex,ey,ez\nX,,0,0,0\n")
+    with pytest.raises(MeasurementFileError, match=r"e\.csv:2:2: position: '' is not a number"):
+        read_axis_errors(str(f))
+    for bad in ({"x": ([0.0], [[np.inf, 0.0, 0.0]])}, {"x": ([np.nan], [[0.0, 0.0, 0.0]])},
+                {"x": ([0.0], [[np.nan, np.nan, np.nan]])}):
+        with pytest.raises(InputError, match="axis X, row 1"):
+            write_axis_errors(str(tmp_path / "w.csv"), bad)
+    assert not (tmp_path / "w.csv").exists()
