@@ -88,8 +88,10 @@ def pick_face(shape, face_name=None, source=None):
                                 % (face_name, len(faces)), file=source)
         k = int(name[4:])
         if not 1 <= k <= len(faces):
-            raise GeometryError("the shape has no %s (it has %d faces: Face1 .. Face%d)"
-                                % (name, len(faces), len(faces)), file=source)
+            raise GeometryError("the shape has no %s (it has %s)"
+                                % (name, "one face: Face1" if len(faces) == 1 else
+                                   "%d faces: Face1 .. Face%d" % (len(faces), len(faces))),
+                                file=source)
         return faces[k - 1], name
     bs = [(k, f) for k, f in enumerate(faces, 1) if surface_type(f) == "BSplineSurface"]
     if len(faces) == 1:

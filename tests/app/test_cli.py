@@ -126,7 +126,7 @@ def test_incomplete_grid_is_refused_with_what_is_missing(tmp_path):
 
 
 @pytest.mark.parametrize("args,words", [
-    (("--face", "Face7"), "has no Face7"),
+    (("--face", "Face7"), "has no Face7 (it has one face: Face1)"),
     (("--method", "mirror"), "needs --stock"),
     (("--weights", "1 1; 1 1"), "odd"),
     (("--mask", "4"), "odd"),
