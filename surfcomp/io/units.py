@@ -43,7 +43,7 @@ def unit_factor(unit, file=None, line=None, column=None):
     """
     key = unit.strip().lower()
     if key not in UNIT_FACTORS:
-        raise InputError("unknown unit %r (expected one of mm, um, in)" % unit,
+        raise InputError("unknown unit %r (expected one of mm, um, in, cm, m)" % unit,
                          file=file, line=line, column=column)
     return UNIT_FACTORS[key]
 

@@ -56,5 +56,8 @@ def test_a_deviation_computed_from_the_points_keeps_their_unit(tmp_path):
 
 
 def test_an_unknown_deviation_unit_is_refused(tmp_path):
-    with pytest.raises(InputError, match="unknown unit 'furlong'"):
+    # every unit the readers take is named (cm and m were taken but not named)
+    with pytest.raises(InputError, match=r"unknown unit 'furlong' \(expected one of mm, um, "
+                                         r"in, cm, m\)"):
         read_any(_file(tmp_path), units="mm", deviation_units="furlong")
+    assert read_any(_file(tmp_path), units="cm").units == "cm"
