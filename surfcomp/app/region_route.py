@@ -16,6 +16,7 @@ from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
+from ..io.report import json_values
 from . import fcenv, region, region_retrim
 from .file_route import cad_format
 from .region_orient import orient
@@ -70,7 +71,8 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
     with Transaction(outputs, inputs) as tx:
         tx.write(output, lambda tmp: _write(out_shape, tmp, Part))
         if report:
-            tx.stage_text(report, json.dumps(rep, indent=1) + "\n")
+            tx.stage_text(report, json.dumps(json_values(rep), indent=1, allow_nan=False)
+                          + "\n")
         tx.commit()
     return rep
 

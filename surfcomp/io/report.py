@@ -123,11 +123,32 @@ CHUNK = 65536
 _HOLE = "\u0000surfcomp-points\u0000"
 
 
+def json_values(obj):
+    """``obj`` with every float that is not finite (nan, inf) as None: JSON has no such
+    numbers (Python's ``NaN`` is refused by strict readers), ``null`` is "no value"."""
+    if isinstance(obj, float):
+        return obj if np.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: json_values(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_values(v) for v in obj]
+    return obj
+
+
+def _rows(a):
+    """The rows of array ``a`` as lists, None where a float is not finite."""
+    if a.dtype.kind == "f" and not np.isfinite(a).all():
+        b = a.astype(object)
+        b[~np.isfinite(a)] = None
+        return b.tolist()
+    return a.tolist()
+
+
 def _array_json(a, fh):
     """Write array ``a`` as a JSON list (of lists for 2-D), ``CHUNK`` rows a line."""
     fh.write("[")
     for k in range(0, a.shape[0], CHUNK):
-        text = json.dumps(a[k:k + CHUNK].tolist())
+        text = json.dumps(_rows(a[k:k + CHUNK]), allow_nan=False)
         fh.write(("\n  " if k == 0 else ",\n  ") + text[1:-1])
     fh.write("\n ]" if a.shape[0] else "]")
 
@@ -135,10 +156,10 @@ def _array_json(a, fh):
 def write(report, fh):
     """Write ``report`` as JSON text to the text stream ``fh``: the dict indented, the
     per-point arrays (numpy) in parts, so the memory needed stays that of one part
-    whatever the number of points."""
+    whatever the number of points; a value that is not a finite number is ``null``."""
     pts = report.get("points")
-    text = json.dumps(dict(report, points=_HOLE if pts is not None else None), indent=1,
-                      sort_keys=False)
+    text = json.dumps(json_values(dict(report, points=_HOLE if pts is not None else None)),
+                      indent=1, sort_keys=False, allow_nan=False)
     if pts is None:
         fh.write(text + "\n")
         return

@@ -7,6 +7,7 @@ import io
 import json
 
 import numpy as np
+import pytest
 
 from surfcomp.io import report as report_io
 
@@ -45,7 +46,10 @@ def test_points_written_in_parts_read_back_equal():
     np.testing.assert_array_equal(back["points"]["nominal"], rep["points"]["nominal"])
     np.testing.assert_array_equal(back["points"]["deviation"][:-1],
                                   rep["points"]["deviation"][:-1])
-    assert np.isnan(back["points"]["deviation"][-1])
+    # JSON has no NaN (strict readers refuse Python's NaN): a value that is not a number
+    # is null, and the text reads back with a strict reader
+    assert back["points"]["deviation"][-1] is None
+    json.loads(text, parse_constant=lambda c: pytest.fail("%s in the JSON text" % c))
     # one part of the (n, 3) array is the largest piece of text ever held
     part = len(json.dumps(rep["points"]["nominal"][:report_io.CHUNK].tolist()))
     assert fh.largest <= 1.01 * part      # parts differ by a few digits
@@ -58,3 +62,12 @@ def test_report_without_points_and_empty_arrays():
     assert json.loads(report_io.dumps(rep)) == rep
     empty = {"points": {"u": np.zeros(0), "nominal": np.zeros((0, 3))}}
     assert json.loads(report_io.dumps(empty)) == {"points": {"u": [], "nominal": []}}
+
+
+def test_values_that_are_not_numbers_are_null_in_the_dict_too():
+    rep = {"alignment": {"rms_before_um": float("nan"), "faces": [{"rms": float("inf")}]},
+           "points": {"deviation": np.array([[1.0, np.nan], [np.inf, 2.0]])}}
+    text = report_io.dumps(rep)
+    assert "NaN" not in text and "Infinity" not in text
+    assert json.loads(text) == {"alignment": {"rms_before_um": None, "faces": [{"rms": None}]},
+                                "points": {"deviation": [[1.0, None], [None, 2.0]]}}
