@@ -20,8 +20,8 @@ from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import FORK_LINES, offset_stream
-from ..io.readers import read_any
 from . import cadread, fcenv
+from .file_route import read_measured
 from .nominal import face_warnings, load_nominal, nominal_from_data
 from .program_geometry import offset_of
 
@@ -55,8 +55,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
     job = pj.job
     job.options.validate()
     nominal = _nominal(job)
-    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
-                  deviation_units=job.deviation_units)
+    ms = read_measured(job)             # a probe log joined to its plan, as -o
     budget.check_job(len(ms), True, max_memory)
     program = ProgramFile(pj.program)
     lines = program.count_lines()
