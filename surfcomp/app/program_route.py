@@ -104,9 +104,10 @@ def summary_lines(comp, po, pj):
              "Program:      %s (%d lines, %d moves; ball radius %g mm)"
              % (pj.program, st["lines_in"], st["moves"], po.offset.radius),
              "Moved:        %d moves (%d lines changed, %d added, %d arcs turned into lines); "
-             "largest move %.2f um; %d points displaced (tolerance %g um, blend %g mm)"
+             "largest move %.2f um; the displacement computed at %d points (tolerance %g um, "
+             "blend %g mm)"
              % (st["moves_moved"], st["lines_changed"], st["lines_added"],
-                st["arcs_converted"], st["largest_move_mm"] * 1e3, st["points_displaced"],
+                st["arcs_converted"], st["largest_move_mm"] * 1e3, st["points_evaluated"],
                 pj.tolerance * 1e3, pj.blend),
              "Contact:      %d cutter-location points on the face, %.2f um off the ball's "
              "offset on average; %s"

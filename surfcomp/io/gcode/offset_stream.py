@@ -220,7 +220,7 @@ class ProgramOffset:
         return {"lines_in": self.n_lines, "lines_out": self.n_lines + st.added,
                 "lines_changed": st.changed, "lines_added": st.added, "moves": self.n_moves,
                 "moves_moved": self.moved, "arcs_converted": st.converted,
-                "points_displaced": self.checked, "largest_move_mm": self.largest}
+                "points_evaluated": self.checked, "largest_move_mm": self.largest}
 
 
 class _Planner:
