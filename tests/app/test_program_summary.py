@@ -33,3 +33,29 @@ def test_a_zero_correction_moves_and_displaces_nothing(pass_and_zero, tmp_path):
     assert moved and moved[0].startswith("Moved:        0 moves (0 lines changed, 0 added")
     assert "largest move 0.00 um" in moved[0]
     assert "displaced" not in run.stdout and "the displacement computed at " in moved[0]
+
+
+@pytest.mark.parametrize("given, warned", [(3.0, False), (2.9, True), (3.1, True)])
+def test_the_contact_line_names_the_radius_the_points_fit(tmp_path, given, warned):
+    """A 3 mm ball's raster given as ball:2.9 is within the refusal's 10 um on the example's
+    slopes; the summary said 'the radius fits within 100 um', now it names the 3 mm the
+    points fit and warns."""
+    from types import SimpleNamespace
+
+    from surfcomp.app.program_route import summary_lines
+    from tests.pure.test_program_offset import raster, run, wave
+
+    _out, po = run(raster(radius=3.0), wave, tmp_path, radius=given)
+    stats = SimpleNamespace(min=0.0, max=0.0, rms=0.0)
+    lines = summary_lines(SimpleNamespace(statistics={"correction": stats}), po,
+                          SimpleNamespace(program="prog.ngc", tolerance=5e-4, blend=1.0))
+    contact = [ln for ln in lines if ln.startswith("Contact:")][0]
+    fitted = float(contact.split("fit a ball of radius ")[1].split(" mm")[0])
+    assert abs(fitted - 3.0) < 0.01, contact
+    assert "from the %g mm given" % given in contact and "fits within" not in contact
+    warnings = [ln for ln in lines if ln.startswith("warning: ")]
+    assert bool(warnings) == warned, lines
+    if warned:
+        assert warnings[0].startswith("warning: prog.ngc: the program's cutter-location "
+                                      "points fit a ball of radius 3.0")
+        assert "not the %g mm given" % given in warnings[0]
