@@ -97,7 +97,8 @@ def _nominal(job):
 
 
 def summary_lines(comp, po, pj):
-    """What the run did, for standard output."""
+    """What the run did, for standard output, then the program's warnings (``warning:
+    FILE: ...``, for standard error)."""
     st = po.stats()
     corr = comp.statistics["correction"]
     fit = po.fit
@@ -114,7 +115,7 @@ def summary_lines(comp, po, pj):
              "offset on average; %s"
              % (fit.points, fit.stock * 1e3, _radius_text(fit, po.offset.radius))]
     return lines + ["warning: " + w for w in _radius_warnings(fit, po.offset.radius, pj.program)
-                    + po.warnings()]
+                    + ["%s: %s" % (pj.program, w) for w in po.warnings()]]
 
 
 #: a ball radius off the one the contact points fit by more than this share of it, with an

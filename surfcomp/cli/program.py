@@ -92,7 +92,7 @@ def run_program(args):
         cadread.discard()
     for w in comp.prepared.warnings:    # the measurements' and the corrected face's, as -o
         print("warning: " + shown(w), file=sys.stderr)
-    for line in summary_lines(comp, po, pj):
-        print(line)
+    for line in summary_lines(comp, po, pj):      # warnings on standard error, as -o's
+        print(line, file=sys.stderr if line.startswith("warning: ") else sys.stdout)
     print(wrote(args.output))
     return 0

@@ -59,3 +59,18 @@ def test_the_contact_line_names_the_radius_the_points_fit(tmp_path, given, warne
         assert warnings[0].startswith("warning: prog.ngc: the program's cutter-location "
                                       "points fit a ball of radius 3.0")
         assert "not the %g mm given" % given in warnings[0]
+
+
+def test_the_programs_warnings_go_to_standard_error_with_its_name(pass_and_zero, tmp_path):
+    """As the compensation's (and ``-o``'s): they were printed on standard output, without
+    the file they are about."""
+    program, meas = pass_and_zero
+    bare = tmp_path / "bare.ngc"
+    bare.write_text(program.read_text().replace("G21 G90 G17", "G90 G17"))
+    out = tmp_path / "moved.ngc"
+    run = _run("compensate", EXAMPLE_STEP, str(meas), "--program", str(bare), "--tool",
+               "ball:%g" % R, "-o", str(out), "--quiet")
+    assert run.returncode == 0, run.stderr
+    assert not any(ln.startswith("warning") for ln in run.stdout.splitlines()), run.stdout
+    assert "warning: %s: no G20/G21 before the first move (line 2): millimetres assumed" \
+        % bare in run.stderr.splitlines(), run.stderr
