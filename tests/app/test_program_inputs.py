@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 from surfcomp.app.nominal import load_nominal
-from tests.app.helpers import EXAMPLE_STEP, grid_on_face
-from tests.app.test_program_warnings import R, _program, _run
+from tests.app.test_program_warnings import EXAMPLE_STEP, R, _program, _run, grid_on_face
 
 TIP = 1.0
 

@@ -6,8 +6,14 @@ import numpy as np
 import pytest
 
 from surfcomp.app.nominal import load_nominal
-from tests.app.helpers import EXAMPLE_STEP, grid_on_face, write_cmm_csv
-from tests.app.test_program_warnings import R, _program, _run
+from tests.app.test_program_warnings import (
+    EXAMPLE_STEP,
+    R,
+    _program,
+    _run,
+    grid_on_face,
+    write_cmm_csv,
+)
 
 
 @pytest.fixture(scope="module")
