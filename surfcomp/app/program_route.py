@@ -10,18 +10,19 @@ of regenerating the CAM operation on the corrected face. The program is written 
 never over an input; nothing is written when it is refused.
 """
 
+import math
 from dataclasses import dataclass
 
 from ..core import budget
 from ..core.command_options import PROGRAM_MOVE
 from ..core.compensation.pipeline import compensate, prepare
-from ..core.compensation.program_offset import parse_tool
+from ..core.compensation.program_offset import CONTACT_TOL, parse_tool
 from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import FORK_LINES, offset_stream
-from ..io.readers import read_any
 from . import cadread, fcenv
+from .file_route import read_measured
 from .nominal import face_warnings, load_nominal, nominal_from_data
 from .program_geometry import offset_of
 
@@ -55,8 +56,7 @@ def run_program_job(pj, outputs, inputs, progress=None, max_memory=None):
     job = pj.job
     job.options.validate()
     nominal = _nominal(job)
-    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
-                  deviation_units=job.deviation_units)
+    ms = read_measured(job)             # a probe log joined to its plan, as -o
     budget.check_job(len(ms), True, max_memory)
     program = ProgramFile(pj.program)
     lines = program.count_lines()
@@ -97,7 +97,8 @@ def _nominal(job):
 
 
 def summary_lines(comp, po, pj):
-    """What the run did, for standard output."""
+    """What the run did, for standard output, then the program's warnings (``warning:
+    FILE: ...``, for standard error)."""
     st = po.stats()
     corr = comp.statistics["correction"]
     fit = po.fit
@@ -105,18 +106,49 @@ def summary_lines(comp, po, pj):
              "Program:      %s (%d lines, %d moves; ball radius %g mm)"
              % (pj.program, st["lines_in"], st["moves"], po.offset.radius),
              "Moved:        %d moves (%d lines changed, %d added, %d arcs turned into lines); "
-             "largest move %.2f um; %d points displaced (tolerance %g um, blend %g mm)"
+             "largest move %.2f um; the displacement computed at %d points (tolerance %g um, "
+             "blend %g mm)"
              % (st["moves_moved"], st["lines_changed"], st["lines_added"],
-                st["arcs_converted"], st["largest_move_mm"] * 1e3, st["points_displaced"],
+                st["arcs_converted"], st["largest_move_mm"] * 1e3, st["points_evaluated"],
                 pj.tolerance * 1e3, pj.blend),
              "Contact:      %d cutter-location points on the face, %.2f um off the ball's "
              "offset on average; %s"
-             % (fit.points, fit.stock * 1e3,
-                "the radius fits within %.1f um (slopes up to %.1f degrees)"
-                % (abs(fit.radius_error) * 1e3, fit.max_tilt)
-                if fit.radius_error is not None
-                else "the radius is not checked (slopes below 8 degrees)")]
-    return lines + ["warning: " + w for w in po.warnings()]
+             % (fit.points, fit.stock * 1e3, _radius_text(fit, po.offset.radius))]
+    return lines + ["warning: " + w for w in _radius_warnings(fit, po.offset.radius, pj.program)
+                    + ["%s: %s" % (pj.program, w) for w in po.warnings()]]
+
+
+#: a ball radius off the one the contact points fit by more than this share of it, with an
+#: effect on the slopes above :data:`RADIUS_WARN_EFFECT` (mm; a quarter of the refusal's
+#: CONTACT_TOL, well above a CAM tolerance's scatter), is warned about
+RADIUS_WARN_SHARE = 0.01
+RADIUS_WARN_EFFECT = 0.25 * CONTACT_TOL
+
+
+def _radius_effect(fit):
+    return abs(fit.radius_error) * (1.0 - math.cos(math.radians(fit.max_tilt)))
+
+
+def _radius_text(fit, radius):
+    """The radius check's result: the radius the contact points fit against the one given."""
+    if fit.radius_error is None:
+        return "the radius is not checked (slopes below 8 degrees)"
+    return ("the points fit a ball of radius %.3f mm, %.1f um from the %g mm given (%.1f um "
+            "on slopes up to %.1f degrees)" % (radius + fit.radius_error, fit.radius_error * 1e3,
+                                               radius, _radius_effect(fit) * 1e3, fit.max_tilt))
+
+
+def _radius_warnings(fit, radius, program):
+    """A warning when the contact points clearly fit another ball than the one given, by
+    less than the contact check refuses (on gentle slopes a radius error barely shows)."""
+    if fit.radius_error is None or abs(fit.radius_error) <= RADIUS_WARN_SHARE * radius \
+            or _radius_effect(fit) <= RADIUS_WARN_EFFECT:
+        return []
+    return ["%s: the program's cutter-location points fit a ball of radius %.3f mm, not the "
+            "%g mm given (%.4f mm off on slopes up to %.1f degrees, within the %g mm accepted); "
+            "expected the ball radius the program was made with"
+            % (program, radius + fit.radius_error, radius, _radius_effect(fit), fit.max_tilt,
+               CONTACT_TOL)]
 
 
 def _range(stats):

@@ -31,6 +31,9 @@ def add_program_options(p):
 _NOT_WITH = (("replace", "--replace"), ("save", "--save"), ("gcode", "--gcode"),
              ("report", "--report"), ("points", "--points"), ("curves", "--curves"),
              ("html", "--html"), ("face_only", "--face-only"))
+#: the alignment's options, which the moved program does not apply
+_ALIGN = (("transform", "--transform"), ("rps", "--rps"), ("align_faces", "--align-faces"),
+          ("align_dof", "--align-dof"))
 
 
 def _positive(value, option, minimum=0.0):
@@ -46,6 +49,13 @@ def run_program(args):
         if getattr(args, dest, None):
             raise InputError("%s cannot be combined with --program (it writes the moved "
                              "program only); run 'compensate' without --program for it" % flag)
+    given = (["--align %s" % args.align] if args.align not in (None, "none") else []) + [
+        flag for dest, flag in _ALIGN if getattr(args, dest, None)]
+    if given:
+        raise InputError("%s cannot be combined with --program: the program is moved by the "
+                         "correction of measured points in the nominal's frame, and no "
+                         "alignment is applied to them; expected measurements in the "
+                         "nominal's frame (or 'compensate -o' for an aligned face)" % given[0])
     if not args.output:
         raise InputError("--program needs -o OUT.ngc, the moved program")
     if not args.tool:
@@ -82,7 +92,7 @@ def run_program(args):
         cadread.discard()
     for w in comp.prepared.warnings:    # the measurements' and the corrected face's, as -o
         print("warning: " + shown(w), file=sys.stderr)
-    for line in summary_lines(comp, po, pj):
-        print(line)
+    for line in summary_lines(comp, po, pj):      # warnings on standard error, as -o's
+        print(line, file=sys.stderr if line.startswith("warning: ") else sys.stdout)
     print(wrote(args.output))
     return 0

@@ -32,14 +32,16 @@ R = 3.0
 SURF = werner_surface()          # the example face: 45 x 45 mm, outward normal Su x Sv
 
 
-def raster(radius=R, step=1.0, head="G21 G90 G17"):
-    """A drop-cutter raster program on the example face (tips exact to 0.05 um)."""
+def raster(radius=R, step=1.0, head="G21 G90 G17", lift=0.0):
+    """A drop-cutter raster program on the example face (tips exact to 0.05 um), ``lift``
+    mm above it."""
     rows = np.arange(2.0, 44.0, 6.0)
     xs = np.arange(-2.0, 47.01, step)
     lines = ["%", "(raster test program)", head, "M3 S10000", "G0 Z20"]
     for k, y in enumerate(rows):
         xy = np.column_stack([xs if k % 2 == 0 else xs[::-1], np.full(xs.size, y)])
         z, _ = drop_cutter(SURF, 1, xy, np.full(xs.size, 5.0), radius)
+        z = z + lift
         lines.append("G0 X%.4f Y%.4f" % tuple(xy[0]))
         lines.append("G1 Z%.4f F600 (plunge)" % z[0])
         lines.extend("G1 X%.4f Y%.4f Z%.4f" % (p[0], p[1], q) for p, q in zip(xy[1:], z[1:]))
@@ -178,6 +180,20 @@ def test_a_program_away_from_the_face_is_refused(tmp_path):
     with pytest.raises(GCodeError, match="no cutting move of the program comes near") as exc:
         run(text, wave, tmp_path)
     assert exc.value.line == 3
+
+
+@pytest.mark.parametrize("lift, blend", [(0.9, 1.0), (3.0, 5.0)])
+def test_a_program_within_the_blend_that_never_touches_the_face_is_refused(tmp_path, lift,
+                                                                           blend):
+    """Lifted beyond the contact check's reach (a quarter of the radius) but within the
+    blend: no contact point to check the stock and the radius on; it was moved by a share
+    of the correction and its summary read '0 points ... 0.00 um off the offset'."""
+    text = raster(lift=lift)
+    with pytest.raises(GCodeError, match="no cutter-location point of the program touches "
+                                         "the face") as exc:
+        run(text, wave, tmp_path, blend=blend)
+    assert exc.value.line is not None and exc.value.file == "prog.ngc"
+    assert text.splitlines()[exc.value.line - 1].startswith("G1 ")
 
 
 def with_arcs(text):

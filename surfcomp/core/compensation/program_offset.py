@@ -204,8 +204,9 @@ class BallOffset:
 class OffsetPlan:
     """A :class:`surfcomp.core.axis.moves.MovePlan` of moved points, and what the contact check
     needs of the move ends: per move ``gap``, ``tilt``, ``interior`` (see
-    :class:`Displacement`), ``checked``, the number of points displaced, ``largest`` the
-    largest displacement (mm) and ``moved`` (m,) bool the moves written moved."""
+    :class:`Displacement`), ``checked``, the number of points whose displacement was
+    computed (moved or not), ``largest`` the largest displacement (mm) and ``moved`` (m,)
+    bool the moves written moved."""
 
     plan: MovePlan
     gap: np.ndarray
@@ -377,7 +378,8 @@ def _curvature_suspects(owner, fa, fb, pa, pb, da, db):
 
 def _refine(prog, arcs, offset, owner, fa, fb, da, db, tolerance):
     """Halve the pieces whose moved midpoint leaves the moved chord by more than the
-    tolerance, until none does; returns the pieces and the number of points displaced."""
+    tolerance, until none does; returns the pieces and the number of points whose
+    displacement was computed."""
     added = 0
     pa = _points(prog, arcs, owner, fa)
     pb = _points(prog, arcs, owner, fb)

@@ -220,7 +220,7 @@ class ProgramOffset:
         return {"lines_in": self.n_lines, "lines_out": self.n_lines + st.added,
                 "lines_changed": st.changed, "lines_added": st.added, "moves": self.n_moves,
                 "moves_moved": self.moved, "arcs_converted": st.converted,
-                "points_displaced": self.checked, "largest_move_mm": self.largest}
+                "points_evaluated": self.checked, "largest_move_mm": self.largest}
 
 
 class _Planner:
@@ -385,9 +385,11 @@ def check_contact(off, closest, contact, source=None):
     Raises
     ------
     GCodeError
-        No cutting move comes within the ball radius plus the blend of the face; a
-        cutting point inside the face is more than
-        :data:`surfcomp.core.compensation.program_offset.CONTACT_TOL` inside the nominal; the
+        No cutting move comes within the ball radius plus the blend of the face; none
+        touches it inside its boundary (clearance within a quarter of the radius: the
+        checks below would have nothing to check); a cutting point inside the face is
+        more than :data:`surfcomp.core.compensation.program_offset.CONTACT_TOL` inside the
+        nominal; the
         contact points fit another ball radius or sit off the ball's offset surface
         (:func:`surfcomp.core.compensation.program_offset.fit_contact`).
     """
@@ -403,6 +405,15 @@ def check_contact(off, closest, contact, source=None):
                          file=source, line=closest[1] or None, options=("blend",))
     gap, tilt, interior, lines = (np.concatenate(a) for a in zip(*contact))
     fit = fit_contact(gap, tilt, interior, lines, r)
+    if fit.points == 0:
+        # within the blend but never touching: the stock and radius checks below have
+        # nothing to check, and the program would be moved by a share of the correction
+        raise GCodeError("no cutter-location point of the program touches the face inside "
+                         "its boundary (the ball of radius %g mm within %g mm, a quarter of "
+                         "its radius, of it): the closest cutting point is %.3f mm beyond "
+                         "the ball's contact; a program with stock left, above the face, "
+                         "or for another face; expected the finishing program of this face"
+                         % (r, 0.25 * r, closest[0]), file=source, line=closest[1] or None)
     if fit.deepest < -CONTACT_TOL:
         raise GCodeError("the ball of radius %g mm (tool) at this cutter-location point "
                          "cuts %.4f mm into the nominal face (more than %g mm): the program "
