@@ -21,7 +21,7 @@ from ..io import report as report_io
 from ..io.atomic import Transaction, check_outputs
 from ..io.hashing import sha256_file
 from ..io.outpath import shown
-from ..io.readers import read_any
+from ..io.readers import read_measured
 from ..io.step_face import write_natural_face
 from . import fcenv
 
@@ -222,20 +222,6 @@ def run_job(job, progress=None, inputs=(), max_memory=None):
             tx.stage_text(getattr(job, attr), text)
         tx.commit()
     return comp, rep
-
-
-def read_measured(job):
-    """The job's measurement set: the file, joined to the plan when the job has one."""
-    if job.plan is None and job.touches != 1:
-        raise InputError(note(("touches",), " applies to a probe log read with a "
-                              "measurement plan (", ("plan",), ")"))
-    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
-                  deviation_units=job.deviation_units)
-    if job.plan is None:
-        return ms
-    from ..io.plan_join import join_plan, read_plan
-
-    return join_plan(read_plan(job.plan, job.units), ms, job.options, job.touches)
 
 
 def _texts(job, comp, rep):

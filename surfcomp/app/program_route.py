@@ -21,8 +21,8 @@ from ..core.progress import report, sub
 from ..io.atomic import Transaction
 from ..io.gcode import ProgramFile
 from ..io.gcode.offset_stream import FORK_LINES, offset_stream
+from ..io.readers import read_measured
 from . import cadread, fcenv
-from .file_route import read_measured
 from .nominal import face_warnings, load_nominal, nominal_from_data
 from .program_geometry import offset_of
 

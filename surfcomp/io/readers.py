@@ -10,7 +10,7 @@ none of the table's columns, as plain measured XYZ points.
 import dataclasses
 
 from ..core.choices import MEASUREMENT_FORMATS
-from ..errors import InputError, MeasurementFileError
+from ..errors import InputError, MeasurementFileError, note
 from .align_files import face_column
 from .files import read_once
 from .measurements import read_measurements
@@ -83,3 +83,19 @@ def _read(path, units, fmt, sample):
             # value on line 7 is that, not a table whose header names no known column
             raise (xyz_error if (xyz_error.line or 0) > (table_error.line or 0)
                    else table_error) from None
+
+
+def read_measured(job):
+    """The measurement set of a job (:class:`surfcomp.app.file_route.Job`: its
+    ``measurements``, ``units``, ``fmt``, ``sample``, ``deviation_units``, ``plan``,
+    ``touches`` and ``options``): the file, joined to the plan when the job has one."""
+    if job.plan is None and job.touches != 1:
+        raise InputError(note(("touches",), " applies to a probe log read with a "
+                              "measurement plan (", ("plan",), ")"))
+    ms = read_any(job.measurements, job.units, job.fmt, job.sample,
+                  deviation_units=job.deviation_units)
+    if job.plan is None:
+        return ms
+    from .plan_join import join_plan, read_plan
+
+    return join_plan(read_plan(job.plan, job.units), ms, job.options, job.touches)
