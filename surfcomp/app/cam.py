@@ -277,6 +277,22 @@ def base_operation(obj):
     return module("Dressup").baseOp(obj)
 
 
+#: the names FreeCAD gives a ball end mill's shape (:func:`tool_shape`)
+BALL_END_SHAPES = ("ballend", "ballendmill")
+
+
+def tool_shape(tool):
+    """The lower-case name of a tool's shape (``ballend``, ``endmill``, ``bullnose`` ...):
+    1.1's ``ShapeID``/``ShapeType``, 0.20's and 1.0's ``ShapeName`` (or the name of its
+    ``BitShape`` file), a legacy tool's ``ToolType`` (``ballendmill``); None when the tool
+    names none."""
+    for prop in ("ShapeID", "ShapeType", "ShapeName", "BitShape", "ToolType"):
+        value = getattr(tool, prop, None)
+        if isinstance(value, str) and value.strip():
+            return os.path.splitext(os.path.basename(value.strip()))[0].lower()
+    return None
+
+
 def edge_for_command(cmd, start):
     """The Part edge a move command draws from ``start`` (FreeCAD.Vector), or None."""
     return module("Geom").edgeForCmd(cmd, start)

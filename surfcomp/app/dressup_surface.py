@@ -94,12 +94,31 @@ def ball_offset(obj):
     return offset_of(nominal, corrected, radius, float(obj.Blend.Value))
 
 
+def check_ball_end(obj, base):
+    """Refuse a base whose tool is known not to be a ball end mill: the dressup moves the
+    ball's centre along the face normal at its contact, which is not where a flat or
+    bull-nose cutter touches (``compensate --program`` refuses ``flat:`` and ``bull:``
+    alike). A tool that names no shape is taken as the ball ``BallRadius`` gives."""
+    from .cam_job import tool_controller_of
+
+    tc = tool_controller_of(base)
+    shape = cam.tool_shape(getattr(tc, "Tool", None))
+    if shape is not None and shape not in cam.BALL_END_SHAPES:
+        raise InputError("%s: the tool of %s (%s, tool controller %s) has the shape %r, not "
+                         "a ball end mill's: the surface correction moves ball-end programs "
+                         "only (a flat or bull-nose cutter touches the face elsewhere); "
+                         "expected a ball end mill's finishing operation"
+                         % (obj.Label, cam.base_operation(base).Label, tc.Tool.Label,
+                            tc.Label, shape))
+
+
 def move_path(obj):
     """The dressup's Path from its base (what ``execute`` does) and the result, or an empty
     Path and None without a base."""
     base = obj.Base
     if base is None or not base.isDerivedFrom("Path::Feature"):
         return Path.Path(), None
+    check_ball_end(obj, base)
     cmds = cam.placed_commands(base)
     source = "%s (on %s)" % (obj.Label, cam.base_operation(base).Label)
     res, fit, op = offset_commands([(c.Name, c.Parameters) for c in cmds], ball_offset(obj),

@@ -143,3 +143,39 @@ def test_aliases_resolve_on_demand_to_one_module_with_its_own_spec(home):
         assert r["job"] == ["PathScripts.PathJob", "PathScripts.PathJob", True]
         assert r["surface"] == ["PathScripts.PathSurface", True]
     assert r["unknown"] == "ModuleNotFoundError"
+
+
+@pytest.mark.parametrize("bit_file, shape", [
+    (cam.BALL_END_BIT, "ballend"), ("5mm_Endmill.fctb", "endmill"),
+    ("6mm_Bullnose.fctb", "bullnose"),
+])
+def test_the_tool_shape_is_read_on_every_release(home, doc, bit_file, shape):
+    """0.20 and 1.0 name a bit's shape in ShapeName, 1.1 in ShapeID and ShapeType; the
+    surface correction dressup refuses a base whose tool is no ball end mill (a flat or
+    bull-nose cutter touches the face elsewhere than the ball the dressup moves)."""
+    from types import SimpleNamespace
+
+    from surfcomp.app.dressup_surface import check_ball_end
+    from surfcomp.errors import InputError
+
+    bit = cam.create_tool_bit(doc, bit_file, "Bit")
+    assert cam.tool_shape(bit) == shape
+    tc = cam.create_tool_controller("TC", bit)
+    base = SimpleNamespace(Name="Surface", Label="Finish", ToolController=tc)
+    dressup = SimpleNamespace(Label="DressupSurfaceCorrection")
+    if shape == "ballend":
+        check_ball_end(dressup, base)
+        return
+    with pytest.raises(InputError) as err:
+        check_ball_end(dressup, base)
+    assert ("DressupSurfaceCorrection: the tool of Finish (%s, tool controller %s) has the "
+            "shape '%s', not a ball end mill's" % (bit.Label, tc.Label, shape)) in str(err.value)
+
+
+def test_a_tool_that_names_no_shape_has_none():
+    from types import SimpleNamespace
+
+    assert cam.tool_shape(None) is None
+    assert cam.tool_shape(SimpleNamespace(Diameter=6.0, ShapeName="")) is None
+    assert cam.tool_shape(SimpleNamespace(ToolType="BallEndMill")) == "ballendmill"
+    assert "ballendmill" in cam.BALL_END_SHAPES
