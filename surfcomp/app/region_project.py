@@ -53,7 +53,9 @@ def _project(faces, i, idx, base, max_offset, dist, parts):
     f = faces[i]
     p = f.project(base[idx], max_distance=max_offset)
     parts[i].append((idx, p))
-    ok = p.converged.copy()
+    # a point beyond the face's border (its foot clamped to the boundary) lies off the face,
+    # as beyond a trim curve: a wall's point below a top face's edge is not the top's
+    ok = p.converged & ~p.outside
     ok[ok] = inside(f.polylines, p.u[ok], p.v[ok])
     dist[i, idx[ok]] = np.abs(p.distance[ok])
 

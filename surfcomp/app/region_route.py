@@ -9,6 +9,7 @@ import os
 
 import numpy as np
 
+from ..core import budget
 from ..core.compensation import curl_cap, region_build, region_field, region_slide
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..core.compensation.folds import find_fold, fold_warning
@@ -50,13 +51,15 @@ def _deviation(ms, normal, signed):
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
                sample=None, deviation_units=None, method="filtered", mask_size=WERNER_MASK_SIZE,
                mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
-               max_factor=region_build.POLE_FACTOR, log=print):
-    """Run a region compensation; returns the report dict. Nothing is written on error."""
+               max_factor=region_build.POLE_FACTOR, log=print, max_memory=None):
+    """Run a region compensation; returns the report dict. Nothing is written on error.
+    ``max_memory``: refuse a measurement whose run needs more (bytes; None: the machine's),
+    as the document route does."""
     outputs = [("output", output)] + ([("report", report)] if report else [])
     inputs = [("nominal", nominal), ("measurements", measurements)]
     check_outputs(outputs, inputs)
     cad_format(output)
-    check_method(method)
+    check_options(method, mask_size, mask_kind, sigma, max_offset, smoothing)
     fcenv.import_freecad()
     import Part
 
@@ -64,6 +67,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
 
     shape, _ = read_shape(nominal)
     ms = read_any(measurements, units, fmt, sample, deviation_units=deviation_units)
+    budget.check_job(len(ms), True, max_memory)
     out_shape, rep = compute_region(
         shape, ms, faces_text, (nominal, measurements), method=method, mask_size=mask_size,
         mask_kind=mask_kind, sigma=sigma, max_offset=max_offset, min_coverage=min_coverage,
@@ -83,6 +87,17 @@ def check_method(method):
                          options=("faces", "method"))
 
 
+def check_options(method, mask_size, mask_kind, sigma, max_offset, smoothing):
+    """Refuse a method other than raw or filtered and values outside the domains one face
+    takes (:meth:`surfcomp.core.compensation.pipeline.Options.validate`: an even mask, a
+    negative max_offset or smoothing), naming the option, before anything is read."""
+    from ..core.compensation.pipeline import Options
+
+    check_method(method)
+    Options(method=method, mask_size=mask_size, mask_kind=mask_kind, sigma=sigma,
+            max_offset=max_offset, smoothing=smoothing).validate()
+
+
 def compute_region(shape, ms, faces_text, sources, method="filtered",
                    mask_size=WERNER_MASK_SIZE, mask_kind="box", sigma=None, max_offset=1.0,
                    min_coverage=0.5, smoothing=None, max_factor=region_build.POLE_FACTOR,
@@ -93,10 +108,13 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     measurement's field that returns the field to correct by (an iteration adds the earlier
     rounds'). Returns ``(shape, report dict)``; nothing is written."""
     nominal, measurements = sources
+    check_options(method, mask_size, mask_kind, sigma, max_offset, smoothing)
     base = _base(ms)
     chosen = region.parse_faces(faces_text, shape)
     candidates = chosen if chosen is not None else [
         k for k, f in enumerate(shape.Faces) if _near(f, base, max_offset)]
+    if not candidates:      # no face's box near a point: every face is left out
+        _none_near("faces auto: no face of the shape", max_offset, measurements)
     faces = [region.region_face(shape, k) for k in candidates]
     turned = orient(shape, faces)
     if turned:
@@ -108,9 +126,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     if chosen is None:
         keep = [i for i in range(len(faces)) if np.sum(owner == i) >= AUTO_MIN_POINTS]
         if not keep:
-            raise MeasurementFileError("faces auto: no face of the shape has %d points within "
-                                       "max_offset %g mm" % (AUTO_MIN_POINTS, max_offset),
-                                       file=measurements, options=("faces", "max_offset"))
+            _none_near("faces auto: no face of the shape", max_offset, measurements)
         first = owner
         faces_all, faces = faces, [faces[i] for i in keep]  # points go to the nearest kept face
         owner, u, v, normal, signed = region.locate(faces, base, max_offset,
@@ -118,6 +134,8 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
         dropped = _dropped(faces_all, keep, first, owner)
     names = [f.name for f in faces]
     on = owner >= 0
+    if not np.any(on):
+        _none_near("none of %s" % ", ".join(names), max_offset, measurements, 1)
     counts = {f.name: int(np.sum(owner == i)) for i, f in enumerate(faces)}
     none = int(np.sum(~on)) - sum(dropped.values())
     log("points per face: " + ", ".join("%s %d" % kv for kv in counts.items())
@@ -168,6 +186,17 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     for line in neighbour_lines(rep["output"]) + [output_line(rep["output"])]:
         log(line)
     return out_shape, rep
+
+
+def _none_near(what, max_offset, measurements, least=AUTO_MIN_POINTS):
+    """Refuse a measurement no face of the region takes (points in other units or in
+    another frame than the nominal's), naming what was looked for."""
+    raise MeasurementFileError("%s has %s within max_offset %g mm (expected points on the "
+                               "region, in the nominal's units and frame: wrong face list, "
+                               "units or alignment?)"
+                               % (what, "a point" if least == 1 else "%d points" % least,
+                                  max_offset), file=measurements,
+                               options=("faces", "max_offset"))
 
 
 def _dropped(faces, keep, first, owner):

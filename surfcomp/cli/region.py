@@ -2,7 +2,21 @@
 """``compensate SOLID MEAS --faces F1,F2,...|auto -o OUT``: a region of faces (issue 30)."""
 
 from ..core.command_options import COMPENSATE
+from ..core.option_tables import INPUTS
+from ..core.options import OPTIONS
 from ..errors import InputError
+
+
+def ignored(args):
+    """(flag, given) of the options of one face that a region does not read, given where
+    they differ from their defaults: a plan's pairing, the grid layout, the grid filter's
+    edge handling, the knot refinement and the mirror stock's acceptance."""
+    return (("--plan", args.plan),
+            ("--touches", args.touches != INPUTS["touches"].default),
+            ("--layout", args.layout != OPTIONS["layout"].default),
+            ("--edge", args.edge != OPTIONS["edge"].default),
+            ("--refine", args.refine != OPTIONS["refine"].default),
+            ("--accept-stock", args.accept_stock))
 
 
 def run_region_command(args):
@@ -20,7 +34,7 @@ def run_region_command(args):
                         ("--tip-radius", args.tip_radius), ("--stock", args.stock),
                         ("--align", args.align != "none"), ("--transform", args.transform),
                         ("--rps", args.rps), ("--align-faces", args.align_faces),
-                        ("--align-dof", args.align_dof)):
+                        ("--align-dof", args.align_dof)) + ignored(args):
         if value:
             raise InputError("%s cannot be combined with --faces -o (it works with --faces on "
                              "a document: --save OUT.FCStd)" % flag
@@ -39,7 +53,8 @@ def run_region_command(args):
                units=args.units or "mm", fmt=args.fmt, sample=args.sample,
                deviation_units=args.deviation_units, method=args.method, mask_size=args.mask,
                mask_kind=args.mask_kind, sigma=args.sigma, max_offset=args.max_offset,
-               min_coverage=args.min_coverage, smoothing=args.smoothing)
+               min_coverage=args.min_coverage, smoothing=args.smoothing,
+               max_memory=args.max_memory)
     print("wrote %s" % args.output)
     if args.report:
         print("wrote %s" % args.report)

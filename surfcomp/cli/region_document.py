@@ -8,6 +8,7 @@ import sys
 from ..errors import InputError
 from .common import ProgressLine
 from .option_flags import shown
+from .region import ignored
 
 
 def run_region_document_command(args):
@@ -22,7 +23,8 @@ def run_region_document_command(args):
                         ("--curves", args.curves), ("--html", args.html),
                         ("--weights", args.weights), ("--face-only", args.face_only),
                         ("--flip-normals", args.flip_normals),
-                        ("--tip-radius", args.tip_radius), ("--stock", args.stock)):
+                        ("--tip-radius", args.tip_radius), ("--stock", args.stock)) \
+            + ignored(args):
         if value:
             raise InputError("%s cannot be combined with --faces on a document" % flag)
     if not 0.0 <= args.min_coverage <= 1.0:
@@ -31,7 +33,12 @@ def run_region_document_command(args):
 
     fcenv.import_freecad()
     from ..app.region_docroute import run_region_document, summary_lines
+    from ..app.region_route import check_options
     from .compensate import align_of
+
+    # as given, before the region object's properties clamp them (MaxOffset -1 reads 0)
+    check_options(args.method, args.mask, args.mask_kind, args.sigma, args.max_offset,
+                  args.smoothing)
 
     res = run_region_document(
         args.nominal, args.measurements, args.object, args.faces, args.save,

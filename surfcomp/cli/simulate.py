@@ -188,6 +188,23 @@ def check_loop_options(args):
                          "method)" % (replicas.flag, args.replicas, replicas.high))
 
 
+def check_unread(args):
+    """Refuse options that only go with another one not given (exit 2): the face of a
+    NOMINAL, the HTML report's method, how the axis error file is read."""
+    if args.nominal is None and (args.face or args.object):
+        raise InputError("%s picks the face of NOMINAL, and none is given (expected NOMINAL, "
+                         "or the preset's own surface without %s)"
+                         % ((("--face",) if args.face else ("--object",)) * 2))
+    if args.report_method is not None and not args.html:
+        raise InputError("--report-method picks the method of the HTML report (expected "
+                         "--html OUT.html with it)")
+    if not args.axis_errors:
+        for o in AXIS_FILE.values():
+            if getattr(args, o.name) != o.default:
+                raise InputError("%s tells how --axis-errors ERR.csv is read (expected the "
+                                 "file with it)" % o.flag)
+
+
 def loop_value(args, preset, name):
     """Option ``name`` of :data:`~surfcomp.core.command_options.SIMULATE` that a preset
     sets: the command line's, else the preset's, else the registry's default (the grid
@@ -282,6 +299,7 @@ def run(args):
         raise InputError("give NOMINAL (a face file) or --preset NAME (one of %s)"
                          % ", ".join(presets_.PRESETS))
     check_loop_options(args)
+    check_unread(args)
     grid, replicas, between = (loop_value(args, preset, name)
                                for name in ("grid", "replicas", "between"))
     try:

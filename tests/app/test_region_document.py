@@ -172,3 +172,16 @@ def test_bad_input_exits_2_and_writes_nothing(shop):
     assert r.returncode == 2 and "--object NAME is required" in r.stderr
     err = _refused(shop, csv, "--faces", "auto", "--object", "Nothing")
     assert "no object 'Nothing'" in err
+
+
+def test_bad_or_unread_options_on_a_document_exit_2_as_given(shop):
+    """The region object's properties clamp what they are given (MaxOffset -1 read 0, and
+    the run was refused for no points within 0 mm); an even mask was taken, and the options
+    of one face that a region does not read were ignored without a word."""
+    csv = shop[2]
+    err = _refused(shop, csv, "--faces", "auto", "--max-offset", "-1")
+    assert "--max-offset -1.0: expected a length in mm" in err
+    err = _refused(shop, csv, "--faces", "auto", "--mask", "4")
+    assert "--mask 4: expected an odd whole number" in err
+    err = _refused(shop, csv, "--faces", "auto", "--layout", "grid")
+    assert "--layout cannot be combined with --faces on a document" in err

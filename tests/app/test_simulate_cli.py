@@ -118,6 +118,25 @@ def test_bad_options_exit_2_and_write_nothing(tmp_path, capsys):
     assert "Face9" in _bad(tmp_path, capsys, "--face", "Face9")
 
 
+def test_options_that_go_with_another_are_refused_without_it(tmp_path, capsys):
+    """Taken without a word before: the HTML report's method without --html, a face of
+    NOMINAL on the preset's own surface, how an axis error file is read without the file."""
+    for args, text in (
+            (("--report-method", "mirror"), "--report-method picks the method of the HTML "
+                                             "report (expected --html OUT.html with it)"),
+            (("--face", "Face3"), "--face picks the face of NOMINAL, and none is given"),
+            (("--object", "Part"), "--object picks the face of NOMINAL, and none is given"),
+            (("--axis-units", "in"), "--axis-units tells how --axis-errors ERR.csv is read"),
+            (("--reference", "1,2,3"), "--reference tells how --axis-errors ERR.csv is read"),
+            (("--max-error", "5"), "--max-error tells how --axis-errors ERR.csv is read")):
+        argv = ["simulate", "--preset", "mirror2019-s1", "--replicas", "1", *args, "--json",
+                tmp_path / "s.json", "--quiet"]
+        assert surfcomp.cli.main([str(a) for a in argv]) == 2, args
+        err = capsys.readouterr().err
+        assert text in err and "Traceback" not in err, (args, err)
+        assert os.listdir(tmp_path) == []
+
+
 def test_out_of_range_and_non_finite_options_name_the_option(tmp_path, capsys):
     """Issue 12: every option value that is not finite, negative where it cannot be, or
     beyond the limits is refused with exit 2 and a message naming the option."""

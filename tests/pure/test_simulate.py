@@ -523,3 +523,21 @@ def test_preset_result_holds_the_paper_and_the_side_by_side(preset_runs):
     assert len(d["methods"][4]["semi_finish"]["error_replicas"]) == 4
     assert "Paper vs simulated: preset mirror2019-s2" in d["side_by_side"]["table"]
     assert d["noise_floor_mm"] > 0.0013 and "leaves_out" in d["model_summary"]
+
+
+def test_side_table_counts_the_plan_points_it_pools():
+    """Measured at a plan's points, the side-by-side table pools the statistics at those
+    points: it names their count, not the evaluation grid's nodes (10 x 7 = 70)."""
+    pr = presets.get_preset("mirror2019-s1")
+    surf, outward = pr.surface()
+    rng = np.random.default_rng(5)
+    u = rng.uniform(*surf.u_range, 30) * 0.9 + 0.05 * surf.u_range[1]
+    v = rng.uniform(*surf.v_range, 30) * 0.9 + 0.05 * surf.v_range[1]
+    points = bspline.evaluate(surf, u, v)
+    res = sm.simulate(surf, outward, pr.machining_model(), grid=pr.grid, replicas=1,
+                      specs=sm.method_specs(["none", "mirror"]), points=points)
+    res.preset = pr
+    text = res.side_table()
+    assert "1 replica(s) x 30 points (the measured points)" in text, text
+    side = {r["method"]: r for r in res.side_by_side()["rows"]}
+    assert side["mirror"]["simulated"]["count"] == 30

@@ -483,7 +483,9 @@ class SimulationResult:
     def side_table(self, paper=None, where="grid"):
         """:meth:`side_by_side` as text (um)."""
         name = "preset %s (%s)" % (self.preset.name, self.preset.imitates) if self.preset else ""
-        count = self.grid[0] * self.grid[1] if where == "grid" else "%d x %d" % self.eval_shape
+        # 'grid' statistics are at the measured points: the plan's when it was measured
+        count = ("%d x %d" % self.eval_shape if where != "grid" else self.probed
+                 if self.probed is not None else self.grid[0] * self.grid[1])
         detail = ("Simulated: %d replica(s) x %s points (%s); mean and std pooled over the "
                   "replicas, max, min and ISO 1101 averaged over them; noise floor %.2f um"
                   % (self.replicas, count, "the measured points" if where == "grid" else where,
