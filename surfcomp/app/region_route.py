@@ -13,6 +13,7 @@ from ..core import budget
 from ..core.compensation import curl_cap, region_build, region_field, region_slide
 from ..core.compensation.filters import WERNER_MASK_SIZE
 from ..core.compensation.folds import find_fold, fold_warning
+from ..core.limits import NORMAL_WARNING_DEG
 from ..core.surface.trimmed import inside
 from ..errors import GeometryError, InputError, MeasurementFileError
 from ..io.atomic import Transaction, check_outputs
@@ -142,6 +143,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
         + "; on no face: %d" % none + dropped_text(dropped))
     d = _deviation(ms, normal, signed)
     lines = np.asarray(ms.lines) if ms.lines is not None else np.arange(2, len(base) + 2)
+    turned_normals = _normal_warnings(ms, normal, owner, names, lines, measurements)
     pts, dev, lines = base[on], d[on], lines[on]
     step = region_field.spacing(pts)
     # coverage of every face
@@ -179,6 +181,8 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     rep = _report(nominal, measurements, faces, counts, none, figures, fidelity,
                   field_radius, step, method, mask_size)
     rep["points_on_dropped_faces"] = dropped
+    for f in rep["faces"]:
+        f["warnings"].extend(turned_normals.get(f["face"], ()))
     for line in summary(rep):
         log(line)
     out_shape, kind, volume = _assemble(shape, faces, fld, closed)
@@ -186,6 +190,30 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     for line in neighbour_lines(rep["output"]) + [output_line(rep["output"])]:
         log(line)
     return out_shape, rep
+
+
+def _normal_warnings(ms, normal, owner, names, lines, source):
+    """Per face name, the warnings of the file's normals more than
+    :data:`surfcomp.core.limits.NORMAL_WARNING_DEG` off the normal of the point's face, as
+    one face warns (the deviation is taken along the given normal, turned to the outward
+    side; far off it, the point is likely another face's)."""
+    if ms.normal is None:
+        return {}
+    cos = np.abs(np.einsum("ij,ij->i", np.asarray(ms.normal, dtype=float), normal))
+    with np.errstate(invalid="ignore"):
+        ang = np.degrees(np.arccos(np.clip(cos, 0.0, 1.0)))
+        off = np.flatnonzero((owner >= 0) & (ang > NORMAL_WARNING_DEG))
+    out = {}
+    for k in off[:10]:
+        name = names[owner[k]]
+        out.setdefault(name, []).append(
+            "%s:%d: the given normal is %.1f degrees off the normal of %s (more than %g)"
+            % (source, lines[k], ang[k], name, NORMAL_WARNING_DEG))
+    if off.size > 10:
+        out.setdefault(names[owner[off[10]]], []).append(
+            "%s: %d more normals are more than %g degrees off their face's normal"
+            % (source, off.size - 10, NORMAL_WARNING_DEG))
+    return out
 
 
 def _none_near(what, max_offset, measurements, least=AUTO_MIN_POINTS):

@@ -78,3 +78,26 @@ def test_bad_or_unread_options_exit_2_and_write_nothing(part, extra, message):
     assert r.returncode == 2, r.stderr
     assert message in r.stderr, r.stderr
     assert not os.path.exists(out)
+
+
+def test_normals_far_off_their_face_are_reported(part):
+    """One face reports a given normal more than 5 degrees off the face normal; a region
+    took any (the deviation is taken along it, turned to the outward side, whatever the
+    angle). 12 normals of Face1's points turned 30 degrees about x: 10 named by line, the
+    rest counted."""
+    tmp, step, _csv, pts, nrm, dev = part
+    turned = nrm.copy()
+    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    rot = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    on_face1 = np.flatnonzero(pts[:, 0] < 9.0)[:12]
+    turned[on_face1] = turned[on_face1] @ rot.T
+    csv = str(tmp / "turned.csv")
+    rp.write_csv(csv, pts, turned, dev)
+    r = rp.run(step, csv, "--faces", "Face1,Face2", "-o", str(tmp / "turned.step"))
+    assert r.returncode == 0, r.stderr
+    said = [ln for ln in r.stdout.splitlines() if "degrees off" in ln]
+    assert len(said) == 11, r.stdout
+    assert all(ln.startswith("warning: %s:" % csv) for ln in said), said
+    assert "the given normal is 30.0 degrees off the normal of Face1 (more than 5)" in said[0]
+    assert said[-1] == ("warning: %s: 2 more normals are more than 5 degrees off their "
+                        "face's normal" % csv)
