@@ -63,3 +63,20 @@ def test_best_fit_on_the_face_absorbs_the_mean_error():
     assert lines[-1].startswith("  offset: 1 fit(s), 1 converged; absorbed mean offset -24.7")
     # the part machined without compensation is the same either way
     assert_allclose(_mean(fitted.after["none"]), _mean(plain.after["none"]), atol=1e-12)
+
+
+def test_without_points_between_nodes_the_between_figures_are_none():
+    """between = 1 evaluates the nodes only: the report's 'between' figures were the
+    nodes' own under the name of the points between them; they are None (null), and the
+    'where' text says there are none."""
+    res = _run()
+    assert res.before[0]["between"] is None
+    assert res.before[0]["grid"].count == 121 and res.before[0]["all"].count == 121
+    d = res.as_dict()
+    assert d["before"]["replicas"][0]["between"] is None
+    assert d["before"]["spread"]["between"] is None
+    assert d["before"]["spread"]["grid"] is not None
+    assert d["where"].endswith("between = the points between nodes (none: between = 1)")
+    two = sm.simulate(example_surface(), 1, MODEL, **dict(LOOP, between=2))
+    assert two.before[0]["between"].count == 21 * 21 - 121
+    assert "(none" not in two.as_dict()["where"]

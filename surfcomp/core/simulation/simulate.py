@@ -207,8 +207,11 @@ def measure(projector, outward, points, rng, probe_sigma=0.0):
 
 
 def _stats3(d, nodes):
-    return {"all": statistics(d), "grid": statistics(d[nodes]), "between": statistics(d[~nodes])
-            if np.any(~nodes) else statistics(d[nodes])}
+    """``{'all', 'grid', 'between'}`` statistics; 'between' None where the evaluation grid
+    has no points between its nodes (``between = 1``: the nodes' figures are no
+    between-nodes figures)."""
+    return {"all": statistics(d), "grid": statistics(d[nodes]),
+            "between": statistics(d[~nodes]) if np.any(~nodes) else None}
 
 
 def _rng(seed, replica, stream):
@@ -501,8 +504,10 @@ class SimulationResult:
     def as_dict(self):
         """JSON-able dict (schema ``surfcomp-simulation/1``, mm)."""
         def block(lst):
-            return {"replicas": [{w: s.as_dict() for w, s in x.items()} for x in lst],
-                    "spread": {w: spread([x[w] for x in lst]) for w in ("all", "grid", "between")}}
+            return {"replicas": [{w: None if s is None else s.as_dict() for w, s in x.items()}
+                                 for x in lst],
+                    "spread": {w: None if any(x[w] is None for x in lst) else
+                               spread([x[w] for x in lst]) for w in ("all", "grid", "between")}}
 
         methods = []
         for spec in self.specs:
@@ -523,11 +528,11 @@ class SimulationResult:
                "grid": list(self.grid), "evaluation_grid": list(self.eval_shape),
                "between": self.between, "margin": self.margin,
                "replicas": self.replicas, "seed": self.seed,
-               "where": "all = grid nodes and points between them; grid = nodes only; "
-                        "between = the points between nodes" if self.probed is None else
-                        "all = the evaluation grid's points; grid = the %d probed points of "
-                        "the plan; between = the evaluation grid's points between its nodes"
-                        % self.probed,
+               "where": ("all = grid nodes and points between them; grid = nodes only; "
+                         "between = the points between nodes" if self.probed is None else
+                         "all = the evaluation grid's points; grid = the %d probed points of "
+                         "the plan; between = the evaluation grid's points between its nodes"
+                         % self.probed) + ("" if self.between > 1 else " (none: between = 1)"),
                "probed_points": self.probed,
                "before": block(self.before),
                "methods": methods,
