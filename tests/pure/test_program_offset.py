@@ -175,6 +175,14 @@ def test_a_wrong_ball_radius_is_refused(tmp_path):
         run(raster(radius=3.0), wave, tmp_path, radius=1.5)
 
 
+def test_a_program_too_deep_is_refused_naming_that_too(tmp_path):
+    """50 um below the face with the right ball: the refusal blamed only the ball's radius
+    or another face."""
+    with pytest.raises(GCodeError, match="cuts 0.0[45].. mm into the nominal face .*a smaller "
+                                         "ball, for another face, or cuts below this one"):
+        run(raster(lift=-0.05), wave, tmp_path)
+
+
 def test_a_program_away_from_the_face_is_refused(tmp_path):
     text = "G21 G90\nG0 X0 Y0 Z50\nG1 X10 F100\nG1 Y10\nM2\n"
     with pytest.raises(GCodeError, match="no cutting move of the program comes near") as exc:

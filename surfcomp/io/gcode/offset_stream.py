@@ -417,8 +417,9 @@ def check_contact(off, closest, contact, source=None):
     if fit.deepest < -CONTACT_TOL:
         raise GCodeError("the ball of radius %g mm (tool) at this cutter-location point "
                          "cuts %.4f mm into the nominal face (more than %g mm): the program "
-                         "was made for a smaller ball or another face; expected the ball "
-                         "radius the program was made with" % (r, -fit.deepest, CONTACT_TOL),
+                         "was made for a smaller ball, for another face, or cuts below this "
+                         "one; expected the ball radius the program was made with and the "
+                         "finishing program of this face" % (r, -fit.deepest, CONTACT_TOL),
                          file=source, line=fit.deepest_line, options=("tool",))
     if fit.radius_error is not None:
         effect = abs(fit.radius_error) * (1.0 - np.cos(np.radians(fit.max_tilt)))
