@@ -292,8 +292,9 @@ FREECADCMD = [
     ({"command": "simulate"}, 2, '"command": "simulate": a job file runs'),
     ({"command": "inspect", "output": "c.step"}, 2,
      '"output": does nothing for "command": "inspect"'),
-    ({"report": "job.json"}, 2, "--report would overwrite the input job file job.json"),
-    ({"output": "nope/../nominal.step"}, 2, "-o cannot be written: its folder"),
+    # a job file's messages name its keys, not the command line's flags
+    ({"report": "job.json"}, 2, ": report would overwrite the input job file job.json"),
+    ({"output": "nope/../nominal.step"}, 2, ": output cannot be written: its folder"),
     ({"output": "vlink/../nominal.step", "method": "raw"}, 0, "wrote "),
 ]
 
