@@ -59,11 +59,26 @@ def g1_shop(folder, count, seed):
     solid, tops = g1_top_solid()
     path = os.path.join(str(folder), "shop.FCStd")
     block_document(path, solid)
+    return (path,) + g1_points(folder, solid, tops, count, seed)
+
+
+def g1_step(folder, count, seed):
+    """The G1 block as ``folder/g1.step`` and :func:`g1_points`: ``(step, csv, solid, pts,
+    nrm, dev)``."""
+    solid, tops = g1_top_solid()
+    step = os.path.join(str(folder), "g1.step")
+    solid.exportStep(step)
+    return (step,) + g1_points(folder, solid, tops, count, seed)
+
+
+def g1_points(folder, solid, tops, count, seed):
+    """``count`` points on each of the G1 block's top faces carrying :func:`ridge_field`,
+    in ``folder/g1.csv``: ``(csv, solid, pts, nrm, dev)``."""
     pts, nrm, dev = sample_faces([solid.Faces[k] for k in tops], count, ridge_field,
                                  seed=seed)
     csv = os.path.join(str(folder), "g1.csv")
     write_csv(csv, pts, nrm, dev)
-    return path, csv, solid, pts, nrm, dev
+    return csv, solid, pts, nrm, dev
 
 
 def _h(x, y):

@@ -30,14 +30,7 @@ def _run(*args):
 @pytest.fixture(scope="module")
 def g1_part(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("region")
-    solid, tops = rp.g1_top_solid()
-    step = str(tmp / "g1.step")
-    solid.exportStep(step)
-    faces = [solid.Faces[k] for k in tops]
-    pts, nrm, dev = rp.sample_faces(faces, 3000, rp.ridge_field, seed=1)
-    csv = str(tmp / "g1.csv")
-    rp.write_csv(csv, pts, nrm, dev)
-    return tmp, step, csv, solid, pts, nrm, dev
+    return (tmp,) + rp.g1_step(tmp, 3000, seed=1)
 
 
 @pytest.fixture(scope="module")

@@ -14,13 +14,7 @@ from tests.app import region_parts as rp
 @pytest.fixture(scope="module")
 def part(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("region_input")
-    solid, tops = rp.g1_top_solid()
-    step = str(tmp / "g1.step")
-    solid.exportStep(step)
-    pts, nrm, dev = rp.sample_faces([solid.Faces[k] for k in tops], 1500, rp.ridge_field,
-                                    seed=4)
-    csv = str(tmp / "g1.csv")
-    rp.write_csv(csv, pts, nrm, dev)
+    step, csv, _solid, pts, nrm, dev = rp.g1_step(tmp, 1500, seed=4)
     return tmp, step, csv, pts, nrm, dev
 
 
