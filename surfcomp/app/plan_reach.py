@@ -33,19 +33,27 @@ def other_faces(shape, face_name):
     return [f for i, f in enumerate(shape.Faces) if i != k]
 
 
+def exact_box(shape):
+    """OCCT's optimal bounding box of ``shape``'s geometry (``BoundBox`` where this FreeCAD
+    has no optimal box). Measured on a copy without the shape's mesh: once the GUI has
+    drawn a shape, its display triangulation widened the optimal box of the shape itself
+    (the example face's top 9.99 mm instead of 9.03), so a plan made in the GUI had a
+    higher safe Z than ``plan`` on the same face."""
+    if not hasattr(shape, "optimalBoundingBox"):
+        return shape.BoundBox
+    return shape.copy().optimalBoundingBox()
+
+
 def part_top(shape, face):
-    """The part's top (mm): the highest Z of the shape (or the face when there is none), from
-    OCCT's optimal bounding box where this FreeCAD has it."""
-    target = shape if shape is not None else face
-    box = target.optimalBoundingBox() if hasattr(target, "optimalBoundingBox") else \
-        target.BoundBox
-    return float(box.ZMax)
+    """The part's top (mm): the highest Z of the shape (or the face when there is none),
+    from :func:`exact_box`."""
+    return float(exact_box(shape if shape is not None else face).ZMax)
 
 
 def _boxes(faces):
     out = np.empty((len(faces), 6))
     for k, f in enumerate(faces):
-        b = f.optimalBoundingBox() if hasattr(f, "optimalBoundingBox") else f.BoundBox
+        b = exact_box(f)
         out[k] = (b.XMin, b.YMin, b.ZMin, b.XMax, b.YMax, b.ZMax)
     return out
 

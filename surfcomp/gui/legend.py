@@ -76,7 +76,8 @@ class LegendEntry(QtGui.QWidget):
 
     def _lines(self):
         d = self.data
-        return [self.name, d["title"]] + ([d["note"]] if d["note"] else [])
+        return [self.name, d["title"]] + ([d["note"]] if d["note"] else []) + \
+            list(d.get("problems", ()))
 
     def _line_height(self):
         return self.fontMetrics().height()
@@ -161,11 +162,10 @@ class LegendEntry(QtGui.QWidget):
             return
         d = self.data
         lh = self._line_height()
-        outside = self.outside_text()
+        red = set(d.get("problems", ())) | ({self.outside_text()} if self.outside else set())
         for text, font, r in self.text_blocks():
             p.setFont(font)
-            p.setPen(QtGui.QColor(150, 0, 0) if self.outside and text == outside
-                     else QtGui.QColor(0, 0, 0))
+            p.setPen(QtGui.QColor(150, 0, 0) if text in red else QtGui.QColor(0, 0, 0))
             _text_layout(font, text, r.width())[0].draw(p, QtCore.QPointF(r.topLeft()))
         p.setFont(self.font())
         p.setPen(QtGui.QColor(0, 0, 0))

@@ -34,7 +34,8 @@ class MapStyle:
     ``warning`` band (fraction of the tolerance, :func:`surfcomp.core.colormap.warning_limits`);
     ``stepped`` draws one flat colour per legend step; ``out_of_range`` gives values
     outside a manual range their own colours (with arrows on the legend); ``note`` is a
-    second title line (the sign convention of a correction map).
+    second title line (the sign convention of a correction map); ``problems`` the settings
+    the map is drawn without, and why (shown under the note, in red).
     """
 
     scheme: str = colormap.DEFAULT_SCHEME
@@ -51,6 +52,7 @@ class MapStyle:
     show_legend: bool = True
     point_size: int = 7
     note: str = ""
+    problems: tuple = ()
 
     def manual(self):
         return self.vmin is not None and self.vmax is not None and self.vmax > self.vmin
@@ -284,7 +286,8 @@ class MapScene:
         title = self._title + (" [%s]" % colormap.UNIT_TEXT[style.unit] if self._title else "")
         if style.tolerance is not None:
             title += " - tolerance band"
-        return {"title": title, "note": style.note, "stops": data["stops"],
+        return {"title": title, "note": style.note, "problems": list(style.problems),
+                "stops": data["stops"],
                 "labels": data["labels"], "side": side, "arrows": arrows,
                 "range": (vmin, vmax), "unit": style.unit}
 

@@ -178,6 +178,8 @@ class FilterPanel:
         self.weights.textChanged.connect(self.changed)
         self.edge.currentIndexChanged.connect(self.changed)
         self.show.currentIndexChanged.connect(self.show_map)
+        # Cancel leaves the objects touched before as they were (marked for a recompute)
+        self.touched = {o.Name for o in self.doc.Objects if "Touched" in o.State}
         self.step = UndoStep(self.doc, translate("SurfComp", "Filter %s") % obj.Label).open()
         vobj = obj.ViewObject
         if vobj is not None and "Map" in vobj.PropertiesList:
@@ -306,8 +308,12 @@ class FilterPanel:
         return True
 
     def reject(self):
+        from ..app.recompute import settle_after_undo
+
         self.timer.stop()
         self.step.abort()
+        # the undo put back every property the previews wrote: nothing is left to recompute
+        settle_after_undo(self.doc, self.touched)
         self._close()
         vobj = self.obj.ViewObject
         if vobj is not None and vobj.Proxy is not None and hasattr(vobj.Proxy, "redraw"):

@@ -21,8 +21,8 @@ from ..app import features, reports
 from ..app.mapmesh import map_data, map_mesh, mesh_key  # noqa: F401  (scripts, bench/)
 from ..core import colormap
 from ..errors import SurfcompError
-from . import cover, prefs
-from .mapscene import MapScene, MapStyle
+from . import cover, map_style, prefs
+from .mapscene import MapScene
 
 #: 2: short property names that fit the property view (RENAMED)
 VERSION = 2
@@ -160,21 +160,10 @@ def has_map_properties(vobj):
 
 
 def style_of(vobj, quantity=None, shared=None):
-    """The :class:`MapStyle` the view properties describe (``shared``: the common range
-    when Shared is on)."""
-    auto = vobj.AutoRange
-    tol = (float(vobj.TolLow.Value), float(vobj.TolHigh.Value)) \
-        if vobj.TolBand else None
-    warn = float(vobj.WarnBand) if 0.0 < float(vobj.WarnBand) < 1.0 else None
-    vmin = None if auto else float(vobj.RangeMin.Value)
-    vmax = None if auto else float(vobj.RangeMax.Value)
-    if auto and shared is not None:
-        vmin, vmax = shared
-    return MapStyle(scheme=vobj.Scheme, vmin=vmin, vmax=vmax, tolerance=tol, warning=warn,
-                    unit=vobj.Unit, stepped=bool(vobj.Stepped),
-                    out_of_range=not auto, show_points=vobj.Points,
-                    show_labels=vobj.Labels, show_legend=vobj.Legend,
-                    note=NOTES.get(quantity, ""))
+    """The :class:`MapStyle` the view properties describe, checked
+    (:func:`surfcomp.gui.map_style.style_of`; ``shared``: the common range when Shared is
+    on)."""
+    return map_style.style_of(vobj, quantity, shared, NOTES)
 
 
 def arrange_legends(doc=None, changed=None):
@@ -372,7 +361,9 @@ class ViewProviderCompensation(_MapViewProvider):
     def restyle(self, arrange=True):
         """Recolour from the view properties (no new geometry, no recompute)."""
         vobj = self.vobj
-        self.scene.set_style(style_of(vobj, vobj.Map, self.shared_range()))
+        style = style_of(vobj, vobj.Map, self.shared_range())
+        self.scene.set_style(style)
+        map_style.report(self, style)
         arrange_legends()
         if vobj.AutoRange and self.scene.range is not None and not np.allclose(
                 (vobj.RangeMin.Value, vobj.RangeMax.Value), self.scene.range,
@@ -505,6 +496,7 @@ class ViewProviderMeasurement(_MapViewProvider):
         if not has_deviation(vobj.Object):
             style.show_legend = style.show_labels = False
         self.scene.set_style(style)
+        map_style.report(self, style)
         arrange_legends()
 
 

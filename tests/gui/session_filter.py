@@ -90,6 +90,13 @@ Gui.updateGui()
 RESULTS["filter_after_reject"] = [comp.MaskSize, comp.MaskKind,
                                   float(np.nanmax(np.abs(np.array(comp.Determined) -
                                                          det_before)))]
+# Cancel leaves nothing to recompute (the object is not marked touched): what a recompute
+# would give is what the undo put back
+RESULTS["state_after_reject"] = [list(comp.State), doc.mustExecute()]
+comp.touch()
+doc.recompute()
+RESULTS["recomputed_after_reject"] = float(np.nanmax(np.abs(np.array(comp.Determined) -
+                                                            det_before)))
 Gui.runCommand("SurfComp_Filter")
 panel = panels.FilterPanel.instance
 panel.mask.setValue(3)

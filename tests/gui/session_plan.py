@@ -18,6 +18,8 @@ panel = plan_panel.PlanPanel.instance
 obj = panel.obj
 RESULTS["default"] = [panel.result.toPlainText(), obj.Layout, obj.Kept, obj.Placed,
                       len(obj.Shape.Vertexes), panel.points.isEnabled()]
+# the face is drawn (its display mesh made) before the panel plans on it
+RESULTS["safe_z"] = obj.SafeZ
 # on the default grid, a max tilt of 15 degrees drops the steeper points: the panel names
 # the option as its field, the Dropped property as the property; the panel as the user
 # sees it

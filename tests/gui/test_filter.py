@@ -67,6 +67,11 @@ def test_bad_mask_shown_in_the_panel_without_a_traceback(session):
 
 def test_cancel_and_ok(session):
     assert session["filter_after_reject"] == [5, "box", 0.0]
+    # nothing left marked for a recompute after Cancel (the tree's mark, the Recompute
+    # button): the undo put back every value, as a recompute confirms
+    state, must = session["state_after_reject"]
+    assert "Touched" not in state and must is False
+    assert session["recomputed_after_reject"] == 0.0
     assert session["filter_after_accept"] == [3, "random", False]
     assert session["undo_after_filter"][0].startswith("Filter ")
 

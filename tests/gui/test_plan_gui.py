@@ -5,8 +5,13 @@ named by the field's label, then adaptive chosen with the keys),
 the points drawn in the 3D view, a tip too large for the face refused in the panel, OK as one
 undo step, Cancel leaving nothing."""
 
+import os
+import subprocess
+import sys
+
 import pytest
 
+from tests.conftest import ROOT
 from tests.gui.harness import read_image, run_session
 
 
@@ -32,6 +37,20 @@ def test_panel_plans_the_default_grid(session):
     text, layout, kept, placed, vertices, points_enabled = session["default"]
     assert (layout, kept, placed, vertices) == ("grid", 100, 100, 100)
     assert text.startswith("100 of 100 points kept; travel ") and points_enabled is False
+
+
+def test_safe_z_as_the_command_line_says(session, tmp_path):
+    """The panel's safe Z is the command line's for the same face and fields: the drawn
+    face's display mesh once widened the part's top to 9.99 mm (safe Z 15.993 mm, against
+    15.034 mm from ``plan``)."""
+    out = subprocess.run([sys.executable, "-m", "surfcomp", "plan",
+                          os.path.join(ROOT, "examples", "nominal.step"), "-o",
+                          str(tmp_path / "plan.csv")], capture_output=True, text=True,
+                         cwd=ROOT, check=True).stdout
+    (line,) = [t for t in out.splitlines() if t.startswith("Safe Z:")]
+    cli = float(line.split()[2])
+    assert session["safe_z"] == pytest.approx(cli, abs=5e-5)
+    assert session["default"][0].endswith("safe Z %.3f mm" % cli)
 
 
 def test_adaptive_chosen_with_the_keys(session):
