@@ -98,7 +98,11 @@ def _read(path, units, fmt, sample):
 def read_measured(job):
     """The measurement set of a job (:class:`surfcomp.app.file_route.Job`: its
     ``measurements``, ``units``, ``fmt``, ``sample``, ``deviation_units``, ``plan``,
-    ``touches`` and ``options``): the file, joined to the plan when the job has one."""
+    ``touches`` and ``options``): the file, joined to the plan when the job has one.
+
+    The plan is in mm whatever ``units`` says (``plan`` writes it so, and the columns of a
+    plan written by hand may carry their own unit): ``units`` is the log's, which is in
+    inches when the program ran in G20 (a CAM post-processor set to inches)."""
     if job.plan is None and job.touches != 1:
         raise InputError(note(("touches",), " applies to a probe log read with a "
                               "measurement plan (", ("plan",), ")"))
@@ -108,4 +112,4 @@ def read_measured(job):
         return ms
     from .plan_join import join_plan, read_plan
 
-    return join_plan(read_plan(job.plan, job.units), ms, job.options, job.touches)
+    return join_plan(read_plan(job.plan), ms, job.options, job.touches)
