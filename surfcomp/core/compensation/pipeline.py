@@ -207,7 +207,8 @@ def prepare(surface, outward, ms, options=None, progress=None):
     # first: points in inches or metres near the origin can pass as on the face, or fail
     # as beyond its border, which would not say why
     mistake = plausibility.unit_mistake(surface, base, options.max_offset, project,
-                                        getattr(ms, "units", None) or "mm")
+                                        getattr(ms, "units", None) or "mm",
+                                        "x" if ms.nominal is None else "x_nom")
     if mistake:
         raise InputError(mistake, file=ms.source, options=("units",))
     _check_on_face(ms, base, proj, dist, options)
