@@ -24,10 +24,12 @@ The deviation is the point-profile ``Value`` the file carries (signed, positive 
 side the nominal normal points to). It is cross-checked against
 ``(actual - nominal) . normal`` (the same convention as
 :func:`surfcomp.core.compensation.deviations.signed_deviation`); differences above ``deviation_tol``
-are warnings. A point without a point-profile value gets the computed deviation (a
-warning says so). When several point-profile values refer to one measured point (the
-CheckMate sample files carry the deviation and a second value 0 for every point) the
-first in file order is used, with a warning.
+are warnings, and values of the opposite sign of their points on half the points or more
+are refused, as a table's dev column is. A point without a point-profile value gets the
+computed deviation (a warning says so). When several point-profile values refer to one
+measured point (the CheckMate sample files carry the deviation and a second value 0 for
+every point) the first in file order is used, with a warning. A nominal point measured
+twice is refused, as in a table.
 
 Several parts
 -------------
@@ -71,6 +73,7 @@ from .measurement_set import (
     NORMAL_ZERO,
     MeasurementSet,
     check_coordinates,
+    check_duplicates,
 )
 from .qif_units import FileUnits
 
@@ -340,6 +343,7 @@ def read_qif(path, sample=None, units=None, deviation_tol=DEV_CHECK_TOL):
         ids, lines = pts["ids"], pts["lines"]
         check_coordinates(nominal, lines, doc.source)
         check_coordinates(measured, lines, doc.source)
+        check_duplicates(nominal, lines, doc.source)
         computed = np.einsum("ij,ij->i", measured - nominal, normal)
         deviation, from_file = _file_deviations(doc, mr, ufac, pts, computed, deviation_tol)
     check_coordinates(np.asarray(deviation, dtype=float)[:, None], lines, doc.source,
@@ -469,6 +473,18 @@ def _file_deviations(doc, mr, ufac, pts, computed, deviation_tol):
                  mr)
     diff = np.abs(deviation - computed)
     bad = np.flatnonzero(from_file & (diff > deviation_tol))
+    if bad.size and 2 * bad.size >= np.count_nonzero(from_file) and np.all(
+            np.abs(deviation[bad] + computed[bad]) <= deviation_tol):
+        # as for a table's dev column: whichever is right, the correction would go the
+        # wrong way for one of them
+        p = int(bad[0])
+        raise MeasurementFileError(
+            "%s: the file's deviation %.6f mm has the opposite sign of (actual - nominal) . "
+            "normal = %.6f mm, as on %d of the %d point-profile values (expected them to agree "
+            "within %g um: do the values measure along the inward normal? Correct the values "
+            "or the nominal normals)" % (ids[p], deviation[p], computed[p], bad.size,
+                                        np.count_nonzero(from_file), deviation_tol * 1e3),
+            file=doc.source, line=lines[p])
     for p in bad[:MAX_POINT_WARNINGS]:
         doc.warnings.append("%s:%d: %s: the file's deviation %.6f mm differs from (actual - "
                             "nominal) . normal = %.6f mm by %.1f um (expected at most %g um)"

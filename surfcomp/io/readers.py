@@ -41,13 +41,22 @@ def read_any(path, units="mm", fmt="auto", sample=None, deviation_units=None):
     -------
     surfcomp.io.measurements.MeasurementSet
     """
-    ms = _read_any(path, units, fmt, sample)
+    ms, kind = _read_any(path, units, fmt, sample)
     if (deviation_units is None or ms.deviation is None or "dev" not in (ms.columns or {})
             or unit_factor(deviation_units) == unit_factor(units or "mm")):
         return ms
+    if kind != "table":
+        # a QIF file's deviations are lengths of the file's own unit, as its points are:
+        # read in another unit, they would no longer match the points they were checked on
+        raise InputError(note(("deviation_units",), " %s applies to the deviation column of a "
+                              "table; this %s file gives its deviations in the unit of its "
+                              "points (%s; expected no " % (deviation_units, kind.upper(),
+                                                           ms.units),
+                              ("deviation_units",), ", or the same as ", ("units",), ")"),
+                         file=str(path))
     # the file again with the deviation's unit: the dev column as the reader scales it
     # (one with a unit of its own keeps it), the coordinates of the first reading
-    dev = _read_any(path, deviation_units, fmt, sample).deviation
+    dev = _read_any(path, deviation_units, fmt, sample)[0].deviation
     return dataclasses.replace(ms, deviation=dev, units="%s, deviation %s"
                                % (ms.units or units or "mm", deviation_units))
 
@@ -57,27 +66,28 @@ def _read_any(path, units, fmt, sample):
         raise MeasurementFileError("unknown format %r (expected one of %s)"
                                    % (fmt, ", ".join(FORMATS)), file=path)
     with read_once(path):
-        ms = _read(path, units, fmt, sample)
+        ms, kind = _read(path, units, fmt, sample)
         faces = face_column(ms)    # the same bytes as the points (read_once)
-    return ms if faces is None else dataclasses.replace(ms, faces=faces)
+    return (ms if faces is None else dataclasses.replace(ms, faces=faces)), kind
 
 
 def _read(path, units, fmt, sample):
+    """(the measurement set, the format it was read as: ``table`` or a point format)"""
     if fmt != "auto" and fmt != "table":
-        return read_point_file(path, fmt=fmt, units=units, sample=sample)
+        return read_point_file(path, fmt=fmt, units=units, sample=sample), fmt
     detected = "table" if fmt == "table" else detect_format(path)
     if detected not in ("xyz", "table"):
-        return read_point_file(path, fmt=detected, units=units, sample=sample)
+        return read_point_file(path, fmt=detected, units=units, sample=sample), detected
     if sample is not None:
         raise InputError("sample=%r applies to QIF files only, this is a table or XYZ file"
                          % (sample,), file=str(path))
     if fmt == "table":
-        return read_measurements(path, units=units)
+        return read_measurements(path, units=units), "table"
     try:
-        return read_measurements(path, units=units)
+        return read_measurements(path, units=units), "table"
     except MeasurementFileError as table_error:
         try:
-            return read_point_file(path, fmt="xyz", units=units)
+            return read_point_file(path, fmt="xyz", units=units), "xyz"
         except MeasurementFileError as xyz_error:
             # the reading that got further is the file's: a plain x y z file with a bad
             # value on line 7 is that, not a table whose header names no known column
@@ -88,7 +98,11 @@ def _read(path, units, fmt, sample):
 def read_measured(job):
     """The measurement set of a job (:class:`surfcomp.app.file_route.Job`: its
     ``measurements``, ``units``, ``fmt``, ``sample``, ``deviation_units``, ``plan``,
-    ``touches`` and ``options``): the file, joined to the plan when the job has one."""
+    ``touches`` and ``options``): the file, joined to the plan when the job has one.
+
+    The plan is in mm whatever ``units`` says (``plan`` writes it so, and the columns of a
+    plan written by hand may carry their own unit): ``units`` is the log's, which is in
+    inches when the program ran in G20 (a CAM post-processor set to inches)."""
     if job.plan is None and job.touches != 1:
         raise InputError(note(("touches",), " applies to a probe log read with a "
                               "measurement plan (", ("plan",), ")"))
@@ -98,4 +112,4 @@ def read_measured(job):
         return ms
     from .plan_join import join_plan, read_plan
 
-    return join_plan(read_plan(job.plan, job.units), ms, job.options, job.touches)
+    return join_plan(read_plan(job.plan), ms, job.options, job.touches)

@@ -230,7 +230,7 @@ VALUES = [
     _dev_all("all-deviations-1e308", "1e308", ("deviation 1e+308 mm", "225 point(s)")),
     _dev("one-deviation-1e10", "1e10", ("deviation 1e+10 mm",)),
     _dev_all("all-deviations-5mm", "5", ("deviation 5.0000 mm", "--max-offset 1 mm",
-                                        "--units um")),
+                                        "--deviation-units um")),
     _dev("one-deviation-1e400-overflows", "1e400", ("1e400",), ),
     _dev("one-deviation-nan", "nan", ("nan",)),
     _dev("one-deviation-inf", "-inf", ("-inf",)),

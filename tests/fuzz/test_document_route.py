@@ -75,7 +75,7 @@ CASES = [
     doc("one-deviation-1e308", setup=with_meas(lambda: I.csv_with({(7, "dev"): "1e308"})),
         file="m.csv", line=I.line_of(7), says=("is this the right file?",)),
     doc("all-deviations-5mm", setup=with_meas(lambda: I.csv_all("dev", "5")), file="m.csv",
-        line=I.line_of(0), says=("--units um",)),
+        line=I.line_of(0), says=("--deviation-units um",)),
     # malformed measurements
     doc("csv-text-in-a-number", setup=with_meas(lambda: I.csv_with({(1, "z_nom"): "abc"})),
         file="m.csv", line=I.line_of(1), says=("abc",)),

@@ -279,3 +279,19 @@ def test_rms_before_is_over_the_points_of_each_face():
     assert d["rms_before_um"] == pytest.approx({"A": 4000.0, "B": 3000.0, "C": 2000.0},
                                                abs=1e-6)
     assert max(d["rms_after_um"].values()) < 1e-6
+
+
+def test_rps_id_that_names_two_points_is_refused():
+    """Before: the last point of that id was taken without a word (a file whose ids repeat,
+    such as one point name per feature, aligned on whichever point came last)."""
+    pts = np.array([[5, 5, 0], [30, 8, 0], [12, 30, 0], [5, 0, 10], [30, 0, 20], [0, 20, 15.0],
+                    [20, 20, 0]])
+    ids = ["p1", "p2", "p3", "p4", "p5", "p6", "p1"]
+    spec = {"primary": ["p1", "p2", "p3"], "secondary": ["p4", "p5"], "tertiary": ["p6"]}
+    with pytest.raises(InputError) as exc:
+        rps_fit(pts, spec, corner(), ids=ids, source="rps.json")
+    assert str(exc.value) == ("rps.json: 3-2-1 primary: the id 'p1' names 2 points of the "
+                              "measurement file (points 1, 7; expected an id that names one "
+                              "point)")
+    _fit, idx = rps_fit(pts, spec, corner(), ids=ids[:6] + ["p7"])    # ids once each
+    assert list(idx) == [0, 1, 2, 3, 4, 5]

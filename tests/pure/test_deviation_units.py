@@ -2,6 +2,9 @@
 """The deviation column's unit apart from the coordinates' (issue 24, item 5): a file with
 coordinates in mm and deviations in um, both without a unit in the column name."""
 
+import os
+import re
+
 import numpy as np
 import pytest
 from numpy.testing import assert_allclose
@@ -61,3 +64,27 @@ def test_an_unknown_deviation_unit_is_refused(tmp_path):
                                          r"in, cm, m\)"):
         read_any(_file(tmp_path), units="mm", deviation_units="furlong")
     assert read_any(_file(tmp_path), units="cm").units == "cm"
+
+
+def test_a_qif_file_refuses_another_deviation_unit(tmp_path):
+    """A QIF file's deviations are in the unit of its points: read in another unit they
+    were scaled apart from the points they are checked against (and with FileUnits the
+    option was dropped while the report said 'deviation um')."""
+    from tests.conftest import ROOT
+
+    qif = os.path.join(ROOT, "tests", "data", "pointfiles", "two_parts_inch.qif")
+    with pytest.raises(InputError) as exc:
+        read_any(qif, deviation_units="um")
+    assert str(exc.value) == (
+        "%s: deviation_units um applies to the deviation column of a table; this QIF file "
+        "gives its deviations in the unit of its points (in; expected no deviation_units, or "
+        "the same as units)" % qif)
+    assert exc.value.options == ("deviation_units", "units")
+    with open(qif, encoding="utf-8") as fh:     # without FileUnits: read in units
+        text = re.sub(r"<FileUnits>.*?</FileUnits>", "", fh.read(), flags=re.S)
+    bare = tmp_path / "bare.qif"
+    bare.write_text(text.replace(' linearUnit="mm"', ""))
+    with pytest.raises(InputError, match="this QIF file gives its deviations"):
+        read_any(str(bare), units="mm", deviation_units="um")
+    ms = read_any(str(bare), units="um", deviation_units="um")
+    assert ms.units == "um" and abs(ms.deviation[0] - 1e-5) < 1e-15

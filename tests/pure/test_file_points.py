@@ -145,3 +145,19 @@ def test_measured_points_with_x_and_y_swapped_are_reported(face):
 def test_the_spread_limit_is_the_size_tolerance(spread, warned):
     d = np.array([-1.0, 0.0, 1.0]) * spread        # sample standard deviation = spread
     assert (pl.spread_warning(d, 100.0) is not None) is warned
+
+
+def test_a_dev_column_in_um_is_pointed_to_deviation_units(face):
+    """Before: the hint said units um, which scales the coordinates as well (the points then
+    lie 1000 times nearer the origin and are refused as another unit); a dev column's own
+    unit is deviation_units."""
+    s, nominal, normal, dev = face
+    with pytest.raises(MeasurementFileError) as exc:
+        run(s, nominal=nominal, normal=normal, deviation=1e3 * dev, columns={"dev": "dev"})
+    assert exc.value.message.endswith("are the deviations in um? Give the unit "
+                                      "(deviation_units um, or a column name like 'dev [um]')")
+    assert exc.value.options == ("max_offset", "deviation_units")
+    # a deviation not read from a dev column (a hand-built set): the unit of the values
+    with pytest.raises(MeasurementFileError) as exc:
+        run(s, nominal=nominal, normal=normal, deviation=1e3 * dev)
+    assert "(units um, or" in exc.value.message

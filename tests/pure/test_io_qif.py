@@ -291,3 +291,35 @@ def test_no_surface_points(tmp_path):
     err = qif_error(str(p))
     assert err.line == 71
     assert "holds no surface points" in err.message and "4 EdgePoint" in err.message
+
+
+def test_values_against_their_own_points_on_most_points_are_refused(tmp_path):
+    """As a table's dev column: the real sample with every point-profile value's sign
+    turned over was read with a warning per point, and compensated the wrong way."""
+    with open(ONE, encoding="utf-8") as fh:
+        text = fh.read()
+    p = tmp_path / "flipped.qif"
+    p.write_text(re.sub(r"<Value>(-?)([^<]*)</Value>",
+                        lambda m: "<Value>%s%s</Value>" % ("" if m.group(1) else "-", m.group(2)),
+                        text), encoding="utf-8")
+    err = qif_error(str(p))
+    assert str(err) == (
+        "%s:1031: W1RFSMRA05: the file's deviation -0.274419 mm has the opposite sign of "
+        "(actual - nominal) . normal = 0.274419 mm, as on 13 of the 13 point-profile values "
+        "(expected them to agree within 1 um: do the values measure along the inward normal? "
+        "Correct the values or the nominal normals)" % p)
+    # one value turned over of two, the other off by 8 um: reported, not refused
+    ms = read_qif(variant(tmp_path, "<Value>0.01</Value>", "<Value>-0.01</Value>"))
+    assert_allclose(ms.deviation, [-0.254, 0.5], rtol=0, atol=1e-12)
+    assert sum("differs from (actual - nominal)" in w for w in ms.warnings) == 2
+
+
+def test_a_nominal_point_measured_twice_is_refused(tmp_path):
+    """As in a table: the second measurement of P1 made two rows of one nominal point, which
+    the grid search read as a fold."""
+    path = variant(tmp_path, "<FeatureItemId>5</FeatureItemId>",
+                   "<FeatureItemId>3</FeatureItemId>")
+    err = qif_error(path)
+    assert str(err) == ("%s:77: nominal point (25.4, 50.8, 76.2) mm is given again; first on "
+                        "line 73 (expected each nominal point once; 1 duplicate pair(s) in all)"
+                        % path)

@@ -114,3 +114,21 @@ def test_fanuc_dprnt_output_reads_as_a_probe_log(tmp_path):
     joined = join_plan(plan, ms, Options(tip_radius=R))
     dev = np.einsum("ij,ij->i", joined.measured - joined.nominal, joined.normal) - R
     assert_allclose(dev, d, atol=1e-4)       # 4 decimals
+
+
+def test_an_inch_log_is_joined_to_the_plan_in_mm(tmp_path):
+    """``units`` is the log's (a program posted in G20 logs inches): the plan stays in mm,
+    as ``plan`` writes it; it used to be scaled by 25.4 with the log, and every line was
+    refused as 'not from this plan's program'."""
+    from surfcomp.app.file_route import Job
+    from surfcomp.io.readers import read_measured
+
+    P, N = write_plan(tmp_path / "plan.csv")
+    d = np.array([0.01, -0.02, 0.0, 0.005, 0.03, -0.01])
+    write_log(tmp_path / "probe.log", (P + (R + d)[:, None] * N) / 25.4)
+    job = Job(nominal="n.step", measurements=str(tmp_path / "probe.log"), units="in",
+              plan=str(tmp_path / "plan.csv"), options=Options(tip_radius=R))
+    ms = read_measured(job)
+    assert ms.units == "in"
+    assert_allclose(ms.nominal, P, atol=1e-9)
+    assert_allclose(np.einsum("ij,ij->i", ms.measured - P, N) - R, d, atol=2e-5)

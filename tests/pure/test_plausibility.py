@@ -104,6 +104,22 @@ def test_points_in_another_length_unit_are_refused_naming_it(scale, unit):
     assert prepare(surf, 1, ms, Options(method="raw")).deviation.size == 81
 
 
+def test_a_table_in_another_unit_is_pointed_to_its_nominal_column():
+    """A table's nominal points in metres: the hint named 'x [m]', which a table refuses (x
+    alone: nominal or measured?); it names 'x_nom [m]'."""
+    from surfcomp.core.compensation.pipeline import Options, prepare
+    from surfcomp.errors import InputError
+    from surfcomp.io.measurements import MeasurementSet
+
+    surf, pts = _flat_face_and_points(1000.0)
+    ms = MeasurementSet(nominal=pts, normal=np.tile([0.0, 0.0, 1.0], (len(pts), 1)),
+                        deviation=np.zeros(len(pts)), lines=np.arange(len(pts)) + 2,
+                        source="f.csv")
+    with pytest.raises(InputError, match=r"not mm \(give the unit: a column name like "
+                                         r"'x_nom \[m\]'\)$"):
+        prepare(surf, 1, ms, Options(method="raw"))
+
+
 @pytest.mark.parametrize("corner, size", [((0.0, 0.0), 5.0), ((60.0, 30.0), 5.0),
                                           ((0.2, 0.2), 0.5)])
 def test_a_small_patch_measured_in_mm_is_no_unit_mistake(corner, size):

@@ -207,7 +207,8 @@ def prepare(surface, outward, ms, options=None, progress=None):
     # first: points in inches or metres near the origin can pass as on the face, or fail
     # as beyond its border, which would not say why
     mistake = plausibility.unit_mistake(surface, base, options.max_offset, project,
-                                        getattr(ms, "units", None) or "mm")
+                                        getattr(ms, "units", None) or "mm",
+                                        "x" if ms.nominal is None else "x_nom")
     if mistake:
         raise InputError(mistake, file=ms.source, options=("units",))
     _check_on_face(ms, base, proj, dist, options)
@@ -311,15 +312,17 @@ def _check_deviations(ms, d, options):
         return
     size = np.where(np.isfinite(d[bad]), np.abs(d[bad]), np.inf)
     k = bad[np.argmax(size)]
-    hint = ("are the deviations in um? Give the unit (units um, or a column name like "
-            "'dev [um]')" if np.isfinite(d[k]) and np.abs(d[k]) < 1e5 * allowed
+    # a dev column's own unit is deviation_units: units would scale the coordinates too
+    unit = "deviation_units" if "dev" in (ms.columns or {}) else "units"
+    hint = ("are the deviations in um? Give the unit (%s um, or a column name like "
+            "'dev [um]')" % unit if np.isfinite(d[k]) and np.abs(d[k]) < 1e5 * allowed
             else "is this the right file?")
     # 4 decimals as the other messages, but no 300-digit number for 1e308
     shown = "%.4f" % d[k] if np.abs(d[k]) < 1e6 else "%.6g" % d[k]
     raise _err(ms, k, "deviation %s mm (expected at most %s %g mm%s; %d point(s) "
                "exceed it): %s" % (shown, option_name(options, "max_offset"), options.max_offset,
                                     " + stock" if options.method == "mirror" else "",
-                                    bad.size, hint), ("max_offset", "units"))
+                                    bad.size, hint), ("max_offset", unit))
 
 
 def _check_units(surface, d, warnings, source):

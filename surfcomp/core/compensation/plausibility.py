@@ -157,9 +157,10 @@ def face_samples(surface, n=9):
                                  np.linspace(*surface.v_range, n)).reshape(-1, 3)
 
 
-def unit_mistake(surface, points, max_offset, project, read_as="mm"):
+def unit_mistake(surface, points, max_offset, project, read_as="mm", column="x"):
     """Why the ``points`` (N, 3, mm as read in the unit ``read_as``) are in another length
-    unit than the one they were read in, or None.
+    unit than the one they were read in, or None. ``column``: the name of their x column
+    the message shows with a unit (``x_nom`` in a table: ``x`` alone is refused there).
 
     Only points that span less than :data:`SMALL_SPAN` of the face's extent (the diagonal
     of the bounding boxes) are tried: scaled by each factor of :data:`UNIT_SCALES`, at
@@ -189,8 +190,8 @@ def unit_mistake(surface, points, max_offset, project, read_as="mm"):
         if unit is None:
             give = "give the coordinates' unit"
         else:
-            give = "give the unit: %sa column name like 'x [%s]'" % (
-                "units %s, or " % unit if unit in INPUTS["units"].choices else "", unit)
+            give = "give the unit: %sa column name like '%s [%s]'" % (
+                "units %s, or " % unit if unit in INPUTS["units"].choices else "", column, unit)
         return ("the %d points span %.4g mm where the face spans %.4g mm, and multiplied "
                 "by %g they lie on it: the file's coordinates are in %s, not %s (%s)"
                 % (len(pts), span, face, factor,

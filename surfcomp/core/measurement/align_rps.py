@@ -34,7 +34,11 @@ def point_indices(spec, ids, n, source=None):
     if not isinstance(spec, dict):
         raise InputError("a 3-2-1 set must name its points as {\"primary\": [3 ids], "
                          "\"secondary\": [2 ids], \"tertiary\": [1 id]}", file=source)
-    lookup = None if ids is None else {str(i): k for k, i in enumerate(ids)}
+    lookup = None
+    if ids is not None:
+        lookup = {}
+        for k, i in enumerate(ids):
+            lookup.setdefault(str(i).strip(), []).append(k)
     out = {}
     for group, size in GROUPS:
         got = spec.get(group)
@@ -56,7 +60,13 @@ def _index(x, lookup, n, group, source):
         if key not in lookup:
             raise InputError("3-2-1 %s: no point with the id %r in the measurement file"
                              % (group, key), file=source)
-        return lookup[key]
+        if len(lookup[key]) > 1:
+            # which of them the fit should take, the file does not say
+            raise InputError("3-2-1 %s: the id %r names %d points of the measurement file "
+                             "(points %s; expected an id that names one point)"
+                             % (group, key, len(lookup[key]),
+                                ", ".join(str(k + 1) for k in lookup[key][:5])), file=source)
+        return lookup[key][0]
     if not key.isdigit() or not 1 <= int(key) <= n:
         raise InputError("3-2-1 %s: %r is not a point number 1 .. %d (the measurement file "
                          "has no point ids)" % (group, key, n), file=source)
