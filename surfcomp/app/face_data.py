@@ -69,6 +69,15 @@ class FaceData:
     boundary: list = None
 
 
+def geometry_box(shape):
+    """The bounding box of ``shape``'s geometry, as it is for the shape read from its file:
+    measured on a copy, without the triangulation the GUI draws or a CAM operation meshes
+    on the shape itself (with one, OCCT bounds the mesh instead: the example face's box is
+    64.28 mm across, not 64.42 mm, so a region's field radius, a share of it, differed
+    between the GUI and the command line)."""
+    return shape.copy().BoundBox
+
+
 def surface_type(face):
     """The face's surface type (``'BSplineSurface'``, ``'Plane'``, ...), or None when
     OpenCASCADE holds no surface for it (a B-spline read with a degree above its limit)."""

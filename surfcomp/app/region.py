@@ -27,7 +27,7 @@ from ..core.surface.projection import Projector
 from ..core.surface.trimmed import area_samples, inside  # noqa: F401  (region.inside)
 from ..errors import GeometryError, InputError
 from .convert import surface_from_part
-from .face_data import to_bspline_face, work_surface
+from .face_data import geometry_box, to_bspline_face, work_surface
 from .nominal import boundary_polylines
 
 #: nominal edges of two faces closer than this (mm) are one shared edge
@@ -158,7 +158,7 @@ def _sample_distances(faces, base, max_offset, n=200):
     low = np.full((len(faces), len(base)), np.inf)
     near = np.full((len(faces), len(base)), np.inf)
     for i, f in enumerate(faces):
-        bb = f.face.BoundBox
+        bb = geometry_box(f.face)
         idx = np.flatnonzero(np.all((base >= np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset)
                                     & (base <= np.array([bb.XMax, bb.YMax, bb.ZMax])
                                        + max_offset), axis=1))
@@ -324,7 +324,7 @@ def shared_edges(shape, faces, all_faces=False, angles=True):
     def of(k):      # a face's box and (edge, degenerated, length), read from OCC once
         if k not in edges:
             g = shape_faces[k]
-            boxes[k] = g.BoundBox
+            boxes[k] = geometry_box(g)
             edges[k] = [(e, e.Degenerated, e.Length) for e in g.Edges]
         return boxes[k], edges[k]
 

@@ -23,6 +23,7 @@ import numpy as np
 from ..core.surface.bspline import derivatives
 from ..core.surface.trimmed import inside
 from ..errors import GeometryError
+from .face_data import geometry_box
 from .region import run_direction, shared_edges
 
 #: parameter samples per direction for the enclosed volume
@@ -42,7 +43,7 @@ def _agree(faces, edges):
 def _volume(faces, flip, members):
     """Enclosed volume (mm^3) of the faces ``members`` with the outward signs ``flip``
     applied (positive: the normals point out)."""
-    pts = np.concatenate([np.array(tuple(faces[i].face.BoundBox.Center))[None]
+    pts = np.concatenate([np.array(tuple(geometry_box(faces[i].face).Center))[None]
                           for i in members])
     c = np.mean(pts, axis=0)
     total = 0.0

@@ -26,6 +26,7 @@ import numpy as np
 from ..core.limits import NIL_INTEGRAL
 from ..errors import GeometryError
 from . import retrim
+from .face_data import geometry_box
 from .shapes import _nearest, _oriented, rebuild_face, replacement_pairs
 from .volumes import volume_change
 
@@ -182,7 +183,7 @@ def closed_solid(shape, faces, integral, label="faces"):
     if problems:
         raise GeometryError("the corrected region does not give a valid solid (%s)"
                             % ", ".join(problems))
-    bb = shape.BoundBox
+    bb = geometry_box(shape)
     centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
     change = 0.0
     for f, plan in zip(faces, plans):

@@ -20,6 +20,7 @@ from ..io.atomic import Transaction, check_outputs
 from ..io.readers import read_any
 from ..io.report import json_values
 from . import fcenv, region, region_retrim
+from .face_data import geometry_box
 from .file_route import cad_format
 from .region_orient import orient
 from .region_project import per_face
@@ -165,7 +166,7 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
                                 radius, max_offset, lines, measurements, names)
     filtered = dev if method == "raw" else region_field.mask_filter_3d(
         pts, dev, mask_size, mask_kind, sigma, step)
-    bb = shape.BoundBox
+    bb = geometry_box(shape)
     field_radius = smoothing or max(4.0 * step, region.FIELD_SHARE * bb.DiagonalLength)
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
@@ -249,7 +250,7 @@ def dropped_text(dropped):
 
 def _near(face, base, max_offset):
     """True when a point lies in the face's bounding box widened by ``max_offset``."""
-    bb = face.BoundBox
+    bb = geometry_box(face)
     lo = np.array([bb.XMin, bb.YMin, bb.ZMin]) - max_offset
     hi = np.array([bb.XMax, bb.YMax, bb.ZMax]) + max_offset
     return bool(np.any(np.all((base >= lo) & (base <= hi), axis=1)))

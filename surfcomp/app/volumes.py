@@ -21,6 +21,7 @@ import numpy as np
 
 from ..core.surface import bspline
 from ..core.surface.trimmed import MAX_KNOTS, correction_integral, domain_integral, knots_of
+from .face_data import geometry_box
 from .nominal import boundary_polylines
 from .retrim import KEPT
 
@@ -76,7 +77,7 @@ def _strip_flux(p, centre, samples):
     speed = np.linalg.norm(deriv, axis=1)
     across = np.cross(normals, deriv / speed[:, None])
     k = len(ts) // 2
-    step = min(0.01, 1e-3 * g.BoundBox.DiagonalLength)
+    step = min(0.01, 1e-3 * geometry_box(g).DiagonalLength)
     probe = FreeCAD.Vector(*(old[k] + step * across[k]))
     if not g.isPartOfDomain(*g.Surface.parameter(probe)):
         across = -across
@@ -109,7 +110,7 @@ def volume_change(nominal, corrected, new_face, plan, centre=None):
     new_lines = boundary_polylines(new_face)
     box = _box(old_lines, new_lines)
     if centre is None:
-        bb = nominal.bspline_face.BoundBox
+        bb = geometry_box(nominal.bspline_face)
         centre = np.array([bb.Center.x, bb.Center.y, bb.Center.z])
     knots = knots_of(nominal.surface, corrected)
     panels = 16
