@@ -417,10 +417,15 @@ class _Parser:
         if bad.size:
             k = int(bad[0])
             ends = sep is not None and rows[k].rstrip().endswith(sep) and counts[k] > expected
+            # 1,5 in a comma-separated row: decimal commas split each number in two
+            decimal = sep == "," and 1.5 * expected <= counts[k] <= 2 * expected and not ends
             raise self.error("the row has %d fields but the header on line %d has %d (expected %d "
                              "fields separated by %s%s)"
                              % (counts[k], h + 1, expected, expected, _SEP_NAMES[sep],
-                                "; the row ends with a separator" if ends else ""), data[k])
+                                "; the row ends with a separator" if ends else
+                                "; decimal commas? between comma-separated fields numbers need "
+                                "a decimal point (or separate the fields by ';' or tabs)"
+                                if decimal else ""), data[k])
 
     def _first_row_with(self, char, rows, numeric):
         """(row index, column, field) of the first numeric field containing ``char``, or None."""

@@ -494,6 +494,16 @@ def test_ragged_rows(row, found, extra):
     assert extra in e.message
 
 
+def test_decimal_commas_between_commas_are_named():
+    """A comma-separated file written with decimal commas (a European locale) splits every
+    number in two: the message says what the fields need."""
+    e = parse_error(nnd_text() + "1,5,1,25,3,0,0,0,0,1,0,012\n")
+    assert e.line == 6 and "has 12 fields but the header on line 1 has 7" in e.message
+    assert "decimal commas? between comma-separated fields numbers need a decimal point" \
+        in e.message
+    assert "decimal commas" not in parse_error(nnd_text() + "1,1,1,0,0,1,0.1,9\n").message
+
+
 def test_ragged_rows_with_blanks():
     e = parse_error(nnd_text(" ") + "1 1 1 0 0 1\n")
     assert e.line == 6 and "has 6 fields but the header on line 1 has 7" in e.message
