@@ -162,3 +162,24 @@ def test_no_claim_without_moves(shop):
     assert op.Probes in (0, 16)
     with pytest.raises(InputError, match=r"tool 0: expected a whole number from 1 to 9999"):
         add_probe_operation(job, plan, tool=0)
+
+
+def test_replacing_the_nominal_leaves_the_plan_on_it(shop):
+    from surfcomp.app import replace
+
+    job = shop.getObject("Job")
+    block = shop.getObject("Block")
+    plan = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="3x3")
+    progress.recompute_with_progress(shop, "test")
+    add_probe_operation(job, plan)
+    before = plan_arrays(plan)[0]
+    mirror = shop.addObject("Part::Mirroring", "Mirror")     # a user the replace rebinds
+    mirror.Source = block
+    changed = replace.replace(shop, shop.getObject("Round1"))
+    progress.recompute_with_progress(shop, "test")
+    # the plan's points are nominal points: deviations are against the nominal, never
+    # against the corrected face (which lies up to 29 um from it here)
+    assert [tuple(c) for c in changed] == [("Mirror", "Source")]
+    assert plan.Nominal is block
+    np.testing.assert_allclose(plan_arrays(plan)[0], before, atol=1e-12, rtol=0)
+    assert post_probe_job(job, "linuxcnc", POST_ARGS).count("G38.2") == 9
