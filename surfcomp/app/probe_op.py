@@ -21,8 +21,11 @@ point: the second touch of ``plan --program`` backs off from ``#5061``-``#5063``
 CAM command cannot hold.
 
 The operation depends on the plan through its link, so it recomputes when the plan does.
-A plan without points, or one that cannot be probed, fails the recompute with the reason
-and leaves an empty ``Path`` (never the moves of an older plan). No FreeCADGui.
+A plan without points, or one that cannot be probed, or a tool controller that is not the
+plan's probe (spindle on, another ball), fails the recompute with the reason and leaves an
+empty ``Path`` (never the moves of an older plan). :func:`post_probe_job` also refuses a
+Job that machines in another work offset or several, an inch post and two operations
+logging to one file. No FreeCADGui.
 """
 
 import Path
@@ -106,11 +109,32 @@ def probe_moves(op):
     plan = op.Plan
     if plan is None:
         raise InputError("probe operation %s has no measurement plan (Plan)" % op.Label)
+    check_probe_tool(op.ToolController, plan)
     if not len(plan.PlanPoints):
         raise InputError("measurement plan %s holds no point to probe (%d placed, %s)"
                          % (plan.Label, plan.Placed, "; ".join(plan.Dropped) or "none kept"))
     return probe_path(list(plan.PointIds), [tuple(p) for p in plan.PlanPoints],
                       [tuple(n) for n in plan.PlanNormals], settings_of(op))
+
+
+def check_probe_tool(tc, plan):
+    """Refuse a tool controller that is not the plan's probe: one that turns the spindle
+    (the post would probe with it running) or whose tool is not the plan's ball (the
+    program's tip centres are the plan's tip radius out along the normal)."""
+    if tc is None:
+        return
+    if str(tc.SpindleDir) != "None" and float(tc.SpindleSpeed) > 0.0:
+        raise InputError("tool controller %s turns the spindle (%s, %g rpm): the probe "
+                         "moves would run with it turning (expected a probe's tool "
+                         "controller, SpindleDir None)"
+                         % (tc.Label, tc.SpindleDir, float(tc.SpindleSpeed)))
+    want = 2.0 * float(plan.TipRadius)
+    have = getattr(getattr(tc, "Tool", None), "Diameter", None)
+    if have is not None and abs(float(have) - want) > 1e-6:
+        raise InputError("tool controller %s's tool is %g mm across, but measurement plan %s "
+                         "has TipRadius %g mm (expected a %g mm ball: the program's "
+                         "positions are the tip centres of that ball)"
+                         % (tc.Label, float(have), plan.Label, float(plan.TipRadius), want))
 
 
 def path_commands(path, settings, label):
@@ -157,7 +181,8 @@ def compute_probe_operation(obj):
 
 def probe_tool_controller(job, tool, tip_radius):
     """The job's tool controller of tool number ``tool``, or a new one with the probe bit
-    (ball diameter ``2 * tip_radius``, spindle off)."""
+    (ball diameter ``2 * tip_radius``, spindle off). A tool controller found by its number
+    is the caller's to check (:func:`check_probe_tool`)."""
     for tc in job.Tools.Group:
         if int(tc.ToolNumber) == int(tool):
             return tc
@@ -189,6 +214,7 @@ def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", check=True,
     ProbeSettings(tool=tool, safe_z=0.0).validate()
     doc = job.Document
     tc = probe_tool_controller(job, tool, plan.TipRadius)
+    check_probe_tool(tc, plan)
     op = doc.addObject("Path::FeaturePython", name)
     ProbeOperation(op)
     op.ToolController = tc
@@ -219,48 +245,85 @@ def recompute_probing(op):
 
 
 def check_recomputed(op):
-    """Raise InputError with the reason when ``op`` (or its plan) failed to recompute or is
-    out of date (its moves would be those of an older plan)."""
+    """Raise InputError with the reason when ``op``, its plan or an object the plan depends
+    on (its nominal) failed to recompute or is out of date (its moves would be those of an
+    older plan), or when its tool controller is not the plan's probe
+    (:func:`check_probe_tool`)."""
     if op.Plan is None:
         raise InputError("probe operation %s has no measurement plan (Plan)" % op.Label)
     for obj in (op.Plan, op):
         if "Invalid" in obj.State or "Error" in obj.State:
             raise InputError("%s did not recompute: %s" % (obj.Label, progress.state_text(obj)))
-        if "Touched" in obj.State:
-            raise InputError("%s is out of date: recompute the document before posting "
-                             "(its probe moves would be those of an older plan)" % obj.Label)
+    for obj in (op.Plan, op, *op.Plan.OutListRecursive):
+        if not {"Touched", "Invalid", "Error"}.isdisjoint(obj.State):
+            what = "" if obj in (op.Plan, op) else ", the input of %s," % op.Plan.Label
+            raise InputError("%s%s is out of date: recompute the document before posting "
+                             "(the probe moves of %s would be those of an older plan)"
+                             % (obj.Label, what, op.Label))
+    check_probe_tool(op.ToolController, op.Plan)
     if op.Probes != len(op.Plan.PlanPoints):
         raise InputError("%s holds %d probe moves for %d plan points"
                          % (op.Label, op.Probes, len(op.Plan.PlanPoints)))
 
 
+def check_job(job, ops):
+    """Refuse probe operations ``ops`` of ``job`` that would probe in another work offset
+    than the Job machines in, or whose logs would overwrite each other: LinuxCNC opens the
+    ``PROBEOPEN`` file anew (truncated) each time."""
+    fixtures = list(job.Fixtures)
+    for op in ops:
+        if fixtures != [op.WorkOffset]:
+            raise InputError(
+                "%s probes in %s (its WorkOffset) but Job %s machines in %s: the program "
+                "would probe %s (expected the Job's one fixture to be %s; the probe log of "
+                "several fixtures would be overwritten by each pass)"
+                % (op.Label, op.WorkOffset, job.Label, ", ".join(fixtures) or "no fixture",
+                   "another part's offset" if len(fixtures) < 2 else
+                   "the %s part once per fixture" % op.WorkOffset, op.WorkOffset))
+    seen = {}
+    for op in ops:
+        name = op.LogFile or "probe.log"
+        if name in seen:
+            raise InputError("%s and %s both log to %s: the second PROBEOPEN would overwrite "
+                             "the first plan's log (expected a LogFile of its own for each "
+                             "probe operation)" % (seen[name].Label, op.Label, name))
+        seen[name] = op
+
+
 def post_probe_job(job, post="linuxcnc", args="--no-show-editor", native=False):
     """Post ``job`` with its post-processor and check that every active probe operation's
-    moves are in the program: ``G38.2`` lines and ``PROBEOPEN``/``PROBECLOSE`` comments, once
-    per fixture. Returns the program text. ``native``: through FreeCAD's own Post Process
-    command (:func:`surfcomp.app.cam.native_post`) instead of
-    :func:`surfcomp.app.cam_job.post_process`.
+    moves are in the program: ``G38.2`` lines and ``PROBEOPEN``/``PROBECLOSE`` comments, in
+    the Job's one fixture, the operation's work offset (:func:`check_job`), in mm. Returns
+    the program text. ``native``: through FreeCAD's own Post Process command
+    (:func:`surfcomp.app.cam.native_post`) instead of :func:`surfcomp.app.cam_job.post_process`.
 
     Raises
     ------
     GCodeError
         The post failed, or the program lacks probe moves or log comments (e.g. posted
-        with ``--no-comments``: LinuxCNC would probe and log nothing).
+        with ``--no-comments``: LinuxCNC would probe and log nothing), or is in inches.
+    InputError
+        An operation or its inputs out of date, or :func:`check_job` refuses the Job.
     """
     ops = [op for op in cam_job.operations_of(job)
            if is_probe_operation(op) and getattr(op, "Active", True)]
     for op in ops:
         check_recomputed(op)
+    check_job(job, ops)
     text = cam.native_post(job, post, args) if native else cam_job.post_process(job, post, args)
     words = [ln.split() for ln in text.splitlines()]
     words = [w[1:] if w and w[0].startswith("N") else w for w in words]
-    fixtures = max(1, len(job.Fixtures))
-    want = {"G38.2": sum(op.Probes for op in ops) * fixtures,
-            "(PROBEOPEN": len(ops) * fixtures, "(PROBECLOSE)": len(ops) * fixtures}
+    want = {"G38.2": sum(op.Probes for op in ops),
+            "(PROBEOPEN": len(ops), "(PROBECLOSE)": len(ops)}
     got = {key: sum(1 for w in words if w and w[0] == key) for key in want}
     if got != want:
         raise GCodeError("post-processor %r (arguments %r) wrote %s where the probe "
                          "operations need %s" % (post, args, _counts(got), _counts(want)))
+    if ops and any("G20" in w for w in words):
+        raise GCodeError("post-processor %r (arguments %r) wrote an inch program (G20): "
+                         "LinuxCNC would log the probe's trip points in inches, and the log "
+                         "is joined to the plan's points in mm (expected a metric post, "
+                         "without --inches)" % (post, args))
     return text
 
 

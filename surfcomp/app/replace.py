@@ -20,6 +20,7 @@ import json
 
 from ..errors import GeometryError, InputError
 from . import cam, features
+from .plan_feature import PLAN_TYPE
 from .undo import UndoStep
 
 #: properties never rebound: group membership and the compensation's own inputs
@@ -146,7 +147,10 @@ def plan(doc, comp):
     clones = set()
     changes = []
     for o in doc.Objects:
-        if o is comp or _replaces(o) or features.is_measurement(o):
+        # measurements and measurement plans stay with the nominal: deviations are
+        # against it, never against the corrected face
+        if o is comp or _replaces(o) or features.is_measurement(o) or \
+                features.is_type(o, PLAN_TYPE):
             continue
         for prop in o.PropertiesList:
             kind = None if prop in SKIP_PROPERTIES else _kind(o.getTypeIdOfProperty(prop))

@@ -106,6 +106,9 @@ def test_the_operation_follows_the_plan(shop, tmp_path):
     op = add_probe_operation(job, plan)
     plan.Count = "3x3"
     plan.TipRadius = 2.0
+    # the probe's ball follows the plan's (the tool controller of another ball is refused:
+    # test_the_probe_is_the_plans_ball)
+    op.ToolController.Tool.Diameter = 4.0
     # a plan changed but not recomputed: the operation's moves are the old plan's, and the
     # post says so instead of writing them
     with pytest.raises(InputError, match="MeasurementPlan is out of date"):
@@ -162,3 +165,111 @@ def test_no_claim_without_moves(shop):
     assert op.Probes in (0, 16)
     with pytest.raises(InputError, match=r"tool 0: expected a whole number from 1 to 9999"):
         add_probe_operation(job, plan, tool=0)
+
+
+def test_the_probe_is_the_plans_ball(shop, tmp_path):
+    job = shop.getObject("Job")
+    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
+                                 Count="3x3")
+    progress.recompute_with_progress(shop, "test")
+    # tool 1 is the Job's ball end mill: its spindle turns at 10000 rpm, so the probe moves
+    # would run with it turning (the post wrote no M5 and no tool change before G38.2)
+    with pytest.raises(InputError, match=r"TC: Ball end 6 mm turns the spindle \(Forward, "
+                                         r"10000 rpm\)"):
+        add_probe_operation(job, plan, tool=1)
+    assert not any(is_probe_operation(o) for o in job.Operations.Group)
+    op = add_probe_operation(job, plan)
+    # the plan's ball changes, the probe's does not: the program's tip centres would be
+    # those of a 4 mm ball probed with a 2 mm one
+    plan.TipRadius = 2.0
+    progress.recompute_with_progress(shop, "test")
+    with pytest.raises(InputError, match=r"TC: Probe T99's tool is 2 mm across, but "
+                                         r"measurement plan MeasurementPlan has TipRadius 2 mm "
+                                         r"\(expected a 4 mm ball"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    op.ToolController.Tool.Diameter = 4.0
+    progress.recompute_with_progress(shop, "test")
+    assert op.Probes == 9 and post_probe_job(job, "linuxcnc", POST_ARGS).count("G38.2") == 9
+    # a spindle turned on after the operation was made: refused at the post
+    op.ToolController.SpindleDir = "Forward"
+    op.ToolController.SpindleSpeed = 1000.0
+    with pytest.raises(InputError, match="turns the spindle"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+
+
+def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
+    job = shop.getObject("Job")
+    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
+                                 Count="3x3")
+    progress.recompute_with_progress(shop, "test")
+    op = add_probe_operation(job, plan)
+    # two fixtures: each pass would probe the G54 part (the operation's own G54) and the
+    # second PROBEOPEN would overwrite the first log
+    job.Fixtures = ["G54", "G55"]
+    with pytest.raises(InputError, match=r"ProbePlan probes in G54 \(its WorkOffset\) but "
+                                         r"Job Job machines in G54, G55"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    # the Job moved to G55 after the operation was added: the part would be probed in G54
+    job.Fixtures = ["G55"]
+    with pytest.raises(InputError, match="machines in G55: the program would probe another "
+                                         "part's offset"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    op.WorkOffset = "G55"
+    progress.recompute_with_progress(shop, "test")
+    text, probes, _worst = posted_probes(job, plan, op, tmp_path, "g55.ngc")
+    lines = [ln.strip() for ln in text.splitlines()]
+    k = lines.index("(PROBEOPEN probe.log)")
+    assert len(probes) == 9 and "G55" in lines[k - 3:k] and "G54" not in lines
+    # an inch post: LinuxCNC would log the trip points in inches, joined to a plan in mm
+    with pytest.raises(GCodeError, match=r"wrote an inch program \(G20\)"):
+        post_probe_job(job, "linuxcnc", POST_ARGS + " --inches")
+
+
+def test_no_post_of_a_stale_or_overwritten_log(shop):
+    job = shop.getObject("Job")
+    block = shop.getObject("Block")
+    plan = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="3x3")
+    progress.recompute_with_progress(shop, "test")
+    add_probe_operation(job, plan)
+    safe = plan.SafeZ
+    # the nominal moved but the document was not recomputed: the plan is not touched
+    # itself, yet its points are those of the old nominal
+    shape = block.Shape.copy()
+    shape.translate(FreeCAD.Vector(0, 0, 1))
+    block.Shape = shape
+    with pytest.raises(InputError, match=r"Block, the input of MeasurementPlan, is out of "
+                                         r"date: recompute the document"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    progress.recompute_with_progress(shop, "test")
+    assert abs(plan.SafeZ - (safe + 1.0)) < 1e-6
+    # a second plan logging to the same file would overwrite the first one's log
+    plan2 = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="2x2")
+    progress.recompute_with_progress(shop, "test")
+    op2 = add_probe_operation(job, plan2, name="ProbeTwo")
+    with pytest.raises(InputError, match=r"ProbePlan and ProbeTwo both log to probe.log"):
+        post_probe_job(job, "linuxcnc", POST_ARGS)
+    op2.LogFile = "probe2.log"
+    progress.recompute_with_progress(shop, "test")
+    text = post_probe_job(job, "linuxcnc", POST_ARGS)
+    assert text.count("G38.2") == 13 and "(PROBEOPEN probe2.log)" in text
+
+
+def test_replacing_the_nominal_leaves_the_plan_on_it(shop):
+    from surfcomp.app import replace
+
+    job = shop.getObject("Job")
+    block = shop.getObject("Block")
+    plan = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="3x3")
+    progress.recompute_with_progress(shop, "test")
+    add_probe_operation(job, plan)
+    before = plan_arrays(plan)[0]
+    mirror = shop.addObject("Part::Mirroring", "Mirror")     # a user the replace rebinds
+    mirror.Source = block
+    changed = replace.replace(shop, shop.getObject("Round1"))
+    progress.recompute_with_progress(shop, "test")
+    # the plan's points are nominal points: deviations are against the nominal, never
+    # against the corrected face (which lies up to 29 um from it here)
+    assert [tuple(c) for c in changed] == [("Mirror", "Source")]
+    assert plan.Nominal is block
+    np.testing.assert_allclose(plan_arrays(plan)[0], before, atol=1e-12, rtol=0)
+    assert post_probe_job(job, "linuxcnc", POST_ARGS).count("G38.2") == 9
