@@ -21,7 +21,7 @@ def test_points_on_the_face_and_off_it(fresh_doc):
     errors, _ = precheck.check_on_face(nom, "Face1", read_any(EXAMPLE_CSV, units="um"))
     assert errors == ["%s: the 2025 points span 0.06177 mm where the face spans 64.27 mm, and "
                       "multiplied by 1000 they lie on it: the file's coordinates are in mm, not "
-                      "um (give the unit: units mm, or a column name like 'x [mm]')"
+                      "um (give the unit: units mm, or a column name like 'x_nom [mm]')"
                       % EXAMPLE_CSV]
     # the nominal moved: the points (in document coordinates) are 5 mm above the face
     nom.Placement = FreeCAD.Placement(FreeCAD.Vector(0, 0, -5), FreeCAD.Rotation())
