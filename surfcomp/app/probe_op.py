@@ -28,6 +28,8 @@ Job that machines in another work offset or several, an inch post and two operat
 logging to one file. No FreeCADGui.
 """
 
+import os
+
 import Path
 
 from ..core.option_tables import PROGRAM
@@ -170,6 +172,7 @@ def compute_probe_operation(obj):
     obj.Path = Path.Path()
     obj.Probes = 0
     obj.Travel = 0.0
+    check_in_job(obj)
     moves = probe_moves(obj)
     s = settings_of(obj)
     obj.Path = Path.Path(path_commands(moves, s, obj.Plan.Label))
@@ -224,12 +227,25 @@ def add_probe_operation(job, plan, tool=_DEF.tool, name="ProbePlan", check=True,
         op.WorkOffset = fixtures[0]
     for key, val in values.items():
         setattr(op, key, val)
+    if "LogFile" not in values:
+        op.LogFile = _free_log_name(job, op)
     cam.add_operation(job, op)
     _created(op)
     recompute_probing(op)
     if check:
         check_recomputed(op)
     return op
+
+
+def _free_log_name(job, op):
+    """``op``'s LogFile, or, where another probe operation of ``job`` logs to it already,
+    the same name with ``op``'s name added (``probe-ProbeTwo.log``): each PROBEOPEN opens
+    its file anew, so two operations must not share one (:func:`check_job`)."""
+    taken = {o.LogFile for o in cam_job.operations_of(job) if is_probe_operation(o)}
+    if op.LogFile not in taken:
+        return op.LogFile
+    stem, ext = os.path.splitext(op.LogFile)
+    return "%s-%s%s" % (stem, op.Name, ext or ".log")
 
 
 def recompute_probing(op):
@@ -288,6 +304,23 @@ def check_job(job, ops):
                              "the first plan's log (expected a LogFile of its own for each "
                              "probe operation)" % (seen[name].Label, op.Label, name))
         seen[name] = op
+
+
+def check_in_job(op):
+    """:func:`check_job` of the Job ``op`` is in (its probe operations) and its post
+    arguments in mm, on every recompute: FreeCAD's own Post Process posts what the
+    operations hold and checks none of it (:func:`post_probe_job` checks again)."""
+    job = cam.find_parent_job(op)
+    if job is None:
+        return
+    ops = [o for o in cam_job.operations_of(job)
+           if is_probe_operation(o) and getattr(o, "Active", True)]
+    check_job(job, ops if op in ops else ops + [op])
+    if "--inches" in str(getattr(job, "PostProcessorArgs", "") or "").split():
+        raise InputError("Job %s posts in inches (--inches in its PostProcessorArgs): "
+                         "LinuxCNC would log %s's trip points in inches, and the log is "
+                         "joined to the plan's points in mm (expected a metric post)"
+                         % (job.Label, op.Label))
 
 
 def post_probe_job(job, post="linuxcnc", args="--no-show-editor", native=False):

@@ -214,6 +214,10 @@ def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
     with pytest.raises(InputError, match="machines in G55: the program would probe another "
                                          "part's offset"):
         post_probe_job(job, "linuxcnc", POST_ARGS)
+    # the operation's recompute refuses it too (FreeCAD's own Post Process checks nothing):
+    # no probe moves are left to post
+    shop.recompute()
+    assert "Invalid" in op.State and len(op.Path.Commands) == 0
     op.WorkOffset = "G55"
     progress.recompute_with_progress(shop, "test")
     text, probes, _worst = posted_probes(job, plan, op, tmp_path, "g55.ngc")
@@ -223,6 +227,11 @@ def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
     # an inch post: LinuxCNC would log the trip points in inches, joined to a plan in mm
     with pytest.raises(GCodeError, match=r"wrote an inch program \(G20\)"):
         post_probe_job(job, "linuxcnc", POST_ARGS + " --inches")
+    # the Job's own post arguments in inches: refused at the operation's recompute
+    job.PostProcessorArgs = "--no-show-editor --inches"
+    op.touch()
+    shop.recompute()
+    assert "Invalid" in op.State and len(op.Path.Commands) == 0
 
 
 def test_no_post_of_a_stale_or_overwritten_log(shop):
@@ -242,10 +251,16 @@ def test_no_post_of_a_stale_or_overwritten_log(shop):
         post_probe_job(job, "linuxcnc", POST_ARGS)
     progress.recompute_with_progress(shop, "test")
     assert abs(plan.SafeZ - (safe + 1.0)) < 1e-6
-    # a second plan logging to the same file would overwrite the first one's log
+    # a second plan gets a log file of its own; logging to the same file would overwrite
+    # the first one's log: the operation's recompute refuses it (FreeCAD's own Post
+    # Process checks nothing), and so does the post
     plan2 = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="2x2")
     progress.recompute_with_progress(shop, "test")
     op2 = add_probe_operation(job, plan2, name="ProbeTwo")
+    assert op2.LogFile == "probe-ProbeTwo.log"
+    op2.LogFile = "probe.log"
+    shop.recompute()
+    assert "Invalid" in op2.State and len(op2.Path.Commands) == 0
     with pytest.raises(InputError, match=r"ProbePlan and ProbeTwo both log to probe.log"):
         post_probe_job(job, "linuxcnc", POST_ARGS)
     op2.LogFile = "probe2.log"
