@@ -25,6 +25,7 @@ from surfcomp.app.probe_op import (
     is_probe_operation,
     post_probe_job,
     probe_moves,
+    recompute_probing,
 )
 from surfcomp.errors import GCodeError, InputError
 from tests.conftest import ROOT
@@ -216,7 +217,8 @@ def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
         post_probe_job(job, "linuxcnc", POST_ARGS)
     # the operation's recompute refuses it too (FreeCAD's own Post Process checks nothing):
     # no probe moves are left to post
-    shop.recompute()
+    op.touch()
+    recompute_probing(op)
     assert "Invalid" in op.State and len(op.Path.Commands) == 0
     op.WorkOffset = "G55"
     progress.recompute_with_progress(shop, "test")
@@ -230,7 +232,7 @@ def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
     # the Job's own post arguments in inches: refused at the operation's recompute
     job.PostProcessorArgs = "--no-show-editor --inches"
     op.touch()
-    shop.recompute()
+    recompute_probing(op)
     assert "Invalid" in op.State and len(op.Path.Commands) == 0
 
 
@@ -259,7 +261,7 @@ def test_no_post_of_a_stale_or_overwritten_log(shop):
     op2 = add_probe_operation(job, plan2, name="ProbeTwo")
     assert op2.LogFile == "probe-ProbeTwo.log"
     op2.LogFile = "probe.log"
-    shop.recompute()
+    recompute_probing(op2)
     assert "Invalid" in op2.State and len(op2.Path.Commands) == 0
     with pytest.raises(InputError, match=r"ProbePlan and ProbeTwo both log to probe.log"):
         post_probe_job(job, "linuxcnc", POST_ARGS)
