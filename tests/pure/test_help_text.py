@@ -1,14 +1,51 @@
 # SPDX-License-Identifier: LGPL-2.1-or-later
 """What the command line's help and the docs say about the options is what the parsers and
-the option registry take: the values the README and docs give an option lie in the
-registry's domain."""
+the option registry take: the options a command's help names are that command's, and the
+values the README and docs give an option lie in the registry's domain."""
 
 import glob
 import os
 import re
 
+from surfcomp.cli import build_parser
 from surfcomp.core.options import OPTIONS
 from tests.conftest import ROOT
+
+#: flags a command's help names although the command has no such option: another
+#: command's option it refers to (``plan --second-touch`` writes the logs that
+#: ``--touches`` reads) or a value (the post-processor's argument)
+OTHER_COMMANDS = {("compensate", "--second-touch"), ("inspect", "--second-touch"),
+                  ("plan", "--touches"), ("compensate", "--no-show-editor")}
+
+_FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+
+
+def _parsers():
+    parser = build_parser()
+    sub = next(a for a in parser._actions if a.choices and "compensate" in a.choices)
+    return sub.choices
+
+
+def _texts(parser):
+    """Every help text of ``parser``: the options', the groups', description and epilog."""
+    for a in parser._actions:
+        yield (a.option_strings or [a.dest])[0], a.help or ""
+    for g in parser._action_groups:
+        yield g.title, g.description or ""
+    yield "description", parser.description or ""
+    yield "epilog", parser.epilog or ""
+
+
+def test_the_help_names_the_commands_own_options():
+    """inspect's --weights said its default was --mask-kind and --mask, and simulate's
+    --mask-kind spoke of custom --weights: neither command has that option."""
+    wrong = []
+    for command, parser in _parsers().items():
+        own = {s for a in parser._actions for s in a.option_strings}
+        for where, text in _texts(parser):
+            wrong += [(command, where, flag) for flag in _FLAG.findall(text)
+                      if flag not in own and (command, flag) not in OTHER_COMMANDS]
+    assert not wrong
 
 
 def _docs():
@@ -33,3 +70,15 @@ def test_the_docs_give_the_compensation_options_values_in_their_domain():
                     if o is not None and not o.low <= float(value) <= o.high:
                         outside.append((os.path.basename(path), number, flag, value))
     assert not outside
+
+
+def test_inspect_takes_the_filter_options_its_determined_component_needs():
+    """inspect's --weights help named --mask-kind, which inspect did not have: its
+    determined component could not be compensate's with a Gaussian mask or another edge."""
+    from surfcomp.cli.common import options_from_args
+
+    args = build_parser("inspect").parse_args(
+        ["inspect", "n.step", "m.csv", "--mask", "7", "--mask-kind", "gaussian", "--sigma",
+         "1.5", "--edge", "nearest"])
+    o = options_from_args(args)
+    assert (o.mask_size, o.mask_kind, o.sigma, o.edge) == (7, "gaussian", 1.5, "nearest")
