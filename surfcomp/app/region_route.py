@@ -168,7 +168,8 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     filtered = dev if method == "raw" else region_field.mask_filter_3d(
         pts, dev, mask_size, mask_kind, sigma, step)
     bb = geometry_box(shape)
-    field_radius = smoothing or max(4.0 * step, region.FIELD_SHARE * bb.DiagonalLength)
+    field_radius = smoothing or max(region.FIELD_SPACINGS * step,
+                                    region.FIELD_SHARE * bb.DiagonalLength)
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
         fld = stack(fld)

@@ -82,3 +82,18 @@ def test_inspect_takes_the_filter_options_its_determined_component_needs():
          "1.5", "--edge", "nearest"])
     o = options_from_args(args)
     assert (o.mask_size, o.mask_kind, o.sigma, o.edge) == (7, "gaussian", 1.5, "nearest")
+
+
+def test_the_faces_help_says_what_smoothing_is_for_a_region():
+    """With --faces, --smoothing is the correction field's radius, by default the larger of
+    4 point spacings and 5 % of the shape's diagonal (surfcomp.app.region_route); the help
+    only gave the one-face meaning, a fit whose default cross-validation chooses."""
+    from surfcomp.core import limits
+    from surfcomp.core.command_options import COMPENSATE
+    from surfcomp.core.options import cli_help
+
+    text = " ".join(cli_help("faces", COMPENSATE).split())
+    assert ("--smoothing is then the radius in mm of the correction field (default the "
+            "larger of %g point spacings and %g x the shape's diagonal)"
+            % (limits.FIELD_SPACINGS, limits.FIELD_SHARE)) in text
+    assert (limits.FIELD_SPACINGS, limits.FIELD_SHARE) == (4.0, 0.05)
