@@ -97,3 +97,17 @@ def test_the_faces_help_says_what_smoothing_is_for_a_region():
             "larger of %g point spacings and %g x the shape's diagonal)"
             % (limits.FIELD_SPACINGS, limits.FIELD_SHARE)) in text
     assert (limits.FIELD_SPACINGS, limits.FIELD_SHARE) == (4.0, 0.05)
+
+
+def test_the_document_route_refuses_touches_it_would_not_read(tmp_path, capsys):
+    """--touches K (probe moves per point of a log read with --plan) was taken and ignored
+    on the shop-document route, which refuses --plan."""
+    from surfcomp.cli import main
+
+    doc = tmp_path / "shop.FCStd"
+    doc.write_bytes(b"not read")
+    rc = main(["compensate", str(doc), os.path.join(ROOT, "examples", "measurements.csv"),
+               "--object", "Part", "--save", str(tmp_path / "out.FCStd"), "--touches", "2"])
+    assert rc == 2
+    assert "--touches reads a probe log with --plan" in capsys.readouterr().err
+    assert not (tmp_path / "out.FCStd").exists()
