@@ -111,3 +111,33 @@ def test_the_document_route_refuses_touches_it_would_not_read(tmp_path, capsys):
     assert rc == 2
     assert "--touches reads a probe log with --plan" in capsys.readouterr().err
     assert not (tmp_path / "out.FCStd").exists()
+
+
+def test_the_axis_docs_give_the_reference_default_the_code_uses(tmp_path, capsys):
+    """docs/axis_errors.md said --reference defaults to the program zero: it is 0,0,0 in the
+    error file's coordinates, which --work-offset moves away from the program zero (the
+    program below comes out as with --reference 0,0,0, not as with the program zero)."""
+    from surfcomp.cli import main
+    from surfcomp.core.command_options import GCODE
+
+    err = tmp_path / "err.csv"
+    err.write_text("axis,position,ex,ey,ez\nX,0,0,0,0\nX,100,0.01,0.002,0\nX,200,0.03,0.001,0\n"
+                   "X,300,0.02,0.004,0.001\nY,0,0,0,0\nY,100,0.001,-0.01,0\n"
+                   "Y,200,0.003,-0.03,0.002\nY,300,0.001,-0.02,0.001\n")
+    program = tmp_path / "p.ngc"
+    program.write_text("G21 G90\nG0 X0 Y0 Z5\nG1 X50 Y20 Z0 F100\nG1 X80 Y60\n")
+
+    def out(*extra):
+        path = tmp_path / ("out%d.ngc" % len(list(tmp_path.iterdir())))
+        assert main(["gcode", str(program), "--axis-errors", str(err), "--model", "quadratic",
+                     "--work-offset", "100,50,0", "-o", str(path), *extra]) == 0
+        capsys.readouterr()
+        return path.read_text()
+
+    default = out()
+    assert default == out("--reference", GCODE["reference"].default)
+    assert default != out("--reference", "100,50,0")            # the program zero
+    with open(os.path.join(ROOT, "docs", "axis_errors.md"), encoding="utf-8") as fh:
+        text = " ".join(fh.read().split())
+    said = re.findall(r"\(`--reference`[^)]*?default ([^ ,;)]+(?:,[^ ,;)]+)*)", text)
+    assert said == [GCODE["reference"].default]
