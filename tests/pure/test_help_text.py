@@ -141,3 +141,19 @@ def test_the_axis_docs_give_the_reference_default_the_code_uses(tmp_path, capsys
         text = " ".join(fh.read().split())
     said = re.findall(r"\(`--reference`[^)]*?default ([^ ,;)]+(?:,[^ ,;)]+)*)", text)
     assert said == [GCODE["reference"].default]
+
+
+def test_plan_says_which_layouts_take_points():
+    """--points N is the count of the adaptive and the uniform layout (its help says so);
+    the refusal with a grid said the adaptive layout alone took it."""
+    import pytest
+
+    from surfcomp.cli.plan import layout_count
+    from surfcomp.errors import InputError
+
+    args = build_parser("plan").parse_args(["plan", "n.step", "-o", "p.csv", "--points", "50"])
+    with pytest.raises(InputError) as exc:
+        layout_count(args)
+    assert exc.value.message.startswith("--points applies to the adaptive and uniform layouts;")
+    args.layout = "uniform"
+    assert layout_count(args) == ("uniform", 50)
