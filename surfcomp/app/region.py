@@ -22,6 +22,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.compensation import region_build, region_edges, region_field
+from ..core.limits import FIELD_SHARE, FIELD_SPACINGS  # noqa: F401  (region.FIELD_SHARE)
 from ..core.surface.bspline import derivatives, evaluate, normals
 from ..core.surface.projection import Projector
 from ..core.surface.trimmed import area_samples, inside  # noqa: F401  (region.inside)
@@ -36,8 +37,6 @@ SHARE_TOL = 0.05
 EDGE_SAMPLES = 200
 #: nominal normals closer than this (degrees) along an edge: the faces meet G1
 G1_ANGLE = 0.1
-#: field radius as a share of the shape's diagonal, at least 4 point spacings
-FIELD_SHARE = 0.05
 #: the shortest length (share of the band) over which a sharp edge's exactness changes
 EASE_SHARE = 0.5
 

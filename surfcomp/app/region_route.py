@@ -53,10 +53,11 @@ def _deviation(ms, normal, signed):
 def run_region(nominal, measurements, faces_text, output, report=None, units="mm", fmt="auto",
                sample=None, deviation_units=None, method="filtered", mask_size=WERNER_MASK_SIZE,
                mask_kind="box", sigma=None, max_offset=1.0, min_coverage=0.5, smoothing=None,
-               max_factor=region_build.POLE_FACTOR, log=print, max_memory=None):
+               max_factor=region_build.POLE_FACTOR, log=print, max_memory=None, object_name=None):
     """Run a region compensation; returns the report dict. Nothing is written on error.
     ``max_memory``: refuse a measurement whose run needs more (bytes; None: the machine's),
-    as the document route does."""
+    as the document route does; ``object_name``: the object of an FCStd nominal holding the
+    faces (Name or Label), as for one face (refused for a CAD file)."""
     outputs = [("output", output)] + ([("report", report)] if report else [])
     inputs = [("nominal", nominal), ("measurements", measurements)]
     check_outputs(outputs, inputs)
@@ -67,7 +68,7 @@ def run_region(nominal, measurements, faces_text, output, report=None, units="mm
 
     from .nominal import read_shape
 
-    shape, _ = read_shape(nominal)
+    shape, _ = read_shape(nominal, object_name)
     ms = read_any(measurements, units, fmt, sample, deviation_units=deviation_units)
     budget.check_job(len(ms), True, max_memory)
     out_shape, rep = compute_region(
@@ -167,7 +168,8 @@ def compute_region(shape, ms, faces_text, sources, method="filtered",
     filtered = dev if method == "raw" else region_field.mask_filter_3d(
         pts, dev, mask_size, mask_kind, sigma, step)
     bb = geometry_box(shape)
-    field_radius = smoothing or max(4.0 * step, region.FIELD_SHARE * bb.DiagonalLength)
+    field_radius = smoothing or max(region.FIELD_SPACINGS * step,
+                                    region.FIELD_SHARE * bb.DiagonalLength)
     fld = region_field.RegionField(pts, filtered, field_radius)
     if stack is not None:
         fld = stack(fld)

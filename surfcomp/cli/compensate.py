@@ -4,6 +4,7 @@
 import sys
 
 from ..core.command_options import COMPENSATE
+from ..core.option_tables import INPUTS
 from ..errors import InputError
 from . import SUMMARIES, registry
 from .common import (
@@ -90,6 +91,10 @@ def run_document(args):
         raise InputError("--%s cannot be combined with --replace/--save/--gcode; run "
                          "'compensate' without them for the files"
                          % other[0].replace("_", "-"))
+    if args.touches != INPUTS["touches"].default:     # a probe log's, read with --plan only
+        raise InputError("--touches reads a probe log with --plan, which cannot be combined "
+                         "with --replace/--save/--gcode; run 'compensate' without them for the "
+                         "files")
     from ..app import fcenv
 
     fcenv.import_freecad()

@@ -94,8 +94,8 @@ def layout_count(args):
         return args.layout, check_points(PLAN["points"].stored if args.points is None
                                          else args.points)
     if args.points is not None:
-        raise InputError("--points applies to the adaptive layout; the %s layout takes --count "
-                         "UxV" % args.layout)
+        raise InputError("--points applies to the %s layouts; the %s layout takes --count "
+                         "UxV" % (" and ".join(POINT_LAYOUTS), args.layout))
     return args.layout, parse_count(PLAN["count"].stored if args.count is None
                                     else args.count)
 

@@ -54,7 +54,7 @@ def run_region_command(args):
                deviation_units=args.deviation_units, method=args.method, mask_size=args.mask,
                mask_kind=args.mask_kind, sigma=args.sigma, max_offset=args.max_offset,
                min_coverage=args.min_coverage, smoothing=args.smoothing,
-               max_memory=args.max_memory)
+               max_memory=args.max_memory, object_name=args.object)
     print("wrote %s" % args.output)
     if args.report:
         print("wrote %s" % args.report)

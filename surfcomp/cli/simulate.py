@@ -109,10 +109,14 @@ def add_parser(subparsers):
                         "paper's table)" % ", ".join(presets_.PRESETS))
     g = p.add_argument_group("loop")
     add_arguments(g, ("grid", "margin", "between", "replicas", "methods"), SIMULATE, **_PRESET)
+    # (no --weights or mask --sigma here: --sigma is the model's; the Gaussian mask's sigma
+    # is a quarter of its size)
     add_arguments(g, ("mask_size", "mask_kind", "edge"), mask_size=dict(
         type=str, default=str(OPTIONS["mask_size"].default), metavar="N[,N...]",
         help="odd mask size(s) of the filtered method; one column per size (default %d)"
-             % OPTIONS["mask_size"].default))
+             % OPTIONS["mask_size"].default), mask_kind=dict(
+        help="mask shape of the filtered method: box, or gaussian with sigma a quarter of "
+             "the mask size in grid steps (default %s)" % OPTIONS["mask_kind"].default))
     add_arguments(g, ("stock",), SIMULATE, **_PRESET)
     add_arguments(g, ("refine",))
     add_arguments(g, ("seed",), SIMULATE)

@@ -24,7 +24,14 @@ reads them:
 from dataclasses import replace
 
 from .choices import AXIS_MODELS, METHODS, UNITS
-from .limits import MAX_GRID, MAX_REPLICAS, MAX_SEGMENTS, MIN_SEGMENT_LENGTH
+from .limits import (
+    FIELD_SHARE,
+    FIELD_SPACINGS,
+    MAX_GRID,
+    MAX_REPLICAS,
+    MAX_SEGMENTS,
+    MIN_SEGMENT_LENGTH,
+)
 from .options import Option
 
 
@@ -136,7 +143,10 @@ COMPENSATE = _table(
     Option("faces", str, None, "Faces", label="Faces", flag="--faces", metavar="F1,F2|auto",
            stored="auto",
            help="compensate a region of several faces at once, continuity kept (FaceN names, "
-                "or auto: the faces the measurements cover)",
+                "or auto: the faces the measurements cover); {smoothing} is then the radius "
+                "in mm of the correction field (default the larger of %g point spacings and "
+                "%g x the shape's diagonal), not a fit chosen by cross-validation "
+                "(docs/regions.md)" % (FIELD_SPACINGS, FIELD_SHARE),
            doc_help="the region: FaceN names separated by commas, or auto (the faces the "
                     "measurements cover)"),
     Option("min_coverage", float, 0.5, "MinCoverage", label="Min coverage",

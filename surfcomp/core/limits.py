@@ -75,6 +75,12 @@ MAX_PLAN_POINTS = 1_000_000
 MIN_SMOOTHING = 1e-3
 MAX_SMOOTHING = 1e4
 
+# ------------------------------------------------------------------ regions of faces
+#: the region's correction field radius when no smoothing is given: this share of the
+#: shape's diagonal, at least FIELD_SPACINGS point spacings (``compensate --faces`` says so)
+FIELD_SHARE = 0.05
+FIELD_SPACINGS = 4.0
+
 # ------------------------------------------------------------------ the simulation loop
 #: largest measurement grid per direction: 800 x 800 with the default ``between`` = 2 is
 #: estimated at 3.7 GB (:mod:`surfcomp.core.budget`; measured 1.6 GB); the

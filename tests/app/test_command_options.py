@@ -43,3 +43,13 @@ def test_the_app_defaults_are_the_registry():
     params = inspect.signature(cam_job.post_process).parameters
     assert (params["post"].default, params["args"].default) == \
         (COMPENSATE["post"].default, COMPENSATE["post_args"].default)
+
+
+def test_the_region_field_radius_is_the_one_the_faces_help_gives():
+    """compensate --faces' help gives the field radius's default from the limits module;
+    the region route computes it from the same names."""
+    from surfcomp.app import region
+    from surfcomp.core import limits
+
+    assert region.FIELD_SHARE is limits.FIELD_SHARE
+    assert region.FIELD_SPACINGS is limits.FIELD_SPACINGS

@@ -174,6 +174,20 @@ def test_bad_input_exits_2_and_writes_nothing(shop):
     assert "no object 'Nothing'" in err
 
 
+def test_the_files_route_reads_the_object_named(shop):
+    """--faces -o OUT.step read the document's only object with B-spline faces whatever
+    --object named (the shop holds Block and its Mirror): the object named is read, and an
+    object the document does not hold is refused."""
+    tmp, path, csv = shop[0], shop[1], shop[2]
+    out = str(tmp / "named.step")
+    r = rp.compensate(path, csv, "--faces", "auto", "--object", "Nothing", "-o", out)
+    assert r.returncode == 2 and "no object 'Nothing'" in r.stderr, r.stdout + r.stderr
+    assert not os.path.exists(out)
+    r = rp.run(path, csv, "--faces", "auto", "--object", "Block", "-o", out)
+    assert r.returncode == 0, r.stderr
+    assert "points per face: Face1 3000, Face2 3000" in r.stdout, r.stdout
+
+
 def test_bad_or_unread_options_on_a_document_exit_2_as_given(shop):
     """The region object's properties clamp what they are given (MaxOffset -1 read 0, and
     the run was refused for no points within 0 mm); an even mask was taken, and the options

@@ -60,11 +60,12 @@ def test_points_in_other_units_are_refused_naming_the_faces(part, faces):
     (["--refine", "3"], "--refine cannot be combined with --faces"),
     (["--accept-stock"], "--accept-stock cannot be combined with --faces"),
     (["--max-memory", "64M"], "compensate of 3000 points needs about"),
+    (["--object", "Block"], "--object applies to FCStd documents only"),
 ])
 def test_bad_or_unread_options_exit_2_and_write_nothing(part, extra, message):
     """Out of their domain these options crashed the run (exit 1) or were taken (an even
     mask); the options of one face that a region does not read, and --max-memory, were
-    ignored without a word."""
+    ignored without a word; --object was ignored too (a STEP file has no objects)."""
     tmp, step, csv, *_ = part
     out = str(tmp / "refused.step")
     r = rp.compensate(step, csv, "--faces", "auto", "-o", out,
