@@ -9,10 +9,12 @@ Safety rules:
 
 - Path and OpenCamLib are set up *before* the document is opened
   (:func:`surfcomp.app.cam.setup_workbench`), and the document is opened through
-  :func:`surfcomp.app.documents.open_document` (Document.xml checked, only trusted proxy
+  :func:`surfcomp.app.documents.open_for_update` (Document.xml checked, only trusted proxy
   modules imported): an object whose module cannot be imported at open time loses its
   proxy, and a document saved like that can never recompute that object again. Such
-  documents are refused (nothing is written).
+  documents are refused (nothing is written); so is a document already open in this
+  FreeCAD session, which FreeCAD would hand back instead of reading the file, so that the
+  route would change the user's open document.
 - The outputs are checked against the inputs and each other before the document is
   opened; the input document is never overwritten unless ``overwrite_input=True``.
 - All outputs (document, G-code) are written together or not at all (temporary files
@@ -32,7 +34,7 @@ from ..io.outpath import shown
 from ..io.readers import read_any
 from . import align_doc, cam, cam_job, features, toolpaths
 from . import progress as recompute_order
-from .documents import open_document, restore_failures
+from .documents import open_for_update, restore_failures
 from .properties import store_options
 
 
@@ -164,7 +166,7 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
 
     report(progress, 0.05, "opening %s" % os.path.basename(document))
     before = set(FreeCAD.listDocuments())
-    doc, refused, info = open_document(document)
+    doc, refused, info = open_for_update(document)
     try:
         check_restored(doc, refused, info, document)
         nominal = _find_object(doc, object_name, document)

@@ -283,3 +283,30 @@ def test_a_cam_error_is_reported_as_failed_not_unchanged(shop, no_tool, route):
         assert rep.operations[0].status == "unchanged"
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+def test_a_document_open_in_this_session_is_refused_and_left_alone(shop, tmp_path):
+    """FreeCAD hands back a document that is open already instead of reading the file: the
+    route would add its objects to the user's open document and replace its nominal there
+    (before: it did, and left them there when it failed later, e.g. on an unknown --job)."""
+    from surfcomp.app.region_docroute import run_region_document
+
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        names = [o.Name for o in doc.Objects]
+        out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+        for run in (lambda: run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                                             save=out, replace=True, gcode=ngc,
+                                             job_name="Nope"),
+                    lambda: run_region_document(shop["doc"], shop["meas"], "Block", "Face2",
+                                                save=out, replace=True)):
+            with pytest.raises(InputError, match=r"shop.FCStd: the document is open in this "
+                                                 r"FreeCAD session \(as shop\).*nothing was "
+                                                 r"changed.*save and close it first"):
+                run()
+            assert [o.Name for o in doc.Objects] == names
+            assert doc.getObject("Clone").Objects == [doc.getObject("Block")]
+            assert doc.Label == "shop" and doc.Name in FreeCAD.listDocuments()
+        assert os.listdir(tmp_path) == []
+    finally:
+        FreeCAD.closeDocument(doc.Name)
