@@ -263,12 +263,20 @@ def _recompute(doc):
 
 
 def _one_job(jobs, job_name):
-    if job_name:
-        jobs = [j for j in jobs if job_name in (j.Name, j.Label)]
-    if len(jobs) != 1:
-        raise InputError("%s Path jobs use the compensation (%s): choose one with the job name"
-                         % (len(jobs) or "no", ", ".join(j.Label for j in jobs) or "none"))
-    return jobs[0]
+    using = ", ".join(j.Label for j in jobs)
+    if not jobs:
+        raise InputError("no Path jobs use the compensation, so there is no program to post "
+                         "(a Job uses it after the replace when the Job's model is the "
+                         "nominal)")
+    chosen = [j for j in jobs if job_name in (j.Name, j.Label)] if job_name else jobs
+    if not chosen:
+        # not "no Path jobs use the compensation": they do, under other names
+        raise InputError("no Path job named %r uses the compensation (the Jobs that do: %s); "
+                         "expected one of their names or labels" % (job_name, using))
+    if len(chosen) != 1:
+        raise InputError("%d Path jobs use the compensation (%s): choose one with the job name"
+                         % (len(chosen), ", ".join(j.Label for j in chosen)))
+    return chosen[0]
 
 
 def post_program(jobs, gcode, post, post_args, job_name, progress=None):

@@ -310,3 +310,16 @@ def test_a_document_open_in_this_session_is_refused_and_left_alone(shop, tmp_pat
         assert os.listdir(tmp_path) == []
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+def test_an_unknown_job_name_names_the_jobs_that_use_the_compensation(shop, tmp_path):
+    """Before: "no Path jobs use the compensation (none)", although the Job did."""
+    digest = sha(shop["doc"])
+    with pytest.raises(InputError, match=r"^no Path job named 'Nope' uses the compensation "
+                                         r"\(the Jobs that do: Job\); expected one of their "
+                                         r"names or labels$"):
+        run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                         save=str(tmp_path / "o.FCStd"), replace=True,
+                         gcode=str(tmp_path / "o.ngc"), job_name="Nope",
+                         options=Options(refine=1))
+    assert os.listdir(tmp_path) == [] and sha(shop["doc"]) == digest
