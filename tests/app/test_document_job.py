@@ -323,3 +323,43 @@ def test_an_unknown_job_name_names_the_jobs_that_use_the_compensation(shop, tmp_
                          gcode=str(tmp_path / "o.ngc"), job_name="Nope",
                          options=Options(refine=1))
     assert os.listdir(tmp_path) == [] and sha(shop["doc"]) == digest
+
+
+def test_replace_refuses_a_job_moved_by_a_surface_correction_dressup(shop, tmp_path):
+    """The Surface correction dressup moves the operation's program by a correction; with
+    the nominal replaced the operation cuts the corrected face, and the dressup moved that
+    again (before: the route posted the program moved twice, summary "regenerated")."""
+    from surfcomp.app import dressup_surface, replace
+    from surfcomp.io.readers import read_any
+
+    dressed = str(tmp_path / "dressed.FCStd")
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        block = doc.getObject("Block")
+        meas = features.make_measurement_from_set(doc, read_any(shop["meas"]))
+        first = features.make_compensation(doc, block, "Face2", meas, output="solid",
+                                           name="Round1")
+        first.Refine = 1
+        doc.recompute()
+        dressup = dressup_surface.Create(doc.getObject("Surface"), first)
+        doc.recompute()
+        assert dressup.MovedMoves > 0 and "Invalid" not in dressup.State
+        doc.saveAs(dressed)
+        # Replace itself (the GUI's) refuses and leaves every link as it was
+        second = features.make_compensation(doc, block, "Face2", meas, output="solid")
+        second.Refine = 1
+        doc.recompute()
+        with pytest.raises(InputError, match=r"^Job holds the surface correction dressup "
+                                             r"DressupSurfaceCorrection, which moves its "
+                                             r"program by the correction of Round1 already"):
+            replace.replace(doc, second)
+        assert doc.getObject("Clone").Objects == [block] and dressup.Compensation is first
+        assert second.ReplacedLinks == "" and block.Visibility
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    digest = sha(dressed)
+    out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+    with pytest.raises(InputError, match="would move that a second time; nothing was replaced"):
+        run_document_job(dressed, shop["meas"], "Block", face="Face2", save=out, replace=True,
+                         gcode=ngc, post_args=POST_ARGS, options=Options(refine=1))
+    assert os.listdir(tmp_path) == ["dressed.FCStd"] and sha(dressed) == digest
