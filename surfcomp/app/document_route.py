@@ -60,6 +60,8 @@ class DocumentJobResult:
     correction_volume: float = 0.0                     # mm^3, integral of the correction
     alignment: list = field(default_factory=list)      # the compensation's Alignment lines
     alignment_warnings: list = field(default_factory=list)
+    base: str = None                                   # the previous round (iterations)
+    round: int = 1
 
 
 
@@ -85,6 +87,49 @@ def _find_object(doc, name, source):
     return obj
 
 
+def _round_of(doc, obj, face, replace, source):
+    """``(nominal, base)``: ``obj`` itself and no base, or, when ``obj`` is a compensation,
+    its nominal and ``obj`` (the new compensation is its next round: deviations stay against
+    the nominal, the correction adds to the earlier rounds').
+
+    Raises
+    ------
+    InputError
+        ``obj`` is a region object, a compensation not computed or of another face than
+        ``face``; or (with ``replace``) a nominal that a compensation replaces now: its users
+        cut that compensation's corrected face, so a new first round would find nothing to
+        replace, and measuring the part they machined asks for that compensation's next round.
+    """
+    from . import replace as replace_mod
+    from .region_doc import is_region
+
+    if is_region(obj):
+        raise InputError("%s is a region compensation: add its next round with --faces "
+                         "(expected a single-face compensation or the nominal's object)"
+                         % obj.Label, file=source)
+    if not features.is_compensation(obj):
+        replacing = [o.Label for o in doc.Objects if replace_mod.is_replacing(o)
+                     and getattr(o, "Nominal", None) is obj]
+        if replace and replacing:
+            raise InputError("%s is replaced by %s now (its users cut that corrected face), so "
+                             "there is nothing of %s to replace; expected --object %s for the "
+                             "next round of %s, or restore the nominal first"
+                             % (obj.Label, ", ".join(replacing), obj.Label, replacing[0],
+                                replacing[0]), file=source)
+        return obj, None
+    features.chain(obj)
+    if face and face != obj.FaceName:
+        raise InputError("%s compensates %s.%s, not %s: its next round compensates the same "
+                         "face (expected --face %s or none)"
+                         % (obj.Label, obj.Nominal.Label, obj.FaceName, face, obj.FaceName),
+                         file=source)
+    if obj.Shape.isNull() or {"Invalid", "Error"} & set(obj.State):
+        raise InputError("%s is not computed (state %s): its next round stacks on its "
+                         "correction; recompute it first" % (obj.Label, ", ".join(obj.State)),
+                         file=source)
+    return obj.Nominal, obj
+
+
 def _jobs_using(doc, comp):
     jobs = []
     for job in cam_job.jobs_of(doc):
@@ -108,9 +153,10 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Measurement file (any format :func:`surfcomp.io.readers.read_any` reads); its data
         is stored in the document.
     object_name : str
-        Name or label of the object holding the nominal face.
+        Name or label of the object holding the nominal face, or of a compensation: the new
+        one is its next round (``Base``; same nominal face, its ``Output`` by default).
     face : str, optional
-        ``FaceN`` (default: the object's only B-spline face).
+        ``FaceN`` (default: the object's only B-spline face; a compensation's own face).
     save : str, optional
         Where to save the updated document (required with ``replace`` or ``gcode``).
     replace : bool
@@ -169,12 +215,16 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
     doc, refused, info = open_for_update(document)
     try:
         check_restored(doc, refused, info, document)
-        nominal = _find_object(doc, object_name, document)
+        nominal, base = _round_of(doc, _find_object(doc, object_name, document), face,
+                                  replace, document)
+        if base is not None:
+            face = base.FaceName
+            output = output or base.Output
         paths_before = toolpaths.snapshot(doc)
         report(progress, 0.1, "reading the measurements")
         comp, meas = _add_compensation(doc, nominal, face, measurements,
                                        (units, deviation_units), fmt, sample, options, output,
-                                       max_memory)
+                                       max_memory, base)
         if align is not None:
             align_doc.settle(meas, align)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
@@ -182,7 +232,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         features.compensation_result(comp)
         comp.recompute()
         result = DocumentJobResult(document=os.path.abspath(document), compensation=comp.Name,
-                                   measurement=meas.Name)
+                                   measurement=meas.Name, round=int(comp.Round),
+                                   base=None if base is None else base.Name)
         if replace:
             report(progress, 0.3, "replacing the nominal")
             result.replaced = replace_mod.replace(doc, comp)
@@ -233,10 +284,11 @@ def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
 
 
 def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output,
-                      max_memory=None):
+                      max_memory=None, base=None):
     """The measurement (``units``: the coordinates' and the deviation column's, or None)
-    and the compensation objects of a document job; the points are read and the estimated
-    peak memory checked before anything is added to the document."""
+    and the compensation objects of a document job (``base``: the previous round); the
+    points are read and the estimated peak memory checked before anything is added to the
+    document."""
     if output is None:
         output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
     ms = read_any(os.fspath(measurements), units=units[0], fmt=fmt or "auto", sample=sample,
@@ -244,7 +296,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     budget.check_job(len(ms), True, max_memory)
     meas = features.make_measurement_from_set(doc, ms)
     comp = features.make_compensation(doc, nominal, face, meas, method=options.method,
-                                      output=output)
+                                      output=output, base=base)
     store_options(comp, options)     # every option, so none is left at its default unsaid
     return comp, meas
 
@@ -325,6 +377,10 @@ def summary_lines(result):
     """Short human-readable lines about a :class:`DocumentJobResult` (for the CLI)."""
     lines = ["compensation %s (measurement %s) added to the document"
              % (result.compensation, result.measurement)]
+    if result.base:
+        lines.append("round %d: stacked on %s (the earlier rounds' correction plus this "
+                     "measurement's; deviations against the nominal)"
+                     % (result.round, result.base))
     if result.output == "solid":
         lines.append("output: the nominal's shape with the face replaced; volume change %.4f "
                      "mm^3, expected from the correction %.4f mm^3 (-integral of delta dA)"

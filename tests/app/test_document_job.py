@@ -363,3 +363,42 @@ def test_replace_refuses_a_job_moved_by_a_surface_correction_dressup(shop, tmp_p
         run_document_job(dressed, shop["meas"], "Block", face="Face2", save=out, replace=True,
                          gcode=ngc, post_args=POST_ARGS, options=Options(refine=1))
     assert os.listdir(tmp_path) == ["dressed.FCStd"] and sha(dressed) == digest
+
+
+def test_the_next_round_stacks_on_the_compensation_the_job_cuts(shop, tmp_path):
+    """A document whose nominal a compensation replaces: ``--object`` naming that
+    compensation adds its next round (Base), deviations against the nominal; naming the
+    nominal with --replace is refused with what to name instead. Before: the nominal was
+    refused as used by nothing, and a compensation was taken for a nominal (its corrected
+    face measured against, no Base, its earlier correction lost from the record)."""
+    first = str(tmp_path / "first.FCStd")
+    one = run_document_job(shop["doc"], shop["meas"], "Block", face="Face2", save=first,
+                           replace=True, options=Options(refine=1))
+    digest = sha(first)
+    with pytest.raises(InputError, match=r"first.FCStd: Block is replaced by Compensation now "
+                                         r".*expected --object Compensation for the next "
+                                         r"round of Compensation, or restore the nominal"):
+        run_document_job(first, shop["meas"], "Block", face="Face2",
+                         save=str(tmp_path / "o.FCStd"), replace=True)
+    with pytest.raises(InputError, match=r"Compensation compensates Block.Face2, not Face3"):
+        run_document_job(first, shop["meas"], "Compensation", face="Face3",
+                         save=str(tmp_path / "o.FCStd"), replace=True)
+    assert sorted(os.listdir(tmp_path)) == ["first.FCStd"] and sha(first) == digest
+    second, ngc = str(tmp_path / "second.FCStd"), str(tmp_path / "second.ngc")
+    two = run_document_job(first, shop["meas"], "Compensation", save=second, replace=True,
+                           gcode=ngc, post_args=POST_ARGS, options=Options(refine=1))
+    assert (two.base, two.round, two.output) == ("Compensation", 2, "solid")
+    assert "round 2: stacked on Compensation" in "\n".join(summary_lines(two))
+    assert two.operations == ["Surface"] and sha(first) == digest
+    # the same measurement again: the earlier correction plus about as much again
+    assert two.statistics["deviation"]["count"] == 225
+    assert two.correction_volume == pytest.approx(2 * one.correction_volume, rel=0.05)
+    doc = FreeCAD.openDocument(second)
+    try:
+        comp, base = doc.getObject(two.compensation), doc.getObject("Compensation")
+        assert comp.Base is base and comp.Nominal is doc.getObject("Block")
+        assert comp.FaceName == "Face2" and doc.getObject("Clone").Objects == [comp]
+        np.testing.assert_allclose(comp.Correction, np.add(base.Correction, comp.Increment),
+                                   atol=1e-12)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
