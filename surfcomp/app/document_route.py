@@ -30,6 +30,7 @@ from ..core.compensation.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
+from ..io.fcstd import parse_document
 from ..io.outpath import shown
 from ..io.readers import read_any
 from . import align_doc, cam, cam_job, features, toolpaths
@@ -281,6 +282,26 @@ def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
     if save and not save.lower().endswith(".fcstd"):
         raise InputError("the saved document must end in .FCStd", file=save)
     check_outputs(*_declared(document, measurements, save, gcode, overwrite_input))
+    if save:
+        _check_linked_files(document, save)
+
+
+def _check_linked_files(document, save):
+    """Refuse ``save`` in a folder from which the document's links to other documents (kept
+    by FreeCAD as paths relative to the document's folder, also in a copy saved elsewhere)
+    would find another file or none: the saved document would reopen without them."""
+    here, there = (os.path.dirname(os.path.abspath(p)) for p in (document, save))
+    for name in parse_document(document)["files"]:
+        if os.path.isabs(name):
+            continue
+        linked, found = (os.path.realpath(os.path.join(d, name)) for d in (here, there))
+        if linked != found:
+            raise InputError("--save in %s: the document links objects of %s by a path "
+                             "relative to its folder, which FreeCAD keeps in the saved copy, "
+                             "so from there the links would point to %s and the saved "
+                             "document would reopen without them; nothing was written. "
+                             "Expected --save in the document's folder %s"
+                             % (there, linked, found, here), file=save)
 
 
 def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output,

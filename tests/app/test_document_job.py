@@ -402,3 +402,43 @@ def test_the_next_round_stacks_on_the_compensation_the_job_cuts(shop, tmp_path):
                                    atol=1e-12)
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+def test_save_where_links_to_other_documents_would_break_is_refused(shop, tmp_path):
+    """FreeCAD keeps a link to another document as a path relative to the document's folder,
+    also in a copy saved elsewhere: saved in another folder the document reopened without
+    the link (before: written, "wrote B/out.FCStd")."""
+    here, there = tmp_path / "A", tmp_path / "B"
+    here.mkdir()
+    there.mkdir()
+    parts = FreeCAD.newDocument("parts")
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        box = parts.addObject("Part::Box", "Fixture")
+        parts.recompute()
+        parts.saveAs(str(here / "parts.FCStd"))
+        doc.saveAs(str(here / "shop.FCStd"))
+        doc.addObject("App::Link", "FixtureLink").LinkedObject = box
+        doc.recompute()
+        doc.save()
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+        FreeCAD.closeDocument(parts.Name)
+    source = str(here / "shop.FCStd")
+    with pytest.raises(InputError, match=r"out.FCStd: --save in .*B: the document links "
+                                         r"objects of .*A/parts.FCStd by a path relative to "
+                                         r"its folder.*B/parts.FCStd.*nothing was written. "
+                                         r"Expected --save in the document's folder .*A$"):
+        run_document_job(source, shop["meas"], "Block", face="Face2",
+                         save=str(there / "out.FCStd"), replace=True, options=Options(refine=1))
+    assert os.listdir(there) == []
+    before = set(FreeCAD.listDocuments())
+    run_document_job(source, shop["meas"], "Block", face="Face2", save=str(here / "out.FCStd"),
+                     replace=True, options=Options(refine=1))
+    doc = FreeCAD.openDocument(str(here / "out.FCStd"))
+    try:
+        linked = doc.getObject("FixtureLink").LinkedObject
+        assert linked is not None and linked.Document.FileName == str(here / "parts.FCStd")
+    finally:
+        for name in set(FreeCAD.listDocuments()) - before:
+            FreeCAD.closeDocument(name)
