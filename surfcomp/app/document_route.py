@@ -9,10 +9,12 @@ Safety rules:
 
 - Path and OpenCamLib are set up *before* the document is opened
   (:func:`surfcomp.app.cam.setup_workbench`), and the document is opened through
-  :func:`surfcomp.app.documents.open_document` (Document.xml checked, only trusted proxy
+  :func:`surfcomp.app.documents.open_for_update` (Document.xml checked, only trusted proxy
   modules imported): an object whose module cannot be imported at open time loses its
   proxy, and a document saved like that can never recompute that object again. Such
-  documents are refused (nothing is written).
+  documents are refused (nothing is written); so is a document already open in this
+  FreeCAD session, which FreeCAD would hand back instead of reading the file, so that the
+  route would change the user's open document.
 - The outputs are checked against the inputs and each other before the document is
   opened; the input document is never overwritten unless ``overwrite_input=True``.
 - All outputs (document, G-code) are written together or not at all (temporary files
@@ -28,11 +30,12 @@ from ..core.compensation.pipeline import Options
 from ..core.progress import report
 from ..errors import ComputationError, GeometryError, InputError
 from ..io.atomic import Transaction, check_outputs
+from ..io.fcstd import parse_document
 from ..io.outpath import shown
 from ..io.readers import read_any
 from . import align_doc, cam, cam_job, features, toolpaths
 from . import progress as recompute_order
-from .documents import open_document, restore_failures
+from .documents import open_for_update, restore_failures
 from .properties import store_options
 
 
@@ -58,6 +61,8 @@ class DocumentJobResult:
     correction_volume: float = 0.0                     # mm^3, integral of the correction
     alignment: list = field(default_factory=list)      # the compensation's Alignment lines
     alignment_warnings: list = field(default_factory=list)
+    base: str = None                                   # the previous round (iterations)
+    round: int = 1
 
 
 
@@ -83,6 +88,49 @@ def _find_object(doc, name, source):
     return obj
 
 
+def _round_of(doc, obj, face, replace, source):
+    """``(nominal, base)``: ``obj`` itself and no base, or, when ``obj`` is a compensation,
+    its nominal and ``obj`` (the new compensation is its next round: deviations stay against
+    the nominal, the correction adds to the earlier rounds').
+
+    Raises
+    ------
+    InputError
+        ``obj`` is a region object, a compensation not computed or of another face than
+        ``face``; or (with ``replace``) a nominal that a compensation replaces now: its users
+        cut that compensation's corrected face, so a new first round would find nothing to
+        replace, and measuring the part they machined asks for that compensation's next round.
+    """
+    from . import replace as replace_mod
+    from .region_doc import is_region
+
+    if is_region(obj):
+        raise InputError("%s is a region compensation: add its next round with --faces "
+                         "(expected a single-face compensation or the nominal's object)"
+                         % obj.Label, file=source)
+    if not features.is_compensation(obj):
+        replacing = [o.Label for o in doc.Objects if replace_mod.is_replacing(o)
+                     and getattr(o, "Nominal", None) is obj]
+        if replace and replacing:
+            raise InputError("%s is replaced by %s now (its users cut that corrected face), so "
+                             "there is nothing of %s to replace; expected --object %s for the "
+                             "next round of %s, or restore the nominal first"
+                             % (obj.Label, ", ".join(replacing), obj.Label, replacing[0],
+                                replacing[0]), file=source)
+        return obj, None
+    features.chain(obj)
+    if face and face != obj.FaceName:
+        raise InputError("%s compensates %s.%s, not %s: its next round compensates the same "
+                         "face (expected --face %s or none)"
+                         % (obj.Label, obj.Nominal.Label, obj.FaceName, face, obj.FaceName),
+                         file=source)
+    if obj.Shape.isNull() or {"Invalid", "Error"} & set(obj.State):
+        raise InputError("%s is not computed (state %s): its next round stacks on its "
+                         "correction; recompute it first" % (obj.Label, ", ".join(obj.State)),
+                         file=source)
+    return obj.Nominal, obj
+
+
 def _jobs_using(doc, comp):
     jobs = []
     for job in cam_job.jobs_of(doc):
@@ -106,9 +154,10 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         Measurement file (any format :func:`surfcomp.io.readers.read_any` reads); its data
         is stored in the document.
     object_name : str
-        Name or label of the object holding the nominal face.
+        Name or label of the object holding the nominal face, or of a compensation: the new
+        one is its next round (``Base``; same nominal face, its ``Output`` by default).
     face : str, optional
-        ``FaceN`` (default: the object's only B-spline face).
+        ``FaceN`` (default: the object's only B-spline face; a compensation's own face).
     save : str, optional
         Where to save the updated document (required with ``replace`` or ``gcode``).
     replace : bool
@@ -164,15 +213,19 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
 
     report(progress, 0.05, "opening %s" % os.path.basename(document))
     before = set(FreeCAD.listDocuments())
-    doc, refused, info = open_document(document)
+    doc, refused, info = open_for_update(document)
     try:
         check_restored(doc, refused, info, document)
-        nominal = _find_object(doc, object_name, document)
+        nominal, base = _round_of(doc, _find_object(doc, object_name, document), face,
+                                  replace, document)
+        if base is not None:
+            face = base.FaceName
+            output = output or base.Output
         paths_before = toolpaths.snapshot(doc)
         report(progress, 0.1, "reading the measurements")
         comp, meas = _add_compensation(doc, nominal, face, measurements,
                                        (units, deviation_units), fmt, sample, options, output,
-                                       max_memory)
+                                       max_memory, base)
         if align is not None:
             align_doc.settle(meas, align)
         report(progress, 0.15, "compensating %s.%s" % (nominal.Label, comp.FaceName))
@@ -180,7 +233,8 @@ def run_document_job(document, measurements, object_name, face=None, save=None, 
         features.compensation_result(comp)
         comp.recompute()
         result = DocumentJobResult(document=os.path.abspath(document), compensation=comp.Name,
-                                   measurement=meas.Name)
+                                   measurement=meas.Name, round=int(comp.Round),
+                                   base=None if base is None else base.Name)
         if replace:
             report(progress, 0.3, "replacing the nominal")
             result.replaced = replace_mod.replace(doc, comp)
@@ -228,13 +282,34 @@ def _check_paths(document, measurements, save, gcode, replace, overwrite_input):
     if save and not save.lower().endswith(".fcstd"):
         raise InputError("the saved document must end in .FCStd", file=save)
     check_outputs(*_declared(document, measurements, save, gcode, overwrite_input))
+    if save:
+        _check_linked_files(document, save)
+
+
+def _check_linked_files(document, save):
+    """Refuse ``save`` in a folder from which the document's links to other documents (kept
+    by FreeCAD as paths relative to the document's folder, also in a copy saved elsewhere)
+    would find another file or none: the saved document would reopen without them."""
+    here, there = (os.path.dirname(os.path.abspath(p)) for p in (document, save))
+    for name in parse_document(document)["files"]:
+        if os.path.isabs(name):
+            continue
+        linked, found = (os.path.realpath(os.path.join(d, name)) for d in (here, there))
+        if linked != found:
+            raise InputError("--save in %s: the document links objects of %s by a path "
+                             "relative to its folder, which FreeCAD keeps in the saved copy, "
+                             "so from there the links would point to %s and the saved "
+                             "document would reopen without them; nothing was written. "
+                             "Expected --save in the document's folder %s"
+                             % (there, linked, found, here), file=save)
 
 
 def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, options, output,
-                      max_memory=None):
+                      max_memory=None, base=None):
     """The measurement (``units``: the coordinates' and the deviation column's, or None)
-    and the compensation objects of a document job; the points are read and the estimated
-    peak memory checked before anything is added to the document."""
+    and the compensation objects of a document job (``base``: the previous round); the
+    points are read and the estimated peak memory checked before anything is added to the
+    document."""
     if output is None:
         output = "solid" if len(nominal.Shape.Faces) > 1 else "face"
     ms = read_any(os.fspath(measurements), units=units[0], fmt=fmt or "auto", sample=sample,
@@ -242,7 +317,7 @@ def _add_compensation(doc, nominal, face, measurements, units, fmt, sample, opti
     budget.check_job(len(ms), True, max_memory)
     meas = features.make_measurement_from_set(doc, ms)
     comp = features.make_compensation(doc, nominal, face, meas, method=options.method,
-                                      output=output)
+                                      output=output, base=base)
     store_options(comp, options)     # every option, so none is left at its default unsaid
     return comp, meas
 
@@ -261,12 +336,20 @@ def _recompute(doc):
 
 
 def _one_job(jobs, job_name):
-    if job_name:
-        jobs = [j for j in jobs if job_name in (j.Name, j.Label)]
-    if len(jobs) != 1:
-        raise InputError("%s Path jobs use the compensation (%s): choose one with the job name"
-                         % (len(jobs) or "no", ", ".join(j.Label for j in jobs) or "none"))
-    return jobs[0]
+    using = ", ".join(j.Label for j in jobs)
+    if not jobs:
+        raise InputError("no Path jobs use the compensation, so there is no program to post "
+                         "(a Job uses it after the replace when the Job's model is the "
+                         "nominal)")
+    chosen = [j for j in jobs if job_name in (j.Name, j.Label)] if job_name else jobs
+    if not chosen:
+        # not "no Path jobs use the compensation": they do, under other names
+        raise InputError("no Path job named %r uses the compensation (the Jobs that do: %s); "
+                         "expected one of their names or labels" % (job_name, using))
+    if len(chosen) != 1:
+        raise InputError("%d Path jobs use the compensation (%s): choose one with the job name"
+                         % (len(chosen), ", ".join(j.Label for j in chosen)))
+    return chosen[0]
 
 
 def post_program(jobs, gcode, post, post_args, job_name, progress=None):
@@ -315,6 +398,10 @@ def summary_lines(result):
     """Short human-readable lines about a :class:`DocumentJobResult` (for the CLI)."""
     lines = ["compensation %s (measurement %s) added to the document"
              % (result.compensation, result.measurement)]
+    if result.base:
+        lines.append("round %d: stacked on %s (the earlier rounds' correction plus this "
+                     "measurement's; deviations against the nominal)"
+                     % (result.round, result.base))
     if result.output == "solid":
         lines.append("output: the nominal's shape with the face replaced; volume change %.4f "
                      "mm^3, expected from the correction %.4f mm^3 (-integral of delta dA)"

@@ -99,6 +99,42 @@ def open_document(path, progress_label=None):
     return doc, refused, info
 
 
+def open_in_session(path):
+    """The document of this FreeCAD session that has ``path`` open (its file, through any
+    link), or None."""
+    FreeCAD = fcenv.import_freecad()
+    for doc in FreeCAD.listDocuments().values():
+        name = getattr(doc, "FileName", "") or ""
+        try:
+            if name and os.path.samefile(name, path):
+                return doc
+        except OSError:
+            continue
+    return None
+
+
+def open_for_update(path):
+    """:func:`open_document` for a route that adds to and changes the document it opens.
+
+    FreeCAD gives back the document already open in this session (the GUI's, a script's)
+    instead of reading the file again, so the route would change the user's open document,
+    and leave it half changed when it fails: such a document is refused, nothing changed.
+
+    Raises
+    ------
+    InputError
+        The document is open in this session, or as :func:`open_document`.
+    """
+    if os.path.isfile(path):
+        doc = open_in_session(path)
+        if doc is not None:
+            raise InputError("the document is open in this FreeCAD session (as %s): the "
+                             "command would change that open document instead of reading "
+                             "the file; nothing was changed. Expected a document that is not "
+                             "open here: save and close it first" % doc.Label, file=path)
+    return open_document(path)
+
+
 def restore_failures(doc, path=None, info=None):
     """Objects of an opened document that did not restore completely.
 
@@ -126,4 +162,5 @@ def restore_failures(doc, path=None, info=None):
     return problems
 
 
-__all__ = ["open_document", "prepare_modules", "restore_failures"]
+__all__ = ["open_document", "open_for_update", "open_in_session", "prepare_modules",
+           "restore_failures"]

@@ -35,7 +35,7 @@ from .document_route import (
     outcome_lines,
     post_program,
 )
-from .documents import open_document
+from .documents import open_for_update
 
 
 @dataclass
@@ -91,7 +91,7 @@ def run_region_document(document, measurements, object_name, faces, save, replac
 
     before = set(FreeCAD.listDocuments())
     report(progress, 0.05, "opening %s" % os.path.basename(document))
-    doc, refused, info = open_document(document)
+    doc, refused, info = open_for_update(document)
     try:
         check_restored(doc, refused, info, document)
         nominal = _find_object(doc, object_name, document)

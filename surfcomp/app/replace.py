@@ -290,6 +290,30 @@ def _check_restored(doc, comp):
                          "again" % (len(lost), comp.Nominal.Label, "; ".join(lost)))
 
 
+def _check_surface_dressups(doc, comp, changes):
+    """Refuse to move a Job that holds a "Surface correction" dressup
+    (:mod:`surfcomp.app.dressup_surface`) onto the compensation: that dressup moves the
+    operation's program by a correction already, and once the operation cuts the corrected
+    face it would move it a second time (the dressup's command refuses the other order)."""
+    from .cam_job import jobs_of
+
+    changed = {o.Name for o, _prop, _kind, _old, _new in changes}
+    for job in jobs_of(doc):
+        inside = job.OutListRecursive
+        if not changed & ({o.Name for o in inside} | {job.Name}):
+            continue
+        for o in inside:
+            if type(getattr(o, "Proxy", None)).__name__ == "DressupSurfaceCorrection":
+                follows = getattr(o.Compensation, "Label", "no compensation")
+                raise InputError("%s holds the surface correction dressup %s, which moves its "
+                                 "program by the correction of %s already: with %s in the "
+                                 "nominal's place its operation would cut the corrected face "
+                                 "and the dressup would move that a second time; nothing was "
+                                 "replaced. Expected one correction: delete the dressup first, "
+                                 "or point its Compensation at %s instead of replacing"
+                                 % (job.Label, o.Label, follows, comp.Label, comp.Label))
+
+
 def replace(doc, comp):
     """Rebind the users of ``comp``'s nominal to ``comp``; hide the nominal.
 
@@ -308,7 +332,8 @@ def replace(doc, comp):
     ------
     InputError
         ``comp`` is not a computed compensation or is already replacing its nominal, or
-        users of the nominal (or their CAM Jobs) lost their Python objects at open time.
+        users of the nominal (or their CAM Jobs) lost their Python objects at open time, or
+        a Job it would move holds a surface correction dressup.
     GeometryError
         A user links a face the compensation's output does not have.
     """
@@ -327,6 +352,7 @@ def replace(doc, comp):
                              "feature links it): there is nothing to replace; export the "
                              "corrected face with Build corrected face instead"
                              % nominal.Label)
+        _check_surface_dressups(doc, comp, changes)
         record = {"links": [], "visibility": {}, "labels": {}}
         for o, prop, kind, old, new in changes:
             record["links"].append({"object": o.Name, "property": prop, "kind": kind,

@@ -67,10 +67,12 @@ def parse_document(path):
     -------
     dict
         ``objects``: list of ``(name, type)``; ``modules``: sorted proxy module names
-        (``<Python module=...>``).
+        (``<Python module=...>``); ``files``: sorted names of the other documents its links
+        point to (``<XLink file=...>``, as FreeCAD saved them: relative to the document's
+        folder, or absolute).
     """
     data = read_document_xml(path)
-    objects, modules = [], set()
+    objects, modules, files = [], set(), set()
     depth = {"Objects": 0}
 
     def start(tag, attrs):
@@ -80,6 +82,8 @@ def parse_document(path):
             objects.append((attrs.get("name"), attrs.get("type")))
         elif tag == "Python" and attrs.get("module"):
             modules.add(attrs["module"])
+        elif tag.startswith("XLink") and attrs.get("file"):
+            files.add(attrs["file"])
 
     def end(tag):
         if tag == "Objects":
@@ -104,4 +108,4 @@ def parse_document(path):
         raise InputError("Document.xml is damaged: its XML declaration names an encoding "
                          "that cannot be read (%s; FreeCAD writes UTF-8)" % exc,
                          file=path) from None
-    return {"objects": objects, "modules": sorted(modules)}
+    return {"objects": objects, "modules": sorted(modules), "files": sorted(files)}

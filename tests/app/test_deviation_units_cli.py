@@ -46,18 +46,22 @@ def test_file_route_reads_the_deviations_in_um(tmp_path):
                     atol=1e-12)
 
 
-def test_document_route_reads_the_deviations_in_um(tmp_path, fresh_doc):
-    doc = fresh_doc
-    nom = doc.addObject("Part::Feature", "Nominal")
-    nom.Shape = Part.read(EXAMPLE_STEP)
-    doc.recompute()
-    doc.saveAs(str(tmp_path / "d.FCStd"))
+def test_document_route_reads_the_deviations_in_um(tmp_path):
+    import FreeCAD
+
+    doc = FreeCAD.newDocument("test")
+    try:
+        nom = doc.addObject("Part::Feature", "Nominal")
+        nom.Shape = Part.read(EXAMPLE_STEP)
+        doc.recompute()
+        doc.saveAs(str(tmp_path / "d.FCStd"))
+    finally:
+        # closed: the route refuses a document open in its session (it would change it)
+        FreeCAD.closeDocument(doc.Name)
     out = run_in_process("compensate", tmp_path / "d.FCStd", _um_file(tmp_path), "--object",
                          "Nominal", "--save", tmp_path / "out.FCStd", "--deviation-units", "um",
                          "--quiet")
     assert out.returncode == 0, out.stderr
-    import FreeCAD
-
     saved = FreeCAD.openDocument(str(tmp_path / "out.FCStd"))
     try:
         meas = saved.getObject("Measurement")

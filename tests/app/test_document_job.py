@@ -283,3 +283,162 @@ def test_a_cam_error_is_reported_as_failed_not_unchanged(shop, no_tool, route):
         assert rep.operations[0].status == "unchanged"
     finally:
         FreeCAD.closeDocument(doc.Name)
+
+
+def test_a_document_open_in_this_session_is_refused_and_left_alone(shop, tmp_path):
+    """FreeCAD hands back a document that is open already instead of reading the file: the
+    route would add its objects to the user's open document and replace its nominal there
+    (before: it did, and left them there when it failed later, e.g. on an unknown --job)."""
+    from surfcomp.app.region_docroute import run_region_document
+
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        names = [o.Name for o in doc.Objects]
+        out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+        for run in (lambda: run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                                             save=out, replace=True, gcode=ngc,
+                                             job_name="Nope"),
+                    lambda: run_region_document(shop["doc"], shop["meas"], "Block", "Face2",
+                                                save=out, replace=True)):
+            with pytest.raises(InputError, match=r"shop.FCStd: the document is open in this "
+                                                 r"FreeCAD session \(as shop\).*nothing was "
+                                                 r"changed.*save and close it first"):
+                run()
+            assert [o.Name for o in doc.Objects] == names
+            assert doc.getObject("Clone").Objects == [doc.getObject("Block")]
+            assert doc.Label == "shop" and doc.Name in FreeCAD.listDocuments()
+        assert os.listdir(tmp_path) == []
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+
+
+def test_an_unknown_job_name_names_the_jobs_that_use_the_compensation(shop, tmp_path):
+    """Before: "no Path jobs use the compensation (none)", although the Job did."""
+    digest = sha(shop["doc"])
+    with pytest.raises(InputError, match=r"^no Path job named 'Nope' uses the compensation "
+                                         r"\(the Jobs that do: Job\); expected one of their "
+                                         r"names or labels$"):
+        run_document_job(shop["doc"], shop["meas"], "Block", face="Face2",
+                         save=str(tmp_path / "o.FCStd"), replace=True,
+                         gcode=str(tmp_path / "o.ngc"), job_name="Nope",
+                         options=Options(refine=1))
+    assert os.listdir(tmp_path) == [] and sha(shop["doc"]) == digest
+
+
+def test_replace_refuses_a_job_moved_by_a_surface_correction_dressup(shop, tmp_path):
+    """The Surface correction dressup moves the operation's program by a correction; with
+    the nominal replaced the operation cuts the corrected face, and the dressup moved that
+    again (before: the route posted the program moved twice, summary "regenerated")."""
+    from surfcomp.app import dressup_surface, replace
+    from surfcomp.io.readers import read_any
+
+    dressed = str(tmp_path / "dressed.FCStd")
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        block = doc.getObject("Block")
+        meas = features.make_measurement_from_set(doc, read_any(shop["meas"]))
+        first = features.make_compensation(doc, block, "Face2", meas, output="solid",
+                                           name="Round1")
+        first.Refine = 1
+        doc.recompute()
+        dressup = dressup_surface.Create(doc.getObject("Surface"), first)
+        doc.recompute()
+        assert dressup.MovedMoves > 0 and "Invalid" not in dressup.State
+        doc.saveAs(dressed)
+        # Replace itself (the GUI's) refuses and leaves every link as it was
+        second = features.make_compensation(doc, block, "Face2", meas, output="solid")
+        second.Refine = 1
+        doc.recompute()
+        with pytest.raises(InputError, match=r"^Job holds the surface correction dressup "
+                                             r"DressupSurfaceCorrection, which moves its "
+                                             r"program by the correction of Round1 already"):
+            replace.replace(doc, second)
+        assert doc.getObject("Clone").Objects == [block] and dressup.Compensation is first
+        assert second.ReplacedLinks == "" and block.Visibility
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+    digest = sha(dressed)
+    out, ngc = str(tmp_path / "out.FCStd"), str(tmp_path / "out.ngc")
+    with pytest.raises(InputError, match="would move that a second time; nothing was replaced"):
+        run_document_job(dressed, shop["meas"], "Block", face="Face2", save=out, replace=True,
+                         gcode=ngc, post_args=POST_ARGS, options=Options(refine=1))
+    assert os.listdir(tmp_path) == ["dressed.FCStd"] and sha(dressed) == digest
+
+
+def test_the_next_round_stacks_on_the_compensation_the_job_cuts(shop, tmp_path):
+    """A document whose nominal a compensation replaces: ``--object`` naming that
+    compensation adds its next round (Base), deviations against the nominal; naming the
+    nominal with --replace is refused with what to name instead. Before: the nominal was
+    refused as used by nothing, and a compensation was taken for a nominal (its corrected
+    face measured against, no Base, its earlier correction lost from the record)."""
+    first = str(tmp_path / "first.FCStd")
+    one = run_document_job(shop["doc"], shop["meas"], "Block", face="Face2", save=first,
+                           replace=True, options=Options(refine=1))
+    digest = sha(first)
+    with pytest.raises(InputError, match=r"first.FCStd: Block is replaced by Compensation now "
+                                         r".*expected --object Compensation for the next "
+                                         r"round of Compensation, or restore the nominal"):
+        run_document_job(first, shop["meas"], "Block", face="Face2",
+                         save=str(tmp_path / "o.FCStd"), replace=True)
+    with pytest.raises(InputError, match=r"Compensation compensates Block.Face2, not Face3"):
+        run_document_job(first, shop["meas"], "Compensation", face="Face3",
+                         save=str(tmp_path / "o.FCStd"), replace=True)
+    assert sorted(os.listdir(tmp_path)) == ["first.FCStd"] and sha(first) == digest
+    second, ngc = str(tmp_path / "second.FCStd"), str(tmp_path / "second.ngc")
+    two = run_document_job(first, shop["meas"], "Compensation", save=second, replace=True,
+                           gcode=ngc, post_args=POST_ARGS, options=Options(refine=1))
+    assert (two.base, two.round, two.output) == ("Compensation", 2, "solid")
+    assert "round 2: stacked on Compensation" in "\n".join(summary_lines(two))
+    assert two.operations == ["Surface"] and sha(first) == digest
+    # the same measurement again: the earlier correction plus about as much again
+    assert two.statistics["deviation"]["count"] == 225
+    assert two.correction_volume == pytest.approx(2 * one.correction_volume, rel=0.05)
+    doc = FreeCAD.openDocument(second)
+    try:
+        comp, base = doc.getObject(two.compensation), doc.getObject("Compensation")
+        assert comp.Base is base and comp.Nominal is doc.getObject("Block")
+        assert comp.FaceName == "Face2" and doc.getObject("Clone").Objects == [comp]
+        np.testing.assert_allclose(comp.Correction, np.add(base.Correction, comp.Increment),
+                                   atol=1e-12)
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+
+
+def test_save_where_links_to_other_documents_would_break_is_refused(shop, tmp_path):
+    """FreeCAD keeps a link to another document as a path relative to the document's folder,
+    also in a copy saved elsewhere: saved in another folder the document reopened without
+    the link (before: written, "wrote B/out.FCStd")."""
+    here, there = tmp_path / "A", tmp_path / "B"
+    here.mkdir()
+    there.mkdir()
+    parts = FreeCAD.newDocument("parts")
+    doc = documents.open_document(shop["doc"])[0]
+    try:
+        box = parts.addObject("Part::Box", "Fixture")
+        parts.recompute()
+        parts.saveAs(str(here / "parts.FCStd"))
+        doc.saveAs(str(here / "shop.FCStd"))
+        doc.addObject("App::Link", "FixtureLink").LinkedObject = box
+        doc.recompute()
+        doc.save()
+    finally:
+        FreeCAD.closeDocument(doc.Name)
+        FreeCAD.closeDocument(parts.Name)
+    source = str(here / "shop.FCStd")
+    with pytest.raises(InputError, match=r"out.FCStd: --save in .*B: the document links "
+                                         r"objects of .*A/parts.FCStd by a path relative to "
+                                         r"its folder.*B/parts.FCStd.*nothing was written. "
+                                         r"Expected --save in the document's folder .*A$"):
+        run_document_job(source, shop["meas"], "Block", face="Face2",
+                         save=str(there / "out.FCStd"), replace=True, options=Options(refine=1))
+    assert os.listdir(there) == []
+    before = set(FreeCAD.listDocuments())
+    run_document_job(source, shop["meas"], "Block", face="Face2", save=str(here / "out.FCStd"),
+                     replace=True, options=Options(refine=1))
+    doc = FreeCAD.openDocument(str(here / "out.FCStd"))
+    try:
+        linked = doc.getObject("FixtureLink").LinkedObject
+        assert linked is not None and linked.Document.FileName == str(here / "parts.FCStd")
+    finally:
+        for name in set(FreeCAD.listDocuments()) - before:
+            FreeCAD.closeDocument(name)
