@@ -48,6 +48,15 @@ def shop(tmp_path):
         FreeCAD.closeDocument(name)
 
 
+def block_plan(shop, count, **values):
+    """The shop document's Job and a recomputed grid plan of ``count`` points on Block's
+    Face2."""
+    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
+                                 Count=count, **values)
+    progress.recompute_with_progress(shop, "test")
+    return shop.getObject("Job"), plan
+
+
 def plan_arrays(plan):
     return (np.array([tuple(p) for p in plan.PlanPoints]),
             np.array([tuple(n) for n in plan.PlanNormals]))
@@ -66,10 +75,7 @@ def posted_probes(job, plan, op, tmp_path, name, native=False):
 
 
 def test_the_jobs_post_processor_writes_the_plan(shop, tmp_path):
-    job = shop.getObject("Job")
-    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
-                                 Count="5x4", TipRadius=1.5)
-    progress.recompute_with_progress(shop, "test")
+    job, plan = block_plan(shop, "5x4", TipRadius=1.5)
     assert plan.Kept == 20
     op = add_probe_operation(job, plan, tool=99, Overtravel=2.0)
     assert op in job.Operations.Group and is_probe_operation(op)
@@ -100,10 +106,7 @@ def test_the_jobs_post_processor_writes_the_plan(shop, tmp_path):
 
 
 def test_the_operation_follows_the_plan(shop, tmp_path):
-    job = shop.getObject("Job")
-    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
-                                 Count="5x4")
-    progress.recompute_with_progress(shop, "test")
+    job, plan = block_plan(shop, "5x4")
     op = add_probe_operation(job, plan)
     plan.Count = "3x3"
     plan.TipRadius = 2.0
@@ -138,10 +141,7 @@ def test_the_operation_follows_the_plan(shop, tmp_path):
 
 
 def test_no_claim_without_moves(shop):
-    job = shop.getObject("Job")
-    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
-                                 Count="4x4")
-    progress.recompute_with_progress(shop, "test")
+    job, plan = block_plan(shop, "4x4")
     op = add_probe_operation(job, plan)
     # a post that drops comments would probe and log nothing: refused
     with pytest.raises(GCodeError, match=r"wrote 16 G38.2, 0 PROBEOPEN, 0 PROBECLOSE where "
@@ -169,10 +169,7 @@ def test_no_claim_without_moves(shop):
 
 
 def test_the_probe_is_the_plans_ball(shop, tmp_path):
-    job = shop.getObject("Job")
-    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
-                                 Count="3x3")
-    progress.recompute_with_progress(shop, "test")
+    job, plan = block_plan(shop, "3x3")
     # tool 1 is the Job's ball end mill: its spindle turns at 10000 rpm, so the probe moves
     # would run with it turning (the post wrote no M5 and no tool change before G38.2)
     with pytest.raises(InputError, match=r"TC: Ball end 6 mm turns the spindle \(Forward, "
@@ -199,10 +196,7 @@ def test_the_probe_is_the_plans_ball(shop, tmp_path):
 
 
 def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
-    job = shop.getObject("Job")
-    plan = make_measurement_plan(shop, shop.getObject("Block"), "Face2", Layout="grid",
-                                 Count="3x3")
-    progress.recompute_with_progress(shop, "test")
+    job, plan = block_plan(shop, "3x3")
     op = add_probe_operation(job, plan)
     # two fixtures: each pass would probe the G54 part (the operation's own G54) and the
     # second PROBEOPEN would overwrite the first log
@@ -237,10 +231,8 @@ def test_the_probe_runs_in_the_jobs_work_offset_in_mm(shop, tmp_path):
 
 
 def test_no_post_of_a_stale_or_overwritten_log(shop):
-    job = shop.getObject("Job")
+    job, plan = block_plan(shop, "3x3")
     block = shop.getObject("Block")
-    plan = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="3x3")
-    progress.recompute_with_progress(shop, "test")
     add_probe_operation(job, plan)
     safe = plan.SafeZ
     # the nominal moved but the document was not recomputed: the plan is not touched
@@ -274,10 +266,8 @@ def test_no_post_of_a_stale_or_overwritten_log(shop):
 def test_replacing_the_nominal_leaves_the_plan_on_it(shop):
     from surfcomp.app import replace
 
-    job = shop.getObject("Job")
+    job, plan = block_plan(shop, "3x3")
     block = shop.getObject("Block")
-    plan = make_measurement_plan(shop, block, "Face2", Layout="grid", Count="3x3")
-    progress.recompute_with_progress(shop, "test")
     add_probe_operation(job, plan)
     before = plan_arrays(plan)[0]
     mirror = shop.addObject("Part::Mirroring", "Mirror")     # a user the replace rebinds
