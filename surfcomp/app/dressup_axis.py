@@ -217,6 +217,7 @@ class DressupAxisErrors(DressupProxy):
         obj.Path = path
         if result is None:      # no base: nothing compensated, no figures of an earlier run
             obj.FitSummary = []
+            obj.Warnings = []
             obj.ErrorBefore = obj.ErrorAfter = obj.MaxCorrection = 0.0
             return
         model, prog_model, res = result

@@ -124,10 +124,12 @@ def test_dressup_on_a_profile_operation(home, doc):
     assert d.ErrorBefore.Value > 0.03 and d.ErrorAfter.Value < 1e-9
     assert d.MaxCorrection.Value == pytest.approx(d.ErrorBefore.Value, rel=0.05)
     assert any("delta_z(z)" in s for s in d.FitSummary)
-    # without a base: an empty path, and none of the figures above kept
+    # without a base: an empty path, and none of the figures above kept (nor the warnings
+    # of an earlier run: they described a path that is gone)
+    d.Warnings = ["a warning of the run before"]
     d.Base = None
     doc.recompute()
-    assert d.Path.Commands == [] and d.FitSummary == []
+    assert d.Path.Commands == [] and d.FitSummary == [] and d.Warnings == []
     assert d.ErrorBefore.Value == d.ErrorAfter.Value == d.MaxCorrection.Value == 0.0
 
 
