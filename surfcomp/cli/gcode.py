@@ -27,7 +27,7 @@ from ..io.hashing import sha256_file
 from ..io.outpath import shown
 from . import SUMMARIES, registry
 from .common import wrote
-from .options import add_arguments
+from .options import add_arguments, check_range
 
 SCHEMA = "surfcomp-gcode-report/1"
 
@@ -103,8 +103,7 @@ def run(args):
     tol = _positive(args.tolerance, "--tolerance")
     arc_tol = _positive(args.arc_tolerance, "--arc-tolerance")
     max_error = _positive(args.max_error, "--max-error")
-    if args.decimals is not None and not 0 <= args.decimals <= 9:
-        raise InputError("--decimals %d: expected 0 to 9" % args.decimals)
+    check_range(GCODE["decimals"], args.decimals)
     reference = _triple(args.reference, "--reference")
     offset = None if args.work_offset is None else _triple(args.work_offset, "--work-offset")
     start = None if args.start is None else _triple(args.start, "--start")

@@ -3,6 +3,7 @@
 :mod:`surfcomp.core.option_tables`): flag, type, default, choices, metavar and help."""
 
 from ..core.options import OPTIONS, cli_help
+from ..errors import InputError
 
 
 def kwargs(name, table=OPTIONS):
@@ -22,6 +23,14 @@ def kwargs(name, table=OPTIONS):
     if o.metavar:
         kw["metavar"] = o.metavar
     return kw
+
+
+def check_range(option, value):
+    """Refuse ``value`` of ``option`` (a registry :class:`surfcomp.core.options.Option`)
+    outside its ``low`` .. ``high``; None (unset) passes."""
+    if value is not None and not option.low <= value <= option.high:
+        raise InputError("%s %s: expected %g to %g" % (option.flag, value, option.low,
+                                                       option.high))
 
 
 def add_arguments(parser, names, table=OPTIONS, **overrides):

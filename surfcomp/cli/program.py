@@ -12,7 +12,7 @@ from ..errors import InputError
 from . import registry
 from .common import ProgressLine, job_from_args, wrote
 from .option_flags import shown
-from .options import add_arguments
+from .options import add_arguments, check_range
 
 
 def add_program_options(p):
@@ -65,8 +65,7 @@ def run_program(args):
     if not (math.isfinite(args.segment_length) and args.segment_length >= MIN_SEGMENT_LENGTH):
         raise InputError("--segment-length %r: expected a length of at least %g mm (1 um)"
                          % (args.segment_length, MIN_SEGMENT_LENGTH))
-    if args.decimals is not None and not 3 <= args.decimals <= 9:
-        raise InputError("--decimals %d: expected 3 to 9" % args.decimals)
+    check_range(PROGRAM_MOVE["decimals"], args.decimals)
     from ..app import cadread
 
     try:

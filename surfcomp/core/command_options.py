@@ -114,8 +114,9 @@ GCODE = _table(
                 "more than this many mm"),
     Option("arc_tolerance", float, 1e-3, None, flag="--arc-tolerance", metavar="MM",
            note="> 0", help="largest chord-to-arc deviation in mm of converted arcs"),
-    Option("decimals", int, None, None, flag="--decimals", metavar="N",
-           unset="4 in mm, 5 in inch", help="least decimals of rewritten numbers"),
+    Option("decimals", int, None, None, flag="--decimals", metavar="N", low=0, high=9,
+           what="a whole number", unset="4 in mm, 5 in inch", note="0 to 9",
+           help="least decimals of rewritten numbers"),
 )
 
 #: ``compensate --program``'s options: the ball-end finishing program moved by the
@@ -133,7 +134,8 @@ PROGRAM_MOVE = _table(
     replace(GCODE["segment_length"],
             help="long moves are first sampled at this spacing in mm, so that nothing near "
                  "the face between their ends is missed"),
-    Option("decimals", int, None, None, flag="--decimals", metavar="N", unset="4",
+    Option("decimals", int, None, None, flag="--decimals", metavar="N", unset="4", low=3,
+           high=9, what="a whole number", note="3 to 9",
            help="least decimals of rewritten numbers"),
 )
 

@@ -69,6 +69,8 @@ MIN_MAX_OFFSET = 1e-4
 MAX_MAX_OFFSET = 100.0
 #: the largest stylus ball radius
 MAX_TIP_RADIUS = 50.0
+#: most probe moves per point a probe log joined to its plan may hold (--touches)
+MAX_TOUCHES = 9
 #: the most points a measurement plan may have
 MAX_PLAN_POINTS = 1_000_000
 #: the smoothing length of a scattered layout's fit: at least, at most

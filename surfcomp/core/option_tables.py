@@ -42,7 +42,7 @@ from .choices import (
     WORK_OFFSETS,
 )
 from .command_options import AXIS_FILE, COMPENSATE, GCODE, PROGRAM_MOVE, SIMULATE
-from .limits import MAX_PLAN_POINTS
+from .limits import MAX_PLAN_POINTS, MAX_TOUCHES
 from .options import OPTIONS, Option
 
 
@@ -70,7 +70,8 @@ INPUTS = _table(
     Option("sample", str, None, None, flag="--sample", metavar="N|ID", unset="the first",
            help="which measured part of a QIF file holding several: 0-based index, serial "
                 "number or MeasurementResults id"),
-    Option("touches", int, 1, None, flag="--touches", metavar="K",
+    Option("touches", int, 1, None, flag="--touches", metavar="K", low=1,
+           high=MAX_TOUCHES, what="a whole number", note="1 to %d" % MAX_TOUCHES,
            help="with --plan: probe moves per point in the log (2 for a LinuxCNC program "
                 "written with {second_touch}; the last one of each point is used)"),
 )

@@ -18,13 +18,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..core.compensation.pipeline import Options, option_name
+from ..core.limits import MAX_TOUCHES
 from ..errors import InputError, MeasurementFileError
 from .files import read_bytes
 from .measurement_set import MeasurementSet
 from .measurements import parse_measurements
 
 #: most probe moves per point a log may hold (``--touches``)
-MAX_TOUCHES = 9
 
 
 @dataclass

@@ -179,3 +179,28 @@ def test_the_core_functions_default_to_the_registry():
     assert got["masks"] == (reg["mask_size"],)
     assert plausibility.DEFAULT_MAX_OFFSET == reg["max_offset"] == 1.0
     assert defaults(corrected.construct)["refine"] == reg["refine"]
+
+
+@pytest.mark.parametrize("table, name, flag, low, high", [
+    ("compensate", "touches", "--touches", 1, limits.MAX_TOUCHES),
+    ("gcode", "decimals", "--decimals", 0, 9),
+    ("program", "decimals", "--decimals", 3, 9),
+])
+def test_ranges_enforced_elsewhere_are_in_the_registry_and_the_help(table, name, flag, low,
+                                                                   high):
+    """--touches (1 to 9, checked where a log is joined to its plan) and the two
+    --decimals (0 to 9 for gcode, 3 to 9 for --program) were enforced but their ranges were
+    written in neither the registry nor the help."""
+    from surfcomp.cli.options import check_range
+    from surfcomp.core.command_options import GCODE, PROGRAM_MOVE
+    from surfcomp.core.option_tables import INPUTS
+
+    tables = {"compensate": INPUTS, "gcode": GCODE, "program": PROGRAM_MOVE}
+    o = tables[table][name]
+    assert (o.flag, o.low, o.high) == (flag, low, high)
+    assert cli_help(name, tables[table]).endswith("%d to %d)" % (low, high))
+    check_range(o, low)
+    check_range(o, high)
+    with pytest.raises(InputError, match=r"^%s %d: expected %d to %d$" % (flag, high + 1, low,
+                                                                          high)):
+        check_range(o, high + 1)
