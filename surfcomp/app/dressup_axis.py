@@ -27,6 +27,7 @@ import numpy as np
 import Path
 
 from ..core.axis.axis_errors import AXES, MODEL_CHOICES, fit_axis_errors
+from ..core.command_options import GCODE
 from ..errors import InputError
 from ..io.axis_csv import AxisErrorTable, read_axis_errors
 from ..io.gcode import compensate_commands
@@ -85,15 +86,15 @@ PROPERTIES = (
     ("App::PropertyLength", "SegmentLength", _GROUP_COMP,
      QT_TRANSLATE_NOOP("App::Property", "Longest piece of a split G1 move or of an arc turned into"
                                         " G1 segments"),
-     2.0, 0),
+     GCODE["segment_length"].default, 0),
     ("App::PropertyLength", "Tolerance", _GROUP_COMP,
      QT_TRANSLATE_NOOP("App::Property", "Split a long G1 move only where the compensated path "
                                         "leaves its chord by more"),
-     1e-4, 0),
+     GCODE["tolerance"].default, 0),
     ("App::PropertyLength", "ArcTolerance", _GROUP_COMP,
      QT_TRANSLATE_NOOP("App::Property", "Largest chord-to-arc deviation of arcs turned into G1 "
                                         "segments"),
-     1e-3, 0),
+     GCODE["arc_tolerance"].default, 0),
     ("App::PropertyStringList", "FitSummary", _GROUP_RESULT,
      QT_TRANSLATE_NOOP("App::Property", "Fitted error functions and the 12 components"),
      None, 1),

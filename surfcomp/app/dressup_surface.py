@@ -17,6 +17,7 @@ dressup is created. No FreeCADGui, no PySide: it recomputes in ``freecadcmd``.
 import FreeCAD
 import Path
 
+from ..core.command_options import PROGRAM_MOVE
 from ..errors import InputError
 from ..io.gcode.offset_stream import offset_commands
 from . import cam
@@ -47,14 +48,14 @@ PROPERTIES = (
     ("App::PropertyLength", "Tolerance", _GROUP,
      QT_TRANSLATE_NOOP("App::Property", "Largest distance of the moved path from the exactly "
                                         "moved one (long moves are split)"),
-     5e-4, 0),
+     PROGRAM_MOVE["tolerance"].default, 0),
     ("App::PropertyLength", "Blend", _GROUP,
      QT_TRANSLATE_NOOP("App::Property", "Beyond the face the correction fades out over this "
                                         "clearance"),
-     1.0, 0),
+     PROGRAM_MOVE["blend"].default, 0),
     ("App::PropertyLength", "SegmentLength", _GROUP,
      QT_TRANSLATE_NOOP("App::Property", "Long moves are first sampled at this spacing"),
-     2.0, 0),
+     PROGRAM_MOVE["segment_length"].default, 0),
     ("App::PropertyInteger", "MovedMoves", _GROUP_RESULT,
      QT_TRANSLATE_NOOP("App::Property", "Moves the correction moved"),
      0, 1),
