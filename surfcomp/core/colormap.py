@@ -81,7 +81,8 @@ def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME, levels=None,
     scheme_name : str
     levels : int, optional
         Stepped colours: the range split into ``levels`` equal steps, each drawn in the
-        colour of its middle (as the stepped legend shows them).
+        colour of its middle (as the stepped legend shows them); a value on the edge of two
+        steps in the colour of the upper one.
     out_of_range : bool
         Values below ``vmin`` / above ``vmax`` take :data:`OUT_OF_RANGE_COLORS`; else the
         end colours of the scheme.
@@ -96,7 +97,14 @@ def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME, levels=None,
     v = np.asarray(values, dtype=float).ravel()
     f = np.clip((v - vmin) / (vmax - vmin), 0.0, 1.0)
     if levels:
-        f = (np.minimum(np.floor(f * levels), levels - 1) + 0.5) / levels
+        # a value on a step's edge (a label of the legend) takes the step above it, the top
+        # end the top step's: its position in steps is rounded off first, as (v - vmin) /
+        # (vmax - vmin) of a round value lands a rounding error either side of the edge
+        # (-0.01 of -0.05 .. 0.05 at 1.9999999999999996, +0.01 at 6.000000000000001)
+        step = f * levels
+        near = np.round(step)
+        step = np.where(np.abs(step - near) < 1e-9, near, step)
+        f = (np.minimum(np.floor(step), levels - 1) + 0.5) / levels
     pos = np.linspace(0.0, 1.0, len(ctrl))
     fin = np.isfinite(f)
     out = np.empty((v.size, 3))
