@@ -207,8 +207,9 @@ class PointLocator:
         self.keep = np.flatnonzero(np.isfinite(dev))
         self.nodes = nodes
         self.tree = cKDTree(nodes[self.keep])
-        self.values = {q: quantity_values(obj, q).ravel()
-                       for q in ("deviation", "determined", "random", "correction")}
+        # every quantity a map shows: a flag on the increment or residual map gives its own
+        # value, not the deviation
+        self.values = {q: quantity_values(obj, q).ravel() for q in QUANTITIES}
         self.ids = self._ids(measurement_set(obj.Measurement), cKDTree)
 
     def _ids(self, ms, tree_type):
@@ -229,7 +230,7 @@ class PointLocator:
     def at(self, local_point):
         """``dict`` of the nearest measured node to ``local_point`` (nominal object's
         coordinates, mm): ``node``, ``id``, ``xyz`` (document coordinates), ``distance``
-        and the node's ``deviation``, ``determined``, ``random``, ``correction`` (mm)."""
+        and the node's value of every quantity of :data:`QUANTITIES` (mm)."""
         dist, k = self.tree.query(np.asarray(local_point, dtype=float))
         node = int(self.keep[k])
         return self.node(node, float(dist))
