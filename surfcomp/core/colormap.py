@@ -189,7 +189,9 @@ def histogram(values, vmin, vmax, bins=20, scheme_name=DEFAULT_SCHEME, tolerance
               warning=None, levels=None):
     """Histogram of ``values`` over ``[vmin, vmax]`` coloured like the map's legend.
 
-    Values outside the range are counted in ``below``/``above``, not in the bins.
+    Values outside the range are counted in ``below``/``above``, not in the bins. With
+    stepped colours (``levels``) the number of bins is the multiple of ``levels`` nearest
+    ``bins``, so each bin lies in one step.
 
     Returns
     -------
@@ -199,6 +201,10 @@ def histogram(values, vmin, vmax, bins=20, scheme_name=DEFAULT_SCHEME, tolerance
     """
     v = np.asarray(values, dtype=float).ravel()
     v = v[np.isfinite(v)]
+    if levels and tolerance is None:
+        # whole bins per step: a bin across a step's edge would count values of two colours
+        # under the colour of its centre
+        bins = levels * max(1, int(round(bins / levels)))
     edges = np.linspace(vmin, vmax, int(bins) + 1)
     counts, _ = np.histogram(v[(v >= vmin) & (v <= vmax)], bins=edges)
     mid = 0.5 * (edges[:-1] + edges[1:])

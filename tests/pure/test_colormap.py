@@ -203,3 +203,15 @@ def test_histogram_counts_and_legend_colours():
     assert h["below"] == np.count_nonzero(v < -0.02)
     assert_allclose(h["colors"], cm.map_colors(0.5 * (h["edges"][1:] + h["edges"][:-1]),
                                                -0.02, 0.02))
+
+
+def test_stepped_histogram_bars_hold_the_values_of_their_colour():
+    """With the histogram panel's 24 bins over 10 steps, a bar across a step's edge counted
+    values of two colours under one: on a spread like the example's a tenth of the points
+    were in a bar of another colour than theirs on the map."""
+    v = np.random.default_rng(2).uniform(-0.047, 0.047, 2000)
+    lo, hi = cm.symmetric_range(v)
+    h = cm.histogram(v, lo, hi, bins=24, levels=10)
+    assert len(h["counts"]) == 20 and h["counts"].sum() == v.size
+    bar = np.clip(np.searchsorted(h["edges"], v, side="right") - 1, 0, len(h["counts"]) - 1)
+    assert_allclose(h["colors"][bar], cm.map_colors(v, lo, hi, levels=10), atol=1e-12)
