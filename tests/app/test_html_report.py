@@ -161,10 +161,12 @@ def test_an_iterations_report_predicts_the_residual_of_its_own_round(fresh_doc):
 
     from surfcomp.app import features, reports
     from surfcomp.io import html_report
-    from tests.app.helpers import EXAMPLE_CSV, EXAMPLE_STEP
+    from tests.conftest import ROOT
 
+    examples = os.path.join(ROOT, "examples")
+    EXAMPLE_CSV = os.path.join(examples, "measurements.csv")
     nom = fresh_doc.addObject("Part::Feature", "Nominal")
-    nom.Shape = Part.read(EXAMPLE_STEP)
+    nom.Shape = Part.read(os.path.join(examples, "nominal.step"))
     first = features.make_compensation(fresh_doc, nom, "Face1",
                                        features.make_measurement(fresh_doc, EXAMPLE_CSV),
                                        method="raw")
