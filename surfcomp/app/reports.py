@@ -106,7 +106,8 @@ def field_values(obj, quantity, u, v, located=None):
 
 def report_of(obj):
     """The JSON report (schema ``surfcomp-report/1``, as the CLI writes it) of a
-    compensation object, recomputed from its properties and links."""
+    compensation object, recomputed from its properties and links; an iteration's points
+    also carry this round's own correction (``increment``, mm)."""
     from ..io import report as report_io
     from .features import compensation_result, nominal_of
 
@@ -122,7 +123,14 @@ def report_of(obj):
         "measurements": {"path": m.SourceName, "sha256": m.SourceSha256, "units": m.Units,
                          "points": int(m.PointCount), "object": m.Label},
     }
-    return report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
+    rep = report_io.build_report("compensate", inputs, comp, comp.prepared.warnings)
+    if obj.Base is not None:
+        # an iteration: the report's correction is the accumulated one; the predicted
+        # residual is what this round's own correction leaves (quantity_values)
+        inc = np.empty(comp.prepared.u.size)
+        inc[comp.prepared.grid.index.ravel()] = _grid(obj, "Increment").ravel()
+        rep["points"]["increment"] = inc
+    return rep
 
 
 def write_html_report(obj, path, style=None):
@@ -199,8 +207,9 @@ class PointLocator:
         self.keep = np.flatnonzero(np.isfinite(dev))
         self.nodes = nodes
         self.tree = cKDTree(nodes[self.keep])
-        self.values = {q: quantity_values(obj, q).ravel()
-                       for q in ("deviation", "determined", "random", "correction")}
+        # every quantity a map shows: a flag on the increment or residual map gives its own
+        # value, not the deviation
+        self.values = {q: quantity_values(obj, q).ravel() for q in QUANTITIES}
         self.ids = self._ids(measurement_set(obj.Measurement), cKDTree)
 
     def _ids(self, ms, tree_type):
@@ -221,7 +230,7 @@ class PointLocator:
     def at(self, local_point):
         """``dict`` of the nearest measured node to ``local_point`` (nominal object's
         coordinates, mm): ``node``, ``id``, ``xyz`` (document coordinates), ``distance``
-        and the node's ``deviation``, ``determined``, ``random``, ``correction`` (mm)."""
+        and the node's value of every quantity of :data:`QUANTITIES` (mm)."""
         dist, k = self.tree.query(np.asarray(local_point, dtype=float))
         node = int(self.keep[k])
         return self.node(node, float(dist))

@@ -81,7 +81,8 @@ def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME, levels=None,
     scheme_name : str
     levels : int, optional
         Stepped colours: the range split into ``levels`` equal steps, each drawn in the
-        colour of its middle (as the stepped legend shows them).
+        colour of its middle (as the stepped legend shows them); a value on the edge of two
+        steps in the colour of the upper one.
     out_of_range : bool
         Values below ``vmin`` / above ``vmax`` take :data:`OUT_OF_RANGE_COLORS`; else the
         end colours of the scheme.
@@ -96,7 +97,14 @@ def map_colors(values, vmin, vmax, scheme_name=DEFAULT_SCHEME, levels=None,
     v = np.asarray(values, dtype=float).ravel()
     f = np.clip((v - vmin) / (vmax - vmin), 0.0, 1.0)
     if levels:
-        f = (np.minimum(np.floor(f * levels), levels - 1) + 0.5) / levels
+        # a value on a step's edge (a label of the legend) takes the step above it, the top
+        # end the top step's: its position in steps is rounded off first, as (v - vmin) /
+        # (vmax - vmin) of a round value lands a rounding error either side of the edge
+        # (-0.01 of -0.05 .. 0.05 at 1.9999999999999996, +0.01 at 6.000000000000001)
+        step = f * levels
+        near = np.round(step)
+        step = np.where(np.abs(step - near) < 1e-9, near, step)
+        f = (np.minimum(np.floor(step), levels - 1) + 0.5) / levels
     pos = np.linspace(0.0, 1.0, len(ctrl))
     fin = np.isfinite(f)
     out = np.empty((v.size, 3))
@@ -181,7 +189,9 @@ def histogram(values, vmin, vmax, bins=20, scheme_name=DEFAULT_SCHEME, tolerance
               warning=None, levels=None):
     """Histogram of ``values`` over ``[vmin, vmax]`` coloured like the map's legend.
 
-    Values outside the range are counted in ``below``/``above``, not in the bins.
+    Values outside the range are counted in ``below``/``above``, not in the bins. With
+    stepped colours (``levels``) the number of bins is the multiple of ``levels`` nearest
+    ``bins``, so each bin lies in one step.
 
     Returns
     -------
@@ -191,6 +201,10 @@ def histogram(values, vmin, vmax, bins=20, scheme_name=DEFAULT_SCHEME, tolerance
     """
     v = np.asarray(values, dtype=float).ravel()
     v = v[np.isfinite(v)]
+    if levels and tolerance is None:
+        # whole bins per step: a bin across a step's edge would count values of two colours
+        # under the colour of its centre
+        bins = levels * max(1, int(round(bins / levels)))
     edges = np.linspace(vmin, vmax, int(bins) + 1)
     counts, _ = np.histogram(v[(v >= vmin) & (v <= vmax)], bins=edges)
     mid = 0.5 * (edges[:-1] + edges[1:])

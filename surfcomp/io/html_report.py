@@ -104,7 +104,9 @@ def grid_arrays(report):
     dict
         ``'x'``, ``'y'`` (n, m) nominal coordinates (mm) and ``'deviation'``,
         ``'determined'``, ``'random'``, ``'correction'``, ``'residual'`` (n, m) in mm
-        (NaN where no point fell); (N,) per point for a scattered layout.
+        (NaN where no point fell); (N,) per point for a scattered layout. The residual is
+        that of this round's own correction: the points' ``increment`` when the report has
+        one (an iteration's, whose ``correction`` is the accumulated one).
     """
     pts = report["points"]
     out = {}
@@ -125,7 +127,10 @@ def grid_arrays(report):
     for key in ("deviation", "determined", "random", "correction"):
         out[key] = put(pts[key])
     meth = report.get("method", {})
-    out["residual"] = predicted_residual(out["determined"], out["correction"], meth.get("name"),
+    # an iteration's report (``increment``): its correction is the accumulated one, and
+    # what the next part keeps is what this round's own correction leaves
+    own = out["correction"] if pts.get("increment") is None else put(pts["increment"])
+    out["residual"] = predicted_residual(out["determined"], own, meth.get("name"),
                                          meth.get("stock_mm"))
     return out
 

@@ -153,6 +153,38 @@ def test_predicted_residual_by_method():
     assert "Expected RMS of the next part" in section
 
 
+def test_an_iterations_report_predicts_the_residual_of_its_own_round(fresh_doc):
+    """A second round's report holds the accumulated correction; its predicted residual is
+    what this round's correction leaves, as the GUI's residual map and filter panel show it
+    (raw: minus the random component), not d_f minus the accumulated correction."""
+    import Part
+
+    from surfcomp.app import features, reports
+    from surfcomp.io import html_report
+    from tests.conftest import ROOT
+
+    examples = os.path.join(ROOT, "examples")
+    EXAMPLE_CSV = os.path.join(examples, "measurements.csv")
+    nom = fresh_doc.addObject("Part::Feature", "Nominal")
+    nom.Shape = Part.read(os.path.join(examples, "nominal.step"))
+    first = features.make_compensation(fresh_doc, nom, "Face1",
+                                       features.make_measurement(fresh_doc, EXAMPLE_CSV),
+                                       method="raw")
+    second = features.make_compensation(fresh_doc, nom, "Face1",
+                                        features.make_measurement(fresh_doc, EXAMPLE_CSV),
+                                        method="raw", base=first, name="Round2")
+    fresh_doc.recompute()
+    assert second.Round == 2 and "Invalid" not in second.State
+    rep = reports.report_of(second)
+    arr = grid_arrays(rep)
+    assert np.nanmax(np.abs(arr["correction"] - arr["determined"])) > 0.02  # accumulated
+    assert_allclose(arr["residual"], reports.quantity_values(second, "residual"), atol=1e-8)
+    assert_allclose(arr["residual"], -arr["random"], atol=1e-8)
+    section = html_report._section_statistics(rep, arr)
+    want = reports.filter_summary(second)["next_part"] * 1e3
+    assert "<span class=\"num\">%.2f µm</span>" % want in section
+
+
 def test_maps_use_the_gui_scheme_and_range():
     """The report's maps use the GUI's rainbow (red at the top of the range) and, when the
     GUI passes its range, grey beyond it (colorbar arrows)."""

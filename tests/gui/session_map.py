@@ -5,6 +5,8 @@
 import Path
 import PathGui  # noqa: F401  (the view provider that draws a Path::Feature)
 
+from surfcomp.app import reports
+
 doc = FreeCAD.newDocument("Map")
 nominal, meas = load_example(doc)
 t0 = time.perf_counter()
@@ -197,6 +199,17 @@ time.sleep(0.3)
 Gui.updateGui()
 flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
 RESULTS["flag_relaid"] = before != [list(flag.getChild(2).point[1])]
+# the same flag on the other maps gives their value at the point, not the deviation
+flag_texts = {}
+for q in ("residual", "increment", "deviation"):
+    vobj.Map = q
+    Gui.updateGui()
+    flag = scene.flags.getChild(scene.flags.getNumChildren() - 1)
+    flag_texts[q] = flag.getChild(5).getChild(3).string.getValues()[0].strip()
+RESULTS["flag_on_max_texts"] = flag_texts
+RESULTS["unit"] = vobj.Unit
+RESULTS["flag_on_max_values"] = {
+    q: float(reports.quantity_values(comp, q).ravel()[i_max]) for q in flag_texts}
 vobj.Flags = flags_before
 
 # -- four visible maps: one legend panel, each legend named and at full size ------------------

@@ -269,6 +269,18 @@ def test_four_maps_one_legend_panel_named_and_full_size(session):
     assert session["legends_after_remove"] == ["Compensation"]
 
 
+def test_a_flag_gives_the_value_of_the_map_it_is_on(session):
+    """The flag on the largest deviation, on the residual and increment maps: their value
+    at the point (filtered: residual 0, increment the determined component), not the
+    deviation it showed on every map but the four the readout names."""
+    texts, values = session["flag_on_max_texts"], session["flag_on_max_values"]
+    unit = session["unit"]
+    for q, text in texts.items():
+        assert text.endswith("  " + colormap.format_value(values[q], unit)), (q, text)
+    assert texts["residual"].endswith("  " + colormap.format_value(0.0, unit))
+    assert texts["increment"] != texts["deviation"]
+
+
 def test_saved_document_reopens_with_its_map_and_flags(session):
     name, mode, vertices, flags, drawn = session["reopened"]
     assert [name, mode, vertices] == ["ViewProviderCompensation", "Map", 8100]

@@ -160,6 +160,24 @@ def test_stepped_colours_are_the_middles_of_the_legend_steps():
     assert_allclose(cm.map_colors([-0.99, -0.51], -1, 1, levels=4), steps[[0, 0]], atol=1e-12)
 
 
+def test_a_value_on_a_step_edge_takes_the_step_above_whatever_the_rounding():
+    """On the default manual range -0.05 .. 0.05 mm in 10 steps, -0.01 and +0.03 mm sit a
+    rounding error below their edges and took the step under the label, +0.01 and +0.02
+    the one above."""
+    lo, hi, n = -0.05, 0.05, 10
+    labels = lo + np.linspace(0.0, 1.0, n + 1) * (hi - lo)
+    typed = np.round(labels, 6)              # the values as a measurement file gives them
+    middles = lo + (np.arange(n) + 0.5) / n * (hi - lo)
+    above = cm.map_colors(middles[list(range(n)) + [n - 1]], lo, hi)
+    for values in (labels, typed):
+        assert_allclose(cm.map_colors(values, lo, hi, levels=n), above, atol=1e-12)
+    lo, hi = -0.047134, 0.047134             # the example's automatic range
+    labels = lo + np.linspace(0.0, 1.0, n + 1) * (hi - lo)
+    middles = lo + (np.arange(n) + 0.5) / n * (hi - lo)
+    assert_allclose(cm.map_colors(labels, lo, hi, levels=n),
+                    cm.map_colors(middles[list(range(n)) + [n - 1]], lo, hi), atol=1e-12)
+
+
 def test_band_fractions_and_warning_band():
     v = np.array([-0.02, -0.009, -0.004, 0.0, 0.004, 0.009, 0.011, 0.03, np.nan, 0.01])
     fr = cm.band_fractions(v, -0.01, 0.01, warning=0.8)
@@ -185,3 +203,15 @@ def test_histogram_counts_and_legend_colours():
     assert h["below"] == np.count_nonzero(v < -0.02)
     assert_allclose(h["colors"], cm.map_colors(0.5 * (h["edges"][1:] + h["edges"][:-1]),
                                                -0.02, 0.02))
+
+
+def test_stepped_histogram_bars_hold_the_values_of_their_colour():
+    """With the histogram panel's 24 bins over 10 steps, a bar across a step's edge counted
+    values of two colours under one: on a spread like the example's a tenth of the points
+    were in a bar of another colour than theirs on the map."""
+    v = np.random.default_rng(2).uniform(-0.047, 0.047, 2000)
+    lo, hi = cm.symmetric_range(v)
+    h = cm.histogram(v, lo, hi, bins=24, levels=10)
+    assert len(h["counts"]) == 20 and h["counts"].sum() == v.size
+    bar = np.clip(np.searchsorted(h["edges"], v, side="right") - 1, 0, len(h["counts"]) - 1)
+    assert_allclose(h["colors"][bar], cm.map_colors(v, lo, hi, levels=10), atol=1e-12)
