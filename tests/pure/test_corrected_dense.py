@@ -111,7 +111,9 @@ def test_check_figures_skip_a_degenerate_edge_not_the_whole_surface():
     _, Su, Sv = bspline.evaluate_grid(nominal, us[1:], vs, order=1)
     n = np.cross(Su, Sv)
     nz = n[..., 2] / np.linalg.norm(n, axis=-1)
-    assert figures.max_realised == pytest.approx(0.005 * np.max(np.abs(nz)), rel=1e-9)
+    # the grid's largest is 0.005 max|n_z|; refined between the nodes
+    # the figure reaches the face's largest, 0.005 where the normal is vertical (the lift)
+    assert 0.005 * np.max(np.abs(nz)) - 1e-12 <= figures.max_realised <= 0.005 + 1e-12
     assert figures.max_realised > 0.004 and figures.max_zero_deviation == 0.0
 
 

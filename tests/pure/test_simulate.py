@@ -254,7 +254,9 @@ def test_as_dict_is_json_and_holds_every_replica(werner_small_random):
     stds = [r["all"]["std"] for r in raw["replicas"]]
     assert_allclose(raw["spread"]["all"]["std"]["range"], np.ptp(stds), atol=1e-15)
     assert len(d["methods"][4]["semi_finish"]["replicas"]) == 4
-    assert max(raw["max_error_at_points_mm"]) < 5e-5
+    # within the limit (0.1 um): with the overshoot judged on the face, not the check grid's
+    # nodes, one replica's raw face moves to a space that meets the points by 0.065 um
+    assert max(raw["max_error_at_points_mm"]) < 1e-4
     assert "Profile error ISO 1101" in d["table"]
 
 

@@ -146,7 +146,8 @@ class CheckFigures:
     ``max_zero_deviation``: max distance from the nominal of the surface built with
     a zero field (the construction's own error), on a grid ``density`` times
     denser than the measurement grid. ``max_realised`` / ``max_intended``: the
-    largest |correction| anywhere on that dense grid vs at the measured points.
+    largest |correction| on the face (that dense grid's, refined between the nodes
+    around its largest local maxima) vs at the measured points.
     """
 
     max_error_at_points: float
@@ -187,6 +188,63 @@ def dense_parameters(surf, shape, density=4):
             np.linspace(v0, v1, density * (shape[1] - 1) + 1))
 
 
+#: how many of the dense grid's local maxima of |realised| are refined between the nodes
+PEAKS_REFINED = 8
+
+
+def _local_peaks(a, us, vs):
+    """(value, u, v) at the nodes of ``a`` (|realised| on the grid us x vs) that no
+    neighbour exceeds, the largest :data:`PEAKS_REFINED` of them."""
+    b = np.pad(np.where(np.isfinite(a), a, -np.inf), 1, constant_values=-np.inf)
+    peak = np.isfinite(a)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di or dj:
+                peak &= a >= b[1 + di:b.shape[0] - 1 + di, 1 + dj:b.shape[1] - 1 + dj]
+    i, j = np.nonzero(peak)
+    top = np.argsort(-a[i, j])[:PEAKS_REFINED]
+    return [(float(a[i[k], j[k]]), float(us[i[k]]), float(vs[j[k]])) for k in top]
+
+
+def _refined_peak(nominal, corrected, outward, peaks, us, vs):
+    """The largest |realised correction| near the grid's largest local maxima, found
+    between the nodes (a compass search on the exact line intersection, from one grid step
+    down to 1e-4 of it): a smooth correction peaks between the nodes of the check grid
+    by up to ~h^2 |f''| / 8, several nm on the example and tens of nm for raw data, which
+    is more than the printed figure resolves. 0 without peaks."""
+    if not peaks:
+        return 0.0
+    peaks = sorted(peaks, reverse=True)[:PEAKS_REFINED]
+    (ua, ub), (va, vb) = nominal.u_range, nominal.v_range
+    u = np.array([p[1] for p in peaks])
+    v = np.array([p[2] for p in peaks])
+    best = np.abs(realised_correction(nominal, corrected, u, v, outward))
+    hu = (us[-1] - us[0]) / max(us.size - 1, 1)
+    hv = (vs[-1] - vs[0]) / max(vs.size - 1, 1)
+    step = np.ones(u.size)
+    du, dv = np.meshgrid([-1.0, 0.0, 1.0], [-1.0, 0.0, 1.0], indexing="ij")
+    du, dv = du.ravel()[[0, 1, 2, 3, 5, 6, 7, 8]], dv.ravel()[[0, 1, 2, 3, 5, 6, 7, 8]]
+    for _ in range(60):
+        live = step > 1e-4
+        if not live.any():
+            break
+        cu = np.clip(u[live, None] + step[live, None] * hu * du, ua, ub)
+        cv = np.clip(v[live, None] + step[live, None] * hv * dv, va, vb)
+        val = np.abs(realised_correction(nominal, corrected, cu.ravel(), cv.ravel(),
+                                         outward)).reshape(cu.shape)
+        val = np.where(np.isfinite(val), val, -np.inf)
+        k = np.argmax(val, axis=1)
+        rows = np.arange(k.size)
+        better = val[rows, k] > best[live]
+        idx = np.nonzero(live)[0]
+        up, vp = cu[rows, k], cv[rows, k]
+        u[idx[better]], v[idx[better]] = up[better], vp[better]
+        best[idx[better]] = val[rows, k][better]
+        step[idx[~better]] *= 0.5
+    finite = best[np.isfinite(best)]
+    return float(finite.max()) if finite.size else 0.0
+
+
 def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, density=4,
                   realised=None):
     """Compute :class:`CheckFigures` for a corrected surface.
@@ -205,6 +263,7 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
         realised = realised_correction(nominal, corrected, u, v, outward, guess=delta)
     us, vs = dense_parameters(nominal, grid_shape, density)
     max_real = max_zero = 0.0
+    peaks = []       # (|realised|, u, v) at the dense grid's local maxima
     # rows of the dense grid in blocks of about a million points (memory stays flat)
     step = max(1, int(1e6 // vs.size))
     for start in range(0, us.size, step):
@@ -220,6 +279,8 @@ def check_figures(nominal, corrected, zero, u, v, delta, outward, grid_shape, de
         if np.isfinite(real).any():
             max_real = max(max_real, float(np.nanmax(np.abs(real))))
             max_zero = max(max_zero, float(np.nanmax(np.abs(zero_dev))))
+            peaks.extend(_local_peaks(np.abs(real), ub, vs))
+    max_real = max(max_real, _refined_peak(nominal, corrected, outward, peaks, us, vs))
     return CheckFigures(max_error_at_points=float(np.max(np.abs(np.ravel(realised)
                                                                 - np.ravel(delta)))),
                         max_zero_deviation=max_zero, max_realised=max_real,
