@@ -28,6 +28,8 @@ QT_TRANSLATE_NOOP = FreeCAD.Qt.QT_TRANSLATE_NOOP
 
 #: version of the document object's property set
 VERSION = 1
+#: the proxy's Type (:func:`surfcomp.app.features.is_type`)
+SURFACE_DRESSUP_TYPE = "SurfComp_DressupSurfaceCorrection"
 
 _GROUP = "SurfaceCorrection"
 _GROUP_RESULT = "Result"
@@ -134,6 +136,7 @@ def move_path(obj):
 class DressupSurfaceCorrection(DressupProxy):
     """Proxy of the surface correction dressup (state lives in properties)."""
 
+    Type = SURFACE_DRESSUP_TYPE
     PROPERTIES = PROPERTIES
     VERSION = VERSION
 

@@ -85,6 +85,12 @@ def is_probe_operation(obj):
     return getattr(getattr(obj, "Proxy", None), "Type", None) == PROBE_OP_TYPE
 
 
+def probe_operations(job, active=True):
+    """The probe operations of ``job`` (``active``: only those that are posted)."""
+    return [o for o in cam_job.operations_of(job)
+            if is_probe_operation(o) and (not active or getattr(o, "Active", True))]
+
+
 def settings_of(op):
     """The :class:`ProbeSettings` of an operation and its plan (tip radius, clearance and
     stand-off are the plan's; the part's top is the plan's safe height less both)."""
@@ -241,7 +247,7 @@ def _free_log_name(job, op):
     """``op``'s LogFile, or, where another probe operation of ``job`` logs to it already,
     the same name with ``op``'s name added (``probe-ProbeTwo.log``): each PROBEOPEN opens
     its file anew, so two operations must not share one (:func:`check_job`)."""
-    taken = {o.LogFile for o in cam_job.operations_of(job) if is_probe_operation(o)}
+    taken = {o.LogFile for o in probe_operations(job, active=False)}
     if op.LogFile not in taken:
         return op.LogFile
     stem, ext = os.path.splitext(op.LogFile)
@@ -313,8 +319,7 @@ def check_in_job(op):
     job = cam.find_parent_job(op)
     if job is None:
         return
-    ops = [o for o in cam_job.operations_of(job)
-           if is_probe_operation(o) and getattr(o, "Active", True)]
+    ops = probe_operations(job)
     check_job(job, ops if op in ops else ops + [op])
     if "--inches" in str(getattr(job, "PostProcessorArgs", "") or "").split():
         raise InputError("Job %s posts in inches (--inches in its PostProcessorArgs): "
@@ -338,8 +343,7 @@ def post_probe_job(job, post="linuxcnc", args="--no-show-editor", native=False):
     InputError
         An operation or its inputs out of date, or :func:`check_job` refuses the Job.
     """
-    ops = [op for op in cam_job.operations_of(job)
-           if is_probe_operation(op) and getattr(op, "Active", True)]
+    ops = probe_operations(job)
     for op in ops:
         check_recomputed(op)
     check_job(job, ops)

@@ -10,7 +10,6 @@ of regenerating the CAM operation on the corrected face. The program is written 
 never over an input; nothing is written when it is refused.
 """
 
-import math
 from dataclasses import dataclass
 
 from ..core import budget
@@ -125,29 +124,25 @@ RADIUS_WARN_SHARE = 0.01
 RADIUS_WARN_EFFECT = 0.25 * CONTACT_TOL
 
 
-def _radius_effect(fit):
-    return abs(fit.radius_error) * (1.0 - math.cos(math.radians(fit.max_tilt)))
-
-
 def _radius_text(fit, radius):
     """The radius check's result: the radius the contact points fit against the one given."""
     if fit.radius_error is None:
         return "the radius is not checked (slopes below 8 degrees)"
     return ("the points fit a ball of radius %.3f mm, %.1f um from the %g mm given (%.1f um "
             "on slopes up to %.1f degrees)" % (radius + fit.radius_error, fit.radius_error * 1e3,
-                                               radius, _radius_effect(fit) * 1e3, fit.max_tilt))
+                                               radius, fit.radius_effect * 1e3, fit.max_tilt))
 
 
 def _radius_warnings(fit, radius, program):
     """A warning when the contact points clearly fit another ball than the one given, by
     less than the contact check refuses (on gentle slopes a radius error barely shows)."""
     if fit.radius_error is None or abs(fit.radius_error) <= RADIUS_WARN_SHARE * radius \
-            or _radius_effect(fit) <= RADIUS_WARN_EFFECT:
+            or fit.radius_effect <= RADIUS_WARN_EFFECT:
         return []
     return ["%s: the program's cutter-location points fit a ball of radius %.3f mm, not the "
             "%g mm given (%.4f mm off on slopes up to %.1f degrees, within the %g mm accepted); "
             "expected the ball radius the program was made with"
-            % (program, radius + fit.radius_error, radius, _radius_effect(fit), fit.max_tilt,
+            % (program, radius + fit.radius_error, radius, fit.radius_effect, fit.max_tilt,
                CONTACT_TOL)]
 
 

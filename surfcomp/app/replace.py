@@ -296,6 +296,7 @@ def _check_surface_dressups(doc, comp, changes):
     operation's program by a correction already, and once the operation cuts the corrected
     face it would move it a second time (the dressup's command refuses the other order)."""
     from .cam_job import jobs_of
+    from .dressup_surface import SURFACE_DRESSUP_TYPE
 
     changed = {o.Name for o, _prop, _kind, _old, _new in changes}
     for job in jobs_of(doc):
@@ -303,7 +304,7 @@ def _check_surface_dressups(doc, comp, changes):
         if not changed & ({o.Name for o in inside} | {job.Name}):
             continue
         for o in inside:
-            if type(getattr(o, "Proxy", None)).__name__ == "DressupSurfaceCorrection":
+            if features.is_type(o, SURFACE_DRESSUP_TYPE):
                 follows = getattr(o.Compensation, "Label", "no compensation")
                 raise InputError("%s holds the surface correction dressup %s, which moves its "
                                  "program by the correction of %s already: with %s in the "

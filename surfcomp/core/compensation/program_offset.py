@@ -490,6 +490,14 @@ class ContactFit:
     deepest: float
     deepest_line: int
 
+    @property
+    def radius_effect(self):
+        """How far off (mm) the radius error puts the steepest contact point: ``|dR| (1 -
+        cos max_tilt)``; None when the radius is not checked."""
+        if self.radius_error is None:
+            return None
+        return abs(self.radius_error) * (1.0 - math.cos(math.radians(self.max_tilt)))
+
 
 def fit_contact(gap, tilt, interior, lines, radius):
     """Fit the contact points' clearance ``gap = stock + dR (1 - n_z)``.

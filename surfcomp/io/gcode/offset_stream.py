@@ -422,7 +422,7 @@ def check_contact(off, closest, contact, source=None):
                          "finishing program of this face" % (r, -fit.deepest, CONTACT_TOL),
                          file=source, line=fit.deepest_line, options=("tool",))
     if fit.radius_error is not None:
-        effect = abs(fit.radius_error) * (1.0 - np.cos(np.radians(fit.max_tilt)))
+        effect = fit.radius_effect
         if effect > CONTACT_TOL:
             raise GCodeError("the program's cutter-location points fit a ball of radius "
                              "%.3f mm, not %g mm (tool; %d contact points on slopes up to "
